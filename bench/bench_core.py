@@ -1,0 +1,59 @@
+"""Geometry core: m_T closed form vs brute force, batched m_T throughput, cushion build time."""
+
+import time
+
+import numpy as np
+
+from bench.reference import brute_force_measure, random_mannequin_arrays
+from ellimann_addon.core import cushion, measure
+
+
+def best_of(fn, repeat=5, number=1):
+    """Best wall time per call (s) over ``repeat`` runs of ``number`` calls: least disturbed by load."""
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        for _ in range(number):
+            fn()
+        times.append((time.perf_counter() - start) / number)
+    return min(times)
+
+
+def run():
+    rng = np.random.default_rng(2026)
+    bodies = [random_mannequin_arrays(rng, 40) for _ in range(20)]
+    girth = bodies[0][3]
+    bodies = [(r, c, d, girth) for r, c, d, _ in bodies]
+    truth = [brute_force_measure(*b, samples=200_000) for b in bodies[:5]]
+
+    def rel_error(fn):
+        return max(np.max(np.abs(fn(*b) - t) / t) for b, t in zip(bodies[:5], truth))
+
+    closed_err = rel_error(measure.tailor_measurements)
+    closed_t = best_of(lambda: [measure.tailor_measurements(*b) for b in bodies], number=1) / len(bodies)
+    print("m_T on one 40-ellipsoid mannequin (random bodies; truth = brute force at 200k samples/ellipse)")
+    print(f"  closed form (Cauchy + exact kinks)  {closed_t * 1e3:8.3f} ms   max rel error {closed_err:.1e}")
+    for samples in (1_000, 10_000, 50_000):
+        err = rel_error(lambda *b, s=samples: brute_force_measure(*b, samples=s))
+        t = best_of(lambda s=samples: [brute_force_measure(*b, samples=s) for b in bodies[:5]], repeat=3) / 5
+        verdict = "worse" if err > closed_err else "equal or better"
+        print(f"  brute force, {samples:6d} samples    {t * 1e3:8.3f} ms   max rel error {err:.1e}  "
+              f"({verdict} accuracy; closed form is {t / closed_t:6.1f}x faster)")
+
+    batch = 1000
+    stacked = [np.stack([bodies[i % len(bodies)][j] for i in range(batch)]) for j in range(3)]
+    t = best_of(lambda: measure.tailor_measurements(*stacked, girth), repeat=3)
+    print(f"m_T batched over {batch} mannequins: {t:.3f} s = {t / batch * 1e3:.3f} ms each, "
+          f"{batch / t:,.0f} mannequins/s")
+
+    eye = np.eye(3)
+    pair = ((eye, (0, 0, 0), (0.06, 0.07, 0.2)), (eye, (0.01, 0.02, -0.35), (0.045, 0.05, 0.18)))
+    print("cushion (thigh-like pair), per subdivision level:")
+    for s in (2, 3, 4, 5):
+        t = best_of(lambda s=s: cushion.cushion_mesh(*pair, subdivisions=s), repeat=3)
+        v, f = cushion.cushion_mesh(*pair, subdivisions=s)
+        print(f"  subdivisions {s}: {len(v):6d} vertices {len(f):6d} faces  {t * 1e3:8.2f} ms")
+
+
+if __name__ == "__main__":
+    run()

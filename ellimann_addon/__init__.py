@@ -1,0 +1,17 @@
+"""ElliMann: measurement-driven female mannequins built from convex ellipsoids and cushions.
+
+``core`` is pure numpy (no Blender); ``blender`` is the thin bpy layer. Blender imports this
+package only through ``register``/``unregister`` so that ``core`` stays importable anywhere.
+"""
+
+
+def register():
+    from . import blender
+
+    blender.register()
+
+
+def unregister():
+    from . import blender
+
+    blender.unregister()

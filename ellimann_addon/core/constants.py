@@ -1,0 +1,77 @@
+"""Project-wide constants: measurement names, section heights, the paper's tables.
+
+Measurements are in centimetres (what tailors type); geometry is in metres (Blender's unit).
+"""
+
+MEASUREMENTS = ("He", "Sh", "Br", "Wa", "Hi")
+
+MEASUREMENT_LABELS = {
+    "He": "Height",
+    "Sh": "Shoulder width",
+    "Br": "Breast perimeter",
+    "Wa": "Waist perimeter",
+    "Hi": "Hip perimeter",
+}
+
+# Section heights as fractions of He above the lowest point of the feet (DESIGN.md,
+# "Measurement heights"); the tools in ../shared/refmodels use the same numbers.
+SECTION_FRACTIONS = {"Sh": 0.790, "Br": 0.720, "Wa": 0.645, "Hi": 0.500}
+GIRTHS = ("Br", "Wa", "Hi")
+
+CM_PER_M = 100.0
+
+# Table 2.3 of the paper: the five Reference Mannequins (cm).
+REFERENCE_MEASUREMENTS = {
+    "small_slim": {"He": 148.0, "Sh": 31.0, "Br": 85.0, "Wa": 63.0, "Hi": 83.0},
+    "tall_slim": {"He": 171.0, "Sh": 30.0, "Br": 84.0, "Wa": 63.0, "Hi": 84.0},
+    "small_chubby": {"He": 148.0, "Sh": 45.0, "Br": 147.0, "Wa": 142.0, "Hi": 152.0},
+    "tall_chubby": {"He": 171.0, "Sh": 53.0, "Br": 153.0, "Wa": 142.0, "Hi": 150.0},
+    "average": {"He": 159.0, "Sh": 43.0, "Br": 117.0, "Wa": 104.0, "Hi": 117.0},
+}
+
+# L: the min-max of each row of Table 2.3.
+RANGES = {
+    key: (
+        min(me[key] for me in REFERENCE_MEASUREMENTS.values()),
+        max(me[key] for me in REFERENCE_MEASUREMENTS.values()),
+    )
+    for key in MEASUREMENTS
+}
+
+# Plausibility limits (cm): outside these a request is refused, not extrapolated.
+# Inside them but outside RANGES it is allowed with a warning.
+ABSURD_LIMITS = {
+    "He": (50.0, 250.0),
+    "Sh": (10.0, 100.0),
+    "Br": (30.0, 300.0),
+    "Wa": (30.0, 300.0),
+    "Hi": (30.0, 300.0),
+}
+
+
+def quartile_points(key):
+    """The three inner quartile points of L for one measurement (the paper's 243 grid)."""
+    low, high = RANGES[key]
+    return tuple(low + (high - low) * q for q in (0.25, 0.5, 0.75))
+
+
+# Table 2.5: the ten mannequins of Figures 2.18 and 2.19 (cm).
+TABLE_2_5 = (
+    (153.75, 35.75, 101.25, 102.5, 134.75),
+    (153.75, 35.75, 118.5, 102.5, 117.5),
+    (153.75, 41.5, 135.75, 102.5, 117.5),
+    (153.75, 47.25, 118.5, 122.25, 134.75),
+    (159.5, 41.5, 118.5, 82.75, 117.5),
+    (159.5, 47.25, 101.25, 82.75, 117.5),
+    (165.25, 35.75, 101.25, 82.75, 117.5),
+    (165.25, 41.5, 101.25, 122.25, 117.5),
+    (165.25, 41.5, 118.5, 102.5, 134.75),
+    (165.25, 47.25, 135.75, 122.25, 117.5),
+)
+
+# Table 2.4: the paper's relative errors (%) over the 243 grid, for comparison.
+PAPER_TABLE_2_4 = {
+    "mean": {"He": 0.2, "Sh": 2.6, "Br": 2.4, "Wa": 0.8, "Hi": 0.9},
+    "max": {"He": 0.4, "Sh": 6.6, "Br": 7.0, "Wa": 1.5, "Hi": 2.2},
+    "min": {"He": 0.0, "Sh": 0.1, "Br": 0.0, "Wa": 0.0, "Hi": 0.1},
+}

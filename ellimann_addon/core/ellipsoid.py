@@ -1,0 +1,175 @@
+"""Ellipsoids as frames and semi-axes, in closed form and vectorised.
+
+An ellipsoid is {c + R diag(D) s : |s| <= 1}: centre ``c`` (3,), rotation ``R`` (3, 3) in SO(3)
+whose columns are the local axes, and semi-axes ``D`` (3,) > 0 along those axes. Every function
+here broadcasts over leading dimensions, so a whole mannequin (n, ...) or a batch of mannequins
+(B, n, ...) goes through one call.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import FrameError
+
+ORTHONORMAL_TOL = 1e-6
+
+
+def shape_matrix(rotation, semi_axes):
+    """M = R diag(D^2) R^T: the ellipsoid is {x : (x-c)^T M^-1 (x-c) <= 1}."""
+    scaled = rotation * (np.asarray(semi_axes)[..., None, :] ** 2)
+    return scaled @ np.swapaxes(rotation, -1, -2)
+
+
+def support(rotation, center, semi_axes, direction):
+    """Support function h(n) = c.n + sqrt(n^T M n) for unit or non-unit directions n."""
+    direction = np.asarray(direction, dtype=float)
+    m = shape_matrix(rotation, semi_axes)
+    quad = np.einsum("...i,...ij,...j->...", direction, m, direction)
+    return np.einsum("...i,...i->...", center, direction) + np.sqrt(quad)
+
+
+def support_point(rotation, center, semi_axes, direction):
+    """The boundary point where the plane with outward normal n touches the ellipsoid."""
+    direction = np.asarray(direction, dtype=float)
+    m = shape_matrix(rotation, semi_axes)
+    mn = np.einsum("...ij,...j->...i", m, direction)
+    quad = np.einsum("...i,...i->...", direction, mn)
+    return center + mn / np.sqrt(quad)[..., None]
+
+
+def axis_extent(rotation, semi_axes, axis):
+    """Half-width of the ellipsoid along world axis 0, 1 or 2: sqrt(M[axis, axis])."""
+    r = np.asarray(rotation)[..., axis, :]
+    return np.sqrt(np.sum((r * semi_axes) ** 2, axis=-1))
+
+
+def bounds(rotation, center, semi_axes):
+    """Axis-aligned bounding box (lo, hi), each (..., 3)."""
+    half = np.sqrt(np.sum((np.asarray(rotation) * np.asarray(semi_axes)[..., None, :]) ** 2, axis=-1))
+    return center - half, center + half
+
+
+def section_at_height(rotation, center, semi_axes, height):
+    """Horizontal section z = height of each ellipsoid, in closed form.
+
+    A plane section of an ellipsoid is an ellipse {u : (u - c2)^T K^-1 (u - c2) <= 1} in (x, y).
+    With M the shape matrix, m = M[:2, 2], dz = height - c_z:
+        c2 = c_xy + dz m / M_zz,   K = (1 - dz^2 / M_zz) (M_xy - m m^T / M_zz).
+    Returns (centre (..., 2), K (..., 2, 2), hit (...)); hit is False where the plane misses.
+    """
+    m = shape_matrix(rotation, semi_axes)
+    mzz = m[..., 2, 2]
+    mxz = m[..., :2, 2]
+    dz = np.asarray(height) - center[..., 2]
+    shrink = 1.0 - dz * dz / mzz
+    hit = shrink > 0.0
+    centre2 = center[..., :2] + (dz / mzz)[..., None] * mxz
+    schur = m[..., :2, :2] - mxz[..., :, None] * mxz[..., None, :] / mzz[..., None, None]
+    k = np.clip(shrink, 0.0, None)[..., None, None] * schur
+    return centre2, k, hit
+
+
+def sample_surface(rotation, center, semi_axes, count=256):
+    """Quasi-uniform points on the surface (Fibonacci sphere mapped through R diag(D)); (..., count, 3)."""
+    unit = fibonacci_sphere(count)
+    local = unit * np.asarray(semi_axes)[..., None, :]
+    return np.einsum("...ij,...kj->...ki", rotation, local) + np.asarray(center)[..., None, :]
+
+
+def fibonacci_sphere(count):
+    """``count`` nearly uniform unit vectors (golden-angle spiral)."""
+    i = np.arange(count) + 0.5
+    z = 1.0 - 2.0 * i / count
+    r = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
+    phi = np.pi * (3.0 - np.sqrt(5.0)) * i
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1)
+
+
+def contains(rotation, center, semi_axes, points, tol=0.0):
+    """True where a point lies inside (or within ``tol`` of the unit level set of) the ellipsoid."""
+    local = np.einsum("...ji,...j->...i", rotation, np.asarray(points) - center) / semi_axes
+    return np.sum(local * local, axis=-1) <= 1.0 + tol
+
+
+def volume(semi_axes):
+    return 4.0 / 3.0 * np.pi * np.prod(semi_axes, axis=-1)
+
+
+def matrix_world(rotation, center, semi_axes):
+    """Blender's object matrix for an ellipsoid on a unit-sphere mesh: S @ diag(D, 1)."""
+    rotation = np.asarray(rotation, dtype=float)
+    out = np.zeros(rotation.shape[:-2] + (4, 4))
+    out[..., :3, :3] = rotation * np.asarray(semi_axes)[..., None, :]
+    out[..., :3, 3] = center
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def decompose_matrix_world(matrix, tol=ORTHONORMAL_TOL):
+    """Inverse of :func:`matrix_world` for one 4x4 matrix; refuses what is not an ellipsoid frame.
+
+    Raises FrameError naming the problem: zero scale, shear (axes not orthogonal) or a
+    left-handed frame (negative scale). Returns (rotation, center, semi_axes).
+    """
+    matrix = np.asarray(matrix, dtype=float)
+    if matrix.shape != (4, 4) or not np.all(np.isfinite(matrix)):
+        raise FrameError("matrix", "must be a finite 4x4 matrix")
+    if not np.allclose(matrix[3], (0.0, 0.0, 0.0, 1.0), atol=tol):
+        raise FrameError("matrix", "has a projective part; expected an affine object matrix")
+    linear = matrix[:3, :3]
+    semi_axes = np.linalg.norm(linear, axis=0)
+    if np.any(semi_axes <= 1e-12):
+        raise FrameError("scale", f"has a zero axis: semi-axes {semi_axes.tolist()}")
+    rotation = linear / semi_axes
+    if not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-4):
+        raise FrameError("rotation", "is sheared: the local axes are not orthogonal (apply rotation/scale "
+                         "of a parent, or rebuild the ellipsoid)")
+    if np.linalg.det(rotation) < 0.0:
+        raise FrameError("rotation", "is left-handed (a negative scale); flip one axis to fix it")
+    return rotation, matrix[:3, 3].copy(), semi_axes
+
+
+@dataclass(frozen=True)
+class Ellipsoid:
+    """One ellipsoid: a convenience wrapper over the array functions above."""
+
+    center: np.ndarray
+    rotation: np.ndarray
+    semi_axes: np.ndarray
+
+    def __post_init__(self):
+        object.__setattr__(self, "center", np.asarray(self.center, dtype=float).reshape(3))
+        object.__setattr__(self, "rotation", np.asarray(self.rotation, dtype=float).reshape(3, 3))
+        object.__setattr__(self, "semi_axes", np.asarray(self.semi_axes, dtype=float).reshape(3))
+
+    @classmethod
+    def sphere(cls, center, radius):
+        return cls(center, np.eye(3), np.full(3, float(radius)))
+
+    @property
+    def shape(self):
+        return shape_matrix(self.rotation, self.semi_axes)
+
+    @property
+    def volume(self):
+        return float(volume(self.semi_axes))
+
+    @property
+    def matrix_world(self):
+        return matrix_world(self.rotation, self.center, self.semi_axes)
+
+    def support(self, direction):
+        return support(self.rotation, self.center, self.semi_axes, direction)
+
+    def support_point(self, direction):
+        return support_point(self.rotation, self.center, self.semi_axes, direction)
+
+    def section(self, height):
+        return section_at_height(self.rotation, self.center, self.semi_axes, height)
+
+    def contains(self, points, tol=0.0):
+        return contains(self.rotation, self.center, self.semi_axes, points, tol)
+
+    def sample(self, count=256):
+        return sample_surface(self.rotation, self.center, self.semi_axes, count)

@@ -1,0 +1,46 @@
+"""Errors that name what is wrong, so the Blender layer and the CLI can report them verbatim."""
+
+from dataclasses import dataclass
+
+
+class ElliMannError(ValueError):
+    """Base class: a user-facing problem with input data (never a bug)."""
+
+
+class FrameError(ElliMannError):
+    """A matrix that is not a valid ellipsoid frame (shear, zero or negative scale)."""
+
+    def __init__(self, field, message):
+        self.field = field
+        super().__init__(f"{field} {message}")
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One validation finding: which ellipsoid (or '' for the mannequin), which field, what."""
+
+    ellipsoid: str
+    field: str
+    message: str
+
+    def __str__(self):
+        where = f"'{self.ellipsoid}' " if self.ellipsoid else ""
+        return f"{where}{self.field}: {self.message}"
+
+
+class MannequinError(ElliMannError):
+    """A mannequin or topology that fails validation; ``problems`` lists every finding."""
+
+    def __init__(self, problems):
+        self.problems = list(problems)
+        head = str(self.problems[0]) if self.problems else "invalid mannequin"
+        more = f" (and {len(self.problems) - 1} more)" if len(self.problems) > 1 else ""
+        super().__init__(head + more)
+
+
+class MeasurementError(ElliMannError):
+    """A requested measurement that is missing, not a number or outside the plausible range."""
+
+    def __init__(self, field, message):
+        self.field = field
+        super().__init__(f"{field}: {message}")

@@ -1,0 +1,39 @@
+"""Fitting an ellipsoid to points (e.g. the selected vertices of a reference mesh)."""
+
+import numpy as np
+
+from .frames import relabel_to_reference
+
+FIT_MODES = ("inscribed", "moments", "enclosing")
+
+
+def fit_ellipsoid(points, mode="inscribed"):
+    """Principal-axes ellipsoid of surface points: (rotation, center, semi_axes), right-handed.
+
+    The axes are the principal directions of the points, labelled to agree best with the world
+    axes. Sizes: ``moments`` matches the second moments of points spread over an ellipsoid's
+    surface (D_i = sqrt(3 lambda_i)); ``inscribed`` scales that shape down until no point lies
+    inside it, so it stays within the traced surface; ``enclosing`` scales it up until every point
+    is inside.
+    """
+    points = np.asarray(points, dtype=float)
+    if points.ndim != 2 or points.shape[1] != 3 or len(points) < 4:
+        raise ValueError("need at least 4 points (n, 3) to fit an ellipsoid")
+    if not np.all(np.isfinite(points)):
+        raise ValueError("points contain NaN or infinity")
+    if mode not in FIT_MODES:
+        raise ValueError(f"mode is '{mode}'; expected one of {', '.join(FIT_MODES)}")
+    center = points.mean(axis=0)
+    offsets = points - center
+    eigenvalues, rotation = np.linalg.eigh(offsets.T @ offsets / len(points))
+    if eigenvalues[0] <= 1e-14 * max(eigenvalues[-1], 1e-300):
+        raise ValueError("points are (nearly) coplanar: select vertices that enclose a volume")
+    if np.linalg.det(rotation) < 0.0:
+        rotation[:, 0] = -rotation[:, 0]
+    semi_axes = np.sqrt(3.0 * eigenvalues)
+    rotation, semi_axes, _ = relabel_to_reference(rotation, semi_axes, np.eye(3))
+    if mode != "moments":
+        local = offsets @ rotation / semi_axes
+        radius = np.linalg.norm(local, axis=1)
+        semi_axes = semi_axes * (radius.min() if mode == "inscribed" else radius.max())
+    return rotation, center, semi_axes

@@ -1,0 +1,226 @@
+"""m_T, the tailor measuring of Section 2.3.5, in closed form and batched.
+
+- He: top of the highest ellipsoid minus bottom of the lowest (support function along +-Z).
+- Br, Wa, Hi: the horizontal section at SECTION_FRACTIONS[key] * He above the lowest point,
+  through the ellipsoids flagged ``girth``; each ellipsoid's section is an ellipse in closed form
+  (:func:`ellipsoid.section_at_height`); the perimeter of the convex hull of those ellipses is
+  Cauchy's formula  P = integral_0^2pi max_i h_i(theta) dtheta  with h_i their support functions.
+- Sh: the section at the shoulder height through all ellipsoids; distance between the two
+  outermost points along X (the paper's Y), again from support functions.
+
+The integral is evaluated exactly up to floating point: the angles where the maximising ellipse
+changes (the kinks of max_i h_i) are located by a grid scan plus Newton steps, and each smooth
+piece is integrated by Gauss-Legendre quadrature.
+"""
+
+import numpy as np
+
+from .constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
+from .ellipsoid import axis_extent, section_at_height
+
+DETECTION_SAMPLES = 128  # grid used to find which ellipse is outermost in each direction
+QUADRATURE_CELLS = 32  # fixed cuts so that every smooth piece spans at most 2pi/32
+GAUSS_ORDER = 12
+NEWTON_STEPS = 3
+REFINE_FACTOR = 16  # sub-samples in a grid cell where a hidden outermost ellipse is possible
+_GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(GAUSS_ORDER)
+_CHUNK = 256  # mannequins per batch chunk (bounds the temporary arrays to tens of MB)
+
+
+def _support_2d(centre, k, theta):
+    """Support function of section ellipses: centre (..., 2), k (..., 2, 2), theta broadcastable."""
+    c, s = np.cos(theta), np.sin(theta)
+    quad = k[..., 0, 0] * c * c + 2.0 * k[..., 0, 1] * c * s + k[..., 1, 1] * s * s
+    return centre[..., 0] * c + centre[..., 1] * s + np.sqrt(np.maximum(quad, 0.0))
+
+
+def _support_2d_with_derivative(centre, k, theta):
+    """(h, dh/dtheta) of section ellipses, sharing the trigonometry."""
+    c, s = np.cos(theta), np.sin(theta)
+    quad = k[..., 0, 0] * c * c + 2.0 * k[..., 0, 1] * c * s + k[..., 1, 1] * s * s
+    root = np.sqrt(np.maximum(quad, 1e-30))
+    dquad = (k[..., 1, 1] - k[..., 0, 0]) * c * s + k[..., 0, 1] * (c * c - s * s)
+    value = centre[..., 0] * c + centre[..., 1] * s + root
+    slope = centre[..., 1] * c - centre[..., 0] * s + dquad / root
+    return value, slope
+
+
+def _compact(centre, k, active):
+    """Move each section's active ellipses to the front; drop columns no section uses."""
+    count = active.sum(axis=-1)
+    width = max(int(count.max(initial=0)), 1)
+    order = np.argsort(~active, axis=-1, kind="stable")[:, :width]
+    rows = np.arange(active.shape[0])[:, None]
+    return centre[rows, order], k[rows, order], active[rows, order]
+
+
+def _max_curvature_radius(k):
+    """Largest radius of curvature of each ellipse: a^2 / b with a >= b its semi-axes."""
+    tr = k[..., 0, 0] + k[..., 1, 1]
+    det = k[..., 0, 0] * k[..., 1, 1] - k[..., 0, 1] ** 2
+    disc = np.sqrt(np.clip(0.25 * tr * tr - det, 0.0, None))
+    big, small = 0.5 * tr + disc, np.clip(0.5 * tr - disc, 1e-30, None)
+    return big / np.sqrt(small)
+
+
+def _winners(centre, k, active, sec, theta):
+    """Index of the outermost active ellipse of section ``sec`` in direction ``theta`` (flat arrays)."""
+    h = _support_2d(centre[sec], k[sec], theta[:, None])
+    return np.argmax(np.where(active[sec], h, -np.inf), axis=1)
+
+
+def hull_perimeter(centre, k, active):
+    """Perimeter of the convex hull of several ellipses per section.
+
+    centre (S, n, 2), k (S, n, 2, 2) section ellipses {u: (u-c)^T k^-1 (u-c) <= 1}, active (S, n)
+    bool. Returns (S,) perimeters; a section with no active ellipse has perimeter 0.
+    """
+    centre, k, active = _compact(np.asarray(centre, float), np.asarray(k, float), np.asarray(active, bool))
+    sections = centre.shape[0]
+    if sections == 0:
+        return np.zeros(0)
+
+    # 1. Which ellipse is outermost in each grid direction.
+    step = 2.0 * np.pi / DETECTION_SAMPLES
+    grid = np.arange(DETECTION_SAMPLES) * step
+    h = _support_2d(centre[:, :, None, :], k[:, :, None, :, :], grid)
+    h = np.where(active[:, :, None], h, -np.inf)
+    winner = np.argmax(h, axis=1)  # (S, N)
+
+    # 2. An ellipse that is outermost only between two grid directions would be missed. Where the
+    #    winner is the same at both ends of a cell, (h_j - h_max)'' <= rho_j + gap (rho_j its
+    #    largest radius of curvature), so it can only surface if its gap to the maximum is below
+    #    that bound times step^2 / 8. Where the winner changes, h_max has a kink and no such bound
+    #    holds. Sample both kinds of cell finely.
+    gap = np.take_along_axis(h, winner[:, None, :], axis=1) - np.where(active[:, :, None], h, 0.0)
+    gap_next = np.roll(gap, -1, axis=2)
+    reach = (_max_curvature_radius(k)[:, :, None] + np.maximum(gap, gap_next)) * (step * step / 8.0)
+    suspect = active[:, :, None] & (np.minimum(gap, gap_next) > 0.0) & (np.minimum(gap, gap_next) <= reach)
+    sec_r, cell_r = np.nonzero(suspect.any(axis=1) | (winner != np.roll(winner, -1, axis=1)))
+    sub = np.arange(1, REFINE_FACTOR) / REFINE_FACTOR
+    theta_r = ((cell_r[:, None] + sub) * step).ravel()
+    sec_r = np.repeat(sec_r, REFINE_FACTOR - 1)
+
+    # 3. Kinks: where the winner changes between consecutive directions, solve h_i = h_j.
+    det_sec = np.concatenate([np.repeat(np.arange(sections), DETECTION_SAMPLES), sec_r])
+    det_theta = np.concatenate([np.tile(grid, sections), theta_r])
+    det_winner = np.concatenate([winner.ravel(), _winners(centre, k, active, sec_r, theta_r)])
+    order = np.lexsort((det_theta, det_sec))
+    det_sec, det_theta, det_winner = det_sec[order], det_theta[order], det_winner[order]
+    nxt_theta, nxt_winner = _next_in_section(det_sec, det_theta, det_winner)
+    change = np.nonzero(det_winner != nxt_winner)[0]
+    sec = det_sec[change]
+    lo, hi = det_theta[change], nxt_theta[change]
+    pair = np.stack([det_winner[change], nxt_winner[change]])  # (2, K): outermost before, after
+    cp, kp = centre[sec, pair], k[sec, pair]
+    g_lo, g_hi = np.subtract(*_support_2d(cp, kp, lo)), np.subtract(*_support_2d(cp, kp, hi))
+    denom = g_lo - g_hi
+    frac = np.divide(g_lo, denom, out=np.full_like(g_lo, 0.5), where=np.abs(denom) > 0.0)
+    theta = lo + (hi - lo) * np.clip(frac, 0.0, 1.0)
+    for _ in range(NEWTON_STEPS):
+        value, slope = _support_2d_with_derivative(cp, kp, theta)
+        g, dg = value[0] - value[1], slope[0] - slope[1]
+        update = np.divide(g, dg, out=np.zeros_like(g), where=np.abs(dg) > 1e-300)
+        theta = np.minimum(np.maximum(theta - update, lo), hi)
+
+    # 4. Cut the circle at the kinks and at fixed cells; integrate each piece's outermost ellipse.
+    cells = np.arange(QUADRATURE_CELLS) * (2.0 * np.pi / QUADRATURE_CELLS)
+    cut_theta = np.concatenate([np.tile(cells, sections), np.mod(theta, 2.0 * np.pi)])
+    cut_sec = np.concatenate([np.repeat(np.arange(sections), QUADRATURE_CELLS), sec])
+    order = np.lexsort((cut_theta, cut_sec))
+    cut_theta, cut_sec = cut_theta[order], cut_sec[order]
+    end, _ = _next_in_section(cut_sec, cut_theta, cut_theta)
+    half = 0.5 * (end - cut_theta)
+    piece_winner = _winners(centre, k, active, cut_sec, cut_theta + half)
+    nodes = (cut_theta + half)[:, None] + half[:, None] * _GL_NODES
+    cw = centre[cut_sec, piece_winner][:, None, :]
+    kw = k[cut_sec, piece_winner][:, None, :, :]
+    piece = half * (_support_2d(cw, kw, nodes) @ _GL_WEIGHTS)
+    piece = np.where(active[cut_sec, piece_winner], piece, 0.0)
+    return np.bincount(cut_sec, weights=piece, minlength=sections)
+
+
+def _next_in_section(sec, theta, value):
+    """For rows sorted by (sec, theta): the next row's theta and value, wrapping around the circle."""
+    nxt = np.arange(1, len(sec) + 1)
+    last = np.ones(len(sec), dtype=bool)
+    last[:-1] = sec[1:] != sec[:-1]
+    nxt[last] = np.searchsorted(sec, sec[last])
+    nxt_theta = theta[nxt] + np.where(last, 2.0 * np.pi, 0.0)
+    return nxt_theta, value[nxt]
+
+
+def hull_boundary(centre, k, active, samples=256):
+    """Points along the convex hull of one section's ellipses (for drawing): (samples, 2).
+
+    Each point is the support point of the outermost ellipse in that direction; consecutive
+    points across a change of ellipse form the hull's straight bridges.
+    """
+    centre, k, active = np.asarray(centre, float), np.asarray(k, float), np.asarray(active, bool)
+    if not active.any():
+        return np.zeros((0, 2))
+    theta = np.linspace(0.0, 2.0 * np.pi, samples, endpoint=False)
+    h = np.where(active[:, None], _support_2d(centre[:, None, :], k[:, None, :, :], theta), -np.inf)
+    winner = np.argmax(h, axis=0)
+    d = np.stack([np.cos(theta), np.sin(theta)], axis=-1)
+    kw = k[winner]
+    kd = np.einsum("sij,sj->si", kw, d)
+    norm = np.sqrt(np.clip(np.einsum("si,si->s", d, kd), 1e-30, None))
+    return centre[winner] + kd / norm[:, None]
+
+
+def section_heights(rotation, center, semi_axes):
+    """Lowest point, He (m) and the world z of each section, for arrays (..., n, 3[, 3])."""
+    z_half = axis_extent(rotation, semi_axes, 2)
+    top = np.max(center[..., 2] + z_half, axis=-1)
+    bottom = np.min(center[..., 2] - z_half, axis=-1)
+    height = top - bottom
+    z = {key: bottom + fraction * height for key, fraction in SECTION_FRACTIONS.items()}
+    return bottom, height, z
+
+
+def tailor_measurements(rotation, center, semi_axes, girth):
+    """m_T for one mannequin (n, ...) or a batch (B, n, ...): array (..., 5) in cm, order MEASUREMENTS.
+
+    ``girth`` (n,) bool marks the ellipsoids that take part in the Br/Wa/Hi sections.
+    """
+    rotation = np.asarray(rotation, dtype=float)
+    center = np.asarray(center, dtype=float)
+    semi_axes = np.asarray(semi_axes, dtype=float)
+    girth = np.asarray(girth, dtype=bool)
+    single = rotation.ndim == 3
+    if single:
+        rotation, center, semi_axes = rotation[None], center[None], semi_axes[None]
+    out = np.concatenate([
+        _measure_chunk(rotation[i:i + _CHUNK], center[i:i + _CHUNK], semi_axes[i:i + _CHUNK], girth)
+        for i in range(0, rotation.shape[0], _CHUNK)
+    ]) if rotation.shape[0] else np.zeros((0, len(MEASUREMENTS)))
+    return out[0] if single else out
+
+
+def _measure_chunk(rotation, center, semi_axes, girth):
+    batch = rotation.shape[0]
+    _, height, z = section_heights(rotation, center, semi_axes)
+    result = {"He": height}
+
+    centre, k, hit = section_at_height(rotation, center, semi_axes, z["Sh"][:, None])
+    half_x = np.sqrt(k[..., 0, 0])
+    right = np.where(hit, centre[..., 0] + half_x, -np.inf).max(axis=-1)
+    left = np.where(hit, centre[..., 0] - half_x, np.inf).min(axis=-1)
+    result["Sh"] = np.where(np.isfinite(right), right - left, 0.0)
+
+    heights = np.stack([z[key] for key in GIRTHS], axis=1)  # (B, 3)
+    centre, k, hit = section_at_height(rotation[:, None], center[:, None], semi_axes[:, None],
+                                       heights[:, :, None])
+    active = hit & girth
+    n = rotation.shape[1]
+    perimeters = hull_perimeter(centre.reshape(-1, n, 2), k.reshape(-1, n, 2, 2), active.reshape(-1, n))
+    perimeters = perimeters.reshape(batch, len(GIRTHS))
+    for index, key in enumerate(GIRTHS):
+        result[key] = perimeters[:, index]
+    return np.stack([result[key] for key in MEASUREMENTS], axis=-1) * CM_PER_M
+
+
+def as_dict(values):
+    """(5,) array in MEASUREMENTS order -> {"He": ..., ...} of plain floats."""
+    return {key: float(value) for key, value in zip(MEASUREMENTS, values)}

@@ -1,0 +1,118 @@
+"""Triangle-mesh helpers in numpy: icosphere, volume, manifold and convexity checks, plane sections."""
+
+import numpy as np
+
+
+def icosphere(subdivisions=3):
+    """Unit icosphere: (vertices (V, 3), faces (F, 3) int, counter-clockwise seen from outside).
+
+    V = 10 * 4**s + 2. Built by repeated 4-to-1 subdivision of an icosahedron.
+    """
+    phi = (1.0 + 5.0 ** 0.5) / 2.0
+    verts = np.array([
+        (-1, phi, 0), (1, phi, 0), (-1, -phi, 0), (1, -phi, 0),
+        (0, -1, phi), (0, 1, phi), (0, -1, -phi), (0, 1, -phi),
+        (phi, 0, -1), (phi, 0, 1), (-phi, 0, -1), (-phi, 0, 1),
+    ], dtype=float)
+    faces = np.array([
+        (0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11),
+        (1, 5, 9), (5, 11, 4), (11, 10, 2), (10, 7, 6), (7, 1, 8),
+        (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9),
+        (4, 9, 5), (2, 4, 11), (6, 2, 10), (8, 6, 7), (9, 8, 1),
+    ])
+    verts /= np.linalg.norm(verts, axis=1, keepdims=True)
+    for _ in range(int(subdivisions)):
+        edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+        unique, inverse = np.unique(edges, axis=0, return_inverse=True)
+        inverse = inverse.reshape(-1)
+        mids = verts[unique[:, 0]] + verts[unique[:, 1]]
+        mids /= np.linalg.norm(mids, axis=1, keepdims=True)
+        m = len(faces)
+        ab, bc, ca = (inverse[:m] + len(verts), inverse[m:2 * m] + len(verts), inverse[2 * m:] + len(verts))
+        a, b, c = faces.T
+        faces = np.concatenate([
+            np.stack([a, ab, ca], 1), np.stack([b, bc, ab], 1),
+            np.stack([c, ca, bc], 1), np.stack([ab, bc, ca], 1),
+        ])
+        verts = np.concatenate([verts, mids])
+    return verts, faces
+
+
+def face_normals(vertices, faces):
+    """Unnormalised face normals (cross products); their length is twice the face area."""
+    v = vertices[faces]
+    return np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+
+
+def volume(vertices, faces):
+    """Signed volume of a closed mesh (positive when faces wind counter-clockwise from outside)."""
+    v = vertices[faces]
+    return float(np.einsum("ij,ij->i", v[:, 0], np.cross(v[:, 1], v[:, 2])).sum() / 6.0)
+
+
+def euler_characteristic(vertices, faces):
+    edges = np.unique(np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1),
+                      axis=0)
+    return len(vertices) - len(edges) + len(faces)
+
+
+def is_closed_manifold(faces):
+    """Every directed edge appears once and its reverse once: closed, 2-manifold, consistently wound."""
+    directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    unique, counts = np.unique(directed, axis=0, return_counts=True)
+    if np.any(counts != 1):
+        return False
+    reverse = {tuple(e) for e in unique[:, ::-1].tolist()}
+    return all(tuple(e) in reverse for e in unique.tolist())
+
+
+def convexity_defect(vertices, faces):
+    """Largest distance of any vertex above any face plane (0 for a convex, outward-wound mesh)."""
+    n = face_normals(vertices, faces)
+    n = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    offsets = np.einsum("ij,ij->i", n, vertices[faces[:, 0]])
+    worst = 0.0
+    for start in range(0, len(faces), 2048):
+        heights = vertices @ n[start:start + 2048].T - offsets[start:start + 2048]
+        worst = max(worst, float(heights.max()))
+    return worst
+
+
+def plane_section_points(vertices, faces, height):
+    """Points where the mesh's edges cross the plane z = height: (k, 2) x-y coordinates."""
+    edges = np.unique(np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1),
+                      axis=0)
+    za, zb = vertices[edges[:, 0], 2] - height, vertices[edges[:, 1], 2] - height
+    crossing = (za * zb) < 0.0
+    on_plane = vertices[np.abs(vertices[:, 2] - height) == 0.0, :2]
+    a, b = vertices[edges[crossing, 0]], vertices[edges[crossing, 1]]
+    t = (za[crossing] / (za[crossing] - zb[crossing]))[:, None]
+    return np.concatenate([a[:, :2] + t * (b[:, :2] - a[:, :2]), on_plane])
+
+
+def convex_hull_2d(points):
+    """Andrew's monotone chain: hull vertices (h, 2) counter-clockwise, no collinear points."""
+    pts = np.unique(np.asarray(points, dtype=float), axis=0)
+    if len(pts) < 3:
+        return pts
+
+    def cross(o, a, b):
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower, upper = [], []
+    for p in pts:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0.0:
+            lower.pop()
+        lower.append(p)
+    for p in pts[::-1]:
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0.0:
+            upper.pop()
+        upper.append(p)
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def polygon_perimeter(polygon):
+    polygon = np.asarray(polygon, dtype=float)
+    if len(polygon) < 2:
+        return 0.0
+    return float(np.linalg.norm(polygon - np.roll(polygon, -1, axis=0), axis=1).sum())

@@ -1,0 +1,88 @@
+import numpy as np
+import pytest
+from conftest import rotation_from_vector
+from scipy.spatial import ConvexHull
+
+from ellimann_addon.core import cushion, mesh
+from ellimann_addon.core.ellipsoid import contains, support
+
+
+def check_convex_closed(v, f):
+    assert mesh.is_closed_manifold(f)
+    assert mesh.euler_characteristic(v, f) == 2
+    assert mesh.volume(v, f) > 0  # outward winding
+    assert mesh.convexity_defect(v, f) <= 1e-12 * np.ptp(v, axis=0).max()
+
+
+@pytest.mark.parametrize("distance", [0.0, 0.1, 0.3, 0.8])
+def test_two_equal_spheres_give_a_capsule(distance):
+    r = 0.1
+    v, f = cushion.cushion_mesh((np.eye(3), (0, 0, 0), (r, r, r)), (np.eye(3), (0, 0, distance), (r, r, r)))
+    check_convex_closed(v, f)
+    exact = np.pi * r * r * distance + 4 / 3 * np.pi * r**3
+    assert mesh.volume(v, f) == pytest.approx(exact, rel=0.01)
+    assert mesh.volume(v, f) < exact  # inscribed
+
+
+def test_resolution_converges():
+    e1 = (np.eye(3), (0, 0, 0), (0.1, 0.1, 0.1))
+    e2 = (np.eye(3), (0.3, 0, 0), (0.1, 0.1, 0.1))
+    exact = np.pi * 0.01 * 0.3 + 4 / 3 * np.pi * 0.001
+    errors = [abs(mesh.volume(*cushion.cushion_mesh(e1, e2, s)) / exact - 1) for s in (2, 3, 4)]
+    assert errors[0] > errors[1] > errors[2]
+
+
+def random_pair(rng, lo=0.02):
+    make = lambda: (rotation_from_vector(rng.normal(size=3) * 2), rng.normal(size=3) * 0.1,  # noqa: E731
+                    rng.uniform(lo, 0.2, 3))
+    return make(), make()
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_random_pairs_are_the_convex_hull(seed):
+    e1, e2 = random_pair(np.random.default_rng(seed), lo=0.01)
+    v, f = cushion.cushion_mesh(e1, e2, 3)
+    check_convex_closed(v, f)
+    assert mesh.volume(v, f) == pytest.approx(ConvexHull(v).volume, rel=1e-9)
+    # Every vertex lies on one of the two ellipsoids and the mesh contains both centres.
+    on_surface = [np.abs(np.sum(((v - c) @ r / d) ** 2, axis=1) - 1) < 1e-9 for r, c, d in (e1, e2)]
+    assert np.all(on_surface[0] | on_surface[1])
+    # Its support equals that of the union in every vertex normal direction (up to resolution).
+    n = np.random.default_rng(seed).normal(size=(50, 3))
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    union = np.maximum(support(*e1, n), support(*e2, n))
+    assert np.all((v @ n.T).max(axis=0) <= union + 1e-12)
+    assert np.all((v @ n.T).max(axis=0) >= union - 0.01 * 0.2)
+
+
+def test_identical_and_nested_ellipsoids():
+    e = (rotation_from_vector((0.3, 0.2, 0.1)), (0.1, 0.2, 0.3), (0.05, 0.1, 0.15))
+    v, f = cushion.cushion_mesh(e, e)
+    check_convex_closed(v, f)
+    small = (np.eye(3), (0.1, 0.2, 0.3), (0.02, 0.02, 0.02))
+    v, f = cushion.cushion_mesh(e, small)
+    check_convex_closed(v, f)
+    assert np.all(contains(e[0], e[1], e[2], v, tol=1e-9))
+
+
+def test_to_frame_expresses_vertices_in_the_first_frame():
+    r = rotation_from_vector((0.4, -0.2, 1.0))
+    e1 = (r, (1.0, 2.0, 3.0), (0.1, 0.2, 0.3))
+    e2 = (np.eye(3), (1.2, 2.0, 3.0), (0.1, 0.1, 0.1))
+    v, _ = cushion.cushion_mesh(e1, e2, 2)
+    local = cushion.to_frame(v, r, e1[1])
+    assert np.allclose(local @ r.T + e1[1], v)
+
+
+def test_exact_hull_of_points_in_convex_position():
+    pts = mesh.icosphere(2)[0] * (0.1, 0.3, 0.2)
+    f = cushion.convex_hull_3d(pts)
+    check_convex_closed(pts, f)
+    assert len(f) == 2 * len(pts) - 4
+
+
+def test_icosphere_sizes_and_orientation():
+    for s in range(4):
+        v, f = mesh.icosphere(s)
+        assert len(v) == 10 * 4**s + 2 and len(f) == 20 * 4**s
+        check_convex_closed(v, f)

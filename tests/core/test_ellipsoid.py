@@ -1,0 +1,87 @@
+import numpy as np
+import pytest
+from conftest import rotation_from_vector
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ellimann_addon.core import ellipsoid as el
+from ellimann_addon.core.errors import FrameError
+
+vectors = st.tuples(*[st.floats(-3, 3)] * 3)
+sizes = st.tuples(*[st.floats(0.02, 0.3)] * 3)
+points3 = st.tuples(*[st.floats(-1, 1)] * 3)
+
+
+@settings(max_examples=60, deadline=None)
+@given(vectors, points3, sizes, vectors)
+def test_support_is_the_max_over_surface_points(rv, c, d, n):
+    n = np.asarray(n)
+    if np.linalg.norm(n) < 1e-3:
+        return
+    n = n / np.linalg.norm(n)
+    e = el.Ellipsoid(c, rotation_from_vector(rv), d)
+    samples = e.sample(4000)
+    assert e.support(n) >= (samples @ n).max() - 1e-12
+    assert e.support(n) == pytest.approx((samples @ n).max(), abs=2e-3 * max(d))
+    p = e.support_point(n)
+    assert p @ n == pytest.approx(e.support(n), abs=1e-12)
+    assert e.contains(p[None], tol=1e-9)[0]
+
+
+@settings(max_examples=60, deadline=None)
+@given(vectors, points3, sizes, st.floats(-0.99, 0.99))
+def test_section_ellipse_lies_on_the_surface(rv, c, d, frac):
+    e = el.Ellipsoid(c, rotation_from_vector(rv), d)
+    z_half = el.axis_extent(e.rotation, e.semi_axes, 2)
+    height = e.center[2] + frac * z_half
+    centre, k, hit = e.section(height)
+    assert hit
+    w, v = np.linalg.eigh(k)
+    t = np.linspace(0, 2 * np.pi, 64)
+    boundary = centre + (np.stack([np.cos(t), np.sin(t)], -1) * np.sqrt(w)) @ v.T
+    points = np.column_stack([boundary, np.full(len(t), height)])
+    local = (points - e.center) @ e.rotation / e.semi_axes
+    assert np.allclose(np.sum(local**2, axis=1), 1.0, atol=1e-9)
+
+
+def test_section_misses_above_and_below():
+    e = el.Ellipsoid.sphere((0, 0, 1), 0.2)
+    assert not e.section(1.21)[2] and not e.section(0.79)[2] and e.section(1.19)[2]
+
+
+def test_sphere_section_through_centre_is_a_circle_of_radius_r():
+    centre, k, hit = el.Ellipsoid.sphere((0.3, -0.2, 1.0), 0.25).section(1.0)
+    assert hit and np.allclose(centre, (0.3, -0.2)) and np.allclose(k, np.eye(2) * 0.25**2)
+
+
+def test_bounds_and_volume_closed_forms():
+    e = el.Ellipsoid((1, 2, 3), rotation_from_vector((0, 0, np.pi / 2)), (0.1, 0.2, 0.3))
+    lo, hi = el.bounds(e.rotation, e.center, e.semi_axes)
+    assert np.allclose(lo, (0.8, 1.9, 2.7)) and np.allclose(hi, (1.2, 2.1, 3.3))
+    assert e.volume == pytest.approx(4 / 3 * np.pi * 0.006)
+
+
+@settings(max_examples=40, deadline=None)
+@given(vectors, points3, sizes)
+def test_matrix_world_round_trip(rv, c, d):
+    r = rotation_from_vector(rv)
+    back = el.decompose_matrix_world(el.matrix_world(r, c, d))
+    assert np.allclose(back[0], r, atol=1e-9) and np.allclose(back[1], c) and np.allclose(back[2], d)
+
+
+def test_decompose_refuses_negative_scale_shear_and_zero_scale():
+    m = el.matrix_world(np.eye(3), (0, 0, 0), (0.1, 0.2, 0.3))
+    negative = m.copy()
+    negative[:3, 0] *= -1
+    with pytest.raises(FrameError, match="left-handed"):
+        el.decompose_matrix_world(negative)
+    sheared = m.copy()
+    sheared[0, 1] = 0.1
+    with pytest.raises(FrameError, match="sheared"):
+        el.decompose_matrix_world(sheared)
+    flat = m.copy()
+    flat[:3, 2] = 0
+    with pytest.raises(FrameError, match="zero axis"):
+        el.decompose_matrix_world(flat)
+    with pytest.raises(FrameError, match="finite"):
+        el.decompose_matrix_world(np.full((4, 4), np.nan))

@@ -1,0 +1,46 @@
+import numpy as np
+import pytest
+from conftest import rotation_from_vector
+
+from ellimann_addon.core import fit, mesh
+from ellimann_addon.core.frames import is_rotation
+
+
+def surface(rotation, center, semi, subdivisions=3):
+    v, _ = mesh.icosphere(subdivisions)
+    return (v * semi) @ rotation.T + center
+
+
+@pytest.mark.parametrize("mode", fit.FIT_MODES)
+def test_fit_recovers_an_ellipsoid_from_its_surface(mode):
+    r = rotation_from_vector((0.3, -0.5, 0.9))
+    pts = surface(r, (0.1, -0.2, 1.2), (0.05, 0.12, 0.2))
+    rot, c, d = fit.fit_ellipsoid(pts, mode)
+    assert is_rotation(rot)
+    assert np.allclose(c, (0.1, -0.2, 1.2))
+    assert np.allclose(np.sort(d), (0.05, 0.12, 0.2), rtol=1e-9)
+
+
+def test_inscribed_inside_enclosing_outside_noisy_points():
+    rng = np.random.default_rng(0)
+    pts = surface(np.eye(3), np.zeros(3), (0.1, 0.15, 0.3)) * rng.uniform(0.9, 1.1, (642, 1))
+    for mode, inside in (("inscribed", False), ("enclosing", True)):
+        rot, c, d = fit.fit_ellipsoid(pts, mode)
+        r2 = np.sum(((pts - c) @ rot / d) ** 2, axis=1)
+        assert np.all(r2 <= 1 + 1e-9) if inside else np.all(r2 >= 1 - 1e-9)
+
+
+def test_fit_labels_axes_to_agree_with_the_world():
+    r, _, _ = fit.fit_ellipsoid(surface(np.eye(3), np.zeros(3), (0.3, 0.1, 0.2)))
+    assert np.allclose(r, np.eye(3), atol=1e-9)
+
+
+def test_fit_refuses_bad_input():
+    with pytest.raises(ValueError, match="at least 4"):
+        fit.fit_ellipsoid(np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="coplanar"):
+        fit.fit_ellipsoid(np.column_stack([np.random.rand(10, 2), np.zeros(10)]))
+    with pytest.raises(ValueError, match="NaN"):
+        fit.fit_ellipsoid(np.full((5, 3), np.nan))
+    with pytest.raises(ValueError, match="mode"):
+        fit.fit_ellipsoid(np.random.rand(10, 3), "best")

@@ -1,0 +1,126 @@
+import json
+
+import numpy as np
+import pytest
+from conftest import TOY_PARTS, make_toy_mannequin
+
+from ellimann_addon.core.errors import MannequinError
+from ellimann_addon.core.mannequin import Mannequin, Part, Topology, stack, twin_name
+
+
+def problems_of(parts):
+    with pytest.raises(MannequinError) as info:
+        Topology(parts)
+    return [str(p) for p in info.value.problems]
+
+
+def replace(parts, target, **changes):
+    return [Part(**{**p.__dict__, **changes}) if p.name == target else p for p in parts]
+
+
+def test_toy_topology_is_valid_and_indexed(toy):
+    topo = toy.topology
+    assert len(topo) == 12
+    assert topo.names[topo.twin_indices[topo.index["6.a Thigh.L"]]] == "6.a Thigh.R"
+    assert topo.twin_indices[topo.index["1.a Head"]] == topo.index["1.a Head"]
+    pairs = {(topo.names[a], topo.names[b]) for a, b in topo.cushion_pairs}
+    assert pairs == {("2.a Chest", "2.b Belly"), ("6.a Thigh.L", "6.b Shin.L"), ("6.a Thigh.R", "6.b Shin.R")}
+    assert topo.girth_mask.sum() == 9
+    assert topo.dependency_mask.shape == (12, 5)
+    assert twin_name("4.a Trapezius.L") == "4.a Trapezius.R"
+
+
+def test_duplicate_names():
+    assert any("used twice" in p for p in problems_of(TOY_PARTS + [TOY_PARTS[0]]))
+
+
+def test_unpaired_left_right():
+    parts = [p for p in TOY_PARTS if p.name != "5.a Arm.R"]
+    assert any("'5.a Arm.L'" in p and "no mirror twin" in p for p in problems_of(parts))
+
+
+def test_missing_or_one_sided_cushion_partner():
+    parts = replace(TOY_PARTS, "1.a Head", partner="1.b Face")
+    assert any("'1.b Face' does not exist" in p for p in problems_of(parts))
+    parts = replace(TOY_PARTS, "3.a Pelvis", partner="1.a Head")
+    assert any("does not name it back" in p for p in problems_of(parts))
+
+
+def test_bad_side_name_and_depends():
+    assert any("suffix" in p for p in problems_of(replace(TOY_PARTS, "1.a Head", side="L")))
+    assert any("depends" in p for p in problems_of(replace(TOY_PARTS, "1.a Head", depends=("Xx",))))
+    assert any("must look like" in p for p in problems_of(replace(TOY_PARTS, "1.a Head", name="Head")))
+
+
+def test_geometry_problems_name_the_ellipsoid_and_field(toy):
+    bad = toy.copy()
+    bad.semi_axes[0, 1] = 0.0
+    bad.center[1, 2] = np.nan
+    bad.rotation[4] = bad.rotation[4] @ np.diag([1.0, 1.0, -1.0])
+    bad.rotation[5] = bad.rotation[5] * 1.1
+    text = [str(p) for p in bad.problems()]
+    assert any("'1.a Head' semi_axes: must be > 0" in t for t in text)
+    assert any("'2.a Chest' center: contains NaN" in t for t in text)
+    assert any("'4.a Trapezius.L' rotation: is a left-handed frame" in t for t in text)
+    assert any("'4.a Trapezius.R' rotation: is not orthonormal" in t for t in text)
+    with pytest.raises(MannequinError):
+        bad.check()
+
+
+def test_json_round_trip_is_exact(toy, tmp_path):
+    toy.measurements = {"He": 160.0, "Sh": 40.0, "Br": 90.0, "Wa": 70.0, "Hi": 95.0}
+    path = tmp_path / "toy.json"
+    toy.save(path)
+    back = Mannequin.load(path)
+    assert back.topology == toy.topology and back.name == "toy" and back.role == "reference"
+    for attr in ("rotation", "center", "semi_axes"):
+        assert np.array_equal(getattr(back, attr), getattr(toy, attr))
+    assert back.measurements == toy.measurements
+    assert list(tmp_path.iterdir()) == [path]  # no temporary file left behind
+
+
+def test_loading_bad_files(tmp_path, toy):
+    broken = tmp_path / "broken.json"
+    broken.write_text("{not json")
+    with pytest.raises(MannequinError, match="not valid JSON"):
+        Mannequin.load(broken)
+    data = toy.to_dict()
+    data["version"] = 99
+    with pytest.raises(MannequinError, match="version"):
+        Mannequin.from_dict(data)
+    data = toy.to_dict()
+    del data["ellipsoids"][3]["semi_axes"]
+    with pytest.raises(MannequinError, match="'3.a Pelvis' semi_axes: missing"):
+        Mannequin.from_dict(data)
+    data = toy.to_dict()
+    data["ellipsoids"][0]["semi_axes"][0] = -1
+    with pytest.raises(MannequinError, match="'1.a Head' semi_axes"):
+        Mannequin.from_dict(json.loads(json.dumps(data)))
+    with pytest.raises(MannequinError, match="format"):
+        Mannequin.from_dict({"ellipsoids": []})
+
+
+def test_topology_mismatch_and_reordering(toy):
+    other_parts = [p for p in TOY_PARTS if not p.name.startswith("5.a")]
+    other = Topology(other_parts)
+    text = [str(p) for p in toy.topology.mismatch(other)]
+    assert "'5.a Arm.L' topology: is missing from the other mannequin" in text
+    reversed_topology = Topology(list(reversed(TOY_PARTS)))
+    flipped = toy.reordered(reversed_topology)
+    assert np.array_equal(flipped.center[::-1], toy.center)
+    r, c, d = stack([toy, flipped])
+    assert np.array_equal(r[0], r[1]) and np.array_equal(c[1], toy.center)
+    with pytest.raises(MannequinError):
+        toy.reordered(other)
+
+
+def test_measure_returns_centimetres(toy):
+    me = toy.measure()
+    assert list(me) == ["He", "Sh", "Br", "Wa", "Hi"]
+    assert 150 < me["He"] < 170 and all(v > 0 for v in me.values())
+
+
+def test_fixture_is_symmetric():
+    from ellimann_addon.core.clean import asymmetry
+
+    assert asymmetry(make_toy_mannequin()) < 1e-12

@@ -1,0 +1,112 @@
+"""m_T: closed forms, agreement with a brute-force hull, invariants."""
+
+import numpy as np
+import pytest
+from conftest import rotation_from_vector
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial import ConvexHull
+from scipy.special import ellipe
+
+from bench.reference import brute_force_measure, random_mannequin_arrays
+from ellimann_addon.core import measure
+from ellimann_addon.core.constants import SECTION_FRACTIONS
+
+
+def perimeter(centres, ks):
+    c, k = np.asarray(centres, float)[None], np.asarray(ks, float)[None]
+    return measure.hull_perimeter(c, k, np.ones(c.shape[:2], bool))[0]
+
+
+def test_circle_through_sphere_centre_is_two_pi_r():
+    r = 0.23
+    assert perimeter([(0.1, 0.2)], [np.eye(2) * r * r]) == pytest.approx(2 * np.pi * r, rel=1e-12)
+
+
+@pytest.mark.parametrize("a,b,angle", [(0.5, 0.2, 0.0), (0.3, 0.29, 1.0), (0.4, 0.05, 2.5), (0.2, 0.2, 0.3)])
+def test_ellipse_perimeter_is_the_complete_elliptic_integral(a, b, angle):
+    rot = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+    k = rot @ np.diag([a * a, b * b]) @ rot.T
+    exact = 4 * a * ellipe(1 - (b / a) ** 2)
+    assert perimeter([(0.0, 0.0)], [k]) == pytest.approx(exact, rel=1e-12)
+
+
+@pytest.mark.parametrize("d", [0.0, 0.05, 0.7, 3.0])
+def test_two_equal_circles_give_the_stadium(d):
+    r = 0.15
+    k = np.eye(2) * r * r
+    assert perimeter([(0, 0), (d * 0.6, d * 0.8)], [k, k]) == pytest.approx(2 * np.pi * r + 2 * d, rel=1e-12)
+
+
+def test_a_circle_inside_another_does_not_count():
+    big, small = np.eye(2) * 0.3**2, np.eye(2) * 0.1**2
+    assert perimeter([(0, 0), (0.1, 0.05)], [big, small]) == pytest.approx(2 * np.pi * 0.3, rel=1e-12)
+
+
+def test_empty_section_has_zero_perimeter():
+    k = np.eye(2)[None, None] * 0.01
+    assert measure.hull_perimeter(np.zeros((1, 1, 2)), k, np.zeros((1, 1), bool))[0] == 0.0
+
+
+def test_agrees_with_brute_force_hull_on_random_mannequins():
+    rng = np.random.default_rng(7)
+    worst = 0.0
+    for _ in range(40):
+        r, c, d, g = random_mannequin_arrays(rng)
+        closed = measure.tailor_measurements(r, c, d, g)
+        brute = brute_force_measure(r, c, d, g)
+        nonzero = brute > 0
+        assert np.all(closed[~nonzero] == 0)
+        worst = max(worst, np.max(np.abs(closed[nonzero] - brute[nonzero]) / brute[nonzero]))
+    assert worst < 1e-6
+
+
+def test_batch_equals_one_by_one():
+    rng = np.random.default_rng(3)
+    r, c, d, g = zip(*[random_mannequin_arrays(rng, 20) for _ in range(5)])
+    batch = measure.tailor_measurements(np.stack(r), np.stack(c), np.stack(d), g[0])
+    single = np.stack([measure.tailor_measurements(r[i], c[i], d[i], g[0]) for i in range(5)])
+    assert np.allclose(batch, single, rtol=1e-12)
+
+
+def test_known_two_sphere_body():
+    """A 'body' of two stacked spheres: every measurement has a closed form."""
+    r = 0.2
+    rotation = np.stack([np.eye(3)] * 2)
+    center = np.array([[0.0, 0.0, r], [0.0, 0.0, 3 * r]])
+    semi = np.full((2, 3), r)
+    he, sh, br, wa, hi = measure.tailor_measurements(rotation, center, semi, np.ones(2, bool))
+    assert he == pytest.approx(400 * r)
+    z_sh = 4 * r * SECTION_FRACTIONS["Sh"]  # 0.632 -> upper sphere
+    assert sh == pytest.approx(200 * np.sqrt(r * r - (z_sh - 3 * r) ** 2))
+    assert hi == pytest.approx(0.0, abs=1e-9)  # z = 2r: the spheres touch at a point
+    z_br = 4 * r * SECTION_FRACTIONS["Br"]
+    assert br == pytest.approx(200 * np.pi * np.sqrt(r * r - (z_br - 3 * r) ** 2))
+    del wa
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.floats(-2, 2), st.floats(-2, 2), st.floats(-1, 1), st.floats(-np.pi, np.pi), st.integers(0, 10**6))
+def test_invariant_to_horizontal_moves_and_turns_about_z(dx, dy, dz, angle, seed):
+    r, c, d, g = random_mannequin_arrays(np.random.default_rng(seed), 12)
+    before = measure.tailor_measurements(r, c, d, g)
+    turn = rotation_from_vector((0, 0, angle))
+    moved = measure.tailor_measurements(turn @ r, c @ turn.T + (dx, dy, dz), d, g)
+    # Sh is measured along X, so it changes under a turn; perimeters and height do not.
+    assert np.allclose(np.delete(moved, 1), np.delete(before, 1), rtol=1e-9, atol=1e-9)
+    shifted = measure.tailor_measurements(r, c + (dx, dy, dz), d, g)
+    assert np.allclose(shifted, before, rtol=1e-9, atol=1e-9)
+
+
+def test_measurements_scale_linearly():
+    r, c, d, g = random_mannequin_arrays(np.random.default_rng(11), 25)
+    assert np.allclose(measure.tailor_measurements(r, 1.7 * c, 1.7 * d, g),
+                       1.7 * measure.tailor_measurements(r, c, d, g), rtol=1e-9)
+
+
+def test_hull_boundary_points_lie_on_the_hull():
+    c = np.array([(0, 0), (0.5, 0.1)])
+    k = np.stack([np.eye(2) * 0.04, np.diag([0.01, 0.03])])
+    pts = measure.hull_boundary(c, k, np.ones(2, bool), samples=512)
+    hull = ConvexHull(pts)
+    assert hull.area == pytest.approx(perimeter(c, k), rel=1e-3)
