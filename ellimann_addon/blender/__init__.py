@@ -3,7 +3,7 @@
 import importlib
 
 # Registered in this order, unregistered in reverse.
-_MODULES = ()
+_MODULES = ("props",)
 
 
 def _modules():

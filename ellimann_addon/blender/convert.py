@@ -1,0 +1,151 @@
+"""Mannequin <-> Blender collection. The only place where objects and core arrays meet.
+
+An ellipsoid is an object using one shared unit-sphere mesh with ``matrix_world = S @ diag(D, 1)``;
+its topology fields live in ``Object.ellimann``. A mannequin is a collection holding those objects,
+with ``Collection.ellimann`` (role, target and measured values).
+"""
+
+import bpy
+import numpy as np
+from mathutils import Matrix
+
+from ..core.constants import MEASUREMENTS
+from ..core.ellipsoid import decompose_matrix_world, matrix_world
+from ..core.errors import FrameError, MannequinError, Problem
+from ..core.mannequin import NAME_PATTERN, Mannequin, Part, Topology
+from ..core.mesh import icosphere
+
+UNIT_SPHERE_NAME = "ElliMann Unit Sphere"
+UNIT_SPHERE_SUBDIVISIONS = 3
+SIDE_COLORS = {"L": (0.85, 0.55, 0.45, 1.0), "R": (0.45, 0.6, 0.85, 1.0), "C": (0.8, 0.78, 0.72, 1.0)}
+
+
+def unit_sphere_mesh():
+    """The shared unit-sphere mesh, created once per file (a user's mesh of that name is left alone)."""
+    mesh = bpy.data.meshes.get(UNIT_SPHERE_NAME)
+    if mesh is not None and mesh.get("ellimann_unit_sphere"):
+        return mesh
+    vertices, faces = icosphere(UNIT_SPHERE_SUBDIVISIONS)
+    mesh = bpy.data.meshes.new(UNIT_SPHERE_NAME)
+    mesh.from_pydata(vertices.tolist(), [], faces.tolist())
+    mesh.shade_smooth()
+    mesh["ellimann_unit_sphere"] = 1
+    mesh.update()
+    return mesh
+
+
+def is_ellipsoid(obj):
+    return obj.type == "MESH" and obj.ellimann.is_part and obj.ellimann.kind == "ELLIPSOID"
+
+
+def ellipsoid_objects(collection):
+    """The collection's ellipsoid objects (not those of child collections), in a stable order."""
+    return sorted((o for o in collection.objects if is_ellipsoid(o)), key=lambda o: natural_key(o.ellimann.part_name))
+
+
+def natural_key(name):
+    """Sort '2.a X' before '10.a X', then letter, label and side."""
+    match = NAME_PATTERN.match(name)
+    if not match:
+        return (float("inf"), name)
+    return (int(match.group("number")), match.group("letter"), match.group("label"), match.group("side") or "")
+
+
+def new_collection(name, parent=None):
+    """A new collection (never an existing one: Blender gives it a unique name) linked under ``parent``."""
+    collection = bpy.data.collections.new(name)
+    (parent or bpy.context.scene.collection).children.link(collection)
+    return collection
+
+
+def write_part(obj, part):
+    props = obj.ellimann
+    props.is_part = True
+    props.kind = "ELLIPSOID"
+    props.part_name = part.name
+    props.side = part.side
+    props.region = part.region
+    props.girth = part.girth
+    props.depends = set(part.depends)
+    props.partner = part.partner
+
+
+def read_part(obj):
+    props = obj.ellimann
+    depends = tuple(m for m in MEASUREMENTS if m in props.depends)
+    return Part(props.part_name, props.side, props.region, props.girth, depends, props.partner)
+
+
+def write_collection_props(collection, mannequin):
+    props = collection.ellimann
+    props.is_mannequin = True
+    props.role = mannequin.role
+    props.has_target = bool(mannequin.measurements)
+    if mannequin.measurements:
+        props.target = [float(mannequin.measurements[m]) for m in MEASUREMENTS]
+
+
+def new_ellipsoid_object(part, rotation, center, semi_axes, collection):
+    obj = bpy.data.objects.new(part.name, unit_sphere_mesh())
+    write_part(obj, part)
+    obj.matrix_world = Matrix(matrix_world(rotation, center, semi_axes).tolist())
+    obj.color = SIDE_COLORS[part.side]
+    collection.objects.link(obj)
+    return obj
+
+
+def mannequin_to_collection(mannequin, name=None, parent=None):
+    """Build a new collection with one ellipsoid object per part. Nothing existing is touched."""
+    collection = new_collection(name or mannequin.name or "Mannequin", parent)
+    write_collection_props(collection, mannequin)
+    for i, part in enumerate(mannequin.topology):
+        new_ellipsoid_object(part, mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i], collection)
+    return collection
+
+
+def collection_to_mannequin(collection, check=True):
+    """Read a mannequin collection back into the core. Raises MannequinError naming every problem."""
+    objects = ellipsoid_objects(collection)
+    if not objects:
+        raise MannequinError([Problem("", "collection", f"'{collection.name}' holds no ElliMann ellipsoids")])
+    problems, parts, frames = [], [], []
+    for obj in objects:
+        part = read_part(obj)
+        parts.append(part)
+        try:
+            frames.append(decompose_matrix_world(np.array(obj.matrix_world)))
+        except FrameError as error:
+            problems.append(Problem(part.name or obj.name, error.field, f"{error} (object '{obj.name}')"))
+    if problems:
+        raise MannequinError(problems)
+    topology = Topology(parts)
+    rotation, center, semi_axes = (np.array(a) for a in zip(*frames))
+    props = collection.ellimann
+    measurements = dict(zip(MEASUREMENTS, map(float, props.target))) if props.has_target else None
+    mannequin = Mannequin(topology, rotation, center, semi_axes, name=collection.name, role=props.role,
+                          measurements=measurements)
+    return mannequin.check() if check else mannequin
+
+
+def update_collection_geometry(collection, mannequin):
+    """Move the collection's ellipsoids to ``mannequin``'s geometry (same parts), e.g. for live updates."""
+    by_name = {o.ellimann.part_name: o for o in ellipsoid_objects(collection)}
+    missing = [name for name in mannequin.topology.names if name not in by_name]
+    if missing:
+        raise MannequinError([Problem(n, "collection", f"has no object in '{collection.name}'") for n in missing])
+    matrices = matrix_world(mannequin.rotation, mannequin.center, mannequin.semi_axes)
+    for name, m in zip(mannequin.topology.names, matrices):
+        by_name[name].matrix_world = Matrix(m.tolist())
+    write_collection_props(collection, mannequin)
+
+
+def write_measured(collection, measured):
+    """Store m_T (cm dict) on the collection."""
+    collection.ellimann.measured = [float(measured[m]) for m in MEASUREMENTS]
+    collection.ellimann.has_measured = True
+
+
+def mannequin_collections(scene=None):
+    """All mannequin collections in the scene's hierarchy."""
+    root = (scene or bpy.context.scene).collection
+    return [c for c in root.children_recursive if c.ellimann.is_mannequin]

@@ -1,0 +1,25 @@
+"""Blender tests on the bpy module: user folders in a temp dir, add-on registered once, empty file per test."""
+
+import os
+import tempfile
+
+# Must be set before bpy is imported so nothing touches the machine's Blender configuration.
+os.environ["BLENDER_USER_RESOURCES"] = tempfile.mkdtemp(prefix="ellimann-blender-user-")
+
+import bpy  # noqa: E402
+import pytest  # noqa: E402
+
+import ellimann_addon  # noqa: E402
+
+
+@pytest.fixture(scope="session", autouse=True)
+def addon():
+    ellimann_addon.register()
+    yield
+    ellimann_addon.unregister()
+
+
+@pytest.fixture(autouse=True)
+def empty_file():
+    bpy.ops.wm.read_homefile(use_empty=True)
+    yield
