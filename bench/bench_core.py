@@ -4,7 +4,7 @@ import time
 
 import numpy as np
 
-from bench.reference import brute_force_measure, random_mannequin_arrays
+from devkit.reference import brute_force_measure, random_mannequin_arrays
 from ellimann_addon.core import cushion, measure
 
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
-from conftest import rotation_from_vector
 
+from devkit.toy import rotation_from_vector
 from ellimann_addon.core import clean
 from ellimann_addon.core.ellipsoid import axis_extent, shape_matrix
 from ellimann_addon.core.frames import SIGNED_PERMUTATIONS, axis_agreement, is_rotation

@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
-from conftest import rotation_from_vector
 from scipy.spatial import ConvexHull
 
+from devkit.toy import rotation_from_vector
 from ellimann_addon.core import cushion, mesh
 from ellimann_addon.core.ellipsoid import contains, support
 

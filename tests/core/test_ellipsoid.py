@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
-from conftest import rotation_from_vector
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from devkit.toy import rotation_from_vector
 from ellimann_addon.core import ellipsoid as el
 from ellimann_addon.core.errors import FrameError
 

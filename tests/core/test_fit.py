@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
-from conftest import rotation_from_vector
 
+from devkit.toy import rotation_from_vector
 from ellimann_addon.core import fit, mesh
 from ellimann_addon.core.frames import is_rotation
 

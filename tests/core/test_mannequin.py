@@ -2,8 +2,8 @@ import json
 
 import numpy as np
 import pytest
-from conftest import TOY_PARTS, make_toy_mannequin
 
+from devkit.toy import TOY_PARTS, make_toy_mannequin
 from ellimann_addon.core.errors import MannequinError
 from ellimann_addon.core.mannequin import Mannequin, Part, Topology, stack, twin_name
 

@@ -2,13 +2,13 @@
 
 import numpy as np
 import pytest
-from conftest import rotation_from_vector
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial import ConvexHull
 from scipy.special import ellipe
 
-from bench.reference import brute_force_measure, random_mannequin_arrays
+from devkit.reference import brute_force_measure, random_mannequin_arrays
+from devkit.toy import rotation_from_vector
 from ellimann_addon.core import measure
 from ellimann_addon.core.constants import SECTION_FRACTIONS
 

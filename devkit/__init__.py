@@ -1,0 +1,1 @@
+"""Dev-only helpers shared by tests, benchmarks and tools (not shipped in the extension zip)."""
