@@ -1,0 +1,408 @@
+"""Build ElliMann's reference data: the Base Mannequin and the five Reference Mannequins.
+
+    .venv/bin/python -m tools.build_reference [--refmodels DIR] [--out DIR] [--docs DIR] [--no-blend]
+    .venv/bin/python -m tools.build_reference --check     # rebuild in memory, compare with the shipped files
+
+Reads the body meshes of ``<repo>/../shared/refmodels`` (see its README) and writes
+``reference_blends/base_mannequin.json`` and the five ``<name>.json`` Reference Mannequins, their
+.blend twins (with the bpy module), ``docs/topology.md`` and ``docs/reference_mannequins.md``.
+
+Steps (paper, Sections 2.3.2-2.3.4):
+1. Trace: every part of tools/reference_topology.py is fitted to its vertices on a body
+   (tools/fitting.py). The selections are made once on the neutral reference body; all bodies share
+   its vertex order, so the same vertices trace the same part on each body.
+2. Base Mannequin: the parts fitted over ``reference_female.obj``, registered and made symmetric.
+3. Reference Mannequins: the parts fitted over each of the five bodies (axes labelled against the
+   Base Mannequin's), registered and made symmetric, then stretched (core.adjust) until m_T meets
+   Table 2.3 within ADJUST_TOLERANCE; then the five are cleaned together (core.clean: registration,
+   symmetry, axis relabelling against the Average RM) and checked against Table 2.3 within
+   ACCEPT_TOLERANCE again.
+Deterministic: no randomness, fixed iteration counts and orders.
+"""
+
+import argparse
+import pathlib
+import sys
+import time
+
+import numpy as np
+
+from ellimann_addon.core.adjust import adjust_to_measurements
+from ellimann_addon.core.clean import asymmetry, clean, landmark_indices, register, relabel, symmetrize
+from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
+from ellimann_addon.core.ellipsoid import section_at_height
+from ellimann_addon.core.frames import axis_agreement, is_rotation
+from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.measure import section_heights
+
+from . import reference_topology as rt
+from .bodies import REFERENCE_BODY, RM_BODIES, body_measurements, load_body, load_labels, vertex_areas
+from .fitting import inscribed_ellipsoid, moments_ellipsoid
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
+DEFAULT_REFMODELS = REPO.parent / "shared" / "refmodels"
+BASE_FILE = "base_mannequin"
+REFERENCE_RM = "average"  # the RM whose axes the others are relabelled against
+ADJUST_TOLERANCE = 1e-4  # relative m_T error the adjustment aims at
+ACCEPT_TOLERANCE = 5e-3  # what every shipped RM must meet (issue: 0.5% of Table 2.3)
+DISPLAY_NAMES = {"small_slim": "Small Slim", "tall_slim": "Tall Slim", "small_chubby": "Small Chubby",
+                 "tall_chubby": "Tall Chubby", "average": "Average", BASE_FILE: "Base Mannequin"}
+
+
+def selections(reference_vertices, labels):
+    """Vertex indices of every part (topology order), chosen on the reference body."""
+    height = reference_vertices[:, 2].max() - reference_vertices[:, 2].min()
+    out = []
+    for spec, side in rt.expanded():
+        idx = rt.select_vertices(spec.select, side, reference_vertices, labels, height)
+        if len(idx) < 8:
+            raise ValueError(f"'{rt.part_name(spec, side)}' selects only {len(idx)} vertices: widen its selection")
+        out.append(idx)
+    return out
+
+
+def fit_mannequin(body, selected, topology, reference=None, kept=None, name="", role="reference",
+                  measurements=None):
+    """Fit every part of ``topology`` over ``body``. Returns (mannequin, kept axis index per part).
+
+    Without ``reference`` the frames are labelled against the world axes (the Base Mannequin);
+    with it (a mannequin of the same topology, and the ``kept`` axes of its fit) each part keeps
+    the principal axis closest to the reference part's kept axis and the reference's roll about it.
+    """
+    areas = vertex_areas(body.vertices, body.faces)
+    n = len(topology)
+    rotation, center, semi_axes = np.zeros((n, 3, 3)), np.zeros((n, 3)), np.zeros((n, 3))
+    kept_out = []
+    for i, ((spec, _), idx) in enumerate(zip(rt.expanded(), selected)):
+        points, weights = body.vertices[idx], areas[idx]
+        if spec.inward is not None:
+            points = np.concatenate([points, points + np.asarray(spec.inward)])
+            weights = np.concatenate([weights, weights])
+        ref_rotation = np.eye(3) if reference is None else reference.rotation[i]
+        match = None if reference is None or kept[i] is None else reference.rotation[i][:, kept[i]]
+        if spec.mode == "moments":
+            rotation[i], center[i], semi_axes[i], k = moments_ellipsoid(points, weights, ref_rotation, spec.frame,
+                                                                              match)
+        else:
+            rotation[i], center[i], semi_axes[i], k = inscribed_ellipsoid(
+                points, weights, body.vertices, areas, ref_rotation, margin=spec.margin, inside_fraction=spec.inside,
+                slack=spec.slack, frame=spec.frame, match=match)
+        kept_out.append(k)
+    mannequin = Mannequin(topology, rotation, center, semi_axes, name=name, role=role, measurements=measurements)
+    return mannequin.check(), kept_out
+
+
+def build(refmodels=DEFAULT_REFMODELS, log=print):
+    """Build BM and the five RMs. Returns (base, {name: rm}, report dict)."""
+    started = time.perf_counter()
+    labels = load_labels(refmodels)
+    reference_body = load_body(refmodels, REFERENCE_BODY)
+    topology = rt.topology()
+    selected = selections(reference_body.vertices, labels)
+
+    base, kept = fit_mannequin(reference_body, selected, topology, name=DISPLAY_NAMES[BASE_FILE], role="base")
+    base_raw_asymmetry = asymmetry(base)
+    base = symmetrize(register(base))
+    log(f"base mannequin fitted ({len(topology)} parts)")
+
+    bodies, raw, adjusted, adjustments = {}, {}, [], {}
+    for name in RM_BODIES:
+        bodies[name] = load_body(refmodels, name)
+        targets = REFERENCE_MEASUREMENTS[name]
+        fitted, _ = fit_mannequin(bodies[name], selected, topology, base, kept, DISPLAY_NAMES[name],
+                                  "reference", dict(targets))
+        raw[name] = symmetrize(register(fitted))
+        result = adjust_to_measurements(raw[name], targets, tolerance=ADJUST_TOLERANCE)
+        if not result.converged:
+            raise RuntimeError(f"{name}: the adjustment did not reach Table 2.3 (m_T {result.measured})")
+        adjustments[name] = result
+        adjusted.append(result.mannequin)
+        log(f"{name}: fitted, adjusted in {result.iterations} Newton steps")
+
+    reference_index = RM_BODIES.index(REFERENCE_RM)
+    cleaned = clean(adjusted, reference_index=reference_index)
+    rms = dict(zip(RM_BODIES, cleaned))
+    base = relabel(base, rms[REFERENCE_RM])
+    for name, rm in rms.items():
+        errors = relative_errors(rm.measure(), REFERENCE_MEASUREMENTS[name])
+        worst = max(errors, key=lambda key: abs(errors[key]))
+        if abs(errors[worst]) > ACCEPT_TOLERANCE:
+            raise RuntimeError(f"{name}: after cleaning m_T {worst} is off Table 2.3 by {errors[worst]:.3%}")
+
+    report = {
+        "seconds": time.perf_counter() - started,
+        "body_measurements": {name: body_measurements(body, labels)
+                              for name, body in [(REFERENCE_BODY, reference_body), *bodies.items()]},
+        "fitted_measurements": {name: m.measure() for name, m in raw.items()},
+        "factors": {name: a.factors for name, a in adjustments.items()},
+        "iterations": {name: a.iterations for name, a in adjustments.items()},
+        "base_raw_asymmetry": base_raw_asymmetry,
+        "agreement": axis_agreement_table(rms),
+        "reference_rm": REFERENCE_RM,
+    }
+    return base, rms, report
+
+
+def relative_errors(measured, targets):
+    return {key: measured[key] / targets[key] - 1.0 for key in MEASUREMENTS}
+
+
+def axis_agreement_table(rms):
+    """Per part, the smallest cosine between an axis and the same axis of the reference RM."""
+    reference = rms[REFERENCE_RM]
+    stacked = np.stack([axis_agreement(m.rotation, reference.rotation) for m in rms.values()])
+    return dict(zip(reference.topology.names, stacked.min(axis=(0, 2)).tolist()))
+
+
+def sections_crossed(mannequin):
+    """{measurement: [part names cut by its section]} (all parts for Sh, girth parts for the girths)."""
+    _, _, heights = section_heights(mannequin.rotation, mannequin.center, mannequin.semi_axes)
+    girth = mannequin.topology.girth_mask
+    out = {}
+    for key in ("Sh", "Br", "Wa", "Hi"):
+        _, _, hit = section_at_height(mannequin.rotation, mannequin.center, mannequin.semi_axes, heights[key])
+        if key != "Sh":
+            hit = hit & girth
+        out[key] = [name for name, h in zip(mannequin.topology.names, hit) if h]
+    return out
+
+
+def file_names():
+    return [BASE_FILE, *RM_BODIES]
+
+
+def save_all(base, rms, out):
+    out = pathlib.Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    base.save(out / f"{BASE_FILE}.json")
+    for name, rm in rms.items():
+        rm.save(out / f"{name}.json")
+
+
+def write_blends(mannequins, folder):
+    """One .blend per mannequin (a collection of ellipsoid objects), through the add-on's converter.
+
+    ``mannequins`` maps file stems to mannequins. Needs the bpy module.
+    """
+    import bpy
+
+    import ellimann_addon
+    from ellimann_addon.blender import convert
+
+    folder = pathlib.Path(folder)
+    ellimann_addon.register()
+    try:
+        for stem, mannequin in mannequins.items():
+            bpy.ops.wm.read_homefile(use_empty=True)
+            convert.mannequin_to_collection(mannequin, name=mannequin.name)
+            bpy.ops.wm.save_as_mainfile(filepath=str(folder / f"{stem}.blend"), compress=True)
+    finally:
+        ellimann_addon.unregister()
+
+
+def check_shipped(base, rms, folder, atol=1e-9):
+    """Differences between a fresh build and the shipped JSON files (empty list: identical)."""
+    folder = pathlib.Path(folder)
+    problems = []
+    for stem, fresh in [(BASE_FILE, base), *rms.items()]:
+        shipped = Mannequin.load(folder / f"{stem}.json")
+        if shipped.topology != fresh.topology:
+            problems.append(f"{stem}: topology differs")
+            continue
+        for attr in ("rotation", "center", "semi_axes"):
+            diff = float(np.abs(getattr(shipped, attr) - getattr(fresh, attr)).max())
+            if diff > atol:
+                problems.append(f"{stem}: {attr} differs by up to {diff:.3g}")
+    return problems
+
+
+# ---------------------------------------------------------------- docs
+
+
+def _fmt(value, digits=2):
+    return f"{value:.{digits}f}"
+
+
+def _row(values, digits=2):
+    return " | ".join(_fmt(values[key], digits) for key in MEASUREMENTS)
+
+
+def topology_doc(base):
+    crossed = sections_crossed(base)
+    lines = [
+        "# ElliMann's reference topology",
+        "",
+        "<!-- generated by `python -m tools.build_reference`; edit tools/reference_topology.py, not this file -->",
+        "",
+        f"{len(base.topology)} ellipsoids, head to feet, arms and hands included. Names follow the paper "
+        "(`<number>.<letter> <Label>[.L|.R]`); the numbers of the two parts the paper names keep the "
+        "paper's (10.a Trapezius, 13.a Rectus Abdominalis). Two ellipsoids with the same number and side "
+        "form a cushion (letters a and b). `.L` parts are on the body's left (+X), `.R` parts are their "
+        "mirror images, central parts are symmetric about x = 0. The `Trapezius` pair is the registration "
+        "landmark of `core/clean.py`.",
+        "",
+        "- **girth**: takes part in the breast, waist and hip sections of m_T (arms and hands do not; the "
+        "shoulder width is measured over every part).",
+        "- **depends**: the measurements the part is interpolated on in synthesis (segmented IDW): head and "
+        "neck on He; shoulders, arms and hands on He and Sh; bust and chest on He and Br; abdomen and "
+        "lower back on He and Wa; pelvis, buttocks and legs on He and Hi.",
+        "- **traced from**: the vertices of the reference body the part is fitted to (regions and bones of "
+        "`refmodels/reference_female_regions.json`, heights `h` as fractions of the body's height, "
+        "`x` lateral and `y` front(-)/back(+) bands in metres).",
+        "",
+        "| part | side | cushion partner | region | girth | depends | traced from |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    specs = dict((rt.part_name(spec, side), spec) for spec, side in rt.expanded())
+    for part in base.topology:
+        spec = specs[part.name]
+        lines.append(f"| {part.name} | {part.side} | {part.partner or '-'} | {part.region} | "
+                     f"{'yes' if part.girth else 'no'} | {', '.join(part.depends)} | {_describe(spec)} |")
+    lines += ["", "## Parts cut by each section of the Base Mannequin", "",
+              "| measurement | height (fraction of He) | parts |", "|---|---|---|"]
+    for key, names in crossed.items():
+        lines.append(f"| {key} | {SECTION_FRACTIONS[key]} | {', '.join(names)} |")
+    return "\n".join(lines) + "\n"
+
+
+def _describe(spec):
+    select = spec.select
+    items = []
+    if select.regions:
+        items.append("regions " + "/".join(select.regions))
+    if select.bones:
+        items.append("bones " + "/".join(f"{b}*" for b in select.bones))
+    for axis in ("h", "x", "y"):
+        lo, hi = getattr(select, axis)
+        if np.isfinite(lo) and lo > -1 or np.isfinite(hi) and hi < 1:
+            lo_text = "" if lo <= -1 else f"{lo:g} ≤ "
+            hi_text = "" if hi >= 1 else f" ≤ {hi:g}"
+            items.append(f"{lo_text}{axis}{hi_text}")
+    if spec.inward is not None:
+        items.append(f"patch extruded by {tuple(float(v) for v in spec.inward)} m")
+    if spec.mode != "inscribed":
+        items.append(f"{spec.mode} fit")
+    return "; ".join(items)
+
+
+def measurements_doc(base, rms, report):
+    lines = [
+        "# Reference Mannequins: Table 2.3 vs m_T",
+        "",
+        "<!-- generated by `python -m tools.build_reference`; do not edit -->",
+        "",
+        "m_T is `Mannequin.measure()` (closed form) of the shipped JSON files in `reference_blends/`. "
+        "Each RM is the topology of `docs/topology.md` fitted inside its body from `refmodels/`, "
+        "stretched (`core.adjust`) until m_T meets Table 2.3, then cleaned together with the others "
+        f"(registration, symmetry, axes relabelled against the {DISPLAY_NAMES[report['reference_rm']]} RM).",
+        "",
+        "| RM | | He | Sh | Br | Wa | Hi | max rel. error |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for name, rm in rms.items():
+        target = REFERENCE_MEASUREMENTS[name]
+        measured = rm.measure()
+        errors = relative_errors(measured, target)
+        worst = max(abs(e) for e in errors.values())
+        lines.append(f"| {DISPLAY_NAMES[name]} | target | " + _row(target) + " | |")
+        lines.append("| | m_T | " + _row(measured) + f" | {worst:.4%} |")
+    lines += [
+        "",
+        "## How far each body and fit were from the table",
+        "",
+        "The body is the mesh in `refmodels/` (measured like m_T on the mesh, as its README says); the fit "
+        "is the RM before the adjustment (inscribed ellipsoids, so a little smaller than the body); the "
+        "factors are the stretches the adjustment applied (He: vertical; Sh: the shoulder and arm parts "
+        "along X; Br, Wa, Hi: the girth parts crossing each section, horizontally).",
+        "",
+        "| RM | | He | Sh | Br | Wa | Hi |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for name in rms:
+        body = report["body_measurements"][name]
+        fitted = report["fitted_measurements"][name]
+        factors = report["factors"][name]
+        lines.append(f"| {DISPLAY_NAMES[name]} | body | " + _row(body) + " |")
+        lines.append("| | fit | " + _row(fitted) + " |")
+        lines.append("| | factor | " + _row(factors, 4) + " |")
+    body = report["body_measurements"][REFERENCE_BODY]
+    measured = base.measure()
+    lines += [
+        "",
+        "## Base Mannequin vs the reference body",
+        "",
+        "The Base Mannequin is traced, not adjusted: its m_T is that of inscribed ellipsoids.",
+        "",
+        "| | He | Sh | Br | Wa | Hi |",
+        "|---|---|---|---|---|---|",
+        "| reference body | " + _row(body) + " |",
+        "| Base Mannequin m_T | " + _row(measured) + " |",
+        "| relative difference | " + " | ".join(f"{measured[k] / body[k] - 1.0:+.1%}" for k in MEASUREMENTS) + " |",
+        "",
+        "## Consistency of axis labels",
+        "",
+        "Smallest cosine between an ellipsoid's axis and the same axis of the same ellipsoid in the "
+        f"{DISPLAY_NAMES[report['reference_rm']]} RM, over the five RMs and three axes: "
+        f"**{min(report['agreement'].values()):.4f}** (1 = identical). The five lowest parts:",
+        "",
+        "| part | smallest agreement |",
+        "|---|---|",
+    ]
+    for name, value in sorted(report["agreement"].items(), key=lambda item: item[1])[:5]:
+        lines.append(f"| {name} | {value:.4f} |")
+    return "\n".join(lines) + "\n"
+
+
+def summary(base, rms):
+    """Lines of sanity checks: validity, symmetry, registration, right-handedness, m_T errors."""
+    lines = []
+    for stem, m in [(BASE_FILE, base), *rms.items()]:
+        m.check()
+        lowest = section_heights(m.rotation, m.center, m.semi_axes)[0]
+        landmark = m.center[landmark_indices(m.topology)].mean(axis=0)
+        text = (f"{stem:15s} right-handed {bool(np.all(is_rotation(m.rotation)))} asymmetry {asymmetry(m):.1e} "
+                f"floor {float(lowest):+.1e} trapezius x,y {landmark[0]:+.1e},{landmark[1]:+.1e}")
+        if stem in REFERENCE_MEASUREMENTS:
+            errors = relative_errors(m.measure(), REFERENCE_MEASUREMENTS[stem])
+            text += f" max m_T error {max(abs(e) for e in errors.values()):.4%}"
+        lines.append(text)
+    return lines
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m tools.build_reference", description=__doc__.split("\n")[0])
+    parser.add_argument("--refmodels", type=pathlib.Path, default=DEFAULT_REFMODELS,
+                        help=f"folder of the reference bodies (default: {DEFAULT_REFMODELS})")
+    parser.add_argument("--out", type=pathlib.Path, default=REPO / "reference_blends",
+                        help="where the mannequins go (default: reference_blends/)")
+    parser.add_argument("--docs", type=pathlib.Path, default=REPO / "docs", help="where the docs go (default: docs/)")
+    parser.add_argument("--no-blend", action="store_true", help="skip the .blend files (no bpy needed)")
+    parser.add_argument("--check", action="store_true",
+                        help="rebuild in memory and compare with the files in --out; write nothing")
+    args = parser.parse_args(argv)
+    if not (args.refmodels / f"{REFERENCE_BODY}.obj").is_file():
+        print(f"error: no {REFERENCE_BODY}.obj in {args.refmodels} (use --refmodels)", file=sys.stderr)
+        return 2
+
+    base, rms, report = build(args.refmodels)
+    for line in summary(base, rms):
+        print(line)
+    print(f"smallest axis agreement with the {REFERENCE_RM} RM: {min(report['agreement'].values()):.4f}")
+    print(f"built in {report['seconds']:.1f} s")
+    if args.check:
+        problems = check_shipped(base, rms, args.out)
+        print("\n".join(problems) if problems else f"identical to the files in {args.out}")
+        return 1 if problems else 0
+
+    save_all(base, rms, args.out)
+    args.docs.mkdir(parents=True, exist_ok=True)
+    (args.docs / "topology.md").write_text(topology_doc(base), encoding="utf-8")
+    (args.docs / "reference_mannequins.md").write_text(measurements_doc(base, rms, report), encoding="utf-8")
+    if not args.no_blend:
+        write_blends({BASE_FILE: base, **rms}, args.out)
+    print(f"wrote {len(rms) + 1} mannequins to {args.out} and the docs to {args.docs}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
