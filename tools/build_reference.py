@@ -61,7 +61,7 @@ def selections(reference_vertices, labels):
     return out
 
 
-def fit_mannequin(body, selected, topology, reference=None, kept=None, name="", role="reference",
+def fit_mannequin(body, selected, obstacles, topology, reference=None, kept=None, name="", role="reference",
                   measurements=None):
     """Fit every part of ``topology`` over ``body``. Returns (mannequin, kept axis index per part).
 
@@ -73,7 +73,7 @@ def fit_mannequin(body, selected, topology, reference=None, kept=None, name="", 
     n = len(topology)
     rotation, center, semi_axes = np.zeros((n, 3, 3)), np.zeros((n, 3)), np.zeros((n, 3))
     kept_out = []
-    for i, ((spec, _), idx) in enumerate(zip(rt.expanded(), selected)):
+    for i, ((spec, _), idx, walls) in enumerate(zip(rt.expanded(), selected, obstacles)):
         points, weights = body.vertices[idx], areas[idx]
         if spec.inward is not None:
             points = np.concatenate([points, points + np.asarray(spec.inward)])
@@ -85,7 +85,7 @@ def fit_mannequin(body, selected, topology, reference=None, kept=None, name="", 
                                                                               match)
         else:
             rotation[i], center[i], semi_axes[i], k = inscribed_ellipsoid(
-                points, weights, body.vertices, areas, ref_rotation, margin=spec.margin, inside_fraction=spec.inside,
+                points, weights, body.vertices[walls], areas[walls], ref_rotation, margin=spec.margin, inside_fraction=spec.inside,
                 slack=spec.slack, frame=spec.frame, match=match)
         kept_out.append(k)
     mannequin = Mannequin(topology, rotation, center, semi_axes, name=name, role=role, measurements=measurements)
@@ -99,19 +99,20 @@ def build(refmodels=DEFAULT_REFMODELS, log=print):
     reference_body = load_body(refmodels, REFERENCE_BODY)
     topology = rt.topology()
     selected = selections(reference_body.vertices, labels)
+    obstacles = [rt.obstacle_vertices(spec, side, labels) for spec, side in rt.expanded()]
 
-    base, kept = fit_mannequin(reference_body, selected, topology, name=DISPLAY_NAMES[BASE_FILE], role="base")
+    base, kept = fit_mannequin(reference_body, selected, obstacles, topology, name=DISPLAY_NAMES[BASE_FILE], role="base")
     base_raw_asymmetry = asymmetry(base)
-    base = symmetrize(register(base))
+    base = register(symmetrize(base))  # symmetric first: mirroring may move the lowest point
     log(f"base mannequin fitted ({len(topology)} parts)")
 
     bodies, raw, adjusted, adjustments = {}, {}, [], {}
     for name in RM_BODIES:
         bodies[name] = load_body(refmodels, name)
         targets = REFERENCE_MEASUREMENTS[name]
-        fitted, _ = fit_mannequin(bodies[name], selected, topology, base, kept, DISPLAY_NAMES[name],
+        fitted, _ = fit_mannequin(bodies[name], selected, obstacles, topology, base, kept, DISPLAY_NAMES[name],
                                   "reference", dict(targets))
-        raw[name] = symmetrize(register(fitted))
+        raw[name] = register(symmetrize(fitted))
         result = adjust_to_measurements(raw[name], targets, tolerance=ADJUST_TOLERANCE)
         if not result.converged:
             raise RuntimeError(f"{name}: the adjustment did not reach Table 2.3 (m_T {result.measured})")
@@ -128,6 +129,11 @@ def build(refmodels=DEFAULT_REFMODELS, log=print):
         worst = max(errors, key=lambda key: abs(errors[key]))
         if abs(errors[worst]) > ACCEPT_TOLERANCE:
             raise RuntimeError(f"{name}: after cleaning m_T {worst} is off Table 2.3 by {errors[worst]:.3%}")
+    for name, m in [(BASE_FILE, base), *rms.items()]:
+        m.check()
+        problems = cleanliness_problems(m)
+        if problems:
+            raise RuntimeError(f"{name}: {'; '.join(problems)}")
 
     report = {
         "seconds": time.perf_counter() - started,
@@ -141,6 +147,22 @@ def build(refmodels=DEFAULT_REFMODELS, log=print):
         "reference_rm": REFERENCE_RM,
     }
     return base, rms, report
+
+
+def cleanliness_problems(mannequin, tol=1e-9):
+    """What keeps a mannequin from being clean: left-handed frames, asymmetry, not registered."""
+    problems = []
+    if not np.all(is_rotation(mannequin.rotation, tol)):
+        problems.append("a frame is not a rotation")
+    if asymmetry(mannequin) > tol:
+        problems.append(f"asymmetric by {asymmetry(mannequin):.2g} m")
+    floor = float(section_heights(mannequin.rotation, mannequin.center, mannequin.semi_axes)[0])
+    if abs(floor) > tol:
+        problems.append(f"lowest point at z = {floor:.2g} m")
+    landmark = mannequin.center[landmark_indices(mannequin.topology)].mean(axis=0)
+    if np.any(np.abs(landmark[:2]) > tol):
+        problems.append(f"trapezius centroid at x, y = {landmark[0]:.2g}, {landmark[1]:.2g} m")
+    return problems
 
 
 def relative_errors(measured, targets):
@@ -250,14 +272,24 @@ def topology_doc(base):
         "`refmodels/reference_female_regions.json`, heights `h` as fractions of the body's height, "
         "`x` lateral and `y` front(-)/back(+) bands in metres).",
         "",
-        "| part | side | cushion partner | region | girth | depends | traced from |",
-        "|---|---|---|---|---|---|---|",
+        "- **fit**: how the part is fitted (`tools/fitting.py`): the largest ellipsoid, by volume, inside "
+        "the body surface and within the selection's box enlarged by `margin` of its half-size (default "
+        f"{rt.Spec.margin:g}); a body vertex may lie inside it down to `slack` of its radius (default "
+        f"{rt.Spec.slack:g}) and vertices of total area `inside` of the nearby surface (default "
+        f"{rt.Spec.inside:g}) deeper. The frame takes one axis from the vertices (*limb*: the line through "
+        "the centroids of the two ends; *main*: the principal axis that stands most apart) and the rest from "
+        "the world axes (on the Reference Mannequins: from the Base Mannequin's part); *fixed*: world axes. "
+        "A *moments* fit is the envelope of the vertices (for spread fingers, which no inscribed ellipsoid fills).",
+        "",
+        "| part | side | cushion partner | region | girth | depends | traced from | fit |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     specs = dict((rt.part_name(spec, side), spec) for spec, side in rt.expanded())
     for part in base.topology:
         spec = specs[part.name]
         lines.append(f"| {part.name} | {part.side} | {part.partner or '-'} | {part.region} | "
-                     f"{'yes' if part.girth else 'no'} | {', '.join(part.depends)} | {_describe(spec)} |")
+                     f"{'yes' if part.girth else 'no'} | {', '.join(part.depends)} | {_describe(spec)} | "
+                     f"{_fit_notes(spec)} |")
     lines += ["", "## Parts cut by each section of the Base Mannequin", "",
               "| measurement | height (fraction of He) | parts |", "|---|---|---|"]
     for key, names in crossed.items():
@@ -274,15 +306,26 @@ def _describe(spec):
         items.append("bones " + "/".join(f"{b}*" for b in select.bones))
     for axis in ("h", "x", "y"):
         lo, hi = getattr(select, axis)
-        if np.isfinite(lo) and lo > -1 or np.isfinite(hi) and hi < 1:
+        if lo > -1 or hi < 1:
             lo_text = "" if lo <= -1 else f"{lo:g} ≤ "
             hi_text = "" if hi >= 1 else f" ≤ {hi:g}"
             items.append(f"{lo_text}{axis}{hi_text}")
     if spec.inward is not None:
-        items.append(f"patch extruded by {tuple(float(v) for v in spec.inward)} m")
-    if spec.mode != "inscribed":
-        items.append(f"{spec.mode} fit")
+        items.append("surface patch extruded by ({}) m".format(", ".join(f"{v:g}" for v in spec.inward)))
     return "; ".join(items)
+
+
+def _fit_notes(spec):
+    defaults = rt.Spec(0, "a", "", "C", "", True, ("He",), rt.Select())
+    items = [f"{spec.frame} frame"]
+    if spec.mode != defaults.mode:
+        items.append(f"{spec.mode} fit")
+    for attr in ("margin", "slack", "inside"):
+        if getattr(spec, attr) != getattr(defaults, attr):
+            items.append(f"{attr} {getattr(spec, attr):g}")
+    if spec.obstacles is not None:
+        items.append("kept inside the " + "/".join(spec.obstacles) + " surface only")
+    return ", ".join(items)
 
 
 def measurements_doc(base, rms, report):
@@ -354,17 +397,13 @@ def measurements_doc(base, rms, report):
 
 
 def summary(base, rms):
-    """Lines of sanity checks: validity, symmetry, registration, right-handedness, m_T errors."""
+    """One line per mannequin: clean or not, and the largest m_T error against Table 2.3."""
     lines = []
     for stem, m in [(BASE_FILE, base), *rms.items()]:
-        m.check()
-        lowest = section_heights(m.rotation, m.center, m.semi_axes)[0]
-        landmark = m.center[landmark_indices(m.topology)].mean(axis=0)
-        text = (f"{stem:15s} right-handed {bool(np.all(is_rotation(m.rotation)))} asymmetry {asymmetry(m):.1e} "
-                f"floor {float(lowest):+.1e} trapezius x,y {landmark[0]:+.1e},{landmark[1]:+.1e}")
+        text = f"{stem:15s} {'; '.join(cleanliness_problems(m)) or 'valid, right-handed, symmetric, registered'}"
         if stem in REFERENCE_MEASUREMENTS:
             errors = relative_errors(m.measure(), REFERENCE_MEASUREMENTS[stem])
-            text += f" max m_T error {max(abs(e) for e in errors.values()):.4%}"
+            text += ", max m_T error vs Table 2.3 {:.4%}".format(max(abs(e) for e in errors.values()))
         lines.append(text)
     return lines
 

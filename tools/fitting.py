@@ -28,7 +28,7 @@ BISECTIONS = 12
 
 
 FRAMES = ("limb", "main", "fixed")
-LIMB_END = 1.0 / 3.0  # share of the points (by area) at each end that gives a limb's axis
+LIMB_END = 1.0 / 3.0  # share of the points (by area) at each end of a limb whose centroids give its axis
 
 
 def principal_frame(points, weights, reference=None, frame="main", match=None):

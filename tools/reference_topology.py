@@ -45,11 +45,14 @@ class Spec:
     select: Select
     margin: float = 0.3  # box enlargement, fraction of the selection's half-extent
     slack: float = 0.03  # how far (fraction of its radius) a body vertex may lie inside the ellipsoid
-    inside: float = 0.003  # fraction of nearby body vertices allowed deeper inside than that
+    inside: float = 0.003  # share of the nearby body surface (by area) allowed deeper inside than that
     inward: tuple = None  # extrude a surface patch by this vector (m) into the body before fitting
     mode: str = "inscribed"  # or "moments": the envelope, for parts no inscribed ellipsoid can fill
     frame: str = "main"  # the axis the frame takes from the points: "limb", "main" or "fixed" (none)
+    obstacles: tuple = None  # regions (without side) whose vertices the part must stay inside; None: all
 
+
+ARM = ("upper_arm", "forearm", "hand")  # an arm pressed against the torso may overlap it
 
 HEAD = ("He",)
 SHOULDERS = ("He", "Sh")
@@ -64,7 +67,7 @@ SPECS = (
     Spec(2, "a", "Neck", "C", "neck", True, HEAD,
          Select(regions=("neck",), h=(0.83, 0.905), x=(0.0, 0.06), y=(-0.075, 1)), frame="limb"),
     Spec(3, "a", "Upper Arm", "L", "arms", False, SHOULDERS,
-         Select(bones=("upperarm01", "upperarm02"), h=(0, 0.84)), frame="limb"),
+         Select(bones=("upperarm01", "upperarm02"), h=(0, 0.84)), frame="limb", obstacles=ARM),
     Spec(3, "b", "Forearm", "L", "arms", False, SHOULDERS, Select(bones=("lowerarm",)), frame="limb"),
     Spec(4, "a", "Hand", "L", "hands", False, SHOULDERS, Select(bones=("wrist", "metacarpal", "finger1-1")),
          slack=0.08),
@@ -141,6 +144,14 @@ def topology():
         partner = part_name(mates[0], side) if mates else ""
         parts.append(Part(part_name(spec, side), side, spec.region, spec.girth, spec.depends, partner))
     return Topology(parts)
+
+
+def obstacle_vertices(spec, side, labels):
+    """Indices of the body vertices that must stay outside the part (all, or those of its regions)."""
+    if spec.obstacles is None:
+        return np.arange(len(labels.region))
+    names = [f"{r}_{side}" for r in spec.obstacles] + list(spec.obstacles)
+    return np.nonzero(np.isin(labels.region, names))[0]
 
 
 def select_vertices(select, side, vertices, labels, height):
