@@ -24,6 +24,7 @@ import argparse
 import pathlib
 import sys
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -31,8 +32,9 @@ from ellimann_addon.core.adjust import adjust_to_measurements
 from ellimann_addon.core.clean import asymmetry, clean, landmark_indices, register, relabel, symmetrize
 from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 from ellimann_addon.core.ellipsoid import section_at_height
+from ellimann_addon.core.files import atomic_write_text
 from ellimann_addon.core.frames import axis_agreement, is_rotation
-from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.mannequin import Mannequin, Topology
 from ellimann_addon.core.measure import section_heights
 
 from . import reference_topology as rt
@@ -49,31 +51,44 @@ DISPLAY_NAMES = {"small_slim": "Small Slim", "tall_slim": "Tall Slim", "small_ch
                  "tall_chubby": "Tall Chubby", "average": "Average", BASE_FILE: "Base Mannequin"}
 
 
-def selections(reference_vertices, labels):
-    """Vertex indices of every part (topology order), chosen on the reference body."""
-    height = reference_vertices[:, 2].max() - reference_vertices[:, 2].min()
-    out = []
-    for spec, side in rt.expanded():
-        idx = rt.select_vertices(spec.select, side, reference_vertices, labels, height)
-        if len(idx) < 8:
-            raise ValueError(f"'{rt.part_name(spec, side)}' selects only {len(idx)} vertices: widen its selection")
-        out.append(idx)
-    return out
+@dataclass(frozen=True)
+class Tracing:
+    """Which vertices trace each part (topology order): its selection, and the vertices it must stay inside.
+
+    Chosen once on the reference body; every body shares its vertex order.
+    """
+
+    topology: Topology
+    selected: list
+    obstacles: list
+
+    @classmethod
+    def on(cls, reference_body, labels):
+        vertices = reference_body.vertices
+        height = vertices[:, 2].max() - vertices[:, 2].min()
+        selected, obstacles = [], []
+        for spec, side in rt.expanded():
+            idx = rt.select_vertices(spec.select, side, vertices, labels, height)
+            if len(idx) < 8:
+                raise ValueError(f"'{rt.part_name(spec, side)}' selects only {len(idx)} vertices: widen its selection")
+            selected.append(idx)
+            obstacles.append(rt.obstacle_vertices(spec, side, labels))
+        return cls(rt.topology(), selected, obstacles)
 
 
-def fit_mannequin(body, selected, obstacles, topology, reference=None, kept=None, name="", role="reference",
-                  measurements=None):
-    """Fit every part of ``topology`` over ``body``. Returns (mannequin, kept axis index per part).
+def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
+    """Fit every part over ``body``. Returns (mannequin, kept axis index per part).
 
-    Without ``reference`` the frames are labelled against the world axes (the Base Mannequin);
+    Without ``reference`` the frames take their roll from the world axes (the Base Mannequin);
     with it (a mannequin of the same topology, and the ``kept`` axes of its fit) each part keeps
-    the principal axis closest to the reference part's kept axis and the reference's roll about it.
+    the axis closest to the reference part's kept axis and the reference's roll about it.
+    ``fields``: name, role, measurements of the mannequin.
     """
     areas = vertex_areas(body.vertices, body.faces)
-    n = len(topology)
+    n = len(tracing.topology)
     rotation, center, semi_axes = np.zeros((n, 3, 3)), np.zeros((n, 3)), np.zeros((n, 3))
     kept_out = []
-    for i, ((spec, _), idx, walls) in enumerate(zip(rt.expanded(), selected, obstacles)):
+    for i, ((spec, _), idx, walls) in enumerate(zip(rt.expanded(), tracing.selected, tracing.obstacles)):
         points, weights = body.vertices[idx], areas[idx]
         if spec.inward is not None:
             points = np.concatenate([points, points + np.asarray(spec.inward)])
@@ -81,15 +96,14 @@ def fit_mannequin(body, selected, obstacles, topology, reference=None, kept=None
         ref_rotation = np.eye(3) if reference is None else reference.rotation[i]
         match = None if reference is None or kept[i] is None else reference.rotation[i][:, kept[i]]
         if spec.mode == "moments":
-            rotation[i], center[i], semi_axes[i], k = moments_ellipsoid(points, weights, ref_rotation, spec.frame,
-                                                                              match)
+            fit = moments_ellipsoid(points, weights, ref_rotation, spec.frame, match)
         else:
-            rotation[i], center[i], semi_axes[i], k = inscribed_ellipsoid(
-                points, weights, body.vertices[walls], areas[walls], ref_rotation, margin=spec.margin, inside_fraction=spec.inside,
-                slack=spec.slack, frame=spec.frame, match=match)
+            fit = inscribed_ellipsoid(points, weights, body.vertices[walls], areas[walls], ref_rotation,
+                                      margin=spec.margin, inside_fraction=spec.inside, slack=spec.slack,
+                                      frame=spec.frame, match=match)
+        rotation[i], center[i], semi_axes[i], k = fit
         kept_out.append(k)
-    mannequin = Mannequin(topology, rotation, center, semi_axes, name=name, role=role, measurements=measurements)
-    return mannequin.check(), kept_out
+    return Mannequin(tracing.topology, rotation, center, semi_axes, **fields).check(), kept_out
 
 
 def build(refmodels=DEFAULT_REFMODELS, log=print):
@@ -97,21 +111,20 @@ def build(refmodels=DEFAULT_REFMODELS, log=print):
     started = time.perf_counter()
     labels = load_labels(refmodels)
     reference_body = load_body(refmodels, REFERENCE_BODY)
-    topology = rt.topology()
-    selected = selections(reference_body.vertices, labels)
-    obstacles = [rt.obstacle_vertices(spec, side, labels) for spec, side in rt.expanded()]
+    tracing = Tracing.on(reference_body, labels)
 
-    base, kept = fit_mannequin(reference_body, selected, obstacles, topology, name=DISPLAY_NAMES[BASE_FILE], role="base")
-    base_raw_asymmetry = asymmetry(base)
+    base, kept = fit_mannequin(reference_body, tracing, name=DISPLAY_NAMES[BASE_FILE], role="base")
+    # the right side is fitted too, as a check: mirror-image selections give near-mirror-image parts
+    # (the optimisation can settle a few mm apart); cleaning keeps the left side
+    log(f"base mannequin fitted ({len(base)} parts; asymmetry before mirroring {asymmetry(base):.1e} m)")
     base = register(symmetrize(base))  # symmetric first: mirroring may move the lowest point
-    log(f"base mannequin fitted ({len(topology)} parts)")
 
     bodies, raw, adjusted, adjustments = {}, {}, [], {}
     for name in RM_BODIES:
         bodies[name] = load_body(refmodels, name)
         targets = REFERENCE_MEASUREMENTS[name]
-        fitted, _ = fit_mannequin(bodies[name], selected, obstacles, topology, base, kept, DISPLAY_NAMES[name],
-                                  "reference", dict(targets))
+        fitted, _ = fit_mannequin(bodies[name], tracing, base, kept, name=DISPLAY_NAMES[name], role="reference",
+                                  measurements=dict(targets))
         raw[name] = register(symmetrize(fitted))
         result = adjust_to_measurements(raw[name], targets, tolerance=ADJUST_TOLERANCE)
         if not result.converged:
@@ -120,8 +133,7 @@ def build(refmodels=DEFAULT_REFMODELS, log=print):
         adjusted.append(result.mannequin)
         log(f"{name}: fitted, adjusted in {result.iterations} Newton steps")
 
-    reference_index = RM_BODIES.index(REFERENCE_RM)
-    cleaned = clean(adjusted, reference_index=reference_index)
+    cleaned = clean(adjusted, reference_index=RM_BODIES.index(REFERENCE_RM))
     rms = dict(zip(RM_BODIES, cleaned))
     base = relabel(base, rms[REFERENCE_RM])
     for name, rm in rms.items():
@@ -130,8 +142,7 @@ def build(refmodels=DEFAULT_REFMODELS, log=print):
         if abs(errors[worst]) > ACCEPT_TOLERANCE:
             raise RuntimeError(f"{name}: after cleaning m_T {worst} is off Table 2.3 by {errors[worst]:.3%}")
     for name, m in [(BASE_FILE, base), *rms.items()]:
-        m.check()
-        problems = cleanliness_problems(m)
+        problems = cleanliness_problems(m.check())
         if problems:
             raise RuntimeError(f"{name}: {'; '.join(problems)}")
 
@@ -141,8 +152,6 @@ def build(refmodels=DEFAULT_REFMODELS, log=print):
                               for name, body in [(REFERENCE_BODY, reference_body), *bodies.items()]},
         "fitted_measurements": {name: m.measure() for name, m in raw.items()},
         "factors": {name: a.factors for name, a in adjustments.items()},
-        "iterations": {name: a.iterations for name, a in adjustments.items()},
-        "base_raw_asymmetry": base_raw_asymmetry,
         "agreement": axis_agreement_table(rms),
         "reference_rm": REFERENCE_RM,
     }
@@ -189,16 +198,18 @@ def sections_crossed(mannequin):
     return out
 
 
-def file_names():
-    return [BASE_FILE, *RM_BODIES]
-
-
-def save_all(base, rms, out):
+def save_all(mannequins, out):
+    """Write the JSON files; returns the stems whose file is new or changed."""
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    base.save(out / f"{BASE_FILE}.json")
-    for name, rm in rms.items():
-        rm.save(out / f"{name}.json")
+    changed = []
+    for stem, mannequin in mannequins.items():
+        path = out / f"{stem}.json"
+        text = mannequin.to_json() + "\n"
+        if not path.is_file() or path.read_text(encoding="utf-8") != text:
+            mannequin.save(path)
+            changed.append(stem)
+    return changed
 
 
 def write_blends(mannequins, folder):
@@ -403,7 +414,7 @@ def summary(base, rms):
         text = f"{stem:15s} {'; '.join(cleanliness_problems(m)) or 'valid, right-handed, symmetric, registered'}"
         if stem in REFERENCE_MEASUREMENTS:
             errors = relative_errors(m.measure(), REFERENCE_MEASUREMENTS[stem])
-            text += ", max m_T error vs Table 2.3 {:.4%}".format(max(abs(e) for e in errors.values()))
+            text += f", max m_T error vs Table 2.3 {max(abs(e) for e in errors.values()):.4%}"
         lines.append(text)
     return lines
 
@@ -433,13 +444,19 @@ def main(argv=None):
         print("\n".join(problems) if problems else f"identical to the files in {args.out}")
         return 1 if problems else 0
 
-    save_all(base, rms, args.out)
+    mannequins = {BASE_FILE: base, **rms}
+    changed = save_all(mannequins, args.out)
     args.docs.mkdir(parents=True, exist_ok=True)
-    (args.docs / "topology.md").write_text(topology_doc(base), encoding="utf-8")
-    (args.docs / "reference_mannequins.md").write_text(measurements_doc(base, rms, report), encoding="utf-8")
+    atomic_write_text(args.docs / "topology.md", topology_doc(base))
+    atomic_write_text(args.docs / "reference_mannequins.md", measurements_doc(base, rms, report))
+    print(f"{len(changed)} of {len(mannequins)} JSON files changed in {args.out}; docs written to {args.docs}")
     if not args.no_blend:
-        write_blends({BASE_FILE: base, **rms}, args.out)
-    print(f"wrote {len(rms) + 1} mannequins to {args.out} and the docs to {args.docs}")
+        # .blend files are not byte-reproducible: rewrite only those whose mannequin changed (or missing)
+        stale = {stem: m for stem, m in mannequins.items()
+                 if stem in changed or not (args.out / f"{stem}.blend").is_file()}
+        if stale:
+            write_blends(stale, args.out)
+        print(f"{len(stale)} .blend files written")
     return 0
 
 

@@ -1,19 +1,20 @@
-"""Fitting one ellipsoid inside a body mesh: principal axes of a vertex selection, then the largest
+"""Fitting one ellipsoid inside a body mesh: a frame from a vertex selection, then the largest
 ellipsoid (by volume) that stays inside the body surface and within the selection's extent.
 
 The paper traces each part so that it "fills as much space as possible while inscribed in the
 reference 3D model surface". Here that is an optimisation per part:
 
-1. Frame: area-weighted principal axes of the selected vertices. Directions the selection does
-   not determine (two nearly equal principal variances) are taken from a reference frame (the Base
-   Mannequin's part, or the world axes), so corresponding parts of different bodies get
-   consistent axes.
-2. Centre and semi-axes: maximise the volume subject to (a) no body vertex inside the ellipsoid
-   (up to a small fraction, for the odd interior vertex of eyes or mouth) and (b) the ellipsoid
-   inside the selection's bounding box in that frame, enlarged by a margin so that neighbouring
-   parts overlap. For a fixed centre, growing one semi-axis while the others are fixed has a
-   closed-form limit per vertex; alternating small growth steps over the axes converges to a
-   maximal ellipsoid. The centre is improved by a deterministic pattern search.
+1. Frame (:func:`principal_frame`): one axis from the area-weighted selected vertices (a limb's
+   direction, or the principal axis that stands apart), the roll about it from a reference frame
+   (world axes for the Base Mannequin, the Base Mannequin's part for the others), so corresponding
+   parts of different bodies get consistent axes.
+2. Centre and semi-axes (:func:`inscribed_ellipsoid`): maximise the volume subject to (a) no body
+   vertex inside the ellipsoid, up to a slack and a small share of the surface (the odd interior
+   vertex of eyes or mouth, a skin fold), and (b) the ellipsoid inside the selection's bounding box
+   in that frame, enlarged by a margin so that neighbouring parts overlap. For a fixed centre,
+   growing one semi-axis while the others are fixed has a closed-form limit per vertex; growing
+   all three together in small steps converges to a maximal ellipsoid. The centre is improved by a
+   deterministic pattern search.
 """
 
 import numpy as np
@@ -23,8 +24,8 @@ from ellimann_addon.core.frames import relabel_to_reference
 DEGENERATE = 0.12  # relative gap below which two principal variances do not fix their axes
 GROWTH = 1.15  # largest growth of a semi-axis per round: keeps the ascent from favouring one axis
 ROUNDS = 60
+BISECTIONS = 12  # to find how far a round's growth stays feasible
 PATTERN_STEPS = 5  # halvings of the centre search step
-BISECTIONS = 12
 
 
 FRAMES = ("limb", "main", "fixed")
@@ -88,7 +89,7 @@ def _grow(local, area, limit, start, allowed):
     (area, not count, so that a densely meshed face and a sparsely meshed back weigh alike). Each
     round proposes, for every axis, its largest feasible value with the other two fixed, then moves
     all three towards the proposal as far as stays feasible: the result does not depend on the
-    order of the axes (mirror-image selections give mirror-image ellipsoids).
+    order of the axes.
     """
     sq = local * local
 
@@ -129,13 +130,14 @@ def _grow(local, area, limit, start, allowed):
 
 def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=None, margin=0.1,
                         inside_fraction=0.002, slack=0.0, frame="main", match=None):
-    """The largest ellipsoid of the selection's principal frame inside the body.
+    """The largest ellipsoid, in the part's frame, inside the body and the selection's box.
 
     ``selected`` (k, 3) vertices of the part with area ``weights``; ``obstacles`` (m, 3) body
-    vertices that must stay outside (a fraction ``inside_fraction`` of those near the part may not);
-    ``margin`` enlarges the selection's box on every side, as a fraction of its half-extent;
-    ``slack``: how deep (fraction of the normalised radius) a vertex may lie inside; ``frame``,
-    ``match``: see :func:`principal_frame`. Returns (rotation, center, semi_axes, kept axis index).
+    vertices that must stay outside, with ``obstacle_area`` (m,). A vertex may lie inside down to
+    (1 - ``slack``) of the normalised radius, and vertices of total area ``inside_fraction`` of the
+    nearby surface deeper still. ``margin`` enlarges the selection's box on every side, as a
+    fraction of its half-extent. ``reference``, ``frame``, ``match``: see :func:`principal_frame`.
+    Returns (rotation, center, semi_axes, kept axis index).
     """
     rotation, centroid, kept = principal_frame(selected, weights, reference, frame, match)
     local_sel = (selected - centroid) @ rotation
