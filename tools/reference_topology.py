@@ -67,7 +67,7 @@ SPECS = (
     Spec(2, "a", "Neck", "C", "neck", True, HEAD,
          Select(regions=("neck",), h=(0.83, 0.905), x=(0.0, 0.06), y=(-0.075, 1)), frame="limb"),
     Spec(3, "a", "Upper Arm", "L", "arms", False, SHOULDERS,
-         Select(bones=("upperarm01", "upperarm02"), h=(0, 0.84)), frame="limb", obstacles=ARM),
+         Select(bones=("upperarm01", "upperarm02"), h=(0, 0.84)), slack=0.06, frame="limb", obstacles=ARM),
     Spec(3, "b", "Forearm", "L", "arms", False, SHOULDERS, Select(bones=("lowerarm",)), frame="limb"),
     Spec(4, "a", "Hand", "L", "hands", False, SHOULDERS, Select(bones=("wrist", "metacarpal", "finger1-1")),
          slack=0.08),
