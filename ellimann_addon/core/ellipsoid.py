@@ -121,13 +121,13 @@ def decompose_matrix_world(matrix, tol=ORTHONORMAL_TOL):
     linear = matrix[:3, :3]
     semi_axes = np.linalg.norm(linear, axis=0)
     if np.any(semi_axes <= 1e-12):
-        raise FrameError("scale", f"has a zero axis: semi-axes {semi_axes.tolist()}")
+        raise FrameError("scale", f"has a zero axis: semi-axes {semi_axes.tolist()}", "zero")
     rotation = linear / semi_axes
     if not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-4):
         raise FrameError("rotation", "is sheared: the local axes are not orthogonal (apply rotation/scale "
-                         "of a parent, or rebuild the ellipsoid)")
+                         "of a parent, or rebuild the ellipsoid)", "shear")
     if np.linalg.det(rotation) < 0.0:
-        raise FrameError("rotation", "is left-handed (a negative scale); flip one axis to fix it")
+        raise FrameError("rotation", "is left-handed (a negative scale); flip one axis to fix it", "negative")
     return rotation, matrix[:3, 3].copy(), semi_axes
 
 
@@ -149,7 +149,7 @@ def repair_matrix_world(matrix, flip_axis=None, tol=ORTHONORMAL_TOL):
     singular = np.linalg.svd(linear, compute_uv=False)
     if singular[-1] <= 1e-9 * max(singular[0], 1e-300):
         raise FrameError("scale", f"is zero along some axis (singular values {singular.tolist()}): "
-                         "no ellipsoid matches it")
+                         "no ellipsoid matches it", "zero")
     rotation = linear / semi_axes
     if np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-4):
         if np.linalg.det(rotation) < 0.0:

@@ -74,16 +74,19 @@ def test_decompose_refuses_negative_scale_shear_and_zero_scale():
     m = el.matrix_world(np.eye(3), (0, 0, 0), (0.1, 0.2, 0.3))
     negative = m.copy()
     negative[:3, 0] *= -1
-    with pytest.raises(FrameError, match="left-handed"):
+    with pytest.raises(FrameError, match="left-handed") as info:
         el.decompose_matrix_world(negative)
+    assert info.value.kind == "negative"
     sheared = m.copy()
     sheared[0, 1] = 0.1
-    with pytest.raises(FrameError, match="sheared"):
+    with pytest.raises(FrameError, match="sheared") as info:
         el.decompose_matrix_world(sheared)
+    assert info.value.kind == "shear"
     flat = m.copy()
     flat[:3, 2] = 0
-    with pytest.raises(FrameError, match="zero axis"):
+    with pytest.raises(FrameError, match="zero axis") as info:
         el.decompose_matrix_world(flat)
+    assert info.value.kind == "zero"
     with pytest.raises(FrameError, match="finite"):
         el.decompose_matrix_world(np.full((4, 4), np.nan))
 
