@@ -78,13 +78,17 @@ def is_unit_sphere(mesh):
     return bool(np.all(np.abs(radius - 1.0) < UNIT_SPHERE_TOLERANCE))
 
 
-def ellipsoid_frame(obj):
+def ellipsoid_frame(obj, checked=None):
     """(rotation, center, semi_axes) of an ellipsoid object; FrameError if its matrix or mesh is not one.
 
     A mesh that is no longer the unit sphere (Apply Scale) would otherwise be read as a sphere of
-    radius 1, so it is refused here rather than silently used.
+    radius 1, so it is refused here rather than silently used. ``checked`` (a dict) caches the mesh
+    check across the many objects that share one mesh.
     """
-    if obj.type != "MESH" or not is_unit_sphere(obj.data):
+    checked = {} if checked is None else checked
+    if obj.type == "MESH" and obj.data.as_pointer() not in checked:
+        checked[obj.data.as_pointer()] = is_unit_sphere(obj.data)
+    if obj.type != "MESH" or not checked[obj.data.as_pointer()]:
         raise FrameError("mesh", "is not a unit sphere: a scale or rotation was applied to the mesh "
                          "(Fix Frames restores it)", "mesh")
     return decompose_matrix_world(np.array(obj.matrix_world))
@@ -92,10 +96,10 @@ def ellipsoid_frame(obj):
 
 def read_frames(objects):
     """Stacked (rotation, center, semi_axes) of ellipsoid objects; MannequinError names every bad one."""
-    problems, frames = [], []
+    problems, frames, checked = [], [], {}
     for obj in objects:
         try:
-            frames.append(ellipsoid_frame(obj))
+            frames.append(ellipsoid_frame(obj, checked))
         except FrameError as error:
             problems.append(Problem(obj.ellimann.part_name or obj.name, error.field, f"{error} (object '{obj.name}')"))
     if problems:
@@ -162,8 +166,8 @@ def write_collection_props(collection, mannequin):
         props.target = [float(mannequin.measurements[m]) for m in MEASUREMENTS]
 
 
-def new_ellipsoid_object(part, rotation, center, semi_axes, collection):
-    obj = bpy.data.objects.new(part.name, unit_sphere_mesh())
+def new_ellipsoid_object(part, rotation, center, semi_axes, collection, mesh=None):
+    obj = bpy.data.objects.new(part.name, mesh or unit_sphere_mesh())
     write_part(obj, part)
     obj.matrix_world = Matrix(matrix_world(rotation, center, semi_axes).tolist())
     obj.color = SIDE_COLORS[part.side]
@@ -175,8 +179,10 @@ def mannequin_to_collection(mannequin, name=None, parent=None):
     """Build a new collection with one ellipsoid object per part. Nothing existing is touched."""
     collection = new_collection(name or mannequin.name or "Mannequin", parent)
     write_collection_props(collection, mannequin)
+    mesh = unit_sphere_mesh()
     for i, part in enumerate(mannequin.topology):
-        new_ellipsoid_object(part, mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i], collection)
+        new_ellipsoid_object(part, mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i], collection,
+                             mesh)
     return collection
 
 
