@@ -104,10 +104,29 @@ def _operator_exists(idname):
     return True
 
 
+class _Instance:
+    """Stands in for an instance of a registered Panel or Menu class (bpy cannot make one outside a UI):
+    class attributes and methods (``draw``, ``path_menu``...) resolve on the class, bound to this object."""
+
+    def __init__(self, cls):
+        self._cls = cls
+
+    def __getattr__(self, name):
+        value = getattr(self._cls, name)
+        binder = getattr(value, "__get__", None)
+        if callable(value) and binder is not None and not isinstance(value, type):
+            plain = self._cls.__dict__.get(name) if name in self._cls.__dict__ else None
+            if isinstance(plain, (classmethod, staticmethod)):
+                return value
+            function = getattr(value, "__func__", value)
+            return function.__get__(self, type(self))
+        return value
+
+
 def draw_panel(panel_class, context=None):
     """Run a panel class's ``draw`` (and ``draw_header`` if any) against a Recorder; return it."""
     context = context or bpy.context
-    panel = panel_class.__new__(panel_class)
+    panel = _Instance(panel_class)
     recorder = Recorder()
     panel.layout = recorder
     if hasattr(panel_class, "poll") and not panel_class.poll(context):

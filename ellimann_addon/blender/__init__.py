@@ -3,7 +3,7 @@
 import importlib
 
 # Registered in this order, unregistered in reverse.
-_MODULES = ("props",)
+_MODULES = ("props", "synthesize", "cli")
 
 
 def _modules():

@@ -107,7 +107,7 @@ def validate_request(me):
             bound = lo if value < lo else hi
             by = abs(value - bound)
             warnings.append(f"{key} = {value:g} cm is outside the reference range {lo:g}-{hi:g} cm by {by:.4g} cm "
-                            f"({100.0 * by / bound:.1f}%): the result is extrapolated")
+                            f"({100.0 * by / bound:.1f}%): plain IDW stays inside the range, exact mode extrapolates")
     return warnings
 
 
