@@ -20,7 +20,7 @@ import sys
 import time
 
 from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS, RANGES, TABLE_2_5
-from ..core.errors import ElliMannError, MeasurementError
+from ..core.errors import ElliMannError, MeasurementError, ReferenceSetError
 from ..core.files import atomic_write_text
 from ..core.mannequin import Mannequin
 from ..core.measure import as_dict
@@ -162,7 +162,12 @@ def _output_kind(path):
 
 
 def _references(args):
-    return load_reference_set(args.references)
+    try:
+        return load_reference_set(args.references)
+    except ReferenceSetError as error:
+        if args.references:
+            raise
+        raise UsageError(f"{error} (the shipped Reference Mannequins; use --references DIR for others)") from None
 
 
 def _format_me(values):

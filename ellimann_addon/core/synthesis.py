@@ -55,7 +55,8 @@ SYMMETRY_TOLERANCE = 1e-6  # m: RMs must be symmetric to this for the mirrored s
 
 # Exact mode.
 EXACT_TOLERANCE = 1e-5  # relative m_T error at which refinement stops (0.001 %)
-EXACT_MAX_ITERATIONS = 8
+EXACT_MAX_ITERATIONS = 12
+_JACOBIAN_REFRESH = 4  # Broyden steps before a slow mannequin gets a fresh finite-difference Jacobian
 FACTOR_LIMITS = (0.5, 2.0)  # the refinement never scales anything beyond these
 _MAX_STEP = 0.1  # largest change of a log factor per Newton step
 _FD_STEP = 1e-4  # log-factor step of the finite-difference Jacobian
@@ -458,47 +459,65 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
            max_iterations=EXACT_MAX_ITERATIONS):
     """Deform mannequins (B, n, ...) so that m_T matches ``targets`` (B, 5) cm (exact mode).
 
-    Newton on r(x) = log m_T(deform(exp x)) - log target, x the log factors, with a forward
-    difference Jacobian (5 extra m_T per mannequin and step, all batched). Mannequins already
-    within ``tolerance`` are returned unchanged.
+    Solves r(x) = log m_T(deform(exp x)) - log target = 0 for the log factors x: a forward-difference
+    Jacobian at the start (5 m_T per mannequin), then quasi-Newton steps with Broyden updates (one
+    m_T each), the Jacobian recomputed if a mannequin is slow to converge. All batched; mannequins
+    already within ``tolerance`` are returned unchanged.
     """
     girth = topology.girth_mask
     targets = np.atleast_2d(np.asarray(targets, dtype=float))
     if measured is None:
         measured = tailor_measurements(rotation, center, semi_axes, girth)
     basis = _deform_basis(topology, rotation, center, semi_axes, measured)
-    batch = len(targets)
-    x = np.zeros((batch, len(MEASUREMENTS)))
+    count = len(MEASUREMENTS)
+    x = np.zeros((len(targets), count))
     current = measured.copy()
+    residual = np.log(np.maximum(current, 1e-12) / targets)
+    jacobian = np.zeros((len(targets), count, count))
+    age = np.full(len(targets), -1)  # steps since the Jacobian was computed (-1: never)
     out_center, out_semi = center.copy(), semi_axes.copy()
     lo, hi = np.log(FACTOR_LIMITS)
+    eye = np.eye(count)
     iterations = 0
-    eye = np.eye(len(MEASUREMENTS))
     for _ in range(max_iterations):
-        residual = np.log(np.maximum(current, 1e-12) / targets)
         todo = np.nonzero(np.abs(residual).max(axis=1) > tolerance)[0]
         if not len(todo):
             break
         iterations += 1
-        sub = _subset(basis, todo)
-        # Jacobian by forward differences: rows of probes are x + h e_j.
-        probes = np.concatenate([x[todo]] + [x[todo] + _FD_STEP * eye[j] for j in range(len(MEASUREMENTS))])
-        tiled = _tile(sub, len(MEASUREMENTS) + 1)
-        c, d = deform(tiled, np.tile(center[todo], (len(MEASUREMENTS) + 1, 1, 1)),
-                      np.tile(semi_axes[todo], (len(MEASUREMENTS) + 1, 1, 1)), np.exp(probes))
-        m = tailor_measurements(np.tile(rotation[todo], (len(MEASUREMENTS) + 1, 1, 1, 1)), c, d, girth)
-        m = np.log(np.maximum(m, 1e-12)).reshape(len(MEASUREMENTS) + 1, len(todo), len(MEASUREMENTS))
-        jacobian = np.moveaxis((m[1:] - m[0]) / _FD_STEP, 0, -1)  # (T, measurement, factor)
-        r = m[0] - np.log(targets[todo])
-        jt = np.swapaxes(jacobian, -1, -2)
-        step = -np.linalg.solve(jt @ jacobian + _TIKHONOV * eye, np.einsum("tfm,tm->tf", jt, r))
-        step = np.clip(step, -_MAX_STEP, _MAX_STEP)
-        x[todo] = np.clip(x[todo] + step, lo, hi)
-        c, d = deform(sub, center[todo], semi_axes[todo], np.exp(x[todo]))
+        stale = todo[(age[todo] < 0) | (age[todo] >= _JACOBIAN_REFRESH)]
+        if len(stale):
+            jacobian[stale] = _fd_jacobian(basis, rows=stale, rotation=rotation, center=center, semi_axes=semi_axes,
+                                           x=x, base=np.log(np.maximum(current[stale], 1e-12)), girth=girth)
+            age[stale] = 0
+        j = jacobian[todo]
+        jt = np.swapaxes(j, -1, -2)
+        step = -np.linalg.solve(jt @ j + _TIKHONOV * eye, np.einsum("tfm,tm->tf", jt, residual[todo]))
+        new_x = np.clip(x[todo] + np.clip(step, -_MAX_STEP, _MAX_STEP), lo, hi)
+        c, d = deform(_subset(basis, todo), center[todo], semi_axes[todo], np.exp(new_x))
+        m = tailor_measurements(rotation[todo], c, d, girth)
+        new_residual = np.log(np.maximum(m, 1e-12) / targets[todo])
+        # Broyden: the secant of this step corrects the Jacobian along the step.
+        dx = new_x - x[todo]
+        norm = np.einsum("tf,tf->t", dx, dx)
+        miss = new_residual - residual[todo] - np.einsum("tmf,tf->tm", j, dx)
+        jacobian[todo] = j + np.divide(miss[:, :, None] * dx[:, None, :], norm[:, None, None],
+                                       out=np.zeros_like(j), where=norm[:, None, None] > 0)
+        age[todo] += 1
+        x[todo], residual[todo], current[todo] = new_x, new_residual, m
         out_center[todo], out_semi[todo] = c, d
-        current[todo] = tailor_measurements(rotation[todo], c, d, girth)
-    error = np.abs(np.log(np.maximum(current, 1e-12) / targets)).max(axis=1)
-    return Refinement(out_center, out_semi, current, np.exp(x), iterations, error <= tolerance)
+    converged = np.abs(residual).max(axis=1) <= tolerance
+    return Refinement(out_center, out_semi, current, np.exp(x), iterations, converged)
+
+
+def _fd_jacobian(basis, rows, rotation, center, semi_axes, x, base, girth):
+    """d log m_T / d log factor (T, measurement, factor) by forward differences at x[rows]."""
+    count = len(MEASUREMENTS)
+    probes = np.concatenate([x[rows] + _FD_STEP * np.eye(count)[j] for j in range(count)])
+    c, d = deform(_tile(_subset(basis, rows), count), np.tile(center[rows], (count, 1, 1)),
+                  np.tile(semi_axes[rows], (count, 1, 1)), np.exp(probes))
+    m = tailor_measurements(np.tile(rotation[rows], (count, 1, 1, 1)), c, d, girth)
+    m = np.log(np.maximum(m, 1e-12)).reshape(count, len(rows), count)
+    return np.moveaxis((m - base[None]) / _FD_STEP, 0, -1)
 
 
 def _subset(basis, rows):
