@@ -168,6 +168,10 @@ class ELLIMANN_OT_add_measurement_preset(AddPresetBase, bpy.types.Operator):
     preset_defines = ["props = bpy.context.scene.ellimann_synthesis"]
     preset_values = [f"props.{attr}" for attr in FIELDS.values()]
 
+    @classmethod
+    def poll(cls, context):
+        return hasattr(context.scene, "ellimann_synthesis")
+
 
 classes = (ELLIMANN_PG_synthesis, ELLIMANN_OT_synthesize_mannequin, ELLIMANN_MT_measurement_presets,
            ELLIMANN_OT_add_measurement_preset)

@@ -16,7 +16,7 @@ class ELLIMANN_PT_synthesize(ElliMannPanel, bpy.types.Panel):
     bl_idname = "ELLIMANN_PT_synthesize"
     bl_label = "Synthesize"
     bl_parent_id = "ELLIMANN_PT_main"
-    bl_order = 40
+    bl_order = 60  # after the authoring tools' panels (Trace ... Measure: 10-50)
 
     @classmethod
     def poll(cls, context):
