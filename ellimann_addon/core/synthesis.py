@@ -184,9 +184,10 @@ class ReferenceSet:
             mannequin = mannequin.reordered(first.topology) if mannequin.topology != first.topology else mannequin
             ordered.append(mannequin)
             measurements.append(_reference_measurements(mannequin, source))
-            if asymmetry(mannequin) > SYMMETRY_TOLERANCE:
+            off = asymmetry(mannequin)
+            if off > SYMMETRY_TOLERANCE:
                 raise ReferenceSetError(source, "geometry", f"is not symmetric about x = 0 (asymmetry "
-                                        f"{asymmetry(mannequin) * 1e3:.3g} mm); clean it first")
+                                        f"{off * 1e3:.3g} mm); clean it first")
         self.mannequins = ordered
         self.names = names
         self.sources = sources
@@ -210,7 +211,7 @@ class ReferenceSet:
         self._mask = mask
         # coincide[s, j, l]: RMs j and l have the same measurements in part s's sub-space.
         diff = np.abs(self.measurements[:, None, :] - self.measurements[None, :, :])  # (k, k, 5)
-        self._coincide = np.all((diff[None] <= 1e-9) | (mask[:, None, None, :] == 0.0), axis=-1)
+        self._coincide = np.all((diff[None] <= ZERO_DISTANCE) | (mask[:, None, None, :] == 0.0), axis=-1)
 
     def __len__(self):
         return len(self.mannequins)
@@ -233,12 +234,6 @@ class ReferenceSet:
             raise ReferenceSetError(self.sources[j], "rotation", f"of '{name}' is not the mirror of its twin with the "
                                     "same axis labels as in the other RMs; relabel and symmetrize the set")
         return signs[0]
-
-    def mannequin(self, j):
-        return self.mannequins[j]
-
-    def measurements_dict(self, j):
-        return as_dict(self.measurements[j])
 
 
 def _reference_measurements(mannequin, source):
