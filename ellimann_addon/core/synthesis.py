@@ -57,10 +57,11 @@ SYMMETRY_TOLERANCE = 1e-6  # m: RMs must be symmetric to this for the mirrored s
 EXACT_TOLERANCE = 1e-5  # relative m_T error at which refinement stops (0.001 %)
 EXACT_MAX_ITERATIONS = 12
 _JACOBIAN_REFRESH = 4  # Broyden steps before a slow mannequin gets a fresh finite-difference Jacobian
-FACTOR_LIMITS = (0.5, 2.0)  # the refinement never scales anything beyond these
+FACTOR_LIMITS = (0.75, 4.0 / 3.0)  # the refinement never scales beyond these (it would show)
 _MAX_STEP = 0.1  # largest change of a log factor per Newton step
 _FD_STEP = 1e-4  # log-factor step of the finite-difference Jacobian
 _TIKHONOV = 1e-10  # keeps the Newton system solvable when a measurement does not respond
+_DAMPING = 1e-3  # initial Levenberg-Marquardt damping (relative to each factor's own curvature)
 # Hat functions of the girth blend, in fractions of He: full effect at a section, none beyond the
 # neighbouring knots. Below the hip section the blend fades over the thighs, above the breast over
 # the upper chest (as far above Br as Wa is below it).
@@ -193,6 +194,7 @@ class ReferenceSet:
         self.sources = sources
         self.topology = first.topology
         self.measurements = np.array(measurements)
+        self.mirror_label_mismatch = []  # right parts whose axis labels differ between RMs
         self.rotation = np.stack([m.rotation for m in ordered])
         self.center = np.stack([m.center for m in ordered])
         self.semi_axes = np.stack([m.semi_axes for m in ordered])
@@ -219,22 +221,23 @@ class ReferenceSet:
     def _find_mirror_signs(self):
         """Per left part, the axis signs that turn its sagittal reflection into the right twin's frame.
 
-        All RMs must agree (clean.clean guarantees it: axes are relabelled against one reference).
+        Taken from the RMs (after ``clean.clean`` they all agree). Where they do not, the pattern most
+        RMs use wins: the right ellipsoid is the same set either way, only its axis labels differ.
         """
         if not len(self._left):
             return np.ones((0, 3))
         reflected = SAGITTAL_REFLECTION @ self.rotation[:, self._left]  # (k, l, 3, 3)
         agreement = np.swapaxes(reflected, -1, -2) @ self.rotation[:, self._right]  # diag(signs) if mirrored
         signs = np.where(np.diagonal(agreement, axis1=-2, axis2=-1) >= 0.0, 1.0, -1.0)  # (k, l, 3)
-        off = np.abs(agreement - signs[..., None] * np.eye(3)).max(axis=(-1, -2))  # (k, l)
-        bad = (off > 1e-6) | np.any(signs != signs[0], axis=-1)
-        if np.any(bad):
-            j, p = np.argwhere(bad)[0]
-            name = self.topology.names[self._right[p]]
-            raise ReferenceSetError(self.sources[j], "rotation", f"of '{name}' is not the mirror of its twin with the "
-                                    "same axis labels as in the other RMs; relabel and symmetrize the set")
-        return signs[0]
-
+        mirrored = np.abs(agreement - signs[..., None] * np.eye(3)).max(axis=(-1, -2)) <= 1e-6  # (k, l)
+        chosen = np.empty((len(self._left), 3))
+        self.mirror_label_mismatch = []
+        for p in range(len(self._left)):
+            patterns = [tuple(signs[j, p]) for j in range(len(self)) if mirrored[j, p]]
+            if len(set(patterns)) != 1 or len(patterns) != len(self):
+                self.mirror_label_mismatch.append(self.topology.names[self._right[p]])
+            chosen[p] = max(patterns, key=patterns.count) if patterns else (-1.0, 1.0, 1.0)
+        return chosen
 
 def _reference_measurements(mannequin, source):
     me = mannequin.measurements
@@ -454,10 +457,12 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
            max_iterations=EXACT_MAX_ITERATIONS):
     """Deform mannequins (B, n, ...) so that m_T matches ``targets`` (B, 5) cm (exact mode).
 
-    Solves r(x) = log m_T(deform(exp x)) - log target = 0 for the log factors x: a forward-difference
-    Jacobian at the start (5 m_T per mannequin), then quasi-Newton steps with Broyden updates (one
-    m_T each), the Jacobian recomputed if a mannequin is slow to converge. All batched; mannequins
-    already within ``tolerance`` are returned unchanged.
+    Solves r(x) = log m_T(deform(exp x)) - log target = 0 for the log factors x, Levenberg-Marquardt
+    style: a forward-difference Jacobian at the start (5 m_T per mannequin), Broyden updates after
+    every step (one m_T each), a step kept only if it lowers |r| (else more damping), the Jacobian
+    recomputed if a mannequin is slow to converge. The result is never further from the request than
+    the IDW mannequin it starts from. All batched; mannequins already within ``tolerance`` are
+    returned unchanged.
     """
     girth = topology.girth_mask
     targets = np.atleast_2d(np.asarray(targets, dtype=float))
@@ -470,12 +475,16 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
     residual = np.log(np.maximum(current, 1e-12) / targets)
     jacobian = np.zeros((len(targets), count, count))
     age = np.full(len(targets), -1)  # steps since the Jacobian was computed (-1: never)
+    damping = np.full(len(targets), _DAMPING)
+    # A factor that reaches FACTOR_LIMITS is frozen there and its measurement left as close as that
+    # allows; the other factors keep solving their own measurements (no trading one for another).
+    free = np.ones((len(targets), count), dtype=bool)
     out_center, out_semi = center.copy(), semi_axes.copy()
     lo, hi = np.log(FACTOR_LIMITS)
     eye = np.eye(count)
     iterations = 0
     for _ in range(max_iterations):
-        todo = np.nonzero(np.abs(residual).max(axis=1) > tolerance)[0]
+        todo = np.nonzero((np.abs(residual) * free).max(axis=1) > tolerance)[0]
         if not len(todo):
             break
         iterations += 1
@@ -485,21 +494,31 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
                                            x=x, base=np.log(np.maximum(current[stale], 1e-12)), girth=girth)
             age[stale] = 0
         j = jacobian[todo]
-        jt = np.swapaxes(j, -1, -2)
-        step = -np.linalg.solve(jt @ j + _TIKHONOV * eye, np.einsum("tfm,tm->tf", jt, residual[todo]))
-        new_x = np.clip(x[todo] + np.clip(step, -_MAX_STEP, _MAX_STEP), lo, hi)
+        mask = free[todo]
+        reduced = j * mask[:, :, None] * mask[:, None, :]
+        rt = np.swapaxes(reduced, -1, -2)
+        normal = rt @ reduced
+        scale = np.diagonal(normal, axis1=-2, axis2=-1) + _TIKHONOV  # Marquardt: each factor by its own scale
+        system = normal + (damping[todo, None] * scale + ~mask)[..., None] * eye
+        step = -np.linalg.solve(system, np.einsum("tfm,tm->tf", rt, residual[todo] * mask))
+        wanted = x[todo] + np.clip(step, -_MAX_STEP, _MAX_STEP)
+        new_x = np.clip(wanted, lo, hi)
         c, d = deform(_subset(basis, todo), center[todo], semi_axes[todo], np.exp(new_x))
         m = tailor_measurements(rotation[todo], c, d, girth)
         new_residual = np.log(np.maximum(m, 1e-12) / targets[todo])
-        # Broyden: the secant of this step corrects the Jacobian along the step.
+        # Broyden: the secant of this step corrects the Jacobian along the step, kept or not.
         dx = new_x - x[todo]
         norm = np.einsum("tf,tf->t", dx, dx)
         miss = new_residual - residual[todo] - np.einsum("tmf,tf->tm", j, dx)
         jacobian[todo] = j + np.divide(miss[:, :, None] * dx[:, None, :], norm[:, None, None],
                                        out=np.zeros_like(j), where=norm[:, None, None] > 0)
         age[todo] += 1
-        x[todo], residual[todo], current[todo] = new_x, new_residual, m
-        out_center[todo], out_semi[todo] = c, d
+        better = np.sum((new_residual * mask) ** 2, axis=1) < np.sum((residual[todo] * mask) ** 2, axis=1)
+        damping[todo] = np.where(better, damping[todo] / 3.0, damping[todo] * 4.0)
+        keep = todo[better]
+        x[keep], residual[keep], current[keep] = new_x[better], new_residual[better], m[better]
+        out_center[keep], out_semi[keep] = c[better], d[better]
+        free[keep] &= new_x[better] == wanted[better]
     converged = np.abs(residual).max(axis=1) <= tolerance
     return Refinement(out_center, out_semi, current, np.exp(x), iterations, converged)
 
