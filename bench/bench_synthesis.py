@@ -54,6 +54,12 @@ def run():
     print(f"exact mode: {exact.converged.sum()}/{len(exact)} converged (tolerance "
           f"{synthesis.EXACT_TOLERANCE * 100:g}%); deformation |factor - 1| % mean / max per measurement: "
           + ", ".join(f"{k} {m:.2f}/{x:.2f}" for k, m, x in zip(MEASUREMENTS, spread.mean(0), spread.max(0))))
+    idw = results["idw"]
+    ratio = np.abs(exact.semi_axes / idw.semi_axes - 1.0) * 100.0
+    shift = np.linalg.norm(exact.center - idw.center, axis=-1) * 100.0
+    print(f"exact vs IDW, per ellipsoid: semi-axis change median {np.median(ratio):.2f}%, 99th percentile "
+          f"{np.percentile(ratio, 99):.1f}%, max {ratio.max():.1f}%; centre shift 99th percentile "
+          f"{np.percentile(shift, 99):.2f} cm, max {shift.max():.2f} cm")
     normalized = synthesis.synthesize_batch(reference, requests, metric="normalized")
     table("\nfor comparison, idw with distances normalized by the ranges L", normalized.relative_error(), paper=False)
 

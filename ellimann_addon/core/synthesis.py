@@ -32,7 +32,7 @@ Rotations are never changed by the refinement; every operation is symmetric abou
 import math
 import os
 import pathlib
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -61,6 +61,7 @@ FACTOR_LIMITS = (0.75, 4.0 / 3.0)  # the refinement never scales beyond these (i
 _MAX_STEP = 0.1  # largest change of a log factor per Newton step
 _FD_STEP = 1e-4  # log-factor step of the finite-difference Jacobian
 _TIKHONOV = 1e-10  # keeps the Newton system solvable when a measurement does not respond
+_TAPER = 1.0  # how strongly a section's factor lengthens the parts it cuts off their middle
 _DAMPING = 1e-3  # initial Levenberg-Marquardt damping (relative to each factor's own curvature)
 # Hat functions of the girth blend, in fractions of He: full effect at a section, none beyond the
 # neighbouring knots. Below the hip section the blend fades over the thighs, above the breast over
@@ -372,8 +373,23 @@ class _DeformBasis:
     origin_y: np.ndarray  # (B, n) y of the vertical axis the girth scaling is about, at each part
     vertical: np.ndarray  # (B, n, 3) share of each local axis along world z (R[2, k]^2)
     lateral: np.ndarray  # (B, n, 3) share along world x
+    taper: np.ndarray  # (B, n, 3) how far off its middle each girth part is cut by Br, Wa, Hi (0..1)
+    anchor: np.ndarray  # (B, n, 3) z of the end of the part farther from each section
     shoulder_scaled: np.ndarray  # (n,) parts that widen with Sh
     shoulder_carried: np.ndarray  # (n,) parts moved sideways with Sh (arms)
+
+    _SHARED = ("shoulder_scaled", "shoulder_carried")  # per part, not per mannequin
+
+    def take(self, rows):
+        return _DeformBasis(**{f.name: getattr(self, f.name) if f.name in self._SHARED else getattr(self, f.name)[rows]
+                               for f in fields(self)})
+
+    def tile(self, count):
+        def rep(a):
+            return np.tile(a, (count,) + (1,) * (a.ndim - 1))
+
+        return _DeformBasis(**{f.name: getattr(self, f.name) if f.name in self._SHARED else rep(getattr(self, f.name))
+                               for f in fields(self)})
 
 
 def _hat(fraction, knot):
@@ -408,11 +424,17 @@ def _deform_basis(topology, rotation, center, semi_axes, measured):
     order = [GIRTHS.index(key) for key in ("Hi", "Wa", "Br")]
     fractions = [SECTION_FRACTIONS[key] for key in ("Hi", "Wa", "Br")]
     origin_y = np.stack([np.interp(fraction[b], fractions, centre_y[b, order]) for b in range(len(bottom))])
+    # Where each section cuts each girth part, relative to the part's middle (-1 bottom .. 1 top).
+    half_z = axis_extent(rotation, semi_axes, 2)  # (B, n)
+    cut = np.stack([(z[key][:, None] - center[..., 2]) / half_z for key in GIRTHS], axis=-1)  # (B, n, 3)
+    crossing = (np.abs(cut) < 1.0) & girth[:, None]
+    taper = np.where(crossing, np.abs(cut), 0.0)
+    anchor = center[..., 2, None] - np.sign(cut) * half_z[..., None]
     depends_sh = topology.dependency_mask[:, _INDEX["Sh"]]
     return _DeformBasis(
         bottom=bottom, shoulder_half=0.5 * measured[:, _INDEX["Sh"]] / CM_PER_M, girth_weight=weight,
         origin_y=origin_y, vertical=rotation[..., 2, :] ** 2, lateral=rotation[..., 0, :] ** 2,
-        shoulder_scaled=depends_sh & girth, shoulder_carried=depends_sh & ~girth)
+        taper=taper, anchor=anchor, shoulder_scaled=depends_sh & girth, shoulder_carried=depends_sh & ~girth)
 
 
 def deform(basis, center, semi_axes, factors):
@@ -423,12 +445,20 @@ def deform(basis, center, semi_axes, factors):
     f = np.asarray(factors, dtype=float)
     center = center.copy()
     semi = semi_axes.copy()
+    girth_f = f[:, [_INDEX[key] for key in GIRTHS]]  # (B, 3)
+    # Br, Wa, Hi, first: a part cut by a section away from its middle is lengthened or shortened
+    # from its far end, which widens or narrows it there much more than in its middle (a rib cage
+    # ending higher narrows the waist, not the bust).
+    for g in range(len(GIRTHS)):
+        v = girth_f[:, g, None] ** (_TAPER * basis.taper[..., g])  # (B, n)
+        anchor = basis.anchor[..., g]
+        center[..., 2] = anchor + v * (center[..., 2] - anchor)
+        semi *= 1.0 + (v[..., None] - 1.0) * basis.vertical
     # He: vertical stretch about the floor.
     he = f[:, _INDEX["He"], None]
     center[..., 2] = basis.bottom[:, None] + he * (center[..., 2] - basis.bottom[:, None])
     semi *= 1.0 + (he[..., None] - 1.0) * basis.vertical
     # Br, Wa, Hi: horizontal scaling blended with height.
-    girth_f = f[:, [_INDEX[key] for key in GIRTHS]]  # (B, 3)
     sigma = 1.0 + np.einsum("bng,bg->bn", basis.girth_weight, girth_f - 1.0)
     center[..., 0] *= sigma
     center[..., 1] = basis.origin_y + sigma * (center[..., 1] - basis.origin_y)
@@ -503,7 +533,7 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
         step = -np.linalg.solve(system, np.einsum("tfm,tm->tf", rt, residual[todo] * mask))
         wanted = x[todo] + np.clip(step, -_MAX_STEP, _MAX_STEP)
         new_x = np.clip(wanted, lo, hi)
-        c, d = deform(_subset(basis, todo), center[todo], semi_axes[todo], np.exp(new_x))
+        c, d = deform(basis.take(todo), center[todo], semi_axes[todo], np.exp(new_x))
         m = tailor_measurements(rotation[todo], c, d, girth)
         new_residual = np.log(np.maximum(m, 1e-12) / targets[todo])
         # Broyden: the secant of this step corrects the Jacobian along the step, kept or not.
@@ -527,24 +557,11 @@ def _fd_jacobian(basis, rows, rotation, center, semi_axes, x, base, girth):
     """d log m_T / d log factor (T, measurement, factor) by forward differences at x[rows]."""
     count = len(MEASUREMENTS)
     probes = np.concatenate([x[rows] + _FD_STEP * np.eye(count)[j] for j in range(count)])
-    c, d = deform(_tile(_subset(basis, rows), count), np.tile(center[rows], (count, 1, 1)),
+    c, d = deform(basis.take(rows).tile(count), np.tile(center[rows], (count, 1, 1)),
                   np.tile(semi_axes[rows], (count, 1, 1)), np.exp(probes))
     m = tailor_measurements(np.tile(rotation[rows], (count, 1, 1, 1)), c, d, girth)
     m = np.log(np.maximum(m, 1e-12)).reshape(count, len(rows), count)
     return np.moveaxis((m - base[None]) / _FD_STEP, 0, -1)
-
-
-def _subset(basis, rows):
-    return _DeformBasis(basis.bottom[rows], basis.shoulder_half[rows], basis.girth_weight[rows], basis.origin_y[rows],
-                        basis.vertical[rows], basis.lateral[rows], basis.shoulder_scaled, basis.shoulder_carried)
-
-
-def _tile(basis, count):
-    def rep(a):
-        return np.tile(a, (count,) + (1,) * (a.ndim - 1))
-
-    return _DeformBasis(rep(basis.bottom), rep(basis.shoulder_half), rep(basis.girth_weight), rep(basis.origin_y),
-                        rep(basis.vertical), rep(basis.lateral), basis.shoulder_scaled, basis.shoulder_carried)
 
 
 # --------------------------------------------------------------------------------------------
