@@ -19,7 +19,6 @@ from ..core.files import atomic_write_text
 from .convert import mannequin_to_collection, new_collection, write_measured
 
 BLENDER_FORMATS = ("blend", "glb", "obj")
-FORMATS = BLENDER_FORMATS + ("json",)
 LIVE_SUBDIVISIONS = 3
 CUSHION_COLOR = (0.75, 0.72, 0.68, 1.0)
 
@@ -50,7 +49,7 @@ def empty_scene():
 
 
 def build_cushions(collection):
-    """Cushion meshes for every cushion pair of a mannequin collection (issue-3's builder when present).
+    """Cushion meshes for every cushion pair of a mannequin collection (the authoring tools' builder when present).
 
     Falls back to a minimal builder: one closed convex mesh per pair (core ``cushion_mesh``) in a
     child collection, in the frame of the pair's first ellipsoid.
