@@ -16,6 +16,8 @@ BUILD_CUSHIONS = "ellimann.build_cushions"
 MEASURE_MANNEQUIN = "ellimann.measure_mannequin"
 VALIDATE_MANNEQUIN = "ellimann.validate_mannequin"
 FIX_FRAMES = "ellimann.fix_frames"
+SYNTHESIZE_MANNEQUIN = "ellimann.synthesize_mannequin"
+ADD_MEASUREMENT_PRESET = "ellimann.add_measurement_preset"
 
 PANEL_MAIN = "ELLIMANN_PT_main"
 PANEL_TRACE = "ELLIMANN_PT_trace"
@@ -23,6 +25,7 @@ PANEL_PART = "ELLIMANN_PT_part"
 PANEL_CLEAN = "ELLIMANN_PT_clean"
 PANEL_CUSHIONS = "ELLIMANN_PT_cushions"
 PANEL_MEASURE = "ELLIMANN_PT_measure"
+PANEL_SYNTHESIZE = "ELLIMANN_PT_synthesize"
 
 # Sub-panels of PANEL_MAIN sort by bl_order. Room is left after Measure for the Synthesize (60)
 # and Drape (70) panels that other parts of the add-on add.

@@ -25,6 +25,7 @@ class ELLIMANN_MT_object(bpy.types.Menu):
         layout.separator()
         layout.operator(ids.BUILD_CUSHIONS)
         layout.operator(ids.MEASURE_MANNEQUIN)
+        layout.operator(ids.SYNTHESIZE_MANNEQUIN)
         layout.separator()
         layout.operator(ids.VALIDATE_MANNEQUIN)
         layout.operator(ids.FIX_FRAMES)

@@ -49,3 +49,12 @@ class MeasurementError(ElliMannError):
     def __init__(self, field, message):
         self.field = field
         super().__init__(f"{field}: {message}")
+
+
+class ReferenceSetError(ElliMannError):
+    """A reference-mannequin set that cannot be used for synthesis; names the file and the field."""
+
+    def __init__(self, source, field, message):
+        self.source = source
+        self.field = field
+        super().__init__(f"{source}: {field} {message}" if source else f"{field} {message}")

@@ -7,7 +7,7 @@ from ellimann_addon.blender import ids, menus, operators, panels
 
 OPERATORS = operators.classes()
 ALL_IDS = [v for k, v in vars(ids).items() if k.isupper() and isinstance(v, str) and v.startswith("ellimann.")]
-READ_ONLY = {ids.VALIDATE_MANNEQUIN}
+READ_ONLY = {ids.VALIDATE_MANNEQUIN, ids.ADD_MEASUREMENT_PRESET}
 
 
 def registered_operator_names():
