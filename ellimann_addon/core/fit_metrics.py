@@ -51,7 +51,9 @@ def ellipsoid_signed_distance(points, rotation, center, semi_axes, return_closes
     def f(t):
         return np.sum((ay / (a2 + t[..., None])) ** 2, axis=-1) - 1.0
 
-    degenerate = f(t) < 0.0  # only possible at the floor: no root right of -a_min^2
+    # F < 0 at the start means no root right of -a_min^2 when the start is that floor; elsewhere it
+    # only means the start is the root up to rounding.
+    degenerate = (t <= floor) & (f(t) < 0.0)
     for _ in range(NEWTON_LIMIT):
         denom = a2 + t[..., None]
         ratio = ay / denom
