@@ -12,8 +12,9 @@ nearest boundary point is x_k = a_k^2 y_k / (a_k^2 + t), where t is the root of
 
 F is convex and decreasing there, so Newton started left of the root climbs to it monotonically
 with no overshoot; the start t0 = max_k (a_k y_k - a_k^2) is left of the root because each term
-alone reaches 1 there. When a point inside lies on the plane of the shortest axis, F may have no
-root (the nearest point is then off that plane) and the closed form at t = -a_min^2 is used.
+alone reaches 1 there. (The code shifts t by a_min^2 so no digits are lost near the centre.)
+When a point inside lies on the plane of the shortest axis, F may have no root (the nearest point
+is then off that plane) and the closed form at t = -a_min^2 is used.
 """
 
 import numpy as np
@@ -44,36 +45,38 @@ def ellipsoid_signed_distance(points, rotation, center, semi_axes, return_closes
     ay = a * y
     kmin = np.argmin(a, axis=-1)  # (1, n)
     a2min = np.take_along_axis(a2, kmin[..., None], axis=-1)[..., 0]
-    floor = -a2min * (1.0 - 1e-12)
-    t = np.maximum(np.max(ay - a2, axis=-1), floor)
-    hi = np.where(inside, 0.0, np.sqrt(a2.max(axis=-1)) * np.linalg.norm(y, axis=-1))
+    # Work with s = t + a_min^2 > 0 and g_k = a_k^2 - a_min^2 >= 0, so that a_k^2 + t = g_k + s is
+    # never a small difference of large numbers (points near a centre would lose digits).
+    g = a2 - a2min[..., None]
+    floor = 1e-12 * a2min
+    s = np.maximum(np.max(ay - g, axis=-1), floor)
+    hi = np.where(inside, a2min, a2min + np.sqrt(a2.max(axis=-1)) * np.linalg.norm(y, axis=-1))
 
-    def f(t):
-        return np.sum((ay / (a2 + t[..., None])) ** 2, axis=-1) - 1.0
+    def f(s):
+        return np.sum((ay / (g + s[..., None])) ** 2, axis=-1) - 1.0
 
     # F < 0 at the start means no root right of -a_min^2 when the start is that floor; elsewhere it
     # only means the start is the root up to rounding.
-    degenerate = (t <= floor) & (f(t) < 0.0)
+    degenerate = (s <= floor) & (f(s) < 0.0)
     for _ in range(NEWTON_LIMIT):
-        denom = a2 + t[..., None]
+        denom = g + s[..., None]
         ratio = ay / denom
         value = np.sum(ratio * ratio, axis=-1) - 1.0
         slope = -2.0 * np.sum(ratio * ratio / denom, axis=-1)
         step = np.where(degenerate | (slope == 0.0), 0.0, -value / np.where(slope == 0.0, 1.0, slope))
-        t_new = np.minimum(t + np.maximum(step, 0.0), np.maximum(hi, t))
-        done = np.all(np.abs(t_new - t) <= 1e-15 * np.maximum(np.abs(t), a2min))
-        t = t_new
+        s_new = np.minimum(s + np.maximum(step, 0.0), np.maximum(hi, s))
+        done = np.all(np.abs(s_new - s) <= 1e-15 * s)
+        s = s_new
         if done:
             break
 
-    x = a2 * y / (a2 + t[..., None])
+    x = a2 * y / (g + s[..., None])
     if np.any(degenerate):
         # Nearest point off the shortest axis' plane: the other coordinates from t = -a_min^2,
         # the shortest one from the ellipsoid equation.
         # An axis as short as the shortest has y = 0 there too (else F had a pole): its x is 0.
-        gap = a2 - a2min[..., None]
         with np.errstate(divide="ignore", invalid="ignore"):
-            x_deg = np.where(gap > 0.0, a2 * y / gap, 0.0)
+            x_deg = np.where(g > 0.0, a2 * y / g, 0.0)
         rest = np.sum((x_deg / a) ** 2, axis=-1)
         short = np.take_along_axis(a, kmin[..., None], axis=-1)[..., 0] * np.sqrt(np.clip(1.0 - rest, 0.0, None))
         x_deg = np.where(np.arange(3) == kmin[..., None], short[..., None], x_deg)
