@@ -36,7 +36,7 @@ TIMESTEP = 0.001  # s
 SOLREF = (0.002, 1.0)  # time constant (s), damping ratio
 FRICTION = (1.0, 0.005, 0.0001)  # sliding, torsional, rolling
 # Cushion hull resolution: level 3 = 642 vertices, volume within about 1% (inscribed) of the exact
-# hull and about 118 kB of XML per cushion; level 4 (2,562 vertices) gets 0.25% at four times the size.
+# hull and about 38 kB of XML per cushion; level 4 (2,562 vertices) gets 0.25% at four times the size.
 MJCF_SUBDIVISIONS = 3
 SUBDIVISION_RANGE = (1, 6)  # cushion resolution: 42 to 40,962 hull vertices
 SIDE_RGBA = {"L": (0.85, 0.55, 0.45, 1.0), "R": (0.45, 0.6, 0.85, 1.0), "C": (0.8, 0.78, 0.72, 1.0)}

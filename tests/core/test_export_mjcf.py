@@ -22,11 +22,12 @@ REFERENCE_DIR = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"
 DENSITY = 1000.0  # MuJoCo's default geom density: body mass / DENSITY is the piece's volume
 
 
-def mannequins():
-    """The toy, plus every shipped reference mannequin once reference_blends/ has them."""
+def mannequins(only=None):
+    """The toy, plus the shipped reference mannequins once reference_blends/ has them (or just ``only``)."""
     out = [pytest.param(make_toy_mannequin, id="toy")]
     for path in sorted(REFERENCE_DIR.glob("*.json")):
-        out.append(pytest.param(lambda p=path: Mannequin.load(p), id=path.stem))
+        if only is None or path.stem == only:
+            out.append(pytest.param(lambda p=path: Mannequin.load(p), id=path.stem))
     return out
 
 
@@ -182,17 +183,18 @@ def drop_balls(mannequin, cushions):
             closest = np.minimum(closest, d)
     final = data.xpos[balls].copy()
     speed = np.linalg.norm(data.cvel[balls][:, 3:], axis=1)
-    supported = np.zeros(len(names), dtype=bool)
-    for contact in data.contact[:data.ncon]:
-        for geom in (int(contact.geom1), int(contact.geom2)):
-            if geom in ball_geoms:
-                supported[model.geom_bodyid[geom] == balls] = True
+    # Held by something: within a millimetre of the floor, the body or another ball. (A resting
+    # ball can sit a hair above its support at the last step, with no contact listed.)
+    apart = np.linalg.norm(final[:, None] - final[None], axis=-1) + np.eye(len(final))
+    supported = ((final[:, 2] - BALL_RADIUS <= 1e-3)
+                 | (pieces.signed_distance(final)[0] - BALL_RADIUS <= 1e-3)
+                 | (apart.min(axis=1) - 2 * BALL_RADIUS <= 1e-3))
     return dict(final=final, speed=speed, closest=closest, hit_body=len(hit_body), count=len(names),
                 supported=supported, deepest_contact=deepest_contact)
 
 
 @pytest.mark.parametrize("cushions", [False, True], ids=["ellipsoids", "cushions"])
-@pytest.mark.parametrize("make", mannequins())
+@pytest.mark.parametrize("make", mannequins(only="average"))  # a few seconds each: the toy and one RM
 def test_falling_balls_never_pass_through_the_mannequin(make, cushions):
     mannequin = make()
     out = drop_balls(mannequin, cushions)
@@ -207,7 +209,7 @@ def test_falling_balls_never_pass_through_the_mannequin(make, cushions):
     grown = mannequin.semi_axes + 0.8 * r
     inside = contains(mannequin.rotation[None], mannequin.center[None], grown[None], out["final"][:, None])
     assert not inside.any()
-    # ... all balls at rest, above the floor, each held by a contact (floor, body or another ball).
+    # ... all balls at rest, above the floor, each held by the floor, the body or another ball.
     assert np.all(out["final"][:, 2] > r - 0.003)
     assert np.all(out["speed"] < 0.05), f"fastest {out['speed'].max():.3f} m/s"
     assert out["supported"].all()
