@@ -43,7 +43,8 @@ class Garment:
     """A garment mesh: vertices (V, 3) m, faces (F, 3), seams (S, 2) vertex pairs to sew.
 
     ``panel`` gives each vertex's panel index into ``panel_names``; ``pattern`` the pattern
-    sizes in cm and the options used.
+    sizes in cm and the options used; ``pins`` the vertices a simulation should hold in place
+    (the tube dress' top edge, standing in for the elastic band that keeps a strapless dress up).
     """
 
     name: str
@@ -53,6 +54,7 @@ class Garment:
     panel: np.ndarray = None
     panel_names: tuple = ()
     pattern: dict = field(default_factory=dict)
+    pins: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -215,6 +217,7 @@ def tube_dress(mannequin, ease=0.06, edge=DEFAULT_EDGE, measurements=None, top=0
         faces=_grid_faces(rows, columns, closed=True),
         panel=np.zeros(rows * columns, dtype=int),
         panel_names=("tube",),
+        pins=(rows - 1) * columns + np.arange(columns),
         pattern={"width_cm": width * CM_PER_M, "requested_width_cm": requested * CM_PER_M,
                  "length_cm": (z_top - z_hem) * CM_PER_M, "ease": ease, "enlarged": width > requested,
                  "measurements_cm": sizes, "top": (z_top - bottom) / height, "hem": hem, "edge": edge},

@@ -79,6 +79,8 @@ def test_dress_is_an_open_tube_with_outward_normals(dress, body):
     assert boundary_loops(dress.faces) == 2  # top edge and hem
     assert components(dress.faces, len(dress.vertices)) == 1
     assert len(dress.seams) == 0  # the back seam is welded
+    top = dress.vertices[:, 2].max()
+    assert set(dress.pins.tolist()) == set(np.nonzero(np.isclose(dress.vertices[:, 2], top))[0].tolist())
     tri = dress.vertices[dress.faces]
     normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     radial = tri.mean(axis=1)[:, :2] - np.array([0.0, 0.0])
