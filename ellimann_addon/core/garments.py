@@ -267,7 +267,7 @@ def _chain_y(polygons, x, front):
     for i, (poly, xi) in enumerate(zip(polygons, x)):
         # Directions pi..2pi trace the front chain from the -X extreme to the +X extreme; 0..pi the back
         # chain from +X to -X. Both are monotonic in x for a convex ring.
-        chain = np.concatenate([poly[half:], poly[:1]]) if front else np.concatenate([poly[:half + 1]])[::-1]
+        chain = np.concatenate([poly[half:], poly[:1]]) if front else poly[:half + 1][::-1]
         out[i] = np.interp(xi, chain[:, 0], chain[:, 1])
     return out
 
