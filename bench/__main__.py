@@ -3,7 +3,7 @@
 import importlib
 import sys
 
-BENCHES = ("bench_core",)
+BENCHES = ("bench_core", "bench_synthesis")
 
 
 def main(names=None):

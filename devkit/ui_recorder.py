@@ -60,11 +60,23 @@ class Recorder:
         self.prop(data, prop)
 
     def operator(self, idname, **kwargs):
-        module, _, name = idname.partition(".")
-        if not hasattr(getattr(bpy.ops, module), name) or not _operator_exists(idname):
+        rna = _operator_rna(idname)
+        if rna is None:
             raise AttributeError(f"no operator '{idname}'")
-        self.log.append(("operator", {"idname": idname, **kwargs}))
-        return _OperatorProps()
+        props = _OperatorProps(idname, rna)
+        self.log.append(("operator", {"idname": idname, "props": props.values, **kwargs}))
+        return props
+
+    def operator_menu_enum(self, idname, prop, **kwargs):
+        self.operator(idname)._check(prop)
+        self.log.append(("operator_menu_enum", {"idname": idname, "prop": prop, **kwargs}))
+
+    def prop_search(self, data, prop, search_data, search_prop, **kwargs):
+        if prop not in data.bl_rna.properties:
+            raise AttributeError(f"{type(data).__name__} has no property '{prop}'")
+        if search_prop not in search_data.bl_rna.properties:
+            raise AttributeError(f"{type(search_data).__name__} has no collection '{search_prop}'")
+        self.log.append(("prop", {"data": data, "prop": prop, "search": search_prop, **kwargs}))
 
     def menu(self, menu, **kwargs):
         if not hasattr(bpy.types, menu):
@@ -92,27 +104,77 @@ class Recorder:
 
 
 class _OperatorProps:
-    """Accepts property assignments on an operator button (``op = layout.operator(...); op.x = 1``)."""
+    """Property assignments on an operator button (``op = layout.operator(...); op.x = 1``), checked
+    against the operator's properties (an enum value against its items)."""
+
+    def __init__(self, idname, rna):
+        object.__setattr__(self, "idname", idname)
+        object.__setattr__(self, "rna", rna)
+        object.__setattr__(self, "values", {})
+
+    def _check(self, name):
+        if name not in self.rna.properties:
+            raise AttributeError(f"operator '{self.idname}' has no property '{name}'")
+        return self.rna.properties[name]
+
+    def __setattr__(self, name, value):
+        prop = self._check(name)
+        if prop.type == "ENUM" and not prop.is_enum_flag and prop.enum_items:
+            if value not in prop.enum_items.keys():
+                raise ValueError(f"'{value}' is not an item of {self.idname}.{name}: {prop.enum_items.keys()}")
+        self.values[name] = value
 
 
-def _operator_exists(idname):
+def _operator_rna(idname):
     module, _, name = idname.partition(".")
     try:
-        getattr(getattr(bpy.ops, module), name).get_rna_type()
+        return getattr(getattr(bpy.ops, module), name).get_rna_type()
     except (KeyError, AttributeError):
-        return False
-    return True
+        return None
+
+
+class _StandIn:
+    """Plays ``self`` for a Panel, Menu or Operator class outside Blender's drawing code: registered
+    bpy_struct classes cannot be instantiated from Python. Unknown attributes come from the class, with
+    its functions bound to the stand-in."""
+
+    def __init__(self, cls, layout, **values):
+        self.__dict__.update(values, _cls=cls, layout=layout)
+
+    def __getattr__(self, name):
+        attr = getattr(self._cls, name)
+        if callable(attr) and hasattr(attr, "__get__") and not hasattr(attr, "__self__"):
+            return attr.__get__(self)
+        return attr
+
+
+def draw_menu_function(draw, context=None):
+    """Run a draw function appended to a Blender menu (``draw(self, context)``) against a Recorder."""
+    recorder = Recorder()
+    draw(_StandIn(object, recorder), context or bpy.context)
+    return recorder
 
 
 def draw_panel(panel_class, context=None):
-    """Run a panel class's ``draw`` (and ``draw_header`` if any) against a Recorder; return it."""
+    """Run a panel's (or menu's) ``draw`` (and ``draw_header`` if any) against a Recorder; return it.
+
+    A panel whose ``poll`` fails is not drawn (the recorder stays empty), as in Blender.
+    """
     context = context or bpy.context
-    panel = panel_class.__new__(panel_class)
     recorder = Recorder()
-    panel.layout = recorder
+    panel = _StandIn(panel_class, recorder)
     if hasattr(panel_class, "poll") and not panel_class.poll(context):
         return recorder
     if hasattr(panel_class, "draw_header"):
         panel.draw_header(context)
     panel.draw(context)
+    return recorder
+
+
+def draw_operator(operator_class, context=None, **values):
+    """Run an operator's own ``draw`` (its dialog / redo panel) against a Recorder, with property values."""
+    module, _, name = operator_class.bl_idname.partition(".")
+    rna = getattr(getattr(bpy.ops, module), name).get_rna_type()
+    recorder = Recorder()
+    operator_class.draw(_StandIn(operator_class, recorder, bl_rna=rna, **values), context or bpy.context)
     return recorder

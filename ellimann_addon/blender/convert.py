@@ -17,21 +17,102 @@ from ..core.mesh import icosphere
 
 UNIT_SPHERE_NAME = "ElliMann Unit Sphere"
 UNIT_SPHERE_SUBDIVISIONS = 3
+UNIT_SPHERE_TOLERANCE = 1e-4  # single-precision vertices of the icosphere are within 1e-7
 SIDE_COLORS = {"L": (0.85, 0.55, 0.45, 1.0), "R": (0.45, 0.6, 0.85, 1.0), "C": (0.8, 0.78, 0.72, 1.0)}
 
 
 def unit_sphere_mesh():
-    """The shared unit-sphere mesh, created once per file (a user's mesh of that name is left alone)."""
+    """The shared unit-sphere mesh, created once per file (a user's mesh of that name is left alone).
+
+    A tagged mesh whose vertices were moved (Apply Scale on its only user) is not reused.
+    """
     mesh = bpy.data.meshes.get(UNIT_SPHERE_NAME)
-    if mesh is not None and mesh.get("ellimann_unit_sphere"):
-        return mesh
-    vertices, faces = icosphere(UNIT_SPHERE_SUBDIVISIONS)
-    mesh = bpy.data.meshes.new(UNIT_SPHERE_NAME)
-    mesh.from_pydata(vertices.tolist(), [], faces.tolist())
+    candidates = [mesh] if mesh is not None else []
+    candidates += [m for m in bpy.data.meshes if m != mesh]
+    for mesh in candidates:
+        if mesh.get("ellimann_unit_sphere") and is_unit_sphere(mesh):
+            return mesh
+    mesh = mesh_from_arrays(UNIT_SPHERE_NAME, *icosphere(UNIT_SPHERE_SUBDIVISIONS))
     mesh.shade_smooth()
     mesh["ellimann_unit_sphere"] = 1
-    mesh.update()
     return mesh
+
+
+def mesh_from_arrays(name, vertices, faces):
+    """A new triangle mesh from numpy arrays (V, 3) and (F, 3), written with foreach_set."""
+    vertices = np.ascontiguousarray(vertices, dtype=np.float32).reshape(-1, 3)
+    faces = np.ascontiguousarray(faces, dtype=np.int32).reshape(-1, 3)
+    mesh = bpy.data.meshes.new(name)
+    mesh.vertices.add(len(vertices))
+    mesh.vertices.foreach_set("co", vertices.ravel())
+    mesh.loops.add(faces.size)
+    mesh.loops.foreach_set("vertex_index", faces.ravel())
+    mesh.polygons.add(len(faces))
+    mesh.polygons.foreach_set("loop_start", np.arange(0, faces.size, 3, dtype=np.int32))
+    mesh.update(calc_edges=True)
+    return mesh
+
+
+def mesh_vertices(mesh):
+    """Vertex coordinates (V, 3) of a mesh in its object's local space."""
+    co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+    mesh.vertices.foreach_get("co", co)
+    return co.reshape(-1, 3).astype(float)
+
+
+def world_triangles(obj):
+    """(vertices (V, 3) in world space, triangles (T, 3)) of a mesh object."""
+    mesh = obj.data
+    mesh.calc_loop_triangles()
+    triangles = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("vertices", triangles)
+    matrix = np.array(obj.matrix_world)
+    return mesh_vertices(mesh) @ matrix[:3, :3].T + matrix[:3, 3], triangles.reshape(-1, 3)
+
+
+def is_unit_sphere(mesh):
+    """True if every vertex lies on the unit sphere (False once a scale or rotation was applied to it)."""
+    if mesh is None or len(mesh.vertices) < 4:
+        return False
+    radius = np.linalg.norm(mesh_vertices(mesh), axis=1)
+    return bool(np.all(np.abs(radius - 1.0) < UNIT_SPHERE_TOLERANCE))
+
+
+def ellipsoid_frame(obj, checked=None):
+    """(rotation, center, semi_axes) of an ellipsoid object; FrameError if its matrix or mesh is not one.
+
+    A mesh that is no longer the unit sphere (Apply Scale) would otherwise be read as a sphere of
+    radius 1, so it is refused here rather than silently used. ``checked`` (a dict) caches the mesh
+    check across the many objects that share one mesh.
+    """
+    checked = {} if checked is None else checked
+    if obj.type == "MESH" and obj.data.as_pointer() not in checked:
+        checked[obj.data.as_pointer()] = is_unit_sphere(obj.data)
+    if obj.type != "MESH" or not checked[obj.data.as_pointer()]:
+        raise FrameError("mesh", "is not a unit sphere: a scale or rotation was applied to the mesh "
+                         "(Fix Frames restores it)", "mesh")
+    return decompose_matrix_world(np.array(obj.matrix_world))
+
+
+def read_frames(objects):
+    """Stacked (rotation, center, semi_axes) of ellipsoid objects; MannequinError names every bad one."""
+    problems, frames, checked = [], [], {}
+    for obj in objects:
+        try:
+            frames.append(ellipsoid_frame(obj, checked))
+        except FrameError as error:
+            problems.append(Problem(obj.ellimann.part_name or obj.name, error.field, f"{error} (object '{obj.name}')"))
+    if problems:
+        raise MannequinError(problems)
+    if not frames:
+        return np.zeros((0, 3, 3)), np.zeros((0, 3)), np.zeros((0, 3))
+    return tuple(np.array(a) for a in zip(*frames))
+
+
+def write_frames(objects, rotation, center, semi_axes):
+    """Set each object's matrix_world to S @ diag(D, 1)."""
+    for obj, matrix in zip(objects, matrix_world(rotation, center, semi_axes)):
+        obj.matrix_world = Matrix(matrix.tolist())
 
 
 def is_ellipsoid(obj):
@@ -85,8 +166,8 @@ def write_collection_props(collection, mannequin):
         props.target = [float(mannequin.measurements[m]) for m in MEASUREMENTS]
 
 
-def new_ellipsoid_object(part, rotation, center, semi_axes, collection):
-    obj = bpy.data.objects.new(part.name, unit_sphere_mesh())
+def new_ellipsoid_object(part, rotation, center, semi_axes, collection, mesh=None):
+    obj = bpy.data.objects.new(part.name, mesh or unit_sphere_mesh())
     write_part(obj, part)
     obj.matrix_world = Matrix(matrix_world(rotation, center, semi_axes).tolist())
     obj.color = SIDE_COLORS[part.side]
@@ -98,8 +179,10 @@ def mannequin_to_collection(mannequin, name=None, parent=None):
     """Build a new collection with one ellipsoid object per part. Nothing existing is touched."""
     collection = new_collection(name or mannequin.name or "Mannequin", parent)
     write_collection_props(collection, mannequin)
+    mesh = unit_sphere_mesh()
     for i, part in enumerate(mannequin.topology):
-        new_ellipsoid_object(part, mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i], collection)
+        new_ellipsoid_object(part, mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i], collection,
+                             mesh)
     return collection
 
 
@@ -108,18 +191,8 @@ def collection_to_mannequin(collection, check=True):
     objects = ellipsoid_objects(collection)
     if not objects:
         raise MannequinError([Problem("", "collection", f"'{collection.name}' holds no ElliMann ellipsoids")])
-    problems, parts, frames = [], [], []
-    for obj in objects:
-        part = read_part(obj)
-        parts.append(part)
-        try:
-            frames.append(decompose_matrix_world(np.array(obj.matrix_world)))
-        except FrameError as error:
-            problems.append(Problem(part.name or obj.name, error.field, f"{error} (object '{obj.name}')"))
-    if problems:
-        raise MannequinError(problems)
-    topology = Topology(parts)
-    rotation, center, semi_axes = (np.array(a) for a in zip(*frames))
+    rotation, center, semi_axes = read_frames(objects)
+    topology = Topology([read_part(obj) for obj in objects])
     props = collection.ellimann
     measurements = dict(zip(MEASUREMENTS, map(float, props.target))) if props.has_target else None
     mannequin = Mannequin(topology, rotation, center, semi_axes, name=collection.name, role=props.role,
@@ -133,9 +206,8 @@ def update_collection_geometry(collection, mannequin):
     missing = [name for name in mannequin.topology.names if name not in by_name]
     if missing:
         raise MannequinError([Problem(n, "collection", f"has no object in '{collection.name}'") for n in missing])
-    matrices = matrix_world(mannequin.rotation, mannequin.center, mannequin.semi_axes)
-    for name, m in zip(mannequin.topology.names, matrices):
-        by_name[name].matrix_world = Matrix(m.tolist())
+    write_frames([by_name[name] for name in mannequin.topology.names], mannequin.rotation, mannequin.center,
+                 mannequin.semi_axes)
     write_collection_props(collection, mannequin)
 
 

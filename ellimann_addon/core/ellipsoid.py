@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import FrameError
+from .frames import mirror_axis, project_to_rotation, relabel_to_reference
 
 ORTHONORMAL_TOL = 1e-6
 
@@ -120,14 +121,46 @@ def decompose_matrix_world(matrix, tol=ORTHONORMAL_TOL):
     linear = matrix[:3, :3]
     semi_axes = np.linalg.norm(linear, axis=0)
     if np.any(semi_axes <= 1e-12):
-        raise FrameError("scale", f"has a zero axis: semi-axes {semi_axes.tolist()}")
+        raise FrameError("scale", f"has a zero axis: semi-axes {semi_axes.tolist()}", "zero")
     rotation = linear / semi_axes
     if not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-4):
         raise FrameError("rotation", "is sheared: the local axes are not orthogonal (apply rotation/scale "
-                         "of a parent, or rebuild the ellipsoid)")
+                         "of a parent, or rebuild the ellipsoid)", "shear")
     if np.linalg.det(rotation) < 0.0:
-        raise FrameError("rotation", "is left-handed (a negative scale); flip one axis to fix it")
+        raise FrameError("rotation", "is left-handed (a negative scale); flip one axis to fix it", "negative")
     return rotation, matrix[:3, 3].copy(), semi_axes
+
+
+def repair_matrix_world(matrix, flip_axis=None, tol=ORTHONORMAL_TOL):
+    """A valid ellipsoid frame for an object matrix that is not one (negative scale or shear).
+
+    Any invertible affine map L sends the unit sphere to an ellipsoid, the one with shape matrix
+    L L^T, so the repair is exact: the returned (rotation, center, semi_axes) describe the same
+    point set. A left-handed but orthogonal frame gets one axis flipped (``flip_axis``, else the
+    axis most aligned with world X); a sheared one gets the principal axes of L L^T, labelled to
+    agree with L's own axes. A valid matrix comes back unchanged. Raises FrameError for a
+    zero-volume (singular) matrix, which no ellipsoid matches.
+    """
+    matrix = np.asarray(matrix, dtype=float)
+    if matrix.shape != (4, 4) or not np.all(np.isfinite(matrix)):
+        raise FrameError("matrix", "must be a finite 4x4 matrix")
+    linear, center = matrix[:3, :3], matrix[:3, 3].copy()
+    semi_axes = np.linalg.norm(linear, axis=0)
+    singular = np.linalg.svd(linear, compute_uv=False)
+    if singular[-1] <= 1e-9 * max(singular[0], 1e-300):
+        raise FrameError("scale", f"is zero along some axis (singular values {singular.tolist()}): "
+                         "no ellipsoid matches it", "zero")
+    rotation = linear / semi_axes
+    if np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-4):
+        if np.linalg.det(rotation) < 0.0:
+            axis = mirror_axis(rotation) if flip_axis is None else flip_axis
+            rotation[:, axis] = -rotation[:, axis]
+        return project_to_rotation(rotation), center, semi_axes
+    u, singular, _ = np.linalg.svd(linear)
+    if np.linalg.det(u) < 0.0:
+        u[:, 2] = -u[:, 2]
+    rotation, semi_axes, _ = relabel_to_reference(u, singular, project_to_rotation(rotation))
+    return rotation, center, semi_axes
 
 
 @dataclass(frozen=True)

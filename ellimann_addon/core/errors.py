@@ -8,10 +8,15 @@ class ElliMannError(ValueError):
 
 
 class FrameError(ElliMannError):
-    """A matrix that is not a valid ellipsoid frame (shear, zero or negative scale)."""
+    """A matrix that is not a valid ellipsoid frame (shear, zero or negative scale).
 
-    def __init__(self, field, message):
+    ``kind`` says which mistake it is, for code that offers a fix: 'matrix' (not an affine 4x4),
+    'zero' (a zero scale), 'shear', 'negative' (left-handed) or 'mesh' (transform applied to the mesh).
+    """
+
+    def __init__(self, field, message, kind="matrix"):
         self.field = field
+        self.kind = kind
         super().__init__(f"{field} {message}")
 
 
@@ -44,3 +49,12 @@ class MeasurementError(ElliMannError):
     def __init__(self, field, message):
         self.field = field
         super().__init__(f"{field}: {message}")
+
+
+class ReferenceSetError(ElliMannError):
+    """A reference-mannequin set that cannot be used for synthesis; names the file and the field."""
+
+    def __init__(self, source, field, message):
+        self.source = source
+        self.field = field
+        super().__init__(f"{source}: {field} {message}" if source else f"{field} {message}")

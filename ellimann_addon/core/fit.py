@@ -37,3 +37,23 @@ def fit_ellipsoid(points, mode="inscribed"):
         radius = np.linalg.norm(local, axis=1)
         semi_axes = semi_axes * (radius.min() if mode == "inscribed" else radius.max())
     return rotation, center, semi_axes
+
+
+def fit_affine(source, target):
+    """Least-squares affine map with target ~ source @ A.T + t for corresponding points.
+
+    Returns (4x4 matrix [[A, t], [0, 1]], largest residual distance). Used to recover the
+    transform that was applied to a known mesh (e.g. a unit sphere whose scale was applied).
+    """
+    source = np.asarray(source, dtype=float)
+    target = np.asarray(target, dtype=float)
+    if source.shape != target.shape or source.ndim != 2 or source.shape[1] != 3 or len(source) < 4:
+        raise ValueError(f"need two (n, 3) arrays of corresponding points, n >= 4; got shapes {source.shape} "
+                         f"and {target.shape}")
+    design = np.column_stack([source, np.ones(len(source))])
+    solution, *_ = np.linalg.lstsq(design, target, rcond=None)
+    matrix = np.eye(4)
+    matrix[:3, :3] = solution[:3].T
+    matrix[:3, 3] = solution[3]
+    residual = float(np.linalg.norm(design @ solution - target, axis=1).max())
+    return matrix, residual

@@ -17,6 +17,7 @@ import numpy as np
 
 from .constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
 from .ellipsoid import axis_extent, section_at_height
+from .mesh import convex_hull_2d, plane_section_points, polygon_perimeter
 
 DETECTION_SAMPLES = 128  # grid used to find which ellipse is outermost in each direction
 QUADRATURE_CELLS = 32  # fixed cuts so that every smooth piece spans at most 2pi/32
@@ -224,3 +225,62 @@ def _measure_chunk(rotation, center, semi_axes, girth):
 def as_dict(values):
     """(5,) array in MEASUREMENTS order -> {"He": ..., ...} of plain floats."""
     return {key: float(value) for key, value in zip(MEASUREMENTS, values)}
+
+
+def section_hulls(rotation, center, semi_axes, girth, samples=256):
+    """The sections m_T measures, for drawing: {key: (z, hull points (k, 2))} for Sh, Br, Wa, Hi.
+
+    Sh's section runs through every ellipsoid, the girths' only through those flagged ``girth``;
+    the points follow the convex hull of the section ellipses (:func:`hull_boundary`).
+    """
+    rotation = np.asarray(rotation, dtype=float)
+    center = np.asarray(center, dtype=float)
+    semi_axes = np.asarray(semi_axes, dtype=float)
+    girth = np.asarray(girth, dtype=bool)
+    _, _, z = section_heights(rotation, center, semi_axes)
+    out = {}
+    for key in SECTION_FRACTIONS:
+        centre, k, hit = section_at_height(rotation, center, semi_axes, z[key])
+        active = hit if key == "Sh" else hit & girth
+        out[key] = (float(z[key]), hull_boundary(centre, k, active, samples))
+    return out
+
+
+def _concatenate(meshes):
+    vertices = [np.asarray(v, dtype=float).reshape(-1, 3) for v, _ in meshes]
+    offsets = np.cumsum([0] + [len(v) for v in vertices[:-1]])
+    faces = [np.asarray(f, dtype=np.int64).reshape(-1, 3) + o for (_, f), o in zip(meshes, offsets)]
+    if not vertices:
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
+    return np.concatenate(vertices), np.concatenate(faces)
+
+
+def measure_meshes(meshes, girth):
+    """m_T of a body made of closed triangle meshes in world space (e.g. a cushion mannequin).
+
+    ``meshes`` is a sequence of (vertices (V, 3), faces (F, 3)); ``girth`` one bool per mesh.
+    He is the z extent of all vertices; the section heights are the same fractions of He as for
+    ellipsoids. Br, Wa, Hi: perimeter of the 2D convex hull of the points where the girth meshes'
+    edges cross the section plane. Sh: x extent of the section of all meshes at the shoulder height.
+    Returns (values (5,) in cm in MEASUREMENTS order, {key: (z, hull polygon (h, 2))}).
+    """
+    girth = np.asarray(girth, dtype=bool)
+    if len(meshes) == 0 or len(girth) != len(meshes):
+        raise ValueError(f"need one girth flag per mesh and at least one mesh; got {len(meshes)} meshes "
+                         f"and {len(girth)} flags")
+    everything = _concatenate(meshes)
+    girth_only = _concatenate([m for m, g in zip(meshes, girth) if g])
+    bottom, top = everything[0][:, 2].min(), everything[0][:, 2].max()
+    height = top - bottom
+    values = {"He": height}
+    sections = {}
+    for key, fraction in SECTION_FRACTIONS.items():
+        z = bottom + fraction * height
+        points = plane_section_points(*(everything if key == "Sh" else girth_only), z)
+        hull = convex_hull_2d(points) if len(points) else np.zeros((0, 2))
+        sections[key] = (float(z), hull)
+        if key == "Sh":
+            values[key] = float(np.ptp(points[:, 0])) if len(points) else 0.0
+        else:
+            values[key] = polygon_perimeter(hull) if len(hull) >= 3 else 0.0
+    return np.array([values[key] for key in MEASUREMENTS]) * CM_PER_M, sections

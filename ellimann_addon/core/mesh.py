@@ -80,13 +80,17 @@ def convexity_defect(vertices, faces):
 
 def plane_section_points(vertices, faces, height):
     """Points where the mesh's edges cross the plane z = height: (k, 2) x-y coordinates."""
-    edges = np.unique(np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1),
-                      axis=0)
+    faces = np.asarray(faces)
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    above = vertices[:, 2] > height
+    below = vertices[:, 2] < height
+    crossing = (above[edges[:, 0]] & below[edges[:, 1]]) | (below[edges[:, 0]] & above[edges[:, 1]])
+    # Deduplicate only the few crossing edges (each appears in two faces), not the whole mesh.
+    edges = np.unique(np.sort(edges[crossing], axis=1), axis=0)
     za, zb = vertices[edges[:, 0], 2] - height, vertices[edges[:, 1], 2] - height
-    crossing = (za * zb) < 0.0
-    on_plane = vertices[np.abs(vertices[:, 2] - height) == 0.0, :2]
-    a, b = vertices[edges[crossing, 0]], vertices[edges[crossing, 1]]
-    t = (za[crossing] / (za[crossing] - zb[crossing]))[:, None]
+    on_plane = vertices[~above & ~below, :2]
+    a, b = vertices[edges[:, 0]], vertices[edges[:, 1]]
+    t = (za / (za - zb))[:, None]
     return np.concatenate([a[:, :2] + t * (b[:, :2] - a[:, :2]), on_plane])
 
 

@@ -10,6 +10,8 @@ import bpy  # noqa: E402
 import pytest  # noqa: E402
 
 import ellimann_addon  # noqa: E402
+from devkit.blender_scene import parts  # noqa: E402
+from ellimann_addon.blender.convert import mannequin_to_collection  # noqa: E402
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -23,3 +25,12 @@ def addon():
 def empty_file():
     bpy.ops.wm.read_homefile(use_empty=True)
     yield
+
+
+@pytest.fixture
+def toy_collection(toy):
+    """The toy mannequin as a collection, with its first ellipsoid active and nothing selected."""
+    collection = mannequin_to_collection(toy)
+    bpy.context.view_layer.objects.active = parts(collection)["1.a Head"]
+    return collection
+

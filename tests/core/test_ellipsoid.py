@@ -6,6 +6,7 @@ from hypothesis import strategies as st
 from devkit.toy import rotation_from_vector
 from ellimann_addon.core import ellipsoid as el
 from ellimann_addon.core.errors import FrameError
+from ellimann_addon.core.frames import is_rotation
 
 vectors = st.tuples(*[st.floats(-3, 3)] * 3)
 sizes = st.tuples(*[st.floats(0.02, 0.3)] * 3)
@@ -73,15 +74,62 @@ def test_decompose_refuses_negative_scale_shear_and_zero_scale():
     m = el.matrix_world(np.eye(3), (0, 0, 0), (0.1, 0.2, 0.3))
     negative = m.copy()
     negative[:3, 0] *= -1
-    with pytest.raises(FrameError, match="left-handed"):
+    with pytest.raises(FrameError, match="left-handed") as info:
         el.decompose_matrix_world(negative)
+    assert info.value.kind == "negative"
     sheared = m.copy()
     sheared[0, 1] = 0.1
-    with pytest.raises(FrameError, match="sheared"):
+    with pytest.raises(FrameError, match="sheared") as info:
         el.decompose_matrix_world(sheared)
+    assert info.value.kind == "shear"
     flat = m.copy()
     flat[:3, 2] = 0
-    with pytest.raises(FrameError, match="zero axis"):
+    with pytest.raises(FrameError, match="zero axis") as info:
         el.decompose_matrix_world(flat)
+    assert info.value.kind == "zero"
     with pytest.raises(FrameError, match="finite"):
         el.decompose_matrix_world(np.full((4, 4), np.nan))
+
+
+def same_set(matrix, repaired):
+    """Two descriptions of one ellipsoid: same centre and same shape matrix L L^T."""
+    rotation, center, semi = repaired
+    linear = np.asarray(matrix)[:3, :3]
+    return np.allclose(center, np.asarray(matrix)[:3, 3]) and np.allclose(
+        el.shape_matrix(rotation, semi), linear @ linear.T, atol=1e-12)
+
+
+@settings(max_examples=30, deadline=None)
+@given(vectors, points3, sizes, st.integers(0, 2))
+def test_repair_of_negative_scale_keeps_the_set_and_the_other_axes(rv, c, d, axis):
+    r = rotation_from_vector(rv)
+    m = el.matrix_world(r, c, d)
+    m[:3, axis] *= -1
+    repaired = el.repair_matrix_world(m, flip_axis=axis)
+    assert same_set(m, repaired) and is_rotation(repaired[0])
+    assert np.allclose(repaired[0], r, atol=1e-9) and np.allclose(repaired[2], d)
+    auto = el.repair_matrix_world(m)
+    assert same_set(m, auto) and is_rotation(auto[0])
+    el.decompose_matrix_world(el.matrix_world(*auto))
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.floats(-1, 1), min_size=9, max_size=9), points3)
+def test_repair_of_shear_gives_a_valid_frame_for_the_same_set(entries, c):
+    linear = np.eye(3) * 0.3 + np.reshape(entries, (3, 3)) * 0.05  # singular values >= 0.15
+    m = np.eye(4)
+    m[:3, :3], m[:3, 3] = linear, c
+    repaired = el.repair_matrix_world(m)
+    assert same_set(m, repaired) and is_rotation(repaired[0]) and np.all(repaired[2] > 0)
+    el.decompose_matrix_world(el.matrix_world(*repaired))
+
+
+def test_repair_leaves_a_valid_frame_alone_and_refuses_a_flat_one():
+    r = rotation_from_vector((0.2, 0.4, -0.1))
+    m = el.matrix_world(r, (1, 2, 3), (0.1, 0.2, 0.3))
+    rotation, center, semi = el.repair_matrix_world(m)
+    assert np.allclose(rotation, r) and np.allclose(center, (1, 2, 3)) and np.allclose(semi, (0.1, 0.2, 0.3))
+    flat = m.copy()
+    flat[:3, 1] = flat[:3, 0]
+    with pytest.raises(FrameError, match="zero along some axis"):
+        el.repair_matrix_world(flat)

@@ -44,3 +44,17 @@ def test_fit_refuses_bad_input():
         fit.fit_ellipsoid(np.full((5, 3), np.nan))
     with pytest.raises(ValueError, match="mode"):
         fit.fit_ellipsoid(np.random.rand(10, 3), "best")
+
+
+def test_fit_affine_recovers_an_applied_transform():
+    unit, _ = mesh.icosphere(2)
+    affine = np.eye(4)
+    affine[:3, :3] = rotation_from_vector((0.1, 0.7, -0.3)) @ np.diag((0.1, 0.2, 0.05))
+    affine[:3, 3] = (0.3, -0.1, 1.0)
+    matrix, residual = fit.fit_affine(unit, unit @ affine[:3, :3].T + affine[:3, 3])
+    assert np.allclose(matrix, affine, atol=1e-12) and residual < 1e-12
+    edited = unit.copy()
+    edited[0] *= 1.5
+    assert fit.fit_affine(unit, edited)[1] > 0.05
+    with pytest.raises(ValueError, match="corresponding points"):
+        fit.fit_affine(unit, unit[:-1])

@@ -11,6 +11,8 @@ from devkit.reference import brute_force_measure, random_mannequin_arrays
 from devkit.toy import rotation_from_vector
 from ellimann_addon.core import measure
 from ellimann_addon.core.constants import SECTION_FRACTIONS
+from ellimann_addon.core.cushion import cushion_mesh
+from ellimann_addon.core.mesh import icosphere
 
 
 def perimeter(centres, ks):
@@ -110,3 +112,65 @@ def test_hull_boundary_points_lie_on_the_hull():
     pts = measure.hull_boundary(c, k, np.ones(2, bool), samples=512)
     hull = ConvexHull(pts)
     assert hull.area == pytest.approx(perimeter(c, k), rel=1e-3)
+
+
+def ellipsoid_meshes(mannequin, subdivisions):
+    unit, faces = icosphere(subdivisions)
+    return [(unit * mannequin.semi_axes[i] @ mannequin.rotation[i].T + mannequin.center[i], faces)
+            for i in range(len(mannequin))]
+
+
+def test_mesh_measure_converges_to_the_closed_form_from_inside(toy):
+    closed = measure.tailor_measurements(toy.rotation, toy.center, toy.semi_axes, toy.topology.girth_mask)
+    errors = []
+    for subdivisions in (3, 4, 5):
+        values, _ = measure.measure_meshes(ellipsoid_meshes(toy, subdivisions), toy.topology.girth_mask)
+        # Vertices lie on the ellipsoids, so each mesh is inside its ellipsoid: never more than m_T.
+        assert np.all(values <= closed * (1 + 1e-12))
+        errors.append(np.abs(values / closed - 1.0).max())
+    assert errors[0] > errors[1] > errors[2]
+    assert errors[2] < 3e-4
+
+
+def test_mesh_measure_of_a_capsule_cushion():
+    r, length = 0.1, 0.6
+    sphere = (np.eye(3), np.zeros(3), np.full(3, r))
+    top = (np.eye(3), np.array([0.0, 0.0, length]), np.full(3, r))
+    vertices, faces = cushion_mesh(sphere, top, subdivisions=5)
+    values, sections = measure.measure_meshes([(vertices, faces)], [True])
+    he, sh, br, wa, hi = values / 100.0
+    assert he == pytest.approx(length + 2 * r, rel=1e-9)
+    # Every section cuts the cylindrical part: a circle of radius r.
+    assert sh == pytest.approx(2 * r, rel=2e-3)
+    for girth in (br, wa, hi):
+        assert girth == pytest.approx(2 * np.pi * r, rel=2e-3) and girth < 2 * np.pi * r
+    for key, fraction in SECTION_FRACTIONS.items():
+        z, polygon = sections[key]
+        assert z == pytest.approx(-r + fraction * (length + 2 * r))
+        assert np.allclose(np.linalg.norm(polygon, axis=1), r, rtol=2e-3)
+
+
+def test_mesh_measure_girths_use_only_girth_meshes(toy):
+    meshes = ellipsoid_meshes(toy, 3)
+    none = np.zeros(len(toy), bool)
+    values, sections = measure.measure_meshes(meshes, none)
+    assert values[2:] == pytest.approx([0, 0, 0]) and len(sections["Br"][1]) == 0
+    assert values[0] > 0 and values[1] > 0
+    with pytest.raises(ValueError, match="one girth flag per mesh"):
+        measure.measure_meshes(meshes, none[:-1])
+    with pytest.raises(ValueError, match="at least one mesh"):
+        measure.measure_meshes([], [])
+
+
+def test_section_hulls_trace_the_measured_sections(toy):
+    r, c, d, g = toy.rotation, toy.center, toy.semi_axes, toy.topology.girth_mask
+    values = measure.as_dict(measure.tailor_measurements(r, c, d, g))
+    hulls = measure.section_hulls(r, c, d, g, samples=1024)
+    bottom, height, z = measure.section_heights(r, c, d)
+    assert set(hulls) == set(SECTION_FRACTIONS)
+    for key, (height_z, points) in hulls.items():
+        assert height_z == pytest.approx(z[key])
+        if key == "Sh":
+            assert np.ptp(points[:, 0]) * 100 == pytest.approx(values["Sh"], rel=1e-4)
+        else:
+            assert ConvexHull(points).area * 100 == pytest.approx(values[key], rel=1e-4)

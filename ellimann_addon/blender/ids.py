@@ -1,0 +1,40 @@
+"""Every operator, panel and menu id of the add-on, in one place (tests check the prefixes).
+
+Operators are ``ellimann.verb_noun`` with classes ``ELLIMANN_OT_verb_noun``; panels and menus are
+``ELLIMANN_PT_...`` / ``ELLIMANN_MT_...``.
+"""
+
+NEW_MANNEQUIN = "ellimann.new_mannequin"
+ADD_ELLIPSOID = "ellimann.add_ellipsoid"
+FIT_ELLIPSOID = "ellimann.fit_ellipsoid"
+MIRROR_ELLIPSOIDS = "ellimann.mirror_ellipsoids"
+MIRROR_SIDE = "ellimann.mirror_side"
+RELABEL_AXES = "ellimann.relabel_axes"
+SYMMETRIZE_CENTRAL = "ellimann.symmetrize_central"
+REGISTER_MANNEQUIN = "ellimann.register_mannequin"
+BUILD_CUSHIONS = "ellimann.build_cushions"
+MEASURE_MANNEQUIN = "ellimann.measure_mannequin"
+VALIDATE_MANNEQUIN = "ellimann.validate_mannequin"
+FIX_FRAMES = "ellimann.fix_frames"
+SYNTHESIZE_MANNEQUIN = "ellimann.synthesize_mannequin"
+ADD_MEASUREMENT_PRESET = "ellimann.add_measurement_preset"
+
+PANEL_MAIN = "ELLIMANN_PT_main"
+PANEL_TRACE = "ELLIMANN_PT_trace"
+PANEL_PART = "ELLIMANN_PT_part"
+PANEL_CLEAN = "ELLIMANN_PT_clean"
+PANEL_CUSHIONS = "ELLIMANN_PT_cushions"
+PANEL_MEASURE = "ELLIMANN_PT_measure"
+PANEL_SYNTHESIZE = "ELLIMANN_PT_synthesize"
+
+# Sub-panels of PANEL_MAIN sort by bl_order. Room is left after Measure for the Synthesize (60)
+# and Drape (70) panels that other parts of the add-on add.
+PANEL_ORDER = {PANEL_TRACE: 10, PANEL_PART: 20, PANEL_CLEAN: 30, PANEL_CUSHIONS: 40, PANEL_MEASURE: 50}
+
+MENU_OBJECT = "ELLIMANN_MT_object"
+
+
+def class_name(idname):
+    """'ellimann.add_ellipsoid' -> 'ELLIMANN_OT_add_ellipsoid' (what Blender calls the operator type)."""
+    module, _, name = idname.partition(".")
+    return f"{module.upper()}_OT_{name}"

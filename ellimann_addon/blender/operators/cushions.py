@@ -1,0 +1,44 @@
+"""Cushions: for every cushion pair, the convex hull of its two ellipsoids as a closed mesh object."""
+
+import bpy
+from bpy.props import IntProperty
+
+from ...core.cushion import DEFAULT_SUBDIVISIONS
+from ...core.errors import MannequinError
+from .. import ids
+from ..cushions import build_cushions
+from ..selection import active_mannequin
+from .common import cancel, plural
+
+
+class ELLIMANN_OT_build_cushions(bpy.types.Operator):
+    """Build the convex hull of every cushion pair of the active mannequin as a closed mesh object"""
+
+    bl_idname = ids.BUILD_CUSHIONS
+    bl_label = "Build Cushions"
+    bl_options = {"REGISTER", "UNDO"}
+
+    subdivisions: IntProperty(name="Resolution", default=DEFAULT_SUBDIVISIONS, min=1, max=6,
+                              description="Icosphere subdivisions of the hull's directions "
+                                          "(vertices = 10 * 4^n + 2)")
+
+    @classmethod
+    def poll(cls, context):
+        return context.mode == "OBJECT" and active_mannequin(context) is not None
+
+    def execute(self, context):
+        collection = active_mannequin(context)
+        try:
+            objects, removed = build_cushions(collection, self.subdivisions)
+        except MannequinError as error:
+            if error.problems[0].field == "cushions":
+                return cancel(self, str(error.problems[0].message))
+            return cancel(self, f"Fix '{collection.name}' first", error.problems)
+        replaced = f", replacing {removed}" if removed else ""
+        target = objects[0].users_collection[0].name
+        self.report({"INFO"}, f"Built {plural(len(objects), 'cushion')} in '{target}'{replaced}")
+        return {"FINISHED"}
+
+
+classes = (ELLIMANN_OT_build_cushions,)
+register, unregister = bpy.utils.register_classes_factory(classes)

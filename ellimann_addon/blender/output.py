@@ -1,0 +1,157 @@
+"""Write mannequins to .blend, .glb and .obj from Blender, atomically (headless CLI and scripts).
+
+Each file is written from an empty scene holding only that mannequin (and its cushions when asked),
+to a temporary file in the target folder that is renamed into place once complete.
+"""
+
+import contextlib
+import os
+import shutil
+import sys
+import tempfile
+
+import bpy
+
+from ..core.cushion import DEFAULT_SUBDIVISIONS
+from ..core.files import atomic_write_text
+from .convert import mannequin_to_collection, write_measured
+from .cushions import build_cushions
+
+BLENDER_FORMATS = ("blend", "glb", "obj")
+LIVE_SUBDIVISIONS = 3
+
+
+@contextlib.contextmanager
+def stdout_to_stderr():
+    """Send what Blender prints to stderr, so stdout stays machine-readable.
+
+    Blender prints both from C (file descriptor 1) and through Python's ``sys.stdout`` (reports).
+    """
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        os.dup2(2, 1)
+        with contextlib.redirect_stdout(sys.stderr):
+            yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def empty_scene():
+    """Start from an empty file (add-ons stay registered)."""
+    with stdout_to_stderr():
+        bpy.ops.wm.read_homefile(use_empty=True)
+    return bpy.context.scene
+
+
+def objects_recursive(collection):
+    """Objects of a collection and its children (``Collection.all_objects`` crashed the bpy module here)."""
+    objects = list(collection.objects)
+    for child in collection.children_recursive:
+        objects += [o for o in child.objects if o not in objects]
+    return objects
+
+
+def shown_objects(collection):
+    """What a file shows: cushions where there are any, ellipsoids for every part without a cushion."""
+    objects = objects_recursive(collection)
+    has_cushions = any(o.ellimann.kind == "CUSHION" for o in objects)
+    return [o for o in objects if o.ellimann.is_part and (
+        o.ellimann.kind == "CUSHION" or (o.ellimann.kind == "ELLIPSOID" and not (has_cushions and o.ellimann.partner)))]
+
+
+def add_mannequin(mannequin, measured=None, cushions=False):
+    """The mannequin as a new collection in the current scene; with cushions, the paired ellipsoids are hidden."""
+    collection = mannequin_to_collection(mannequin)
+    if measured is not None:
+        write_measured(collection, measured)
+    if cushions:
+        _add_cushions(collection)
+    return collection
+
+
+def _add_cushions(collection, subdivisions=DEFAULT_SUBDIVISIONS):
+    build_cushions(collection, subdivisions)
+    shown = set(shown_objects(collection))
+    # Hidden in the view layer, not disabled (hide_viewport): Blender does not evaluate disabled
+    # objects, so after reopening the file their matrix_world would be the identity.
+    bpy.context.view_layer.update()  # new objects get their view-layer bases (hide_set needs them)
+    for obj in objects_recursive(collection):
+        if obj.ellimann.kind == "ELLIPSOID" and obj not in shown:
+            obj.hide_set(True)
+            obj.hide_render = True
+
+
+def refresh_cushions(collection, subdivisions=LIVE_SUBDIVISIONS):
+    """Rebuild a mannequin's cushions after its ellipsoids moved (replaces only the cushions ElliMann built).
+
+    Live updates use a coarser mesh (642 vertices instead of 2,562) to keep up with a dragged
+    slider; Synthesize builds them at full resolution.
+    """
+    _add_cushions(collection, subdivisions)
+
+
+def write_mannequin(mannequin, paths, measured=None, cushions=False):
+    """Write one mannequin to every path in ``paths`` (format from the extension). Returns the paths."""
+    paths = [os.fspath(p) for p in paths]
+    blender_paths = [p for p in paths if extension(p) in BLENDER_FORMATS]
+    for path in paths:
+        if extension(path) == "json":
+            atomic_write_text(path, mannequin.to_json() + "\n")
+    if blender_paths:
+        empty_scene()
+        collection = add_mannequin(mannequin, measured, cushions)
+        for path in blender_paths:
+            _write_blender_file(path, collection)
+    return paths
+
+
+def extension(path):
+    return os.path.splitext(os.fspath(path))[1].lower().lstrip(".")
+
+
+@contextlib.contextmanager
+def atomic_output(path):
+    """Yield a temporary path for Blender to write; once it has, rename it onto ``path`` (same folder).
+
+    The temporary file sits in a private folder beside the target, so Blender writes a fresh file
+    (no backup of an existing one, normal permissions) and one rename on the same file system puts it
+    in place. Nothing is left behind on failure.
+    """
+    path = os.path.abspath(os.fspath(path))
+    folder = os.path.dirname(path)
+    os.makedirs(folder, exist_ok=True)
+    scratch = tempfile.mkdtemp(prefix=".ellimann-", dir=folder)
+    temp = os.path.join(scratch, os.path.basename(path))
+    try:
+        yield temp
+        if not os.path.isfile(temp) or not os.path.getsize(temp):
+            raise OSError(f"Blender wrote nothing to {path}")
+        os.replace(temp, path)
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+
+
+def _write_blender_file(path, collection):
+    kind = extension(path)
+    with atomic_output(path) as temp, stdout_to_stderr():
+        if kind == "blend":
+            bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)
+        else:
+            _select_only(shown_objects(collection))
+            if kind == "glb":
+                bpy.ops.export_scene.gltf(filepath=temp, export_format="GLB", use_selection=True,
+                                          export_extras=True, export_yup=True)
+            else:
+                bpy.ops.wm.obj_export(filepath=temp, export_selected_objects=True, export_materials=False,
+                                      check_existing=False)
+
+
+def _select_only(objects):
+    bpy.context.view_layer.update()  # give newly linked objects their view-layer bases before selecting
+    for obj in bpy.context.view_layer.objects:
+        obj.select_set(False)
+    for obj in objects:
+        obj.select_set(True)

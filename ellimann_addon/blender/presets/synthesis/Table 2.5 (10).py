@@ -1,0 +1,9 @@
+import bpy
+
+props = bpy.context.scene.ellimann_synthesis
+
+props.he = 165.25
+props.sh = 47.25
+props.br = 135.75
+props.wa = 122.25
+props.hi = 117.5

@@ -1,0 +1,9 @@
+import bpy
+
+props = bpy.context.scene.ellimann_synthesis
+
+props.he = 153.75
+props.sh = 35.75
+props.br = 118.5
+props.wa = 102.5
+props.hi = 117.5

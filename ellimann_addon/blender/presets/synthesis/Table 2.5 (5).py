@@ -1,0 +1,9 @@
+import bpy
+
+props = bpy.context.scene.ellimann_synthesis
+
+props.he = 159.5
+props.sh = 41.5
+props.br = 118.5
+props.wa = 82.75
+props.hi = 117.5

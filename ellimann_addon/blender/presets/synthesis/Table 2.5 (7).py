@@ -1,0 +1,9 @@
+import bpy
+
+props = bpy.context.scene.ellimann_synthesis
+
+props.he = 165.25
+props.sh = 35.75
+props.br = 101.25
+props.wa = 82.75
+props.hi = 117.5

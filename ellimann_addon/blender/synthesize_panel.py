@@ -1,0 +1,64 @@
+"""The Synthesize sub-panel of the ElliMann sidebar tab.
+
+Registered after the main panel ``ELLIMANN_PT_main`` (its parent), hence a module of its own.
+"""
+
+import bpy
+
+from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS
+from .panel_base import ElliMannPanel
+from .synthesize import FIELDS, ELLIMANN_MT_measurement_presets
+
+
+class ELLIMANN_PT_synthesize(ElliMannPanel, bpy.types.Panel):
+    """Type five measurements, get a mannequin"""
+
+    bl_idname = "ELLIMANN_PT_synthesize"
+    bl_label = "Synthesize"
+    bl_parent_id = "ELLIMANN_PT_main"
+    bl_order = 60  # after the authoring tools' panels (Trace ... Measure: 10-50)
+
+    @classmethod
+    def poll(cls, context):
+        return hasattr(context.scene, "ellimann_synthesis")
+
+    def draw(self, context):
+        layout = self.layout
+        props = context.scene.ellimann_synthesis
+        target = props.target
+        measured = tuple(target.ellimann.measured) if target is not None and target.ellimann.has_measured else None
+
+        row = layout.row(align=True)
+        row.menu("ELLIMANN_MT_measurement_presets", text=ELLIMANN_MT_measurement_presets.bl_label)
+        row.operator("ellimann.add_measurement_preset", text="", icon="ADD")
+        row.operator("ellimann.add_measurement_preset", text="", icon="REMOVE").remove_active = True
+
+        header = layout.row()
+        header.label(text="Request (cm)")
+        header.label(text="m_T (cm)" if measured else "")
+        column = layout.column(align=True)
+        for index, key in enumerate(MEASUREMENTS):
+            row = column.row()
+            row.prop(props, FIELDS[key], text=MEASUREMENT_LABELS[key])
+            row.label(text=f"{measured[index]:.2f}" if measured else "")
+
+        layout.row().prop(props, "mode", expand=True)
+        layout.row().prop(props, "output", expand=True)
+        options = layout.column(align=True)
+        options.prop(props, "metric")
+        options.prop(props, "power")
+        options.prop(props, "references")
+
+        layout.operator("ellimann.synthesize_mannequin", icon="OUTLINER_OB_ARMATURE")
+        row = layout.row()
+        row.prop(props, "live")
+        if target is not None:
+            row.label(text=f"{target.name}" + (f" ({props.live_ms:.1f} ms)" if props.live_ms else ""))
+        if props.status:
+            box = layout.box()
+            for line in props.status.split("; "):
+                box.label(text=line, icon="ERROR")
+
+
+classes = (ELLIMANN_PT_synthesize,)
+register, unregister = bpy.utils.register_classes_factory(classes)

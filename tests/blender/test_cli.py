@@ -1,0 +1,303 @@
+"""The command line: ``main(argv)`` in-process, and ``python -m ellimann_addon`` in a subprocess.
+
+``blender --command ellimann`` needs a Blender binary, which the bpy-module test machines lack; the
+add-on registers ``main`` itself as that command (checked below), so the in-process tests cover it.
+"""
+
+import csv
+import json
+import os
+import pathlib
+import subprocess
+import sys
+
+import bpy
+import pytest
+
+from devkit import synthetic
+from ellimann_addon.blender import cli
+from ellimann_addon.core.constants import MEASUREMENTS
+from ellimann_addon.core.mannequin import Mannequin
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]
+VALUES = dict(zip(MEASUREMENTS, (165.0, 41.5, 101.25, 82.75, 117.5)))
+
+
+@pytest.fixture(scope="module")
+def references(tmp_path_factory):
+    return str(synthetic.write_reference_folder(tmp_path_factory.mktemp("rm")))
+
+
+def run(args, capsys):
+    code = cli.main(args)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def python_m(*args, cwd=ROOT):
+    return subprocess.run([sys.executable, "-m", "ellimann_addon", *args], cwd=cwd, capture_output=True, text=True,
+                          env=dict(os.environ, BLENDER_USER_RESOURCES=os.environ["BLENDER_USER_RESOURCES"]),
+                          timeout=300)
+
+
+def assert_one_line_error(code, err, *words):
+    assert code == 1
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    for word in words:
+        assert word in lines[0]
+
+
+# ------------------------------------------------------------------------------------------------ entry points
+
+
+def test_python_m_help_is_fast_and_does_not_load_blender():
+    code = ("import sys\nfrom ellimann_addon.blender.cli import main\ncode = main(['--help'])\n"
+            "print('bpy loaded' if 'bpy' in sys.modules else 'bpy not loaded', code)")
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True).stdout
+    assert "synth" in out and "batch" in out and "measure" in out and "demo" in out
+    assert out.strip().endswith("bpy not loaded 0")
+
+
+@pytest.mark.parametrize("kind", ["json", "blend"])
+def test_python_m_synth_and_measure_end_to_end(tmp_path, references, kind):
+    out = tmp_path / f"one.{kind}"
+    done = python_m("synth", *REQUEST, "-o", str(out), "--references", references)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith(f"wrote {out}") and done.stdout.count("\n") == 1
+    measured = python_m("measure", str(out), "--json")
+    assert measured.returncode == 0
+    data = json.loads(measured.stdout)  # stdout holds the dict and nothing else, even when Blender loads a file
+    assert measured.stdout == json.dumps(data) + "\n" and list(data) == list(MEASUREMENTS)
+    assert data == pytest.approx(VALUES, rel=1e-4)
+
+
+def test_python_m_bad_input_is_one_line_and_exit_code_1(tmp_path, references):
+    done = python_m("synth", *REQUEST[:-1], "500", "-o", str(tmp_path / "x.json"), "--references", references)
+    assert_one_line_error(done.returncode, done.stderr, "Hi", "30-300 cm")
+    assert not (tmp_path / "x.json").exists()
+
+
+def test_the_add_on_registers_main_as_the_blender_command():
+    assert cli._handle is not None  # bpy.utils.register_cli_command("ellimann", cli.main) ran in register()
+
+
+def test_a_malformed_command_line_exits_2(capsys):
+    code, _, err = run(["synth", "--he", "160"], capsys)
+    assert code == 2 and "required" in err
+    code, _, err = run(["fly"], capsys)
+    assert code == 2
+
+
+# ------------------------------------------------------------------------------------------------ synth
+
+
+def test_synth_json_meets_the_request_in_exact_mode(tmp_path, capsys, references):
+    out = tmp_path / "sub" / "m.json"
+    code, stdout, err = run(["synth", *REQUEST, "-o", str(out), "--references", references], capsys)
+    assert code == 0 and err == ""
+    mannequin = Mannequin.load(out)
+    assert mannequin.name == "ElliMann 165-41.5-101.25-82.75-117.5" and mannequin.measurements == VALUES
+    assert mannequin.measure() == pytest.approx(VALUES, rel=1e-4)
+    assert "max error 0.00" in stdout
+
+
+def test_synth_idw_reports_its_error(tmp_path, capsys, references):
+    out = tmp_path / "m.json"
+    code, stdout, _ = run(["synth", *REQUEST, "--mode", "idw", "-o", str(out), "--references", references], capsys)
+    assert code == 0
+    error = float(stdout.rsplit("max error ", 1)[1].rstrip("%\n"))
+    measured = Mannequin.load(out).measure()
+    assert error == pytest.approx(max(abs(measured[k] - VALUES[k]) / VALUES[k] * 100 for k in MEASUREMENTS), abs=1e-3)
+    assert error > 0.1  # plain IDW misses: the point of exact mode
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--he", "nan"], ("He", "finite")),
+    (["--sh", "-3"], ("Sh", "> 0")),
+    (["--br", "1000"], ("Br", "30-300 cm")),
+    (["--he", "abc"], None),  # argparse: exit 2
+])
+def test_synth_refuses_bad_measurements(tmp_path, capsys, references, args, words):
+    request = REQUEST.copy()
+    index = request.index(args[0])
+    request[index + 1] = args[1]
+    out = tmp_path / "m.json"
+    code, stdout, err = run(["synth", *request, "-o", str(out), "--references", references], capsys)
+    if words is None:
+        assert code == 2 and "not a number" in err
+    else:
+        assert_one_line_error(code, err, *words)
+    assert not out.exists() and stdout == ""
+
+
+def test_synth_refuses_unknown_outputs_and_missing_references(tmp_path, capsys, references):
+    code, _, err = run(["synth", *REQUEST, "-o", str(tmp_path / "m.stl"), "--references", references], capsys)
+    assert_one_line_error(code, err, ".blend, .glb, .obj or .json")
+    code, _, err = run(["synth", *REQUEST, "-o", str(tmp_path / "m.json"), "--references", str(tmp_path / "no")],
+                       capsys)
+    assert_one_line_error(code, err, "does not exist")
+
+
+def test_synth_warns_outside_L(tmp_path, capsys, references):
+    request = REQUEST.copy()
+    request[1] = "180"
+    code, _, err = run(["synth", *request, "-o", str(tmp_path / "m.json"), "--references", references], capsys)
+    assert code == 0
+    assert "warning: He = 180 cm is outside the reference range 148-171 cm by 9 cm" in err
+
+
+def test_synth_blender_formats_with_cushions(tmp_path, capsys, references):
+    reference = synthetic.make_reference_set()
+    pairs = len(reference.topology.cushion_pairs)
+    singles = sum(1 for p in reference.topology if not p.partner)
+    for kind in ("blend", "glb", "obj"):
+        out = tmp_path / f"m.{kind}"
+        code, stdout, err = run(["synth", *REQUEST, "--cushions", "-o", str(out), "--references", references], capsys)
+        assert code == 0, err
+        assert stdout.startswith(f"wrote {out}") and stdout.count("\n") == 1  # Blender's chatter went to stderr
+        assert out.stat().st_size > 1000
+        assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary left over
+    assert (tmp_path / "m.glb").read_bytes()[:4] == b"glTF"
+    objects = [line for line in (tmp_path / "m.obj").read_text().splitlines() if line.startswith("o ")]
+    assert len(objects) == pairs + singles
+    code, stdout, _ = run(["measure", str(tmp_path / "m.blend"), "--json"], capsys)
+    assert code == 0 and json.loads(stdout) == pytest.approx(VALUES, rel=1e-4)
+    bpy.ops.wm.open_mainfile(filepath=str(tmp_path / "m.blend"))
+    cushions = [o for o in bpy.data.objects if o.ellimann.kind == "CUSHION"]
+    assert len(cushions) == pairs
+    hidden = [o for o in bpy.data.objects if o.ellimann.kind == "ELLIPSOID" and o.hide_get()]
+    assert len(hidden) == 2 * pairs
+
+
+# ------------------------------------------------------------------------------------------------ measure
+
+
+def test_measure_json_prints_exactly_the_dict(tmp_path, capsys, references):
+    out = tmp_path / "m.json"
+    run(["synth", *REQUEST, "-o", str(out), "--references", references], capsys)
+    code, stdout, err = run(["measure", str(out), "--json"], capsys)
+    assert code == 0 and err == ""
+    data = json.loads(stdout)
+    assert stdout == json.dumps(data) + "\n" and list(data) == list(MEASUREMENTS)
+    code, stdout, _ = run(["measure", str(out)], capsys)
+    assert code == 0 and "Height" in stdout and "165.00 cm" in stdout
+
+
+def test_measure_refuses_what_it_cannot_read(tmp_path, capsys):
+    code, _, err = run(["measure", str(tmp_path / "none.json")], capsys)
+    assert_one_line_error(code, err, "no such file")
+    (tmp_path / "bad.json").write_text("{not json")
+    code, _, err = run(["measure", str(tmp_path / "bad.json")], capsys)
+    assert_one_line_error(code, err, "not valid JSON")
+    (tmp_path / "m.txt").write_text("x")
+    code, _, err = run(["measure", str(tmp_path / "m.txt")], capsys)
+    assert_one_line_error(code, err, ".json or .blend")
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "empty.blend"))
+    code, _, err = run(["measure", str(tmp_path / "empty.blend"), "--json"], capsys)
+    assert_one_line_error(code, err, "no ElliMann mannequin")
+
+
+# ------------------------------------------------------------------------------------------------ batch
+
+
+def write_csv(path, rows, header=("He", "Sh", "Br", "Wa", "Hi", "name")):
+    with open(path, "w", newline="") as stream:
+        writer = csv.writer(stream)
+        writer.writerow(header)
+        writer.writerows(rows)
+    return str(path)
+
+
+GOOD_ROWS = [
+    (159, 43, 117, 104, 117, "average"),
+    (153.75, 35.75, 101.25, 102.5, 134.75, "t1"),
+    (165.25, 47.25, 135.75, 122.25, 117.5, ""),
+]
+
+
+def read_report(path):
+    with open(path, newline="") as stream:
+        return list(csv.DictReader(stream))
+
+
+def test_batch_skips_bad_rows_and_reports_everything(tmp_path, capsys, references):
+    rows = GOOD_ROWS[:2] + [(160, 40, "abc", 90, 100, "bad_number"), (500, 40, 100, 90, 100, "absurd"),
+                            (160, 40, 100, 90, 100, "t1"), (160, 40, 100, 90, 100, "no/slash")] + GOOD_ROWS[2:]
+    source = write_csv(tmp_path / "in.csv", rows)
+    out = tmp_path / "out"
+    code, stdout, err = run(["batch", source, "-o", str(out), "--format", "json,blend", "--references", references],
+                            capsys)
+    assert code == 1
+    assert "line 4: skipped: Br: 'abc' is not a number" in err
+    assert "line 5: skipped: He: 500 cm is not a plausible value" in err
+    assert "line 6: skipped: name: 't1' is already used on line 3" in err
+    assert "line 7: skipped: name:" in err
+    assert "3/3" in err  # progress
+    assert "3 of 7 mannequins written" in stdout
+    report = read_report(out / "report.csv")
+    assert [r["line"] for r in report] == ["2", "3", "4", "5", "6", "7", "8"]
+    assert [r["status"] for r in report] == ["ok", "ok", "error", "error", "error", "error", "ok"]
+    assert report[-1]["name"] == "row-00007"
+    for row in (r for r in report if r["status"] == "ok"):
+        mannequin = Mannequin.load(out / f"{row['name']}.json")
+        for key in MEASUREMENTS:
+            assert float(row[f"{key}_measured"]) == pytest.approx(mannequin.measure()[key], abs=1e-3)
+            assert float(row[f"{key}_error_pct"]) < 0.01
+        assert (out / f"{row['name']}.blend").is_file()
+        assert row["files"].split() == [str(out / f"{row['name']}.json"), str(out / f"{row['name']}.blend")]
+    assert not (out / "bad_number.json").exists() and not (out / "absurd.json").exists()
+
+
+def test_batch_shards_partition_the_rows(tmp_path, capsys, references):
+    rows = [(150 + i, 40, 110, 95, 110, f"m{i:02d}") for i in range(10)]
+    source = write_csv(tmp_path / "in.csv", rows)
+    out = tmp_path / "out"
+    seen = []
+    for shard in (1, 2, 3):
+        code, stdout, _ = run(["batch", source, "-o", str(out), "--shard", f"{shard}/3", "--mode", "idw",
+                               "--references", references], capsys)
+        assert code == 0 and f"shard {shard}/3 of 10 rows" in stdout
+        seen.append({r["name"] for r in read_report(out / f"report-{shard}-of-3.csv")})
+    assert set().union(*seen) == {r[-1] for r in rows}
+    assert sum(len(s) for s in seen) == 10
+    assert not (out / "report.csv").exists()
+
+
+@pytest.mark.parametrize("header, extra, words", [
+    (("He", "Sh", "Br", "Hi"), [], ("lacks column(s) Wa",)),
+    (("He", "Sh", "Br", "Wa", "Hi"), ["--shard", "4/3"], ("--shard must be I/N",)),
+    (("He", "Sh", "Br", "Wa", "Hi"), ["--format", "blend,stl"], ("--format",)),
+])
+def test_batch_refuses_bad_files_and_options(tmp_path, capsys, references, header, extra, words):
+    source = write_csv(tmp_path / "in.csv", [(159, 43, 117, 104, 117)[:len(header)]], header)
+    code, _, err = run(["batch", source, "-o", str(tmp_path / "out"), *extra, "--references", references], capsys)
+    assert_one_line_error(code, err, *words)
+    code, _, err = run(["batch", str(tmp_path / "missing.csv"), "-o", str(tmp_path / "out")], capsys)
+    assert_one_line_error(code, err, "missing.csv")
+
+
+def test_batch_header_is_case_insensitive_and_extra_columns_are_ignored(tmp_path, capsys, references):
+    source = write_csv(tmp_path / "in.csv", [(1, 159, 43, 117, 104, 117)], ("id", "he", "SH", "Br", "wa", "Hi"))
+    code, _, err = run(["batch", source, "-o", str(tmp_path / "out"), "--references", references], capsys)
+    assert code == 0, err
+    assert (tmp_path / "out" / "row-00001.json").is_file()
+
+
+# ------------------------------------------------------------------------------------------------ demo
+
+
+def test_demo_writes_files_report_and_lineup(tmp_path, capsys, references):
+    out = tmp_path / "demo"
+    code, stdout, err = run(["demo", "-o", str(out), "--references", references], capsys)
+    assert code == 0, err
+    for i in range(1, 11):
+        assert (out / f"table_2_5_{i:02d}.blend").is_file()
+        assert Mannequin.load(out / f"table_2_5_{i:02d}.json").measurements is not None
+    report = read_report(out / "report.csv")
+    assert len(report) == 10 and all(float(r["Br_error_pct"]) < 0.01 for r in report)
+    markdown = (out / "report.md").read_text()
+    assert "| 10 | 165.25 | 47.25 | 135.75 | 122.25 | 117.5 |" in markdown and "max, IDW" in markdown
+    assert (out / "lineup.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "10 mannequins" in stdout

@@ -1,0 +1,84 @@
+"""glTF export keeps piece names and measurements in extras, exports only the mannequin, writes atomically."""
+
+import bpy
+import numpy as np
+import pytest
+
+from ellimann_addon.blender import convert
+from ellimann_addon.blender.export import EXTRAS_KEY, export_gltf, read_glb_json
+from ellimann_addon.core.constants import MEASUREMENTS
+from ellimann_addon.core.errors import ElliMannError, MannequinError
+from ellimann_addon.core.quaternion import quaternion_to_rotation
+
+# glTF is Y-up: Blender's exporter maps (x, y, z) -> (x, z, -y).
+Z_UP_FROM_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+
+
+@pytest.fixture
+def mannequin(toy):
+    toy.measurements = {"He": 161.0, "Sh": 48.0, "Br": 86.0, "Wa": 70.0, "Hi": 88.0}
+    return toy
+
+
+def test_pieces_keep_names_parts_and_frames(mannequin, tmp_path):
+    collection = convert.mannequin_to_collection(mannequin)
+    stranger = bpy.data.objects.new("not a part", None)
+    bpy.context.scene.collection.objects.link(stranger)
+    path = export_gltf(collection, tmp_path / "toy.glb")
+    doc = read_glb_json(path)
+    nodes = {n["name"]: n for n in doc["nodes"]}
+    assert set(nodes) == set(mannequin.topology.names)  # only the mannequin's pieces
+    assert len(doc["meshes"]) == 1  # one shared unit sphere: the node transform is the ellipsoid
+    for i, part in enumerate(mannequin.topology):
+        node = nodes[part.name]
+        extras = node["extras"][EXTRAS_KEY]
+        assert (extras["part"], extras["side"], extras["region"], extras["girth"], extras["partner"]) == (
+            part.name, part.side, part.region, part.girth, part.partner)
+        assert extras["depends"] == [m for m in MEASUREMENTS if m in part.depends]
+        assert np.allclose(extras["center_m"], mannequin.center[i], atol=1e-6)
+        assert np.allclose(np.array(extras["axes"]).T, mannequin.rotation[i], atol=1e-6)
+        assert np.allclose(extras["semi_axes_m"], mannequin.semi_axes[i], rtol=1e-6)
+        # The node's own TRS, brought back to Z-up, is the same ellipsoid.
+        x, y, z, w = node.get("rotation", (0.0, 0.0, 0.0, 1.0))  # glTF leaves out defaults
+        scale = node.get("scale", (1.0, 1.0, 1.0))
+        linear = Z_UP_FROM_Y_UP @ (quaternion_to_rotation([w, x, y, z]) * scale) @ Z_UP_FROM_Y_UP.T
+        expected = mannequin.rotation[i] * mannequin.semi_axes[i]
+        assert np.allclose(linear, expected, atol=1e-6)
+        assert np.allclose(Z_UP_FROM_Y_UP @ node.get("translation", (0.0, 0.0, 0.0)), mannequin.center[i], atol=1e-6)
+
+
+def test_measurements_travel_in_the_scene_extras(mannequin, tmp_path):
+    collection = convert.mannequin_to_collection(mannequin)
+    doc = read_glb_json(export_gltf(collection, tmp_path / "toy.glb"))
+    scene = doc["scenes"][doc.get("scene", 0)]
+    extras = scene["extras"][EXTRAS_KEY]
+    assert extras["format"] == "ellimann.gltf-extras" and extras["version"] == 1
+    assert extras["name"] == collection.name and extras["role"] == mannequin.role
+    assert extras["target_cm"] == pytest.approx(mannequin.measurements)
+    assert extras["measured_cm"] == pytest.approx(mannequin.measure(), rel=1e-5)
+
+
+def test_export_leaves_no_trace_in_the_file(mannequin, tmp_path):
+    collection = convert.mannequin_to_collection(mannequin)
+    first = collection.objects[0]
+    first[EXTRAS_KEY] = "the user's own value"
+    export_gltf(collection, tmp_path / "toy.glb")
+    assert first[EXTRAS_KEY] == "the user's own value"
+    assert all(EXTRAS_KEY not in o for o in collection.objects if o is not first)
+    assert EXTRAS_KEY not in collection
+    assert [p.name for p in tmp_path.iterdir()] == ["toy.glb"]  # no temporary file left
+
+
+def test_bad_input_writes_nothing(mannequin, tmp_path):
+    collection = convert.mannequin_to_collection(mannequin)
+    with pytest.raises(ElliMannError, match="glb"):
+        export_gltf(collection, tmp_path / "toy.gltf")
+    target = tmp_path / "toy.glb"
+    target.write_bytes(b"previous")
+    obj = next(o for o in collection.objects if o.ellimann.part_name == "3.a Pelvis")
+    obj.scale.x = -obj.scale.x  # a left-handed frame is not an ellipsoid
+    with pytest.raises(MannequinError, match="3.a Pelvis"):
+        export_gltf(collection, target)
+    assert target.read_bytes() == b"previous"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["toy.glb"]
+    assert all(EXTRAS_KEY not in o for o in collection.objects)

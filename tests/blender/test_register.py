@@ -1,0 +1,37 @@
+"""Enable -> disable -> enable in this process leaves nothing behind and works again."""
+
+import bpy
+
+import ellimann_addon
+from ellimann_addon.blender import menus, operators, panels, props
+
+
+def all_classes():
+    return list(props.classes) + operators.classes() + list(panels.classes) + [menus.ELLIMANN_MT_object]
+
+
+def leftovers():
+    """Everything of ElliMann still registered with Blender."""
+    found = [name for name in dir(bpy.types) if name.startswith("ELLIMANN")]
+    found += [cls.__name__ for cls in all_classes() if cls.is_registered]
+    found += [f"{owner.__name__}.ellimann" for owner in (bpy.types.Object, bpy.types.Collection, bpy.types.Scene)
+              if hasattr(owner, "ellimann")]
+    found += [f"bpy.ops.ellimann.{name}" for name in dir(bpy.ops.ellimann) if not name.startswith("_")]
+    found += [f"{menu} entry" for menu, draw in menus.MENU_ENTRIES
+              if draw in getattr(bpy.types, menu)._dyn_ui_initialize()]
+    return found
+
+
+def test_disable_leaves_nothing_and_enable_works_again():
+    assert len(all_classes()) == 2 + 12 + 6 + 1
+    assert not [c.__name__ for c in all_classes() if not c.is_registered]
+    assert {"Object.ellimann", "bpy.ops.ellimann.fit_ellipsoid", "VIEW3D_MT_add entry"} <= set(leftovers())
+    ellimann_addon.unregister()
+    try:
+        assert leftovers() == []
+    finally:
+        ellimann_addon.register()
+    assert not [c.__name__ for c in all_classes() if not c.is_registered]
+    bpy.ops.ellimann.new_mannequin(name="Again")
+    assert bpy.ops.ellimann.add_ellipsoid() == {"FINISHED"}
+    assert bpy.data.collections["Again"].ellimann.is_mannequin

@@ -1,0 +1,192 @@
+"""Procedural garments: clean meshes, sized from the measurements, starting clear of the body."""
+
+import numpy as np
+import pytest
+
+from devkit.poses import make_apose_toy
+from devkit.toy import make_toy_mannequin
+from ellimann_addon.core import garments, mesh
+from ellimann_addon.core.constants import SECTION_FRACTIONS
+from ellimann_addon.core.errors import ElliMannError, MeasurementError
+from ellimann_addon.core.fit_metrics import mannequin_signed_distance
+from ellimann_addon.core.measure import section_heights
+
+
+@pytest.fixture(scope="module")
+def body():
+    return make_apose_toy()
+
+
+@pytest.fixture(scope="module")
+def dress(body):
+    return garments.tube_dress(body)
+
+
+@pytest.fixture(scope="module")
+def shirt(body):
+    return garments.t_shirt(body)
+
+
+def boundary_loops(faces):
+    """Number of boundary loops of a mesh whose directed edges are unique (else AssertionError)."""
+    directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    assert len(np.unique(directed, axis=0)) == len(directed), "an edge is used twice in one direction"
+    edges = {tuple(e) for e in directed.tolist()}
+    boundary = {a: b for a, b in edges if (b, a) not in edges}
+    assert len(set(boundary.values())) == len(boundary), "a boundary vertex is passed twice"
+    loops, seen = 0, set()
+    for start in boundary:
+        if start in seen:
+            continue
+        loops += 1
+        v = start
+        while v not in seen:
+            seen.add(v)
+            v = boundary[v]
+    return loops
+
+
+def components(faces, count):
+    parent = np.arange(count)
+
+    def find(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for a, b, c in faces.tolist():
+        for u, v in ((a, b), (b, c)):
+            parent[find(u)] = find(v)
+    return len({find(i) for i in np.unique(faces)})
+
+
+def girth_at(garment, height, panels=(0,)):
+    """Perimeter (cm) of the garment's section at a height, over the given panels' faces."""
+    faces = garment.faces[np.isin(garment.panel[garment.faces[:, 0]], panels)]
+    points = mesh.plane_section_points(garment.vertices, faces, height)
+    return mesh.polygon_perimeter(mesh.convex_hull_2d(points)) * 100.0
+
+
+def section_z(mannequin, key):
+    bottom, height, _ = section_heights(mannequin.rotation, mannequin.center, mannequin.semi_axes)
+    return bottom + SECTION_FRACTIONS[key] * height
+
+
+def test_dress_is_an_open_tube_with_outward_normals(dress, body):
+    assert dress.vertices.shape[1] == 3 and dress.faces.min() >= 0
+    assert mesh.euler_characteristic(dress.vertices, dress.faces) == 0
+    assert boundary_loops(dress.faces) == 2  # top edge and hem
+    assert components(dress.faces, len(dress.vertices)) == 1
+    assert len(dress.seams) == 0  # the back seam is welded
+    top = dress.vertices[:, 2].max()
+    assert set(dress.pins.tolist()) == set(np.nonzero(np.isclose(dress.vertices[:, 2], top))[0].tolist())
+    tri = dress.vertices[dress.faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    radial = tri.mean(axis=1)[:, :2] - np.array([0.0, 0.0])
+    assert np.all(np.einsum("ij,ij->i", normal[:, :2], radial) > 0)  # a tube round the z axis: outward
+
+
+def test_garments_start_clear_of_the_body(dress, shirt, body):
+    for garment in (dress, shirt):
+        d, names = mannequin_signed_distance(garment.vertices, body)
+        assert d.min() >= 0.5 * garments.MIN_CLEARANCE, f"{garment.name} touches {names[int(np.argmin(d))]}"
+
+
+def test_dress_girth_covers_the_body_and_follows_the_pattern(dress, body):
+    measured = body.measure()
+    width = dress.pattern["width_cm"]
+    assert width >= max(measured["Br"], measured["Hi"]) * 1.06 - 1e-9
+    for key in ("Br", "Hi", "Wa"):
+        z = section_z(body, key)
+        if dress.vertices[:, 2].min() <= z <= dress.vertices[:, 2].max():
+            g = girth_at(dress, z)
+            assert g >= measured[key]
+            assert g == pytest.approx(width, rel=0.01)  # rings are the pattern width, unstretched
+    bottom, height, _ = section_heights(body.rotation, body.center, body.semi_axes)
+    assert dress.vertices[:, 2].min() == pytest.approx(bottom + 0.38 * height)
+    assert dress.vertices[:, 2].max() == pytest.approx(bottom + dress.pattern["top"] * height)
+
+
+def test_dress_width_scales_with_the_measurements(body):
+    base = body.measure()
+    widths = []
+    for factor in (1.2, 1.4):
+        sizes = {k: v * factor for k, v in base.items()}
+        g = garments.tube_dress(body, measurements=sizes)
+        assert not g.pattern["enlarged"]
+        widths.append(g.pattern["width_cm"])
+        assert g.pattern["width_cm"] == pytest.approx(max(sizes["Br"], sizes["Hi"]) * 1.06)
+        assert girth_at(g, section_z(body, "Hi")) == pytest.approx(g.pattern["width_cm"], rel=0.01)
+    assert widths[1] / widths[0] == pytest.approx(1.4 / 1.2)
+
+
+def test_garments_scale_with_the_body(body):
+    big = body.copy(center=body.center * 1.1, semi_axes=body.semi_axes * 1.1)
+    for make in (garments.tube_dress, garments.t_shirt):
+        small_g, big_g = make(body), make(big)
+        span = np.ptp(small_g.vertices, axis=0)
+        assert np.ptp(big_g.vertices, axis=0) == pytest.approx(span * 1.1, rel=0.05)
+
+
+def test_shirt_pieces_are_manifold_and_sewn_where_expected(shirt, body):
+    v, f = shirt.vertices, shirt.faces
+    # Body: the hem, and one loop round both armholes, shoulders and neck; each sleeve: two ends.
+    assert boundary_loops(f) == 2 + 2 + 2
+    assert components(f, len(v)) == 3  # body, left sleeve, right sleeve
+    assert shirt.panel_names == ("body", "front yoke", "back yoke", "left sleeve", "right sleeve")
+    seams = shirt.seams
+    assert seams.min() >= 0 and seams.max() < len(v) and np.all(seams[:, 0] != seams[:, 1])
+    kinds = {tuple(sorted(shirt.panel[s])) for s in seams.tolist()}
+    assert (1, 2) in kinds  # shoulder seams join the front and back yokes
+    assert {(0, 3), (1, 3), (2, 3), (0, 4), (1, 4), (2, 4)} & kinds  # sleeves join the armholes
+    for sleeve in (3, 4):
+        pairs = seams[(shirt.panel[seams[:, 0]] == sleeve) | (shirt.panel[seams[:, 1]] == sleeve)]
+        assert len(np.unique(pairs[:, 0])) == len(pairs) == len(np.unique(pairs[:, 1]))  # one-to-one
+    gap = np.linalg.norm(v[seams[:, 0]] - v[seams[:, 1]], axis=1)
+    assert gap.max() < 0.2  # seams start a few cm apart: sewing closes them, it does not move panels
+    # The shoulder seams stay outside the neck opening.
+    shoulder = seams[shirt.panel[seams[:, 0]] == 1]
+    assert np.all(np.abs(v[shoulder[:, 0], 0]) >= shirt.pattern["neck_width_cm"] / 200.0 - 1e-9)
+
+
+def test_shirt_girths_cover_the_body_with_ease(shirt, body):
+    measured = body.measure()
+    assert set(shirt.pattern["girth_cm"]) == {"Br", "Wa", "Hi"}  # all three lines lie below the armpit
+    for key, pattern in shirt.pattern["girth_cm"].items():
+        assert pattern == pytest.approx(measured[key] * 1.08)  # the pattern: the measurement plus ease
+        g = girth_at(shirt, section_z(body, key))
+        assert measured[key] < g <= pattern
+        assert g == pytest.approx(pattern, rel=0.002)  # a ring of the pattern's girth, less its chords
+
+
+def test_shirt_sizes_scale_with_the_measurements(body):
+    base = body.measure()
+    sizes = {k: v * 1.3 for k, v in base.items()}
+    g = garments.t_shirt(body, measurements=sizes)
+    for key, value in g.pattern["girth_cm"].items():
+        assert value == pytest.approx(sizes[key] * 1.08, rel=1e-6)
+
+
+def test_arms_hanging_at_the_hips_shorten_the_dress_instead_of_piercing_them():
+    toy = make_toy_mannequin()  # its hands rest against the hips
+    g = garments.tube_dress(toy)
+    assert g.pattern["top"] < 0.75
+    d, _ = mannequin_signed_distance(g.vertices, toy)
+    assert d.min() >= 0.5 * garments.MIN_CLEARANCE
+
+
+def test_bad_input_is_refused(body):
+    with pytest.raises(ElliMannError, match="ease"):
+        garments.tube_dress(body, ease=-0.1)
+    with pytest.raises(ElliMannError, match="edge"):
+        garments.t_shirt(body, edge=0.0)
+    with pytest.raises(ElliMannError, match="hem"):
+        garments.tube_dress(body, top=0.4, hem=0.5)
+    with pytest.raises(MeasurementError, match="target"):
+        garments.tube_dress(body, measurements="target")  # the toy has no target measurements
+    with pytest.raises(MeasurementError, match="Hi"):
+        garments.t_shirt(body, measurements={"He": 160, "Sh": 40, "Br": 90, "Wa": 70})
+    target = body.copy(measurements={"He": 161.0, "Sh": 49.0, "Br": 90.0, "Wa": 70.0, "Hi": 95.0})
+    assert garments.tube_dress(target, measurements="target").pattern["requested_width_cm"] == \
+        pytest.approx(95.0 * 1.06)

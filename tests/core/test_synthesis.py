@@ -1,0 +1,338 @@
+"""Synthesis F: segmented IDW (paper Eq. 2.1) and the exact refinement, on the synthetic reference set and,
+when ``reference_blends/`` holds them, on the shipped Reference Mannequins too."""
+
+import itertools
+import json
+import os
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from devkit import synthetic
+from ellimann_addon.core import synthesis
+from ellimann_addon.core.clean import asymmetry
+from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, quartile_points
+from ellimann_addon.core.ellipsoid import shape_matrix
+from ellimann_addon.core.errors import MeasurementError, ReferenceSetError
+from ellimann_addon.core.frames import is_rotation
+from ellimann_addon.core.mannequin import Mannequin
+
+SETS = ["synthetic"] + (["shipped"] if all((synthesis.REFERENCE_FOLDER / f"{n}.json").is_file()
+                                           for n in synthesis.REFERENCE_NAMES) else [])
+GRID = np.array(list(itertools.product(*[quartile_points(k) for k in MEASUREMENTS])))
+
+
+@pytest.fixture(scope="module", params=SETS)
+def reference(request):
+    if request.param == "shipped":
+        return synthesis.load_reference_set()
+    return synthetic.make_reference_set()
+
+
+def random_requests(seed, count, widen=0.0):
+    rng = np.random.default_rng(seed)
+    low = np.array([RANGES[k][0] for k in MEASUREMENTS])
+    high = np.array([RANGES[k][1] for k in MEASUREMENTS])
+    span = high - low
+    return rng.uniform(low - widen * span, high + widen * span, size=(count, 5))
+
+
+# ---------------------------------------------------------------------------------------------- IDW
+
+
+@pytest.mark.parametrize("metric", synthesis.METRICS)
+@pytest.mark.parametrize("power", [1.0, 2.0, 4.0])
+def test_each_reference_mannequin_is_reproduced_exactly(reference, metric, power):
+    result = synthesis.synthesize_batch(reference, reference.measurements, metric=metric, power=power, measure=False)
+    np.testing.assert_allclose(shape_matrix(result.rotation, result.semi_axes),
+                               shape_matrix(reference.rotation, reference.semi_axes), atol=1e-12)
+    np.testing.assert_allclose(result.center, reference.center, atol=1e-12)
+    labelled = [i for i, name in enumerate(reference.topology.names) if name not in reference.mirror_label_mismatch]
+    np.testing.assert_allclose(result.rotation[:, labelled], reference.rotation[:, labelled], atol=1e-12)
+    np.testing.assert_allclose(result.semi_axes[:, labelled], reference.semi_axes[:, labelled], atol=1e-12)
+
+
+def test_a_part_is_exact_when_only_its_sub_space_matches_a_reference(reference):
+    """Legs depend on He and Hi: at an RM's He and Hi they are that RM's legs, whatever Sh, Br, Wa are."""
+    mask = reference.topology.dependency_mask
+    coincide = reference._coincide
+    source = reference._source
+    others = random_requests(7, 1)[0]
+    checked = 0
+    for row, part in enumerate(source):
+        for j in range(len(reference)):
+            request = np.where(mask[part], reference.measurements[j], others)
+            result = synthesis.interpolate(reference, request[None])
+            group = np.nonzero(coincide[row, j])[0]
+            if len(group) == 1:
+                np.testing.assert_allclose(result[0][0, part], reference.rotation[j, part], atol=1e-12)
+                np.testing.assert_allclose(result[1][0, part], reference.center[j, part], atol=1e-12)
+                np.testing.assert_allclose(result[2][0, part], reference.semi_axes[j, part], atol=1e-12)
+                checked += 1
+            else:  # RMs that coincide in this sub-space: the result mixes only them
+                weights = synthesis.idw_weights(reference, request[None])[0, row]
+                assert weights[group].sum() == pytest.approx(1.0, abs=1e-12)
+    assert checked > 0
+
+
+def test_parts_shared_by_coinciding_references_are_continuous(reference):
+    """He-only parts cannot tell Small Slim from Small Chubby (both He = 148): approaching the point
+    where they meet changes the result continuously."""
+    base = reference.measurements[0].copy()
+    base[1:] = [RANGES[k][0] + 0.3 * (RANGES[k][1] - RANGES[k][0]) for k in MEASUREMENTS[1:]]
+    near = base + np.array([1e-7, 0, 0, 0, 0])
+    a = synthesis.interpolate(reference, base[None])
+    b = synthesis.interpolate(reference, near[None])
+    for x, y in zip(a, b):
+        assert np.abs(x - y).max() < 1e-6
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 10_000), metric=st.sampled_from(synthesis.METRICS),
+       power=st.floats(synthesis.POWER_LIMITS[0], synthesis.POWER_LIMITS[1]))
+def test_weights_are_non_negative_and_sum_to_one(seed, metric, power):
+    reference = _SYNTHETIC
+    requests = np.concatenate([random_requests(seed, 8, widen=0.5), reference.measurements[seed % 5][None]])
+    weights = synthesis.idw_weights(reference, requests, metric, power)
+    assert np.all(weights >= 0.0)
+    np.testing.assert_allclose(weights.sum(axis=-1), 1.0, atol=1e-12)
+
+
+_SYNTHETIC = synthetic.make_reference_set()
+
+
+@pytest.mark.parametrize("metric", synthesis.METRICS)
+def test_results_stay_within_the_references_and_are_valid_symmetric_mannequins(reference, metric):
+    requests = random_requests(3, 40, widen=0.3)
+    result = synthesis.synthesize_batch(reference, requests, metric=metric, measure=False)
+    tol = 1e-12
+    for array, stack in ((result.center, reference.center), (result.semi_axes, reference.semi_axes)):
+        assert np.all(array >= stack.min(axis=0) - tol)
+        assert np.all(array <= stack.max(axis=0) + tol)
+    assert np.all(is_rotation(result.rotation, tol=1e-9))
+    for i in range(len(result)):
+        mannequin = result.mannequin(i)
+        assert mannequin.problems() == []
+        assert asymmetry(mannequin) < 1e-12
+
+
+def test_rotations_are_averaged_then_projected():
+    """Between two references only, the rotation mean is the projected weighted sum (closed form check)."""
+    reference = _SYNTHETIC
+    request = (reference.measurements[0] + reference.measurements[1]) / 2
+    weights = synthesis.idw_weights(reference, request[None])[0]
+    rotation, _, _ = synthesis.interpolate(reference, request[None])
+    part = reference._source[0]
+    summed = np.einsum("k,kij->ij", weights[0], reference.rotation[:, part])
+    u, _, vt = np.linalg.svd(summed)
+    np.testing.assert_allclose(rotation[0, part], u @ vt, atol=1e-12)
+
+
+def test_single_synthesis_matches_the_batch_and_names_the_mannequin(reference):
+    request = dict(zip(MEASUREMENTS, (159.0, 43.0, 117.0, 104.0, 117.0)))
+    mannequin, measured, warnings = synthesis.synthesize(reference, request)
+    batch = synthesis.synthesize_batch(reference, [list(request.values())])
+    np.testing.assert_array_equal(mannequin.center, batch.center[0])
+    assert mannequin.name == "ElliMann 159-43-117-104-117"
+    assert mannequin.role == "synthesized" and mannequin.measurements == request
+    assert measured == pytest.approx(dict(zip(MEASUREMENTS, batch.measured[0])))
+    assert warnings == []
+
+
+# ---------------------------------------------------------------------------------------------- exact mode
+
+
+def test_exact_mode_meets_its_target_on_a_sample_of_the_grid(reference):
+    sample = GRID[np.random.default_rng(5).choice(len(GRID), 24, replace=False)]
+    idw = synthesis.synthesize_batch(reference, sample)
+    exact = synthesis.synthesize_batch(reference, sample, mode="exact")
+    error = exact.relative_error()
+    assert error.mean(axis=0).max() <= 0.1
+    assert error.max() <= 0.5
+    assert exact.converged.all()
+    # Refinement keeps the frames and the symmetry, and only scales (no part flips or collapses).
+    np.testing.assert_array_equal(exact.rotation, idw.rotation)
+    assert np.all(exact.semi_axes > 0)
+    assert np.all((exact.factors >= synthesis.FACTOR_LIMITS[0]) & (exact.factors <= synthesis.FACTOR_LIMITS[1]))
+    for i in range(0, len(sample), 6):
+        assert asymmetry(exact.mannequin(i)) < 1e-12
+
+
+def test_exact_mode_changes_nothing_when_m_T_already_matches(reference):
+    """At an RM's own m_T the refinement has nothing to do: the result is that RM."""
+    measured = synthesis.tailor_measurements(reference.rotation, reference.center, reference.semi_axes,
+                                             reference.topology.girth_mask)
+    # IDW at the RM's nominal point gives the RM; ask exact mode for what that RM measures.
+    rotation, center, semi_axes = synthesis.interpolate(reference, reference.measurements)
+    result = synthesis.refine(reference.topology, rotation, center, semi_axes, measured)
+    assert result.iterations == 0
+    np.testing.assert_allclose(result.center, reference.center, atol=1e-12)
+    np.testing.assert_array_equal(result.factors, 1.0)
+
+
+def test_an_unreachable_measurement_stops_at_the_factor_limit_without_spoiling_the_others():
+    request = [[159.0, 43.0, 250.0, 104.0, 117.0]]  # Br far outside L: would need the chest doubled
+    idw = synthesis.synthesize_batch(_SYNTHETIC, request)
+    exact = synthesis.synthesize_batch(_SYNTHETIC, request, mode="exact")
+    assert not exact.converged[0]
+    assert exact.factors[0, 2] == pytest.approx(synthesis.FACTOR_LIMITS[1])
+    assert exact.relative_error()[0, 2] < idw.relative_error()[0, 2]
+    others = [0, 1, 3, 4]
+    assert exact.relative_error()[0, others].max() < 100 * synthesis.EXACT_TOLERANCE
+    _, _, warnings = synthesis.synthesize(_SYNTHETIC, request[0], mode="exact")
+    assert warnings[-1].startswith("exact mode did not fully converge: Br is off by")
+
+
+def test_refinement_responds_to_each_measurement_in_its_own_neighbourhood():
+    reference = _SYNTHETIC
+    rotation, center, semi_axes = synthesis.interpolate(reference, reference.measurements[4:5])
+    girth = reference.topology.girth_mask
+    measured = synthesis.tailor_measurements(rotation, center, semi_axes, girth)
+    basis = synthesis._deform_basis(reference.topology, rotation, center, semi_axes, measured)
+    for k, key in enumerate(MEASUREMENTS):
+        factors = np.ones((1, 5))
+        factors[0, k] = 1.02
+        c, d = synthesis.deform(basis, center, semi_axes, factors)
+        ratio = synthesis.tailor_measurements(rotation, c, d, girth)[0] / measured[0]
+        assert ratio[k] == pytest.approx(1.02, abs=0.01), key  # its own measurement follows the factor
+        assert np.abs(ratio - 1.0).max() == pytest.approx(abs(ratio[k] - 1.0)), key  # and moves most
+
+
+# ---------------------------------------------------------------------------------------------- requests
+
+
+GOOD = {"He": 159.0, "Sh": 43.0, "Br": 117.0, "Wa": 104.0, "Hi": 117.0}
+
+
+@pytest.mark.parametrize("field, value, words", [
+    ("He", float("nan"), "finite"),
+    ("Sh", float("inf"), "finite"),
+    ("Br", 0.0, "> 0"),
+    ("Wa", -5.0, "> 0"),
+    ("Hi", "abc", "number"),
+    ("He", None, "number"),
+    ("Br", True, "number"),
+    ("He", 500.0, "plausible"),
+    ("Sh", 5.0, "plausible"),
+])
+def test_bad_requests_are_refused_naming_the_field_and_the_range(field, value, words):
+    request = dict(GOOD, **{field: value})
+    with pytest.raises(MeasurementError) as info:
+        synthesis.validate_request(request)
+    assert info.value.field == field
+    assert words in str(info.value)
+    low, high = ABSURD_LIMITS[field]
+    assert f"{low:g}-{high:g} cm" in str(info.value)
+
+
+def test_missing_unknown_and_short_requests_are_refused():
+    with pytest.raises(MeasurementError, match="Wa: is missing") as info:
+        synthesis.validate_request({k: v for k, v in GOOD.items() if k != "Wa"})
+    assert info.value.field == "Wa"
+    with pytest.raises(MeasurementError, match="Neck"):
+        synthesis.validate_request(dict(GOOD, Neck=30.0))
+    with pytest.raises(MeasurementError) as info:
+        synthesis.validate_request([159.0, 43.0, 117.0])
+    assert info.value.field == "Wa"
+    with pytest.raises(MeasurementError, match="row 1") as info:
+        synthesis.validate_requests([list(GOOD.values()), [159.0, 43.0, float("nan"), 104.0, 117.0]])
+    assert info.value.field == "Br"
+
+
+def test_values_outside_L_are_allowed_with_a_warning_saying_how_far():
+    warnings = synthesis.validate_request(dict(GOOD, He=175.0, Wa=60.0))
+    assert len(warnings) == 2
+    assert warnings[0].startswith("He = 175 cm is outside the reference range 148-171 cm by 4 cm")
+    assert warnings[1].startswith("Wa = 60 cm is outside the reference range 63-142 cm by 3 cm")
+    assert synthesis.validate_request(GOOD) == []
+
+
+def test_bad_options_are_refused():
+    for options in ({"mode": "magic"}, {"metric": "manhattan"}, {"power": 0.0}, {"power": float("nan")}):
+        with pytest.raises(synthesis.ElliMannError):
+            synthesis.synthesize_batch(_SYNTHETIC, [list(GOOD.values())], **options)
+
+
+# ---------------------------------------------------------------------------------------------- loading
+
+
+@pytest.fixture
+def folder(tmp_path):
+    return synthetic.write_reference_folder(tmp_path / "rm")
+
+
+def test_load_reference_set_reads_the_five_files(folder):
+    loaded = synthesis.load_reference_set(folder)
+    built = _SYNTHETIC
+    assert loaded.names == list(synthesis.REFERENCE_NAMES)
+    np.testing.assert_array_equal(loaded.measurements, built.measurements)
+    np.testing.assert_allclose(loaded.center, built.center, atol=1e-15)
+
+
+def _edit(path, change):
+    data = json.loads(path.read_text())
+    change(data)
+    path.write_text(json.dumps(data))
+
+
+def test_a_missing_file_is_named(folder):
+    (folder / "tall_slim.json").unlink()
+    with pytest.raises(ReferenceSetError, match=r"tall_slim\.json: file is missing"):
+        synthesis.load_reference_set(folder)
+
+
+def test_a_topology_mismatch_is_named(folder):
+    _edit(folder / "average.json", lambda d: d["ellipsoids"].pop(0))
+    with pytest.raises(ReferenceSetError, match=r"average\.json: topology differs .*1\.a Head"):
+        synthesis.load_reference_set(folder)
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda d: d["measurements_cm"].pop("Br"), r"small_chubby\.json: measurements_cm\.Br is missing"),
+    (lambda d: d.update(measurements_cm=None), r"small_chubby\.json: measurements_cm is missing"),
+    (lambda d: d["measurements_cm"].update(Hi=float("nan")), r"small_chubby\.json: file cannot be read.*Hi=nan"),
+])
+def test_missing_or_invalid_measurements_are_named(folder, change, message):
+    _edit(folder / "small_chubby.json", change)
+    with pytest.raises(ReferenceSetError, match=message):
+        synthesis.load_reference_set(folder)
+
+
+def test_an_asymmetric_reference_is_refused(folder):
+    path = folder / "small_slim.json"
+    m = Mannequin.load(path)
+    m.center[m.topology.index["6.a Thigh.L"], 0] += 0.01
+    m.save(path)
+    with pytest.raises(ReferenceSetError, match=r"small_slim\.json: geometry is not symmetric"):
+        synthesis.load_reference_set(folder)
+
+
+def test_right_side_labels_follow_most_references(folder):
+    """An RM whose right-side axes carry other signs (same ellipsoid) is outvoted, and named."""
+    path = folder / "tall_chubby.json"
+    m = Mannequin.load(path)
+    i = m.topology.index["5.a Arm.R"]
+    m.rotation[i] = m.rotation[i] @ np.diag([-1.0, -1.0, 1.0])  # same ellipsoid, other axis signs
+    m.save(path)
+    reference = synthesis.load_reference_set(folder)
+    assert reference.mirror_label_mismatch == ["5.a Arm.R"]
+    result = synthesis.interpolate(reference, reference.measurements)
+    np.testing.assert_allclose(result[0][:, i], _SYNTHETIC.rotation[:, i], atol=1e-12)
+
+
+def test_cached_reference_set_reloads_when_a_file_changes(folder):
+    first = synthesis.cached_reference_set(folder)
+    assert synthesis.cached_reference_set(folder) is first
+    path = folder / "average.json"
+    m = Mannequin.load(path)
+    m.save(path)
+    stat = os.stat(path)
+    os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns + 10**9))
+    assert synthesis.cached_reference_set(folder) is not first
+
+
+def test_mannequin_name_formats_the_request():
+    name = synthesis.mannequin_name([153.75, 35.75, 101.25, 102.5, 134.75])
+    assert name == "ElliMann 153.75-35.75-101.25-102.5-134.75"

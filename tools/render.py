@@ -1,0 +1,229 @@
+"""Dev tool (not shipped): headless Workbench renders of mannequins and reference meshes to PNG.
+
+Everything is drawn in a temporary scene from linked copies of the objects (sharing their data),
+so the file being rendered is left as it was. Each *slot* is one group of solid things (mannequin
+collections or objects) with optional semi-transparent *ghosts* (e.g. the reference body it was
+traced over); several slots stand side by side along X for a line-up.
+
+    python -m tools.render trace-example --mesh BODY.obj --regions BODY_regions.json --out PNG
+    python -m tools.render mannequins A.json [B.json ...] [--ghost A.obj ...] --out PNG [--view SIDE]
+"""
+
+import argparse
+import json
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import bpy
+import numpy as np
+from mathutils import Matrix
+
+import ellimann_addon
+from ellimann_addon.blender.convert import mannequin_to_collection
+from ellimann_addon.core.fit import fit_ellipsoid
+from ellimann_addon.core.mannequin import Mannequin, Part, Topology
+
+GHOST_COLOR = (0.55, 0.55, 0.58, 0.22)
+BACKGROUND = (1.0, 1.0, 1.0)
+VIEWS = {"FRONT": 0.0, "SIDE": 90.0, "THREE_QUARTER": 35.0}  # camera turn about Z, degrees
+
+
+@dataclass
+class Slot:
+    """One place in the picture: solid collections/objects, and ghosts drawn semi-transparent, turned
+    ``turn`` degrees about the vertical (e.g. 90 for a side view next to a front view)."""
+
+    solid: list
+    ghosts: list = field(default_factory=list)
+    turn: float = 0.0
+
+
+def _objects(item):
+    objects = item.all_objects if isinstance(item, bpy.types.Collection) else [item]
+    return [o for o in objects if o.type in ("MESH", "CURVE")]
+
+
+def _copy(obj, collection, placement, color=None):
+    copy = obj.copy()  # a linked copy: shares obj.data
+    copy.parent = None
+    copy.matrix_world = placement @ obj.matrix_world
+    if color is not None:
+        copy.color = color
+    collection.objects.link(copy)
+    return copy
+
+
+def _bounds(objects):
+    points = np.concatenate([np.array(obj.bound_box) @ np.array(obj.matrix_world)[:3, :3].T
+                             + np.array(obj.matrix_world)[:3, 3] for obj in objects])
+    return points.min(axis=0), points.max(axis=0)
+
+
+def render(path, slots, resolution=(800, 1000), view="FRONT", spacing=None, margin=1.08, aa_samples="8"):
+    """Render ``slots`` (a Slot or a list of them, side by side) with Workbench to ``path`` (PNG).
+
+    ``spacing`` is the gap between slots in metres (default 15% of the widest); returns the path.
+    """
+    slots = [slots] if isinstance(slots, Slot) else list(slots)
+    scene = bpy.data.scenes.new("ElliMann render")
+    made_objects, made_data = [], []
+    try:
+        # Copy each slot centred on the origin and turned, then move the slots side by side along X.
+        placed = []
+        for slot in slots:
+            lo, hi = _bounds([o for item in slot.solid + slot.ghosts for o in _objects(item)])
+            centre = Matrix.Translation((-(lo[0] + hi[0]) / 2.0, -(lo[1] + hi[1]) / 2.0, 0.0))
+            placement = Matrix.Rotation(math.radians(slot.turn), 4, "Z") @ centre
+            copies = [_copy(o, scene.collection, placement) for item in slot.solid for o in _objects(item)]
+            copies += [_copy(o, scene.collection, placement, GHOST_COLOR) for item in slot.ghosts
+                       for o in _objects(item)]
+            placed.append(copies)
+            made_objects += copies
+        widths = [np.ptp(np.array(_bounds(copies))[:, 0]) for copies in placed]
+        gap = spacing if spacing is not None else 0.15 * max(widths)
+        x = 0.0
+        for copies, width in zip(placed, widths):
+            shift = Matrix.Translation((x + width / 2.0, 0.0, 0.0))
+            for copy in copies:
+                copy.matrix_world = shift @ copy.matrix_world
+            x += width + gap
+        lo, hi = _bounds(made_objects)
+        center = (lo + hi) / 2.0
+
+        turn = math.radians(VIEWS[view])
+        right = np.array([math.cos(turn), math.sin(turn), 0.0])
+        corners = np.array([[a, b, c] for a in (lo[0], hi[0]) for b in (lo[1], hi[1]) for c in (lo[2], hi[2])])
+        width = np.ptp((corners - center) @ right)
+        height = hi[2] - lo[2]
+        camera_data = bpy.data.cameras.new("ElliMann render camera")
+        camera_data.type = "ORTHO"
+        camera_data.ortho_scale = margin * max(height, width * resolution[1] / resolution[0]) * (
+            max(resolution) / resolution[1])
+        camera_data.clip_end = 100.0
+        camera = bpy.data.objects.new("ElliMann render camera", camera_data)
+        made_data.append(camera_data)
+        made_objects.append(camera)
+        scene.collection.objects.link(camera)
+        # The camera looks along +Y (at the body's front) for FRONT, turned about Z for the other views.
+        back = np.array([math.sin(turn), -math.cos(turn), 0.0])
+        camera.location = center + 10.0 * back
+        camera.rotation_euler = (math.pi / 2.0, 0.0, turn)
+        scene.camera = camera
+
+        world = bpy.data.worlds.new("ElliMann render world")
+        world.color = BACKGROUND
+        scene.world = world
+        made_data.append(world)
+        scene.render.engine = "BLENDER_WORKBENCH"
+        scene.display.shading.light = "STUDIO"
+        scene.display.shading.color_type = "OBJECT"
+        scene.display.shading.show_cavity = True
+        scene.display.render_aa = aa_samples
+        scene.view_settings.view_transform = "Standard"
+        scene.render.resolution_x, scene.render.resolution_y = resolution
+        scene.render.resolution_percentage = 100
+        scene.render.image_settings.file_format = "PNG"
+        scene.render.image_settings.color_mode = "RGB"
+        scene.render.image_settings.compression = 100
+        scene.render.filepath = str(Path(path).resolve())
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        bpy.ops.render.render(write_still=True, scene=scene.name)
+    finally:
+        for obj in made_objects:
+            bpy.data.objects.remove(obj)
+        for data in made_data:
+            (bpy.data.cameras if isinstance(data, bpy.types.Camera) else bpy.data.worlds).remove(data)
+        bpy.data.scenes.remove(scene)
+    return path
+
+
+def import_obj(path):
+    """Import an OBJ that is already in Blender's axes (Z up, body facing -Y); returns the new objects."""
+    before = set(bpy.data.objects)
+    bpy.ops.wm.obj_import(filepath=str(path), forward_axis="Y", up_axis="Z")
+    return [o for o in bpy.data.objects if o not in before]
+
+
+def obj_vertices(path):
+    """Vertex positions of an OBJ file in file order (n, 3)."""
+    with open(path, encoding="utf-8") as stream:
+        rows = [line.split()[1:4] for line in stream if line.startswith("v ")]
+    return np.array(rows, dtype=float)
+
+
+# Reference body regions -> a traced part each (number, label, side suffix), paper-style names.
+REGION_PARTS = {
+    "head": (1, "Head", ""), "neck": (2, "Neck", ""), "chest": (3, "Chest", ""), "abdomen": (4, "Abdomen", ""),
+    "pelvis": (5, "Pelvis", ""), "upper_arm": (6, "UpperArm", ""), "forearm": (7, "Forearm", ""),
+    "hand": (8, "Hand", ""), "thigh": (9, "Thigh", ""), "shin": (10, "Shin", ""), "foot": (11, "Foot", ""),
+}
+
+
+def traced_mannequin(vertices, regions, mode="moments"):
+    """One ellipsoid per body region, fitted to that region's vertices as the Fit operator does."""
+    labels = np.asarray(regions["labels"])
+    parts, frames = [], []
+    for index, region in enumerate(regions["region_names"]):
+        base, _, side = region.rpartition("_") if region.endswith(("_L", "_R")) else (region, "", "")
+        number, label, _ = REGION_PARTS[base]
+        name = f"{number}.a {label}" + (f".{side}" if side else "")
+        girth = region not in regions["arm_regions"]
+        parts.append(Part(name, side or "C", base, girth, ("He",)))
+        frames.append(fit_ellipsoid(vertices[labels == index], mode))
+    rotation, center, semi_axes = (np.array(a) for a in zip(*frames))
+    return Mannequin(Topology(parts), rotation, center, semi_axes, name="Traced", role="base")
+
+
+def trace_example(mesh_path, regions_path, out, mode="moments", view="FRONT"):
+    """The README picture: ellipsoids fitted to the reference body's regions over the body, front and side."""
+    bpy.ops.wm.read_homefile(use_empty=True)
+    regions = json.loads(Path(regions_path).read_text())
+    mannequin = traced_mannequin(obj_vertices(mesh_path), regions, mode)
+    collection = mannequin_to_collection(mannequin)
+    body = import_obj(mesh_path)
+    front, side = Slot([collection], body), Slot([collection], body, turn=90.0)
+    return render(out, [front, side], resolution=(1000, 900), view=view)
+
+
+def mannequins(files, ghosts, out, view="FRONT"):
+    """Mannequin JSON files side by side, each over its ghost mesh (OBJ) if given."""
+    bpy.ops.wm.read_homefile(use_empty=True)
+    if ghosts and len(ghosts) != len(files):
+        raise SystemExit(f"give one --ghost per mannequin ({len(files)}), or none")
+    slots = []
+    for i, path in enumerate(files):
+        collection = mannequin_to_collection(Mannequin.load(path))
+        slots.append(Slot(solid=[collection], ghosts=import_obj(ghosts[i]) if ghosts else []))
+    return render(out, slots, resolution=(max(800, 420 * len(slots)), 1000), view=view)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m tools.render", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    trace = sub.add_parser("trace-example", help="ellipsoids fitted to a body's regions, over the body")
+    trace.add_argument("--mesh", required=True, type=Path)
+    trace.add_argument("--regions", required=True, type=Path)
+    trace.add_argument("--mode", default="moments", choices=("inscribed", "moments", "enclosing"))
+    lineup = sub.add_parser("mannequins", help="mannequin JSON files side by side")
+    lineup.add_argument("files", nargs="+", type=Path)
+    lineup.add_argument("--ghost", action="append", default=[], type=Path)
+    for p in (trace, lineup):
+        p.add_argument("--out", required=True, type=Path)
+        p.add_argument("--view", default="FRONT", choices=sorted(VIEWS))
+    args = parser.parse_args(argv)
+    ellimann_addon.register()  # the mannequin collections need ElliMann's properties
+    try:
+        if args.command == "trace-example":
+            trace_example(args.mesh, args.regions, args.out, args.mode, args.view)
+        else:
+            mannequins(args.files, args.ghost, args.out, args.view)
+    finally:
+        ellimann_addon.unregister()
+    print(f"wrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
