@@ -13,7 +13,8 @@ Steps (paper, Sections 2.3.2-2.3.4):
    its vertex order, so the same vertices trace the same part on each body.
 2. Base Mannequin: the parts fitted over ``reference_female.obj``, registered and made symmetric.
 3. Reference Mannequins: the parts fitted over each of the five bodies (axes labelled against the
-   Base Mannequin's), registered and made symmetric, then stretched (core.adjust) until m_T meets
+   Base Mannequin's), registered and made symmetric, then deformed by synthesis' exact-mode
+   refinement (core.synthesis.refine: rotations kept, symmetric) until m_T meets
    Table 2.3 within ADJUST_TOLERANCE; then the five are cleaned together (core.clean: registration,
    symmetry, axis relabelling against the Average RM) and checked against Table 2.3 within
    ACCEPT_TOLERANCE again.
@@ -28,14 +29,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ellimann_addon.core.adjust import adjust_to_measurements
 from ellimann_addon.core.clean import asymmetry, clean, landmark_indices, register, relabel, symmetrize
 from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 from ellimann_addon.core.ellipsoid import section_at_height
 from ellimann_addon.core.files import atomic_write_text
 from ellimann_addon.core.frames import axis_agreement, is_rotation
 from ellimann_addon.core.mannequin import Mannequin, Topology
-from ellimann_addon.core.measure import section_heights
+from ellimann_addon.core.measure import as_dict, section_heights
+from ellimann_addon.core.synthesis import refine
 
 from . import reference_topology as rt
 from .bodies import REFERENCE_BODY, RM_BODIES, body_measurements, load_body, load_labels, vertex_areas
@@ -45,7 +46,8 @@ REPO = pathlib.Path(__file__).resolve().parents[1]
 DEFAULT_REFMODELS = REPO.parent / "shared" / "refmodels"
 BASE_FILE = "base_mannequin"
 REFERENCE_RM = "average"  # the RM whose axes the others are relabelled against
-ADJUST_TOLERANCE = 1e-4  # relative m_T error the adjustment aims at
+ADJUST_TOLERANCE = 1e-5  # relative m_T error the adjustment aims at
+ADJUST_ITERATIONS = 40
 ACCEPT_TOLERANCE = 5e-3  # what every shipped RM must meet (issue: 0.5% of Table 2.3)
 DISPLAY_NAMES = {"small_slim": "Small Slim", "tall_slim": "Tall Slim", "small_chubby": "Small Chubby",
                  "tall_chubby": "Tall Chubby", "average": "Average", BASE_FILE: "Base Mannequin"}
@@ -119,21 +121,18 @@ def build(refmodels=DEFAULT_REFMODELS, log=print):
     log(f"base mannequin fitted ({len(base)} parts; asymmetry before mirroring {asymmetry(base):.1e} m)")
     base = register(symmetrize(base))  # symmetric first: mirroring may move the lowest point
 
-    bodies, raw, adjusted, adjustments = {}, {}, [], {}
+    bodies, raw, adjusted, factors = {}, {}, [], {}
     for name in RM_BODIES:
         bodies[name] = load_body(refmodels, name)
         targets = REFERENCE_MEASUREMENTS[name]
         fitted, _ = fit_mannequin(bodies[name], tracing, base, kept, name=DISPLAY_NAMES[name], role="reference",
                                   measurements=dict(targets))
         raw[name] = register(symmetrize(fitted))
-        result = adjust_to_measurements(raw[name], targets, tolerance=ADJUST_TOLERANCE)
-        if not result.converged:
-            raise RuntimeError(f"{name}: the adjustment did not reach Table 2.3 (m_T {result.measured})")
-        adjustments[name] = result
-        adjusted.append(result.mannequin)
-        log(f"{name}: fitted, adjusted in {result.iterations} Newton steps")
+        adjusted.append(adjust(raw[name], targets))
+        factors[name] = adjusted[-1].factors
+        log(f"{name}: fitted and adjusted")
 
-    cleaned = clean(adjusted, reference_index=RM_BODIES.index(REFERENCE_RM))
+    cleaned = clean([a.mannequin for a in adjusted], reference_index=RM_BODIES.index(REFERENCE_RM))
     rms = dict(zip(RM_BODIES, cleaned))
     base = relabel(base, rms[REFERENCE_RM])
     for name, rm in rms.items():
@@ -151,11 +150,33 @@ def build(refmodels=DEFAULT_REFMODELS, log=print):
         "body_measurements": {name: body_measurements(body, labels)
                               for name, body in [(REFERENCE_BODY, reference_body), *bodies.items()]},
         "fitted_measurements": {name: m.measure() for name, m in raw.items()},
-        "factors": {name: a.factors for name, a in adjustments.items()},
+        "factors": factors,
         "agreement": axis_agreement_table(rms),
         "reference_rm": REFERENCE_RM,
     }
     return base, rms, report
+
+
+@dataclass(frozen=True)
+class Adjusted:
+    mannequin: Mannequin
+    factors: dict  # the stretch of each measurement's control (1 = unchanged)
+
+
+def adjust(mannequin, targets):
+    """``mannequin`` deformed until m_T meets ``targets`` (cm): synthesis' exact-mode refinement.
+
+    Rotations are kept and the deformation is symmetric about x = 0 (core.synthesis.refine).
+    """
+    wanted = np.array([[targets[key] for key in MEASUREMENTS]])
+    result = refine(mannequin.topology, mannequin.rotation[None], mannequin.center[None],
+                    mannequin.semi_axes[None], wanted, tolerance=ADJUST_TOLERANCE,
+                    max_iterations=ADJUST_ITERATIONS)
+    if not result.converged[0]:
+        raise RuntimeError(f"{mannequin.name}: the adjustment did not reach {targets} (m_T "
+                           f"{as_dict(result.measured[0])}, factors {result.factors[0].round(4).tolist()})")
+    adjusted = mannequin.copy(center=result.center[0], semi_axes=result.semi_axes[0])
+    return Adjusted(adjusted, as_dict(result.factors[0]))
 
 
 def cleanliness_problems(mannequin, tol=1e-9):
@@ -347,7 +368,8 @@ def measurements_doc(base, rms, report):
         "",
         "m_T is `Mannequin.measure()` (closed form) of the shipped JSON files in `reference_blends/`. "
         "Each RM is the topology of `docs/topology.md` fitted inside its body from `refmodels/`, "
-        "stretched (`core.adjust`) until m_T meets Table 2.3, then cleaned together with the others "
+        "deformed by the exact-mode refinement of synthesis (`core.synthesis.refine`) until m_T meets "
+        "Table 2.3, then cleaned together with the others "
         f"(registration, symmetry, axes relabelled against the {DISPLAY_NAMES[report['reference_rm']]} RM).",
         "",
         "| RM | | He | Sh | Br | Wa | Hi | max rel. error |",
@@ -366,8 +388,8 @@ def measurements_doc(base, rms, report):
         "",
         "The body is the mesh in `refmodels/` (measured like m_T on the mesh, as its README says); the fit "
         "is the RM before the adjustment (inscribed ellipsoids, so a little smaller than the body); the "
-        "factors are the stretches the adjustment applied (He: vertical; Sh: the shoulder and arm parts "
-        "along X; Br, Wa, Hi: the girth parts crossing each section, horizontally).",
+        "factors are those of the refinement (He: vertical stretch; Sh: shoulders widened, arms carried "
+        "out; Br, Wa, Hi: girth parts scaled horizontally, blended with height around each section).",
         "",
         "| RM | | He | Sh | Br | Wa | Hi |",
         "|---|---|---|---|---|---|---|",
