@@ -5,7 +5,8 @@
 
 Reads the body meshes of ``<repo>/../shared/refmodels`` (see its README) and writes
 ``reference_blends/base_mannequin.json`` and the five ``<name>.json`` Reference Mannequins, their
-.blend twins (with the bpy module), ``docs/topology.md`` and ``docs/reference_mannequins.md``.
+.blend twins and a Workbench line-up ``docs/images/reference_lineup.png`` (both with the bpy module),
+``docs/topology.md`` and ``docs/reference_mannequins.md``.
 
 Steps (paper, Sections 2.3.2-2.3.4):
 1. Trace: every part of tools/reference_topology.py is fitted to its vertices on a body
@@ -49,6 +50,7 @@ REFERENCE_RM = "average"  # the RM whose axes the others are relabelled against
 ADJUST_TOLERANCE = 1e-5  # relative m_T error the adjustment aims at
 ADJUST_ITERATIONS = 40
 ACCEPT_TOLERANCE = 5e-3  # what every shipped RM must meet (issue: 0.5% of Table 2.3)
+LINEUP_ORDER = ("small_chubby", "small_slim", "average", "tall_slim", "tall_chubby")  # the paper's Figure 2.9
 DISPLAY_NAMES = {"small_slim": "Small Slim", "tall_slim": "Tall Slim", "small_chubby": "Small Chubby",
                  "tall_chubby": "Tall Chubby", "average": "Average", BASE_FILE: "Base Mannequin"}
 
@@ -252,6 +254,14 @@ def write_blends(mannequins, folder):
             bpy.ops.wm.save_as_mainfile(filepath=str(folder / f"{stem}.blend"), compress=True)
     finally:
         ellimann_addon.unregister()
+
+
+def write_lineup(files, path):
+    """Workbench render of mannequin JSON files side by side (tools/render.py). Needs the bpy module."""
+    from . import render
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    render.main(["mannequins", *map(str, files), "--out", str(path)])
 
 
 def check_shipped(base, rms, folder, atol=1e-9):
@@ -473,12 +483,15 @@ def main(argv=None):
     atomic_write_text(args.docs / "reference_mannequins.md", measurements_doc(base, rms, report))
     print(f"{len(changed)} of {len(mannequins)} JSON files changed in {args.out}; docs written to {args.docs}")
     if not args.no_blend:
-        # .blend files are not byte-reproducible: rewrite only those whose mannequin changed (or missing)
+        # .blend and .png files are not byte-reproducible: rewrite only what changed (or is missing)
         stale = {stem: m for stem, m in mannequins.items()
                  if stem in changed or not (args.out / f"{stem}.blend").is_file()}
         if stale:
             write_blends(stale, args.out)
         print(f"{len(stale)} .blend files written")
+        lineup = args.docs / "images" / "reference_lineup.png"
+        if set(changed) & set(RM_BODIES) or not lineup.is_file():
+            write_lineup([args.out / f"{stem}.json" for stem in LINEUP_ORDER], lineup)
     return 0
 
 
