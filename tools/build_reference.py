@@ -458,7 +458,7 @@ def main(argv=None):
     parser.add_argument("--out", type=pathlib.Path, default=REPO / "reference_blends",
                         help="where the mannequins go (default: reference_blends/)")
     parser.add_argument("--docs", type=pathlib.Path, default=REPO / "docs", help="where the docs go (default: docs/)")
-    parser.add_argument("--no-blend", action="store_true", help="skip the .blend files (no bpy needed)")
+    parser.add_argument("--no-blend", action="store_true", help="skip the .blend files and the line-up (no bpy needed)")
     parser.add_argument("--check", action="store_true",
                         help="rebuild in memory and compare with the files in --out; write nothing")
     args = parser.parse_args(argv)
