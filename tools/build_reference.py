@@ -99,12 +99,15 @@ def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
             weights = np.concatenate([weights, weights])
         ref_rotation = np.eye(3) if reference is None else reference.rotation[i]
         match = None if reference is None or kept[i] is None else reference.rotation[i][:, kept[i]]
+        bottom, height = body.vertices[:, 2].min(), np.ptp(body.vertices[:, 2])
+        floor = -np.inf if spec.floor is None else bottom + spec.floor * height
+        level = None if spec.level is None else bottom + spec.level * height
         if spec.mode == "moments":
             fit = moments_ellipsoid(points, weights, ref_rotation, spec.frame, match)
         else:
             fit = inscribed_ellipsoid(points, weights, body.vertices[walls], areas[walls], ref_rotation,
                                       margin=spec.margin, inside_fraction=spec.inside, slack=spec.slack,
-                                      frame=spec.frame, match=match)
+                                      frame=spec.frame, match=match, floor=floor, level=level)
         rotation[i], center[i], semi_axes[i], k = fit
         kept_out.append(k)
     return Mannequin(tracing.topology, rotation, center, semi_axes, **fields).check(), kept_out
@@ -367,6 +370,10 @@ def _fit_notes(spec):
             items.append(f"{attr} {getattr(spec, attr):g}")
     if spec.obstacles is not None:
         items.append("kept inside the " + "/".join(spec.obstacles) + " surface only")
+    if spec.floor is not None:
+        items.append(f"kept above h = {spec.floor:g}")
+    if spec.level is not None:
+        items.append(f"centred at h = {spec.level:g}")
     return ", ".join(items)
 
 

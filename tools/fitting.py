@@ -129,7 +129,7 @@ def _grow(local, area, limit, start, allowed):
 
 
 def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=None, margin=0.1,
-                        inside_fraction=0.002, slack=0.0, frame="main", match=None):
+                        inside_fraction=0.002, slack=0.0, frame="main", match=None, floor=-np.inf, level=None):
     """The largest ellipsoid, in the part's frame, inside the body and the selection's box.
 
     ``selected`` (k, 3) vertices of the part with area ``weights``; ``obstacles`` (m, 3) body
@@ -137,6 +137,11 @@ def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=N
     (1 - ``slack``) of the normalised radius, and vertices of total area ``inside_fraction`` of the
     nearby surface deeper still. ``margin`` enlarges the selection's box on every side, as a
     fraction of its half-extent. ``reference``, ``frame``, ``match``: see :func:`principal_frame`.
+    ``floor``: world z the box may not reach below (along the local axis closest to vertical; exact
+    for a "fixed" frame), to keep a part clear of a section it must not cut. ``level``: world z of the
+    centre, if given (same axis): a part centred on the section it makes is cut where its girth
+    changes least with height, so interpolated mannequins whose parts sit a little higher or lower
+    still measure what their references do.
     Returns (rotation, center, semi_axes, kept axis index).
     """
     rotation, centroid, kept = principal_frame(selected, weights, reference, frame, match)
@@ -144,6 +149,13 @@ def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=N
     lo, hi = local_sel.min(axis=0), local_sel.max(axis=0)
     half = 0.5 * (hi - lo)
     lo, hi = lo - margin * half, hi + margin * half
+    up = int(np.argmax(np.abs(rotation[2])))
+    if np.isfinite(floor):
+        bound = (floor - centroid[2]) / rotation[2, up]
+        if rotation[2, up] > 0.0:
+            lo[up] = max(lo[up], bound)
+        else:
+            hi[up] = min(hi[up], bound)
     box_centre = 0.5 * (lo + hi)
     local_obs = (obstacles - centroid) @ rotation
     near = np.all((local_obs > lo) & (local_obs < hi), axis=1)
@@ -159,12 +171,16 @@ def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=N
         return float(np.prod(semi)), semi
 
     centre = box_centre.copy()
+    free = [0, 1, 2]
+    if level is not None:
+        centre[up] = (level - centroid[2]) / rotation[2, up]
+        free.remove(up)
     best, semi = solve(centre)
     step = 0.25 * (hi - lo) / 2.0
     for _ in range(PATTERN_STEPS):
         while True:
-            # best of the six moves (not the first improving one), so the search has no preferred axis or sign
-            trials = [centre + sign * step * np.eye(3)[axis] for axis in range(3) for sign in (1.0, -1.0)]
+            # best of the moves (not the first improving one), so the search has no preferred axis or sign
+            trials = [centre + sign * step * np.eye(3)[axis] for axis in free for sign in (1.0, -1.0)]
             results = [solve(trial) for trial in trials]
             k = int(np.argmax([value for value, _ in results]))
             if results[k][0] <= best * (1.0 + 1e-9):

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ellimann_addon.core.constants import SECTION_FRACTIONS
 from ellimann_addon.core.mannequin import Part, Topology
 
 
@@ -50,9 +51,18 @@ class Spec:
     mode: str = "inscribed"  # or "moments": the envelope, for parts no inscribed ellipsoid can fill
     frame: str = "main"  # the axis the frame takes from the points: "limb", "main" or "fixed" (none)
     obstacles: tuple = None  # regions (without side) whose vertices the part must stay inside; None: all
+    floor: float = None  # lowest height (fraction of the body's) the part may reach: keeps it off a section
+    level: float = None  # height (fraction of the body's) of the centre: centres a part on its section
 
 
 ARM = ("upper_arm", "forearm", "hand")  # an arm pressed against the torso may overlap it
+
+# The chest parts depend on Br, not Wa: they must stay above the waist section (0.645 He), with room
+# for the Reference Mannequins' adjustment, which may lengthen them downwards.
+CHEST_FLOOR = 0.67
+# The waist's sides and back are centred on its section (see fitting.inscribed_ellipsoid's ``level``);
+# the front is left to the belly, which on the chubby bodies bulges below a crease at the waist.
+WAIST_LEVEL = SECTION_FRACTIONS["Wa"]
 
 HEAD = ("He",)
 SHOULDERS = ("He", "Sh")
@@ -90,17 +100,18 @@ SPECS = (
     Spec(10, "a", "Trapezius", "L", "shoulders", True, SHOULDERS,
          Select(bones=("spine01", "clavicle", "shoulder01", "neck01"), h=(0.81, 0.88), x=(0.035, 0.14)),
          inward=(0.0, 0.0, -0.04)),
-    Spec(11, "a", "Thorax", "C", "chest", True, BUST, Select(regions=("chest",), h=(0.66, 0.83), y=(-1, -0.02)),
-         inward=(0.0, 0.06, 0.0), frame="fixed"),
+    Spec(11, "a", "Thorax", "C", "chest", True, BUST, Select(regions=("chest",), h=(0.685, 0.80), y=(-1, -0.02)),
+         inward=(0.0, 0.06, 0.0), frame="fixed", floor=CHEST_FLOOR),
     Spec(11, "b", "Upper Back", "C", "chest", True, BUST,
-         Select(regions=("chest",), h=(0.66, 0.80), x=(0, 0.11), y=(-0.04, 1)), inward=(0.0, -0.06, 0.0),
-         frame="fixed"),
+         Select(regions=("chest",), h=(0.685, 0.80), x=(0, 0.11), y=(-0.04, 1)), inward=(0.0, -0.06, 0.0),
+         frame="fixed", floor=CHEST_FLOOR),
     Spec(12, "a", "Oblique", "L", "abdomen", True, WAIST,
-         Select(regions=("abdomen",), h=(0.59, 0.70), x=(0.07, 1)), frame="fixed"),
+         Select(regions=("abdomen",), h=(0.59, 0.70), x=(0.07, 1)), frame="fixed", level=WAIST_LEVEL),
     Spec(13, "a", "Rectus Abdominalis", "C", "abdomen", True, WAIST,
          Select(regions=("abdomen",), h=(0.59, 0.70), y=(-1, -0.03)), inward=(0.0, 0.05, 0.0), frame="fixed"),
     Spec(13, "b", "Lower Back", "C", "abdomen", True, WAIST,
-         Select(regions=("abdomen",), h=(0.59, 0.70), y=(-0.03, 1)), inward=(0.0, -0.05, 0.0), frame="fixed"),
+         Select(regions=("abdomen",), h=(0.59, 0.70), y=(-0.03, 1)), inward=(0.0, -0.05, 0.0), frame="fixed",
+         level=WAIST_LEVEL),
     Spec(14, "a", "Pelvis", "C", "hips", True, HIPS, Select(regions=("pelvis",), h=(0.47, 0.57)), inside=0.001,
          frame="fixed"),
     Spec(15, "a", "Gluteus", "L", "hips", True, HIPS,

@@ -106,6 +106,17 @@ def test_each_section_cuts_the_parts_that_make_that_measurement(base, rms):
         assert not {"Cranium", "Neck", "Calf", "Foot"} & set().union(*cut.values()), name
 
 
+def test_girth_sections_cut_only_parts_that_depend_on_their_measurement(base, rms):
+    # The segmented scheme interpolates each part on the measurements it depends on: a breast part
+    # reaching down into the waist section would make the waist follow the requested breast.
+    for name, m in everything(base, rms):
+        _, _, heights = section_heights(m.rotation, m.center, m.semi_axes)
+        for key in ("Br", "Wa", "Hi"):
+            _, _, hit = section_at_height(m.rotation, m.center, m.semi_axes, heights[key])
+            strays = [p.name for p, h in zip(m.topology, hit & m.topology.girth_mask) if h and key not in p.depends]
+            assert strays == [], f"{name} {key}"
+
+
 def test_docs_list_every_part_and_the_shipped_measurements(base, rms):
     topology = (DOCS / "topology.md").read_text(encoding="utf-8")
     assert all(f"| {name} |" in topology for name in base.topology.names)
