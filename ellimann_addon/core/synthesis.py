@@ -32,8 +32,9 @@ the weights are the paper's; what is bounded by the RMs is the proportions, not 
 (a request outside L is scaled beyond the RMs).
 
 **Exact mode** (beyond the paper): IDW is a weighted mean, so m_T of its result misses the request
-by a few percent (Table 2.4). ``refine`` then deforms the mannequin gently until m_T matches: five
-factors, solved by Newton's method on log m_T with a finite-difference Jacobian:
+(the paper's by a few percent, Table 2.4; proportional IDW by less). ``refine`` then deforms the
+mannequin gently until m_T matches: five factors, solved by quasi-Newton steps on log m_T (starting
+from the RMs' mean Jacobian, Broyden updates):
 
 - He: vertical stretch about the floor (centres' z, and each semi-axis by its vertical share);
 - Br, Wa, Hi: horizontal scaling of the girth ellipsoids about the body's vertical axis, blended
@@ -250,6 +251,7 @@ class ReferenceSet:
         self._width_exponent = widths / np.maximum(widths.sum(axis=1, keepdims=True), 1.0)
         self._size_origin = self.measurements.mean(axis=0)  # scales are relative to the RMs' mean
         self._normalized = {}
+        self._jacobian = None
 
     def __len__(self):
         return len(self.mannequins)
@@ -266,6 +268,21 @@ class ReferenceSet:
         vertical = np.exp(log @ self._height_exponent.T)
         horizontal = np.exp(log @ self._width_exponent.T) if normalize == "proportional" else ones
         return horizontal, vertical
+
+    def refine_jacobian(self):
+        """(5, 5) d log m_T / d log factor of the refinement, the mean over the RMs (computed once).
+
+        Exact mode starts its Broyden updates from it instead of five m_T per mannequin: the
+        deformation acts alike on every body (its entries vary by a few hundredths between the RMs).
+        """
+        if self._jacobian is None:
+            girth = self.topology.girth_mask
+            measured = tailor_measurements(self.rotation, self.center, self.semi_axes, girth)
+            basis = _deform_basis(self.topology, self.rotation, self.center, self.semi_axes, measured)
+            each = _fd_jacobian(basis, np.arange(len(self)), self.rotation, self.center, self.semi_axes,
+                                np.zeros((len(self), len(MEASUREMENTS))), np.log(measured), girth)
+            self._jacobian = each.mean(axis=0)
+        return self._jacobian
 
     def normalized_geometry(self, normalize):
         """The RMs' centres and semi-axes (k, s, 3) of the interpolated parts, divided by their own scales."""
@@ -570,15 +587,16 @@ class Refinement:
 
 
 def refine(topology, rotation, center, semi_axes, targets, measured=None, tolerance=EXACT_TOLERANCE,
-           max_iterations=EXACT_MAX_ITERATIONS):
+           max_iterations=EXACT_MAX_ITERATIONS, jacobian=None):
     """Deform mannequins (B, n, ...) so that m_T matches ``targets`` (B, 5) cm (exact mode).
 
     Solves r(x) = log m_T(deform(exp x)) - log target = 0 for the log factors x, Levenberg-Marquardt
-    style: a forward-difference Jacobian at the start (5 m_T per mannequin), Broyden updates after
-    every step (one m_T each), a step kept only if it lowers |r| (else more damping), the Jacobian
-    recomputed if a mannequin is slow to converge. The result is never further from the request than
-    the IDW mannequin it starts from. All batched; mannequins already within ``tolerance`` are
-    returned unchanged.
+    style: starting from ``jacobian`` ((5, 5) or (B, 5, 5), e.g. ``ReferenceSet.refine_jacobian``)
+    or, without one, a forward-difference Jacobian (5 m_T per mannequin); Broyden updates after
+    every step (one m_T each), a step kept only if it lowers |r| (else more damping), a
+    forward-difference Jacobian if a mannequin is slow to converge. The result is never further from
+    the request than the IDW mannequin it starts from. All batched; mannequins already within
+    ``tolerance`` are returned unchanged.
     """
     girth = topology.girth_mask
     targets = np.atleast_2d(np.asarray(targets, dtype=float))
@@ -589,8 +607,12 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
     x = np.zeros((len(targets), count))
     current = measured.copy()
     residual = np.log(np.maximum(current, 1e-12) / targets)
-    jacobian = np.zeros((len(targets), count, count))
-    age = np.full(len(targets), -1)  # steps since the Jacobian was computed (-1: never)
+    if jacobian is None:
+        jacobian = np.zeros((len(targets), count, count))
+        age = np.full(len(targets), -1)  # steps since the Jacobian was computed (-1: never)
+    else:
+        jacobian = np.broadcast_to(np.asarray(jacobian, dtype=float), (len(targets), count, count)).copy()
+        age = np.zeros(len(targets), dtype=int)
     damping = np.full(len(targets), _DAMPING)
     # A factor that reaches FACTOR_LIMITS is frozen there and its measurement left as close as that
     # allows; the other factors keep solving their own measurements (no trading one for another).
@@ -711,7 +733,8 @@ def synthesize_batch(reference, requests, mode="idw", metric="raw", power=DEFAUL
     factors = np.ones_like(requests)
     converged = np.ones(len(requests), dtype=bool)
     if mode == "exact":
-        result = refine(reference.topology, rotation, center, semi_axes, requests, measured, tolerance)
+        result = refine(reference.topology, rotation, center, semi_axes, requests, measured, tolerance,
+                        jacobian=reference.refine_jacobian())
         center, semi_axes, measured = result.center, result.semi_axes, result.measured
         factors, converged = result.factors, result.converged
     return Synthesis(reference.topology, requests, rotation, center, semi_axes, measured, factors, converged, mode)

@@ -224,6 +224,11 @@ def test_exact_mode_meets_its_target_on_a_sample_of_the_grid(reference):
     assert np.all((exact.factors >= synthesis.FACTOR_LIMITS[0]) & (exact.factors <= synthesis.FACTOR_LIMITS[1]))
     for i in range(0, len(sample), 6):
         assert asymmetry(exact.mannequin(i)) < 1e-12
+    # synthesize_batch starts from the RMs' mean Jacobian; from forward differences it meets the same target.
+    assert reference.refine_jacobian() is reference.refine_jacobian()
+    fd = synthesis.refine(reference.topology, idw.rotation, idw.center, idw.semi_axes, sample)
+    assert fd.converged.all()
+    np.testing.assert_allclose(fd.measured, exact.measured, rtol=3 * synthesis.EXACT_TOLERANCE)
 
 
 def test_proportional_idw_starts_exact_mode_closer_than_the_papers(reference):
