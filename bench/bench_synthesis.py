@@ -21,8 +21,9 @@ import numpy as np
 from bench.bench_core import best_of
 from devkit.synthetic import shipped_or_synthetic
 from ellimann_addon.core import synthesis
-from ellimann_addon.core.constants import MEASUREMENTS, PAPER_TABLE_2_4, quartile_points
-from ellimann_addon.core.measure import tailor_measurements
+from ellimann_addon.core.constants import MEASUREMENTS, PAPER_TABLE_2_4, SECTION_FRACTIONS, quartile_points
+from ellimann_addon.core.ellipsoid import section_at_height
+from ellimann_addon.core.measure import hull_perimeter, section_heights, tailor_measurements
 
 VARIANTS = (  # label, synthesize_batch options
     ("paper IDW (Eq. 2.1: normalize none, raw cm, p = 2)", {"normalize": "none"}),
@@ -62,6 +63,69 @@ def deformation(title, result, seconds):
           + ", ".join(f"{k} {m:.2f}/{x:.2f}" for k, m, x in zip(MEASUREMENTS, spread.mean(0), spread.max(0))))
 
 
+def _stat(values):
+    return f"{values.mean():5.2f} /{values.max():6.2f}"
+
+
+def _section(rotation, center, semi_axes, z, parts, key):
+    """Sh (x extent over ``parts``) or a girth perimeter of the section at heights z (B,), in cm."""
+    centre, k, hit = section_at_height(rotation, center, semi_axes, z[:, None])
+    hit = hit & parts
+    if key == "Sh":
+        half = np.sqrt(k[..., 0, 0])
+        right = np.where(hit, centre[..., 0] + half, -np.inf).max(axis=-1)
+        left = np.where(hit, centre[..., 0] - half, np.inf).min(axis=-1)
+        return (right - left) * 100.0
+    return hull_perimeter(centre, k, hit) * 100.0
+
+
+def diagnose(reference, requests):
+    """Where the paper's IDW error comes from, per measurement (mean / max over the grid, in % or cm).
+
+    The parts that depend on X are placed with the IDW weights of X's sub-space; their weighted mean
+    He is the height they are built for, their weighted mean X the size. Moving the section to that
+    height takes out the vertical misplacement; comparing the weighted mean X with the request shows
+    what IDW's own averaging of the measurement misses; what is left is m_T's non-linearity (a
+    blended body does not measure as the blend of the measurements). Foreign parts: parts that do not
+    depend on X but change it (cut by its girth section, or outermost at the shoulders), and by how much.
+    """
+    topology = reference.topology
+    weights = synthesis.idw_weights(reference, requests)
+    rotation, center, semi_axes = synthesis.interpolate(reference, requests, normalize="none")
+    girth = topology.girth_mask
+    measured = tailor_measurements(rotation, center, semi_axes, girth)
+    bottom, height, z = section_heights(rotation, center, semi_axes)
+    source = list(reference._source)
+    print("\nwhy the paper's IDW misses (mean / max over the grid, % unless cm):")
+    he_only = [row for row, part in enumerate(source) if topology.dependency_mask[part].sum() == 1]
+    if he_only:
+        implied = weights[:, he_only[0]] @ reference.measurements
+        error = 100.0 * np.abs(implied[:, 0] - requests[:, 0]) / requests[:, 0]
+        print(f"  He: paper IDW {_stat(100.0 * np.abs(measured[:, 0] - requests[:, 0]) / requests[:, 0])}; "
+              f"the head (on He alone) is built for sum_j w_j He_j, off by {_stat(error)}")
+    for index, key in enumerate(MEASUREMENTS[1:], start=1):
+        own = topology.dependency_mask[:, index]
+        rows = [row for row, part in enumerate(source) if own[part]]
+        if not rows:
+            continue
+        implied = weights[:, rows[0]] @ reference.measurements  # (B, 5) what the parts of X are built for
+        placed = bottom + SECTION_FRACTIONS[key] * implied[:, 0] / 100.0
+        parts = np.ones_like(girth) if key == "Sh" else girth
+        moved = _section(rotation, center, semi_axes, placed, parts, key)
+        own_only = _section(rotation, center, semi_axes, z[key], parts & own, key)
+        foreign = np.abs(measured[:, index] - own_only) > 1e-9
+        added = 100.0 * (measured[:, index] - own_only) / measured[:, index]
+        target = requests[:, index]
+        print(f"  {key}: paper IDW {_stat(100.0 * np.abs(measured[:, index] - target) / target)}; its parts are "
+              f"built for an He off by {_stat(100.0 * np.abs(implied[:, 0] - requests[:, 0]) / requests[:, 0])} "
+              f"(section {_stat(np.abs(placed - z[key]) * 100.0)} cm off); with the section moved there "
+              f"{_stat(100.0 * np.abs(moved - target) / target)}\n"
+              f"      of which sum_j w_j {key}_j vs {key} {_stat(100.0 * np.abs(implied[:, index] - target) / target)}"
+              f" + m_T non-linearity {_stat(100.0 * np.abs(moved - implied[:, index]) / implied[:, index])}; "
+              f"parts of other measurements change it in {foreign.sum()} mannequins, by "
+              f"{_stat(added)}")
+
+
 def reference_version():
     try:
         out = subprocess.run(["git", "log", "-1", "--format=%h %cs", "--", "reference_blends"], capture_output=True,
@@ -79,6 +143,7 @@ def run():
     version = f", reference_blends at {reference_version()}" if label.startswith("shipped") else ""
     print(f"reference set: {label}{version}, {len(reference)} RMs x {n} ellipsoids; grid: {len(requests)} requests")
 
+    diagnose(reference, requests)
     results = {}
     for title, options in VARIANTS:
         start = time.perf_counter()
