@@ -94,7 +94,7 @@ def diagnose(reference, requests):
     rotation, center, semi_axes = synthesis.interpolate(reference, requests, normalize="none")
     girth = topology.girth_mask
     measured = tailor_measurements(rotation, center, semi_axes, girth)
-    bottom, height, z = section_heights(rotation, center, semi_axes)
+    bottom, _, z = section_heights(rotation, center, semi_axes)
     source = list(reference._source)
     print("\nwhy the paper's IDW misses (mean / max over the grid, % unless cm):")
     he_only = [row for row, part in enumerate(source) if topology.dependency_mask[part].sum() == 1]
@@ -127,10 +127,14 @@ def diagnose(reference, requests):
 
 
 def reference_version():
+    """The last commit that changed reference_blends/ (the numbers depend on the RMs), + local changes."""
+    def git(*args):
+        return subprocess.run(["git", *args, "--", "reference_blends"], capture_output=True, text=True, check=True,
+                              cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__)))).stdout.strip()
+
     try:
-        out = subprocess.run(["git", "log", "-1", "--format=%h %cs", "--", "reference_blends"], capture_output=True,
-                             text=True, check=True, cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-        return out.stdout.strip() or "uncommitted"
+        commit = git("log", "-1", "--format=%h %cs") or "uncommitted"
+        return commit + (" + local changes" if git("status", "--porcelain") else "")
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
 

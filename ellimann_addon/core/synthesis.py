@@ -18,7 +18,7 @@ the axis signs the RMs use, so every result is exactly symmetric and exact at th
 
 **Proportional IDW** (``normalize="proportional"``, the default; ``"none"`` is the paper's Eq. 2.1).
 Plain IDW places a part that depends on (He, Br) as the RMs nearest in (He, Br) are, so its height is
-their weighted mean He, not the request's (off by 2% on average on the 243 grid), and the section at
+their weighted mean He, not the request's (about 2% off on the 243 grid), and the section at
 0.72 He cuts the chest in the wrong place; and a weighted mean of the RMs' Br is not the requested Br
 (IDW does not reproduce linear functions). So each RM's part is first divided by that RM's own
 scales, the same IDW weights average these proportions, and the mean is multiplied by the request's
@@ -64,9 +64,7 @@ REFERENCE_NAMES = tuple(REFERENCE_MEASUREMENTS)  # small_slim, tall_slim, small_
 REFERENCE_FOLDER = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"
 METRICS = ("raw", "normalized")
 MODES = ("idw", "exact")
-# What IDW averages: the RMs' geometry as it is (the paper, Eq. 2.1), with heights in proportion
-# to each RM's He, or with heights in proportion to He and widths to the part's own girth/width
-# measurement (the default: see "Proportional IDW" above).
+# What IDW averages: the RMs' geometry (the paper), or their proportions ("Proportional IDW" above).
 NORMALIZATIONS = ("none", "height", "proportional")
 PAPER_NORMALIZE = "none"
 DEFAULT_NORMALIZE = "proportional"
@@ -420,8 +418,8 @@ def _center_scale(horizontal, vertical):
 def _axis_scale(rotation, horizontal, vertical):
     """(..., 3) scale of each semi-axis: vertical^v * horizontal^(1 - v), v = the axis' share along world z.
 
-    The rotation is kept; for an axis along z or in the horizontal plane this is the exact effect of
-    scaling the ellipsoid by diag(horizontal, horizontal, vertical).
+    The rotation is kept; for an upright ellipsoid (one axis along z) this is exactly the ellipsoid
+    scaled by diag(horizontal, horizontal, vertical).
     """
     v = rotation[..., 2, :] ** 2
     return vertical[..., None] ** v * horizontal[..., None] ** (1.0 - v)

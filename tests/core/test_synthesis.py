@@ -170,7 +170,7 @@ def _scaled(reference, base, me):
 
 def test_proportional_idw_reproduces_proportionally_scaled_bodies_exactly(reference):
     """If the RMs differ only by these scales, proportional IDW returns the body scaled to any request,
-    even far outside L; the paper's IDW does not."""
+    outside L too; the paper's IDW does not."""
     scaled = synthesis.ReferenceSet([_scaled(reference, 4, me) for me in reference.measurements],
                                     names=reference.names)
     requests = random_requests(9, 12, widen=0.3)
