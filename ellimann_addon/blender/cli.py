@@ -4,9 +4,10 @@
 - ``python -m ellimann_addon …`` (with the ``bpy`` module installed)
 
 Subcommands: ``synth`` (one mannequin), ``batch`` (a CSV of measurements), ``measure`` (m_T of a
-file) and ``demo`` (the paper's Table 2.5 mannequins with a report and a line-up picture).
-Blender is imported only when a .blend/.glb/.obj file or a picture is involved, so ``--help`` and
-JSON work start at once. User mistakes end with a one-line reason and a non-zero exit code:
+file), ``demo`` (the paper's Table 2.5 mannequins with a report and a line-up picture) and
+``drape`` (a garment on a mannequin with Blender's cloth simulation).
+Blender is imported only when a .blend/.glb/.obj file, a drape or a picture is involved, so
+``--help`` and JSON/MJCF work start at once. User mistakes end with a one-line reason and a non-zero exit code:
 1 for bad input or a failed row, 2 for a malformed command line.
 """
 
@@ -33,9 +34,11 @@ from ..core.synthesis import (
     synthesize_batch,
     validate_request,
 )
+from ..core.writers import core_format, write_core_file
 
 PROG = "ellimann"
-FORMATS = ("blend", "glb", "obj", "json")
+FORMATS = ("blend", "glb", "obj", "json", "mjcf")  # --format names
+EXTENSIONS = {"mjcf": "xml"}  # format -> file extension where they differ
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,99}$")
 CHUNK = 256  # rows synthesized per core batch
 
@@ -63,7 +66,8 @@ def _add_synthesis_options(parser):
                         help="IDW distance: raw cm as in the paper (default) or normalized by the ranges L")
     parser.add_argument("--power", type=_number, default=DEFAULT_POWER, help="IDW power p (default 2)")
     parser.add_argument("--cushions", action="store_true",
-                        help="show cushions (convex hulls of the cushion pairs) in .blend/.glb/.obj outputs")
+                        help="cushions (convex hulls of the cushion pairs) instead of their ellipsoids: shown in "
+                             ".blend/.glb/.obj outputs, convex mesh geoms in MJCF")
     parser.add_argument("--references", metavar="DIR",
                         help="folder with the five Reference Mannequin .json files (default: the shipped "
                              "reference_blends/)")
@@ -81,7 +85,8 @@ def build_parser():
         synth.add_argument(f"--{key.lower()}", dest=key, type=_number, required=True, metavar="CM",
                            help=f"{MEASUREMENT_LABELS[key]} (reference range {low:g}-{high:g})")
     synth.add_argument("-o", "--output", required=True, metavar="OUT",
-                       help="output file: .blend, .glb, .obj or .json (ElliMann's mannequin JSON)")
+                       help="output file: .blend, .glb, .obj, .json (ElliMann's mannequin JSON) or .xml (MJCF, "
+                            "for MuJoCo)")
     synth.add_argument("--name", help="mannequin name (default: 'ElliMann He-Sh-Br-Wa-Hi')")
     _add_synthesis_options(synth)
     synth.set_defaults(run=run_synth)
@@ -94,7 +99,8 @@ def build_parser():
     batch.add_argument("csv", metavar="MEASUREMENTS.csv")
     batch.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
     batch.add_argument("--format", default="json",
-                       help="comma-separated output formats among blend,glb,obj,json (default json)")
+                       help="comma-separated output formats among blend,glb,obj,json,mjcf (default json; mjcf "
+                            "writes NAME.xml)")
     batch.add_argument("--shard", metavar="I/N",
                        help="process only rows I, I+N, I+2N… (I from 1 to N), for a render farm; the report "
                             "is DIR/report-I-of-N.csv")
@@ -155,10 +161,15 @@ def _ensure_registered():
 
 
 def _output_kind(path):
-    kind = os.path.splitext(path)[1].lower().lstrip(".")
-    if kind not in FORMATS:
-        raise UsageError(f"OUT must end in .blend, .glb, .obj or .json, got {path!r}")
+    extension = os.path.splitext(path)[1].lower().lstrip(".")
+    kind = next((k for k in FORMATS if _extension(k) == extension), None)
+    if kind is None:
+        raise UsageError(f"OUT must end in .blend, .glb, .obj, .json or .xml (MJCF), got {path!r}")
     return kind
+
+
+def _extension(kind):
+    return EXTENSIONS.get(kind, kind)
 
 
 def _references(args):
@@ -175,13 +186,14 @@ def _format_me(values):
 
 
 def _write(mannequin, paths, measured, cushions):
-    if any(os.path.splitext(p)[1].lower() != ".json" for p in paths):
+    """Write every path (format from the extension); Blender is loaded only for .blend/.glb/.obj."""
+    if any(core_format(p) is None for p in paths):
         _ensure_registered()
         from .output import write_mannequin
 
         return write_mannequin(mannequin, paths, measured, cushions)
     for path in paths:
-        atomic_write_text(path, mannequin.to_json() + "\n")
+        write_core_file(mannequin, path, cushions)
     return paths
 
 
@@ -299,7 +311,7 @@ def run_batch(args):
                                   args.power)
         for i, (line, name, values, warnings) in enumerate(chunk):
             mannequin = result.mannequin(i, name)
-            paths = [os.path.join(args.output, f"{name}.{kind}") for kind in formats]
+            paths = [os.path.join(args.output, f"{name}.{_extension(kind)}") for kind in formats]
             measured = as_dict(result.measured[i])
             note = "; ".join(warnings)
             if not result.converged[i]:
