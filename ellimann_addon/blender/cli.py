@@ -21,8 +21,10 @@ import sys
 import time
 
 from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS, RANGES, TABLE_2_5
+from ..core.ellipsoid import bounds
 from ..core.errors import ElliMannError, MeasurementError, ReferenceSetError
 from ..core.files import atomic_write_text
+from ..core.garments import BUILDERS as GARMENTS
 from ..core.mannequin import Mannequin
 from ..core.measure import as_dict
 from ..core.synthesis import (
@@ -122,6 +124,25 @@ def build_parser():
     demo.add_argument("--no-picture", dest="picture", action="store_false", help="skip the line-up render")
     _add_synthesis_options(demo)
     demo.set_defaults(run=run_demo)
+
+    drape = commands.add_parser("drape", help="drape a garment on a mannequin with Blender's cloth simulation",
+                                description="Build a garment sized from the mannequin's m_T, drape it with "
+                                            "Blender cloth (the mannequin's convex pieces as colliders), bake the "
+                                            "frames and save the scene as a .blend; prints the fit (garment-to-"
+                                            "body distances, vertices inside the body).")
+    drape.add_argument("mannequin", metavar="MANNEQUIN", help="a .json or .blend mannequin")
+    drape.add_argument("--garment", choices=tuple(GARMENTS), default="tube_dress",
+                       help="tube_dress (strapless, pinned at the top edge; default) or t_shirt (sewn at the "
+                            "shoulders and armholes)")
+    drape.add_argument("--frames", type=int, default=60, help="frames to simulate (default 60, at 24 fps)")
+    drape.add_argument("--cushions", action="store_true",
+                       help="collide with the cushions and the ellipsoids not in one (default: ellipsoids only)")
+    drape.add_argument("--edge", type=_number, default=2.5, metavar="CM",
+                       help="edge length of the cloth mesh in cm (default 2.5; smaller is finer and slower)")
+    drape.add_argument("--collection", help="the mannequin collection in a .blend holding several")
+    drape.add_argument("-o", "--output", required=True, metavar="OUT.blend")
+    drape.add_argument("--render", metavar="OUT.png", help="also a Workbench picture of the last frame")
+    drape.set_defaults(run=run_drape)
     return parser
 
 
@@ -491,6 +512,44 @@ def _report_markdown(result, reference, args):
             continue
         lines.append(f"| {label} | " + " | ".join(f"{v:.3f}" for v in values) + " |")
     return "\n".join(lines) + "\n"
+
+
+# ------------------------------------------------------------------------------------------------ drape
+
+
+def run_drape(args):
+    for path, ending, what in ((args.output, ".blend", "-o"), (args.render, ".png", "--render")):
+        if path is not None and not path.lower().endswith(ending):
+            raise UsageError(f"{what} must end in {ending}, got {path!r}")
+    kind = os.path.splitext(args.mannequin)[1].lower()
+    if kind not in (".json", ".blend"):
+        raise UsageError(f"MANNEQUIN must be a .json or .blend mannequin, got {args.mannequin!r}")
+    if not os.path.isfile(args.mannequin):
+        raise UsageError(f"{args.mannequin}: no such file")
+    if kind == ".json":
+        mannequin = Mannequin.load(args.mannequin)
+    bpy = _ensure_registered()
+    from .drape import DrapeSettings, drape
+    from .output import add_mannequin, atomic_output, empty_scene, stdout_to_stderr
+
+    settings = DrapeSettings(frames=args.frames, edge=args.edge / 100.0, cushions=args.cushions).checked()
+    if kind == ".json":
+        empty_scene()
+        add_mannequin(mannequin, cushions=args.cushions and bool(mannequin.topology.cushion_pairs))
+    else:
+        mannequin = _load_blend_mannequin(args.mannequin, args.collection)
+    with stdout_to_stderr():
+        result = drape(mannequin, args.garment, settings)
+        with atomic_output(args.output) as temp:
+            bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)
+    print(f"wrote {args.output}: {result.garment.name} on '{mannequin.name}', {result.summary()}")
+    if args.render:
+        from .render import render_view
+
+        low, high = bounds(mannequin.rotation, mannequin.center, mannequin.semi_axes)
+        render_view(args.render, low.min(axis=0), high.max(axis=0))
+        print(f"wrote {args.render}")
+    return 0
 
 
 # ------------------------------------------------------------------------------------------------ Blender

@@ -20,9 +20,13 @@ clearance (W - P) / (2 pi) all round. Nothing starts inside the body (tests chec
   Each sleeve is a tube round the upper arm, its top ring sewn to the armhole (pairs).
 Sizes come from the mannequin's m_T (default), its target measurements (``measurements="target"``)
 or a dict in cm. Heights are fractions of the body's height above its lowest point.
+
+Both wrap the ellipsoids. A body with other surfaces (cushion hulls, which fill the hollows
+between their two ellipsoids, or a dense body mesh) may reach through that initial shape:
+:func:`clear_of` pushes such vertices out before a simulation starts.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -168,6 +172,37 @@ def _clear_rows(mannequin, rings):
                                     mannequin.semi_axes).min(axis=1).reshape(len(rings), -1).min(axis=1)
     bad = np.nonzero(gap < 0.5 * MIN_CLEARANCE)[0]
     return int(bad[0]) if len(bad) else len(rings)
+
+
+def clear_of(garment, distance, clearance=0.5 * MIN_CLEARANCE, iterations=12, step=1e-3):
+    """The garment with every vertex moved to at least ``clearance`` (m) outside a body (by default
+    the least gap the builders leave to the ellipsoids).
+
+    ``distance(points (P, 3)) -> (P,)`` is the body's signed distance (negative inside), e.g.
+    ``lambda p: BodyPieces(m, cushions=True).signed_distance(p)[0]``. Vertices closer than
+    ``clearance`` move along the distance's gradient (central differences of ``step``) by what they
+    lack, a few rounds until none is left; the rest stay put. ``pattern["cleared"]`` counts the
+    moved vertices. Raises ElliMannError if some stay too close (a body the garment cannot wrap).
+    """
+    vertices = np.array(garment.vertices, dtype=float)
+    moved = np.zeros(len(vertices), dtype=bool)
+    for _ in range(iterations):
+        gap = np.asarray(distance(vertices), dtype=float)
+        close = np.nonzero(gap < clearance)[0]
+        if not len(close):
+            break
+        p = vertices[close]
+        gradient = np.stack([(np.asarray(distance(p + step * e)) - np.asarray(distance(p - step * e))) / (2 * step)
+                             for e in np.eye(3)], axis=1)
+        gradient /= np.maximum(np.linalg.norm(gradient, axis=1, keepdims=True), 1e-12)
+        # A little beyond the clearance: the gradient of a union is only piecewise smooth.
+        vertices[close] += (clearance - gap[close] + 0.1 * clearance)[:, None] * gradient
+        moved[close] = True
+    else:
+        if np.any(np.asarray(distance(vertices)) < clearance):
+            raise ElliMannError(f"garment: some vertices of the {garment.name} cannot be moved {clearance} m clear "
+                                "of the body")
+    return replace(garment, vertices=vertices, pattern={**garment.pattern, "cleared": int(moved.sum())})
 
 
 # ----------------------------------------------------------------------------------------------
@@ -509,3 +544,14 @@ def _orient_away_from_body(vertices, faces, panel, mannequin):
         if np.mean(outward[mine]) < 0.5:  # a panel is wound one way throughout: flip it whole
             out[mine] = out[mine][:, ::-1]
     return out
+
+
+# Garments by the key the CLI and the Drape panel use.
+BUILDERS = {"tube_dress": tube_dress, "t_shirt": t_shirt}
+
+
+def make_garment(mannequin, kind, **options):
+    """The garment ``kind`` (a BUILDERS key) for ``mannequin``; ``options`` go to its builder."""
+    if kind not in BUILDERS:
+        raise ElliMannError(f"garment: must be one of {', '.join(BUILDERS)}, got {kind!r}")
+    return BUILDERS[kind](mannequin, **options)

@@ -8,7 +8,7 @@ from devkit.toy import make_toy_mannequin
 from ellimann_addon.core import garments, mesh
 from ellimann_addon.core.constants import SECTION_FRACTIONS
 from ellimann_addon.core.errors import ElliMannError, MeasurementError
-from ellimann_addon.core.fit_metrics import mannequin_signed_distance
+from ellimann_addon.core.fit_metrics import BodyPieces, mannequin_signed_distance
 from ellimann_addon.core.measure import section_heights
 
 
@@ -190,3 +190,30 @@ def test_bad_input_is_refused(body):
     target = body.copy(measurements={"He": 161.0, "Sh": 49.0, "Br": 90.0, "Wa": 70.0, "Hi": 95.0})
     assert garments.tube_dress(target, measurements="target").pattern["requested_width_cm"] == \
         pytest.approx(95.0 * 1.06)
+
+
+def test_clear_of_moves_vertices_out_of_the_cushion_hulls(shirt, body):
+    # The shirt wraps the ellipsoids; the chest-belly cushion also fills the waist hollow between them.
+    hulls = BodyPieces(body, cushions=True, subdivisions=3)
+    before = hulls.signed_distance(shirt.vertices)[0]
+    assert before.min() < 0.0
+    cleared = garments.clear_of(shirt, lambda p: hulls.signed_distance(p)[0])
+    after = hulls.signed_distance(cleared.vertices)[0]
+    assert after.min() >= 0.5 * garments.MIN_CLEARANCE - 1e-9
+    moved = np.linalg.norm(cleared.vertices - shirt.vertices, axis=1) > 0
+    assert cleared.pattern["cleared"] == moved.sum() and not np.any(moved & (before > 0.5 * garments.MIN_CLEARANCE))
+    assert np.linalg.norm(cleared.vertices - shirt.vertices, axis=1).max() < 0.03  # a nudge, not a new garment
+    assert np.array_equal(cleared.faces, shirt.faces) and np.array_equal(cleared.seams, shirt.seams)
+
+
+def test_clear_of_leaves_a_clear_garment_alone_and_refuses_a_body_it_cannot_leave(dress, body):
+    same = garments.clear_of(dress, lambda p: mannequin_signed_distance(p, body)[0])
+    assert np.array_equal(same.vertices, dress.vertices) and same.pattern["cleared"] == 0
+    with pytest.raises(ElliMannError, match="cannot be moved"):
+        garments.clear_of(dress, lambda p: np.full(len(p), -1.0))
+
+
+def test_garments_by_key(body):
+    assert garments.make_garment(body, "tube_dress", edge=0.05).name == "Tube dress"
+    with pytest.raises(ElliMannError, match="garment: must be one of tube_dress, t_shirt"):
+        garments.make_garment(body, "skirt")
