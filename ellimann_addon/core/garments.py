@@ -139,9 +139,28 @@ def _resample(polyline, count, closed):
     return np.stack([np.interp(target, s, pts[:, i]) for i in range(pts.shape[1])], axis=-1)
 
 
+def _fill_gaps(centre, k, active):
+    """Rings whose plane cuts no part take the sections of the nearest ring that has some.
+
+    Between two parts that do not overlap (a torso with a gap at the hips, the elbow between an
+    upper arm and a forearm that only their cushion joins) the garment then stays a straight tube.
+    Returns None if no ring cuts anything.
+    """
+    covered = active.any(axis=1)
+    if not covered.any():
+        return None
+    if covered.all():
+        return centre, k, active
+    rows = np.nonzero(covered)[0]
+    nearest = rows[np.argmin(np.abs(np.arange(len(covered))[:, None] - rows[None]), axis=1)]
+    return centre[nearest], k[nearest], active[nearest]
+
+
 def _girth_perimeters(mannequin, mask, heights):
-    centre, k, active = _sections(mannequin, mask, heights)
-    return hull_perimeter(centre, k, active), (centre, k, active)
+    sections = _fill_gaps(*_sections(mannequin, mask, heights))
+    if sections is None:
+        raise ElliMannError("mannequin: no girth ellipsoid at the garment's heights")
+    return hull_perimeter(*sections), sections
 
 
 def _grid_faces(rows, cols, closed):
@@ -231,8 +250,6 @@ def tube_dress(mannequin, ease=0.06, edge=DEFAULT_EDGE, measurements=None, top=0
     z = np.linspace(z_hem, z_top, rows)
     girth = mannequin.topology.girth_mask
     perimeter, (centre, k, active) = _girth_perimeters(mannequin, girth, z)
-    if not np.all(active.any(axis=1)):
-        raise ElliMannError("mannequin: no girth ellipsoid at some height of the dress")
     requested = max(sizes["Br"], sizes["Hi"]) / CM_PER_M * (1.0 + ease)
     needed = float(perimeter.max()) + 2.0 * np.pi * MIN_CLEARANCE
     width = max(requested, needed)
@@ -505,9 +522,10 @@ def _sleeve(mannequin, arm, loop, vertices, sizes, sleeve_ease, length, edge, cl
     count = len(loop)
     for shift in np.arange(0.0, length, 0.25 * edge):
         sigma = start + shift + np.linspace(0.0, length, max(2, int(np.ceil(length / edge)) + 1))
-        centre, k, hit = section_at_height(rot[None], cen[None], semi[None], sigma[:, None])
-        if not np.all(hit.any(axis=1)):
+        sections = _fill_gaps(*section_at_height(rot[None], cen[None], semi[None], sigma[:, None]))
+        if sections is None:
             continue
+        centre, k, hit = sections
         perimeter = hull_perimeter(centre, k, hit)
         width = np.maximum(girth, perimeter + 2.0 * np.pi * clearance)
         polygons = _hull_rings(centre, k, hit, (width - perimeter) / (2.0 * np.pi))

@@ -7,6 +7,7 @@ from devkit.poses import make_apose_toy
 from devkit.toy import make_toy_mannequin
 from ellimann_addon.core import garments, mesh
 from ellimann_addon.core.constants import SECTION_FRACTIONS
+from ellimann_addon.core.ellipsoid import axis_extent
 from ellimann_addon.core.errors import ElliMannError, MeasurementError
 from ellimann_addon.core.fit_metrics import BodyPieces, mannequin_signed_distance
 from ellimann_addon.core.measure import section_heights
@@ -217,3 +218,21 @@ def test_garments_by_key(body):
     assert garments.make_garment(body, "tube_dress", edge=0.05).name == "Tube dress"
     with pytest.raises(ElliMannError, match="garment: must be one of tube_dress, t_shirt"):
         garments.make_garment(body, "skirt")
+
+
+def test_gaps_between_parts_are_bridged_by_straight_tubes(body):
+    # Belly and pelvis shortened so that no girth part is cut between them (the real RMs have such
+    # gaps at the hips, and upper arm and forearm meet only in their cushion).
+    gap = body.copy(semi_axes=body.semi_axes.copy())
+    belly, pelvis = gap.topology.index["2.b Belly"], gap.topology.index["3.a Pelvis"]
+    gap.semi_axes[belly, 2], gap.semi_axes[pelvis, 2] = 0.05, 0.06
+    top = gap.center[:, 2] + axis_extent(gap.rotation, gap.semi_axes, 2)
+    low = gap.center[:, 2] - axis_extent(gap.rotation, gap.semi_axes, 2)
+    girth = gap.topology.girth_mask
+    empty = (top[pelvis], low[belly])
+    assert not np.any(girth & (low < empty[1]) & (top > empty[0]))  # nothing cut in between
+    dress = garments.tube_dress(gap)
+    z = dress.vertices[:, 2]
+    assert np.any((z > empty[0]) & (z < empty[1]))  # rings in the gap, shaped like their neighbours
+    d, _ = mannequin_signed_distance(dress.vertices, gap)
+    assert d.min() >= 0.5 * garments.MIN_CLEARANCE
