@@ -214,8 +214,8 @@ def evaluated_vertices(obj):
 def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None):
     """Drape ``garment`` (a ``core.garments.BUILDERS`` key or a core Garment) on ``mannequin`` (a core Mannequin).
 
-    A garment named by its key is built from the mannequin's m_T and, with cushions, moved clear
-    of the cushion hulls; a Garment given as such is used as it is.
+    A garment named by its key is built from the mannequin's m_T and moved clear of the pieces
+    (:func:`garments.clear_of`); a Garment given as such is used as it is.
 
     Returns a :class:`DrapeResult` whose ``fit`` compares the final garment with the exact pieces
     (ellipsoids in closed form, cushions at a fine resolution): negative distances are inside.
@@ -227,9 +227,9 @@ def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None)
     cushions = settings.cushions and bool(mannequin.topology.cushion_pairs)
     if isinstance(garment, str):
         garment = garments.make_garment(mannequin, garment, edge=settings.edge)
-        if cushions:  # the builders wrap the ellipsoids; a cushion also fills the hollow between its two
-            clearing = BodyPieces(mannequin, True, CLEARING_SUBDIVISIONS)
-            garment = garments.clear_of(garment, lambda points: clearing.signed_distance(points)[0])
+        # The builders wrap the ellipsoids, a few mm off; a cushion also fills the hollow between its two.
+        clearing = BodyPieces(mannequin, cushions, CLEARING_SUBDIVISIONS)
+        garment = garments.clear_of(garment, lambda points: clearing.signed_distance(points)[0])
     pieces = collision_pieces(mannequin, cushions, settings.sphere_subdivisions, settings.cushion_subdivisions)
     exact = BodyPieces(mannequin, cushions, EXACT_SUBDIVISIONS)
     collection, obj = setup(garment, pieces, settings, name or f"Drape {garment.name} on {mannequin.name}")
