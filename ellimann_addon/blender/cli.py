@@ -7,8 +7,8 @@ Subcommands: ``synth`` (one mannequin), ``batch`` (a CSV of measurements), ``mea
 file), ``demo`` (the paper's Table 2.5 mannequins with a report and a line-up picture) and
 ``drape`` (a garment on a mannequin with Blender's cloth simulation).
 Blender is imported only when a .blend/.glb/.obj file, a drape or a picture is involved, so
-``--help`` and JSON/MJCF work start at once. User mistakes end with a one-line reason and a non-zero exit code:
-1 for bad input or a failed row, 2 for a malformed command line.
+``--help`` and JSON/MJCF work start at once. User mistakes end with a one-line reason and a
+non-zero exit code: 1 for bad input or a failed row, 2 for a malformed command line.
 """
 
 import argparse
@@ -36,11 +36,10 @@ from ..core.synthesis import (
     synthesize_batch,
     validate_request,
 )
-from ..core.writers import core_format, write_core_file
+from ..core.writers import EXTENSIONS, core_format, write_core_file
 
 PROG = "ellimann"
-FORMATS = ("blend", "glb", "obj", "json", "mjcf")  # --format names
-EXTENSIONS = {"mjcf": "xml"}  # format -> file extension where they differ
+FORMATS = ("blend", "glb", "obj", "json", "mjcf")  # --format names; the file extension is the name but for mjcf
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,99}$")
 CHUNK = 256  # rows synthesized per core batch
 
