@@ -66,11 +66,12 @@ def relabel(mannequin, reference):
 def clean(mannequins, reference_index=0, source="L"):
     """The paper's cleaning of a set of mannequins sharing one topology.
 
-    Registers each, makes each symmetric (``source`` side mirrored, central ellipsoids
-    symmetrized), then relabels every ellipsoid's axes against the reference mannequin's.
-    Relabelling changes no ellipsoid as a set, so symmetry and registration are kept.
+    Registers each (so the sagittal plane is x = 0), makes each symmetric (``source`` side
+    mirrored, central ellipsoids symmetrized), registers again (mirroring can move the lowest point
+    and the landmarks' centroid), then relabels every ellipsoid's axes against the reference
+    mannequin's. Relabelling changes no ellipsoid as a set, so symmetry and registration are kept.
     """
-    cleaned = [symmetrize(register(m), source) for m in mannequins]
+    cleaned = [register(symmetrize(register(m), source)) for m in mannequins]
     reference = cleaned[reference_index]
     return [m if i == reference_index else relabel(m, reference) for i, m in enumerate(cleaned)]
 

@@ -53,3 +53,15 @@ def test_missing_landmarks_are_reported(toy):
 
     with pytest.raises(MannequinError, match="no 'Deltoid' ellipsoids"):
         clean.register(toy, label="Deltoid")
+
+
+def test_clean_registers_after_mirroring(toy):
+    """An asymmetric input whose right foot is lowest: mirroring the left lifts the body off the floor."""
+    m = disturbed(toy, 3)
+    right_shin = m.topology.index["6.b Shin.R"]
+    m.center[right_shin, 2] -= 0.05
+    cleaned = clean.clean([m])[0]
+    lowest = np.min(cleaned.center[:, 2] - axis_extent(cleaned.rotation, cleaned.semi_axes, 2))
+    assert lowest == pytest.approx(0.0, abs=1e-12)
+    idx = clean.landmark_indices(cleaned.topology)
+    assert np.allclose(cleaned.center[idx, :2].mean(axis=0), 0.0, atol=1e-12)

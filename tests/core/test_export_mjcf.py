@@ -193,6 +193,10 @@ def drop_balls(mannequin, cushions):
                 supported=supported, deepest_contact=deepest_contact)
 
 
+# MuJoCo's contacts are soft: a 2 cm ball dropped onto a thin piece sinks in by up to ~3.5 mm.
+SOFT_CONTACT_DEPTH = 0.005
+
+
 @pytest.mark.parametrize("cushions", [False, True], ids=["ellipsoids", "cushions"])
 @pytest.mark.parametrize("make", mannequins(only="average"))  # a few seconds each: the toy and one RM
 def test_falling_balls_never_pass_through_the_mannequin(make, cushions):
@@ -202,14 +206,17 @@ def test_falling_balls_never_pass_through_the_mannequin(make, cushions):
     # Collisions really happened: a good share of the balls struck the body on their way down.
     assert out["hit_body"] >= 0.1 * out["count"]
     # Along the whole fall no ball centre came closer to the body than its radius, up to MuJoCo's
-    # soft-contact penetration (about a millimetre); sampled every CHECK_EVERY steps.
-    assert np.min(out["closest"]) > r - 0.003, f"deepest approach {np.min(out['closest']) - r:.4f} m"
-    assert out["deepest_contact"] > -0.003
+    # soft-contact penetration (a few millimetres when a ball lands on a finger); sampled every
+    # CHECK_EVERY steps. Passing through would take at least the thinnest piece's half-thickness.
+    thinnest = mannequin.semi_axes.min()
+    tolerance = min(SOFT_CONTACT_DEPTH, 0.5 * thinnest)
+    assert np.min(out["closest"]) > r - tolerance, f"deepest approach {np.min(out['closest']) - r:.4f} m"
+    assert out["deepest_contact"] > -tolerance
     # At the end: no centre inside any ellipsoid grown by most of the radius (the brief's check)...
     grown = mannequin.semi_axes + 0.8 * r
     inside = contains(mannequin.rotation[None], mannequin.center[None], grown[None], out["final"][:, None])
     assert not inside.any()
     # ... all balls at rest, above the floor, each held by the floor, the body or another ball.
-    assert np.all(out["final"][:, 2] > r - 0.003)
+    assert np.all(out["final"][:, 2] > r - SOFT_CONTACT_DEPTH)
     assert np.all(out["speed"] < 0.05), f"fastest {out['speed'].max():.3f} m/s"
     assert out["supported"].all()
