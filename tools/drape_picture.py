@@ -14,13 +14,14 @@ from dataclasses import replace
 
 import numpy as np
 
-from bench.bench_drape import BODY, EDGE, REFMODELS, load_obj
+from bench.bench_drape import BODY, EDGE, REFMODELS
 from ellimann_addon.core import garments
 from ellimann_addon.core.collision import collision_pieces
 from ellimann_addon.core.ellipsoid import bounds
 from ellimann_addon.core.fit_metrics import BodyPieces, mesh_distance
 from ellimann_addon.core.mannequin import Mannequin
 from ellimann_addon.core.synthesis import REFERENCE_FOLDER
+from tools.bodies import load_obj
 
 SPACING = 1.05  # m between slots
 BODY_COLOR = (0.8, 0.78, 0.72, 1.0)
