@@ -26,7 +26,7 @@ from ..core.errors import ElliMannError
 from ..core.fit_metrics import BodyPieces, fit_statistics
 from .convert import mesh_from_arrays, new_collection
 
-DRAPE_KEY = "ellimann_drape"  # ID property on a drape collection: the garment key
+DRAPE_KEY = "ellimann_drape"  # ID property on a drape collection: the garment's name
 PIN_GROUP = "Pin"
 CLOTH_NAME = "Cloth"
 GARMENT_COLOR = (0.22, 0.45, 0.75, 1.0)
@@ -186,7 +186,7 @@ def setup(garment, pieces, settings, name, parent=None):
 
 def bake(scene, obj, frames):
     """Simulate frames 1..frames frame by frame; returns (wall, cpu): the seconds each of frames
-    2..frames took, by the clock and in this process's CPU time (less disturbed by other programs).
+    2..frames took, by the clock and in this process's CPU time (all its threads together).
 
     Leaves the cache baked (saved with the .blend) and the scene on the last frame.
     """
@@ -239,7 +239,8 @@ def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None)
         garment = garments.clear_of(garment, lambda points: clearing.signed_distance(points, CLEARING_CUTOFF)[0])
     pieces = collision_pieces(mannequin, cushions, settings.sphere_subdivisions, settings.cushion_subdivisions)
     exact = BodyPieces(mannequin, cushions, EXACT_SUBDIVISIONS)
-    collection, obj = setup(garment, pieces, settings, name or f"Drape {garment.name} on {mannequin.name}")
+    collection, obj = setup(garment, pieces, settings, name or f"Drape {garment.name} on {mannequin.name}",
+                            scene.collection)
     collection[DRAPE_KEY] = garment.name
     wall, cpu = bake(scene, obj, settings.frames)
     vertices = evaluated_vertices(obj)

@@ -12,7 +12,7 @@ import pytest
 from devkit.blender_scene import parts, select, state
 from devkit.poses import make_apose_toy
 from devkit.ui_recorder import draw_panel
-from ellimann_addon.blender import cli, drape_panel, ids, menus
+from ellimann_addon.blender import cli, drape_panel, ids
 from ellimann_addon.blender.convert import mannequin_to_collection
 from ellimann_addon.blender.drape import CLOTH_NAME, PIN_GROUP, DrapeSettings, drape, evaluated_vertices
 from ellimann_addon.core.errors import ElliMannError
@@ -108,6 +108,12 @@ def test_operator_drapes_the_active_mannequin_and_reports(body):
     assert any("8 frames" in label for label in recorder.labels())
 
 
+def test_drape_panel_draws_in_an_empty_file():
+    recorder = draw_panel(drape_panel.ELLIMANN_PT_drape)
+    assert recorder.operators() == [ids.DRAPE_GARMENT] and recorder.labels() == []
+    assert drape_panel.ELLIMANN_PT_drape.bl_parent_id == ids.PANEL_MAIN and drape_panel.ELLIMANN_PT_drape.bl_order == 70
+
+
 def test_operator_refuses_a_broken_mannequin_and_needs_one(body):
     assert not bpy.ops.ellimann.drape_garment.poll()
     collection = mannequin_to_collection(body)
@@ -119,15 +125,6 @@ def test_operator_refuses_a_broken_mannequin_and_needs_one(body):
     with pytest.raises(RuntimeError, match="Fix 'toy \\(A-pose\\)' first: '6.a Thigh.L'"):
         bpy.ops.ellimann.drape_garment()
     assert state() == before
-
-
-def test_object_menu_offers_drape(body):
-    menu = menus.ELLIMANN_MT_object
-    from devkit.ui_recorder import Recorder
-
-    recorder = Recorder()
-    menu.draw(type("Menu", (), {"layout": recorder})(), bpy.context)
-    assert ids.DRAPE_GARMENT in recorder.operators()
 
 
 # ------------------------------------------------------------------------------------------------ CLI
