@@ -3,7 +3,7 @@
 import importlib
 import sys
 
-BENCHES = ("bench_core", "bench_synthesis")
+BENCHES = ("bench_core", "bench_synthesis", "bench_drape")
 
 
 def main(names=None):

@@ -3,7 +3,7 @@
 import importlib
 
 # Registered in this order, unregistered in reverse.
-_MODULES = ("props", "operators", "panels", "menus", "synthesize", "synthesize_panel", "cli")
+_MODULES = ("props", "operators", "panels", "menus", "synthesize", "synthesize_panel", "drape_panel", "cli")
 
 
 def _modules():

@@ -4,10 +4,11 @@
 - ``python -m ellimann_addon …`` (with the ``bpy`` module installed)
 
 Subcommands: ``synth`` (one mannequin), ``batch`` (a CSV of measurements), ``measure`` (m_T of a
-file) and ``demo`` (the paper's Table 2.5 mannequins with a report and a line-up picture).
-Blender is imported only when a .blend/.glb/.obj file or a picture is involved, so ``--help`` and
-JSON work start at once. User mistakes end with a one-line reason and a non-zero exit code:
-1 for bad input or a failed row, 2 for a malformed command line.
+file), ``demo`` (the paper's Table 2.5 mannequins with a report and a line-up picture) and
+``drape`` (a garment on a mannequin with Blender's cloth simulation).
+Blender is imported only when a .blend/.glb/.obj file, a drape or a picture is involved, so
+``--help`` and JSON/MJCF work start at once. User mistakes end with a one-line reason and a
+non-zero exit code: 1 for bad input or a failed row, 2 for a malformed command line.
 """
 
 import argparse
@@ -20,8 +21,10 @@ import sys
 import time
 
 from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS, RANGES, TABLE_2_5
+from ..core.ellipsoid import bounds
 from ..core.errors import ElliMannError, MeasurementError, ReferenceSetError
 from ..core.files import atomic_write_text
+from ..core.garments import BUILDERS as GARMENTS
 from ..core.mannequin import Mannequin
 from ..core.measure import as_dict
 from ..core.synthesis import (
@@ -36,9 +39,10 @@ from ..core.synthesis import (
     synthesize_batch,
     validate_request,
 )
+from ..core.writers import EXTENSIONS, core_format, write_core_file
 
 PROG = "ellimann"
-FORMATS = ("blend", "glb", "obj", "json")
+FORMATS = ("blend", "glb", "obj", "json", "mjcf")  # --format names; the file extension is the name but for mjcf
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,99}$")
 CHUNK = 256  # rows synthesized per core batch
 
@@ -70,7 +74,8 @@ def _add_synthesis_options(parser):
                              "and widths to its own measurement; height: heights only; none: the RMs' geometry "
                              "as it is (the paper)")
     parser.add_argument("--cushions", action="store_true",
-                        help="show cushions (convex hulls of the cushion pairs) in .blend/.glb/.obj outputs")
+                        help="cushions (convex hulls of the cushion pairs) instead of their ellipsoids: shown in "
+                             ".blend/.glb/.obj outputs, convex mesh geoms in MJCF")
     parser.add_argument("--references", metavar="DIR",
                         help="folder with the five Reference Mannequin .json files (default: the shipped "
                              "reference_blends/)")
@@ -88,7 +93,8 @@ def build_parser():
         synth.add_argument(f"--{key.lower()}", dest=key, type=_number, required=True, metavar="CM",
                            help=f"{MEASUREMENT_LABELS[key]} (reference range {low:g}-{high:g})")
     synth.add_argument("-o", "--output", required=True, metavar="OUT",
-                       help="output file: .blend, .glb, .obj or .json (ElliMann's mannequin JSON)")
+                       help="output file: .blend, .glb, .obj, .json (ElliMann's mannequin JSON) or .xml (MJCF, "
+                            "for MuJoCo)")
     synth.add_argument("--name", help="mannequin name (default: 'ElliMann He-Sh-Br-Wa-Hi')")
     _add_synthesis_options(synth)
     synth.set_defaults(run=run_synth)
@@ -101,7 +107,8 @@ def build_parser():
     batch.add_argument("csv", metavar="MEASUREMENTS.csv")
     batch.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
     batch.add_argument("--format", default="json",
-                       help="comma-separated output formats among blend,glb,obj,json (default json)")
+                       help="comma-separated output formats among blend,glb,obj,json,mjcf (default json; mjcf "
+                            "writes NAME.xml)")
     batch.add_argument("--shard", metavar="I/N",
                        help="process only rows I, I+N, I+2N… (I from 1 to N), for a render farm; the report "
                             "is DIR/report-I-of-N.csv")
@@ -123,6 +130,25 @@ def build_parser():
     demo.add_argument("--no-picture", dest="picture", action="store_false", help="skip the line-up render")
     _add_synthesis_options(demo)
     demo.set_defaults(run=run_demo)
+
+    drape = commands.add_parser("drape", help="drape a garment on a mannequin with Blender's cloth simulation",
+                                description="Build a garment sized from the mannequin's m_T, drape it with "
+                                            "Blender cloth (the mannequin's convex pieces as colliders), bake the "
+                                            "frames and save the scene as a .blend; prints the fit (garment-to-"
+                                            "body distances, vertices inside the body).")
+    drape.add_argument("mannequin", metavar="MANNEQUIN", help="a .json or .blend mannequin")
+    drape.add_argument("--garment", choices=tuple(GARMENTS), default="tube_dress",
+                       help="tube_dress (strapless, pinned at the top edge; default) or t_shirt (sewn at the "
+                            "shoulders and armholes)")
+    drape.add_argument("--frames", type=int, default=60, help="frames to simulate (default 60, at 24 fps)")
+    drape.add_argument("--cushions", action="store_true",
+                       help="collide with the cushions and the ellipsoids not in one (default: ellipsoids only)")
+    drape.add_argument("--edge", type=_number, default=2.5, metavar="CM",
+                       help="edge length of the cloth mesh in cm (default 2.5; smaller is finer and slower)")
+    drape.add_argument("--collection", help="the mannequin collection in a .blend holding several")
+    drape.add_argument("-o", "--output", required=True, metavar="OUT.blend")
+    drape.add_argument("--render", metavar="OUT.png", help="also a Workbench picture of the last frame")
+    drape.set_defaults(run=run_drape)
     return parser
 
 
@@ -162,10 +188,15 @@ def _ensure_registered():
 
 
 def _output_kind(path):
-    kind = os.path.splitext(path)[1].lower().lstrip(".")
-    if kind not in FORMATS:
-        raise UsageError(f"OUT must end in .blend, .glb, .obj or .json, got {path!r}")
+    extension = os.path.splitext(path)[1].lower().lstrip(".")
+    kind = next((k for k in FORMATS if _extension(k) == extension), None)
+    if kind is None:
+        raise UsageError(f"OUT must end in .blend, .glb, .obj, .json or .xml (MJCF), got {path!r}")
     return kind
+
+
+def _extension(kind):
+    return EXTENSIONS.get(kind, kind)
 
 
 def _references(args):
@@ -182,13 +213,14 @@ def _format_me(values):
 
 
 def _write(mannequin, paths, measured, cushions):
-    if any(os.path.splitext(p)[1].lower() != ".json" for p in paths):
+    """Write every path (format from the extension); Blender is loaded only for .blend/.glb/.obj."""
+    if any(core_format(p) is None for p in paths):
         _ensure_registered()
         from .output import write_mannequin
 
         return write_mannequin(mannequin, paths, measured, cushions)
     for path in paths:
-        atomic_write_text(path, mannequin.to_json() + "\n")
+        write_core_file(mannequin, path, cushions)
     return paths
 
 
@@ -307,7 +339,7 @@ def run_batch(args):
                                   args.power, normalize=args.normalize)
         for i, (line, name, values, warnings) in enumerate(chunk):
             mannequin = result.mannequin(i, name)
-            paths = [os.path.join(args.output, f"{name}.{kind}") for kind in formats]
+            paths = [os.path.join(args.output, f"{name}.{_extension(kind)}") for kind in formats]
             measured = as_dict(result.measured[i])
             note = "; ".join(warnings)
             if not result.converged[i]:
@@ -490,6 +522,44 @@ def _report_markdown(result, reference, args):
             continue
         lines.append(f"| {label} | " + " | ".join(f"{v:.3f}" for v in values) + " |")
     return "\n".join(lines) + "\n"
+
+
+# ------------------------------------------------------------------------------------------------ drape
+
+
+def run_drape(args):
+    for path, ending, what in ((args.output, ".blend", "-o"), (args.render, ".png", "--render")):
+        if path is not None and not path.lower().endswith(ending):
+            raise UsageError(f"{what} must end in {ending}, got {path!r}")
+    kind = os.path.splitext(args.mannequin)[1].lower()
+    if kind not in (".json", ".blend"):
+        raise UsageError(f"MANNEQUIN must be a .json or .blend mannequin, got {args.mannequin!r}")
+    if not os.path.isfile(args.mannequin):
+        raise UsageError(f"{args.mannequin}: no such file")
+    if kind == ".json":
+        mannequin = Mannequin.load(args.mannequin)
+    bpy = _ensure_registered()
+    from .drape import DrapeSettings, drape
+    from .output import add_mannequin, atomic_output, empty_scene, stdout_to_stderr
+
+    settings = DrapeSettings(frames=args.frames, edge=args.edge / 100.0, cushions=args.cushions).checked()
+    if kind == ".json":
+        empty_scene()
+        add_mannequin(mannequin, cushions=args.cushions and bool(mannequin.topology.cushion_pairs))
+    else:
+        mannequin = _load_blend_mannequin(args.mannequin, args.collection)
+    with stdout_to_stderr():
+        result = drape(mannequin, args.garment, settings)
+        with atomic_output(args.output) as temp:
+            bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)
+    print(f"wrote {args.output}: {result.garment.name} on '{mannequin.name}', {result.summary()}")
+    if args.render:
+        from .render import render_view
+
+        low, high = bounds(mannequin.rotation, mannequin.center, mannequin.semi_axes)
+        render_view(args.render, low.min(axis=0), high.max(axis=0))
+        print(f"wrote {args.render}")
+    return 0
 
 
 # ------------------------------------------------------------------------------------------------ Blender

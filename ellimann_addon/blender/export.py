@@ -60,6 +60,9 @@ def scene_extras(mannequin):
 def export_gltf(collection, path):
     """Write a mannequin collection (and its child collections) to a binary glTF (.glb), atomically.
 
+    Objects hidden from renders are left out: in a mannequin shown with cushions those are the
+    ellipsoids the cushions replace, so the file holds each convex piece once.
+
     Raises ElliMannError for a path not ending in .glb and MannequinError (naming the parts) for
     a collection that is not a valid mannequin; nothing is written then, and the file is
     unchanged. Returns the path.
@@ -80,7 +83,7 @@ def export_gltf(collection, path):
             saved[owner] = owner.get(EXTRAS_KEY)
             owner[EXTRAS_KEY] = value
         result = bpy.ops.export_scene.gltf(filepath=temp, export_format="GLB", export_extras=True,
-                                           collection=collection.name, export_yup=True)
+                                           collection=collection.name, export_yup=True, use_renderable=True)
         if result != {"FINISHED"}:
             raise ElliMannError(f"path: Blender's glTF exporter did not finish ({result})")
         os.replace(temp, path)

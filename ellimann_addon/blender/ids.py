@@ -18,6 +18,7 @@ VALIDATE_MANNEQUIN = "ellimann.validate_mannequin"
 FIX_FRAMES = "ellimann.fix_frames"
 SYNTHESIZE_MANNEQUIN = "ellimann.synthesize_mannequin"
 ADD_MEASUREMENT_PRESET = "ellimann.add_measurement_preset"
+DRAPE_GARMENT = "ellimann.drape_garment"
 
 PANEL_MAIN = "ELLIMANN_PT_main"
 PANEL_TRACE = "ELLIMANN_PT_trace"
@@ -26,10 +27,12 @@ PANEL_CLEAN = "ELLIMANN_PT_clean"
 PANEL_CUSHIONS = "ELLIMANN_PT_cushions"
 PANEL_MEASURE = "ELLIMANN_PT_measure"
 PANEL_SYNTHESIZE = "ELLIMANN_PT_synthesize"
+PANEL_DRAPE = "ELLIMANN_PT_drape"
 
 # Sub-panels of PANEL_MAIN sort by bl_order. Room is left after Measure for the Synthesize (60)
 # and Drape (70) panels that other parts of the add-on add.
 PANEL_ORDER = {PANEL_TRACE: 10, PANEL_PART: 20, PANEL_CLEAN: 30, PANEL_CUSHIONS: 40, PANEL_MEASURE: 50}
+DRAPE_ORDER = 70
 
 MENU_OBJECT = "ELLIMANN_MT_object"
 

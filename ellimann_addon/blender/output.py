@@ -1,7 +1,9 @@
-"""Write mannequins to .blend, .glb and .obj from Blender, atomically (headless CLI and scripts).
+"""Write mannequins to .blend, .glb, .obj, .json and .xml (MJCF), atomically (headless CLI and scripts).
 
-Each file is written from an empty scene holding only that mannequin (and its cushions when asked),
-to a temporary file in the target folder that is renamed into place once complete.
+Blender files are written from an empty scene holding only that mannequin (and its cushions when
+asked), to a temporary file in the target folder that is renamed into place once complete. A .glb
+goes through :func:`export.export_gltf`, so it always carries ElliMann's extras. JSON and MJCF
+come from the core (:mod:`core.writers`) and need no scene.
 """
 
 import contextlib
@@ -13,9 +15,10 @@ import tempfile
 import bpy
 
 from ..core.cushion import DEFAULT_SUBDIVISIONS
-from ..core.files import atomic_write_text
+from ..core.writers import core_format, write_core_file
 from .convert import mannequin_to_collection, write_measured
 from .cushions import build_cushions
+from .export import export_gltf
 
 BLENDER_FORMATS = ("blend", "glb", "obj")
 LIVE_SUBDIVISIONS = 3
@@ -94,12 +97,16 @@ def refresh_cushions(collection, subdivisions=LIVE_SUBDIVISIONS):
 
 
 def write_mannequin(mannequin, paths, measured=None, cushions=False):
-    """Write one mannequin to every path in ``paths`` (format from the extension). Returns the paths."""
+    """Write one mannequin to every path in ``paths`` (format from the extension). Returns the paths.
+
+    ``cushions``: .blend/.glb/.obj show the cushions instead of the ellipsoids they replace; MJCF
+    gets one convex mesh geom per cushion pair.
+    """
     paths = [os.fspath(p) for p in paths]
     blender_paths = [p for p in paths if extension(p) in BLENDER_FORMATS]
     for path in paths:
-        if extension(path) == "json":
-            atomic_write_text(path, mannequin.to_json() + "\n")
+        if core_format(path):
+            write_core_file(mannequin, path, cushions)
     if blender_paths:
         empty_scene()
         collection = add_mannequin(mannequin, measured, cushions)
@@ -136,17 +143,17 @@ def atomic_output(path):
 
 def _write_blender_file(path, collection):
     kind = extension(path)
+    if kind == "glb":  # atomic itself; leaves out what renders do not show (ellipsoids a cushion replaces)
+        with stdout_to_stderr():
+            export_gltf(collection, path)
+        return
     with atomic_output(path) as temp, stdout_to_stderr():
         if kind == "blend":
             bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)
         else:
             _select_only(shown_objects(collection))
-            if kind == "glb":
-                bpy.ops.export_scene.gltf(filepath=temp, export_format="GLB", use_selection=True,
-                                          export_extras=True, export_yup=True)
-            else:
-                bpy.ops.wm.obj_export(filepath=temp, export_selected_objects=True, export_materials=False,
-                                      check_existing=False)
+            bpy.ops.wm.obj_export(filepath=temp, export_selected_objects=True, export_materials=False,
+                                  check_existing=False)
 
 
 def _select_only(objects):

@@ -54,20 +54,35 @@ def _add_label(text, location, size=0.07):
     return obj
 
 
-def _frame_front(scene, low, high, pixels, margin=1.06):
+def _frame_front(scene, low, high, pixels, margin=1.06, azimuth=0.0):
+    """An orthographic camera framing the box low..high, looking at the body's front from ``azimuth``
+    degrees round to its left (0: straight from the front)."""
     camera = bpy.data.objects.new("ElliMann Camera", bpy.data.cameras.new("ElliMann Camera"))
     scene.collection.objects.link(camera)
     camera.data.type = "ORTHO"
-    width, height = high[0] - low[0], high[2] - low[2]
+    turn = math.radians(azimuth)
+    right = np.array([math.cos(turn), math.sin(turn)])  # the picture's x axis, in the floor plane
+    corners = np.array([[x, y] for x in (low[0], high[0]) for y in (low[1], high[1])]) @ right
+    width, height = corners.max() - corners.min(), high[2] - low[2]
     resolution = (pixels, max(16, round(pixels * height / width)))
     camera.data.sensor_fit = "HORIZONTAL"
     camera.data.ortho_scale = margin * width
-    camera.location = (0.5 * (low[0] + high[0]), low[1] - 10.0, 0.5 * (low[2] + high[2]))
-    camera.rotation_euler = (math.pi / 2, 0.0, 0.0)  # looks along +Y: the body faces -Y
+    centre = 0.5 * (np.asarray(low) + np.asarray(high))
+    back = np.array([math.sin(turn), -math.cos(turn)])  # from the centre towards the camera
+    camera.location = (centre[0] + 10.0 * back[0], centre[1] + 10.0 * back[1], centre[2])
+    camera.rotation_euler = (math.pi / 2, 0.0, turn)  # at 0 looks along +Y: the body faces -Y
     camera.data.clip_end = 50.0
     scene.camera = camera
     scene.render.resolution_x, scene.render.resolution_y = resolution
     scene.render.resolution_percentage = 100
+
+
+def render_view(filepath, low, high, width=800, azimuth=0.0):
+    """Workbench picture of the current scene as it is, framing the box low..high (m), written atomically."""
+    scene = bpy.context.scene
+    _frame_front(scene, low, high, width, azimuth=azimuth)
+    _workbench(scene)
+    return _render(scene, filepath)
 
 
 def _workbench(scene):

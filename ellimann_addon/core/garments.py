@@ -20,9 +20,13 @@ clearance (W - P) / (2 pi) all round. Nothing starts inside the body (tests chec
   Each sleeve is a tube round the upper arm, its top ring sewn to the armhole (pairs).
 Sizes come from the mannequin's m_T (default), its target measurements (``measurements="target"``)
 or a dict in cm. Heights are fractions of the body's height above its lowest point.
+
+Both wrap the ellipsoids. A body with other surfaces (cushion hulls, which fill the hollows
+between their two ellipsoids, or a dense body mesh) may reach through that initial shape:
+:func:`clear_of` pushes such vertices out before a simulation starts.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -135,9 +139,28 @@ def _resample(polyline, count, closed):
     return np.stack([np.interp(target, s, pts[:, i]) for i in range(pts.shape[1])], axis=-1)
 
 
+def _fill_gaps(centre, k, active):
+    """Rings whose plane cuts no part take the sections of the nearest ring that has some.
+
+    Between two parts that do not overlap (a torso with a gap at the hips, the elbow between an
+    upper arm and a forearm that only their cushion joins) the garment then stays a straight tube.
+    Returns None if no ring cuts anything.
+    """
+    covered = active.any(axis=1)
+    if not covered.any():
+        return None
+    if covered.all():
+        return centre, k, active
+    rows = np.nonzero(covered)[0]
+    nearest = rows[np.argmin(np.abs(np.arange(len(covered))[:, None] - rows[None]), axis=1)]
+    return centre[nearest], k[nearest], active[nearest]
+
+
 def _girth_perimeters(mannequin, mask, heights):
-    centre, k, active = _sections(mannequin, mask, heights)
-    return hull_perimeter(centre, k, active), (centre, k, active)
+    sections = _fill_gaps(*_sections(mannequin, mask, heights))
+    if sections is None:
+        raise ElliMannError("mannequin: no girth ellipsoid at the garment's heights")
+    return hull_perimeter(*sections), sections
 
 
 def _grid_faces(rows, cols, closed):
@@ -170,6 +193,37 @@ def _clear_rows(mannequin, rings):
     return int(bad[0]) if len(bad) else len(rings)
 
 
+def clear_of(garment, distance, clearance=0.5 * MIN_CLEARANCE, iterations=12, step=1e-3):
+    """The garment with every vertex moved to at least ``clearance`` (m) outside a body (by default
+    the least gap the builders leave to the ellipsoids).
+
+    ``distance(points (P, 3)) -> (P,)`` is the body's signed distance (negative inside), e.g.
+    ``lambda p: BodyPieces(m, cushions=True).signed_distance(p)[0]``. Vertices closer than
+    ``clearance`` move along the distance's gradient (central differences of ``step``) by what they
+    lack, a few rounds until none is left; the rest stay put. ``pattern["cleared"]`` counts the
+    moved vertices. Raises ElliMannError if some stay too close (a body the garment cannot wrap).
+    """
+    vertices = np.array(garment.vertices, dtype=float)
+    moved = np.zeros(len(vertices), dtype=bool)
+    for _ in range(iterations):
+        gap = np.asarray(distance(vertices), dtype=float)
+        close = np.nonzero(gap < clearance)[0]
+        if not len(close):
+            break
+        p = vertices[close]
+        gradient = np.stack([(np.asarray(distance(p + step * e)) - np.asarray(distance(p - step * e))) / (2 * step)
+                             for e in np.eye(3)], axis=1)
+        gradient /= np.maximum(np.linalg.norm(gradient, axis=1, keepdims=True), 1e-12)
+        # A little beyond the clearance: the gradient of a union is only piecewise smooth.
+        vertices[close] += (clearance - gap[close] + 0.1 * clearance)[:, None] * gradient
+        moved[close] = True
+    else:
+        if np.any(np.asarray(distance(vertices)) < clearance):
+            raise ElliMannError(f"garment: some vertices of the {garment.name} cannot be moved {clearance} m clear "
+                                "of the body")
+    return replace(garment, vertices=vertices, pattern={**garment.pattern, "cleared": int(moved.sum())})
+
+
 # ----------------------------------------------------------------------------------------------
 # Tube dress
 
@@ -196,8 +250,6 @@ def tube_dress(mannequin, ease=0.06, edge=DEFAULT_EDGE, measurements=None, top=0
     z = np.linspace(z_hem, z_top, rows)
     girth = mannequin.topology.girth_mask
     perimeter, (centre, k, active) = _girth_perimeters(mannequin, girth, z)
-    if not np.all(active.any(axis=1)):
-        raise ElliMannError("mannequin: no girth ellipsoid at some height of the dress")
     requested = max(sizes["Br"], sizes["Hi"]) / CM_PER_M * (1.0 + ease)
     needed = float(perimeter.max()) + 2.0 * np.pi * MIN_CLEARANCE
     width = max(requested, needed)
@@ -470,9 +522,10 @@ def _sleeve(mannequin, arm, loop, vertices, sizes, sleeve_ease, length, edge, cl
     count = len(loop)
     for shift in np.arange(0.0, length, 0.25 * edge):
         sigma = start + shift + np.linspace(0.0, length, max(2, int(np.ceil(length / edge)) + 1))
-        centre, k, hit = section_at_height(rot[None], cen[None], semi[None], sigma[:, None])
-        if not np.all(hit.any(axis=1)):
+        sections = _fill_gaps(*section_at_height(rot[None], cen[None], semi[None], sigma[:, None]))
+        if sections is None:
             continue
+        centre, k, hit = sections
         perimeter = hull_perimeter(centre, k, hit)
         width = np.maximum(girth, perimeter + 2.0 * np.pi * clearance)
         polygons = _hull_rings(centre, k, hit, (width - perimeter) / (2.0 * np.pi))
@@ -509,3 +562,14 @@ def _orient_away_from_body(vertices, faces, panel, mannequin):
         if np.mean(outward[mine]) < 0.5:  # a panel is wound one way throughout: flip it whole
             out[mine] = out[mine][:, ::-1]
     return out
+
+
+# Garments by the key the CLI and the Drape panel use.
+BUILDERS = {"tube_dress": tube_dress, "t_shirt": t_shirt}
+
+
+def make_garment(mannequin, kind, **options):
+    """The garment ``kind`` (a BUILDERS key) for ``mannequin``; ``options`` go to its builder."""
+    if kind not in BUILDERS:
+        raise ElliMannError(f"garment: must be one of {', '.join(BUILDERS)}, got {kind!r}")
+    return BUILDERS[kind](mannequin, **options)

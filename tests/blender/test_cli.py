@@ -16,6 +16,7 @@ import pytest
 
 from devkit import synthetic
 from ellimann_addon.blender import cli
+from ellimann_addon.blender.export import EXTRAS_KEY, read_glb_json
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.mannequin import Mannequin
 
@@ -135,7 +136,7 @@ def test_synth_refuses_bad_measurements(tmp_path, capsys, references, args, word
 
 def test_synth_refuses_unknown_outputs_and_missing_references(tmp_path, capsys, references):
     code, _, err = run(["synth", *REQUEST, "-o", str(tmp_path / "m.stl"), "--references", references], capsys)
-    assert_one_line_error(code, err, ".blend, .glb, .obj or .json")
+    assert_one_line_error(code, err, ".blend, .glb, .obj, .json or .xml (MJCF)")
     code, _, err = run(["synth", *REQUEST, "-o", str(tmp_path / "m.json"), "--references", str(tmp_path / "no")],
                        capsys)
     assert_one_line_error(code, err, "does not exist")
@@ -160,7 +161,10 @@ def test_synth_blender_formats_with_cushions(tmp_path, capsys, references):
         assert stdout.startswith(f"wrote {out}") and stdout.count("\n") == 1  # Blender's chatter went to stderr
         assert out.stat().st_size > 1000
         assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary left over
-    assert (tmp_path / "m.glb").read_bytes()[:4] == b"glTF"
+    doc = read_glb_json(tmp_path / "m.glb")  # through export_gltf: ElliMann's extras, each convex piece once
+    nodes = {n["name"]: n["extras"][EXTRAS_KEY]["kind"] for n in doc["nodes"]}
+    assert sorted(nodes.values()) == ["CUSHION"] * pairs + ["ELLIPSOID"] * singles
+    assert doc["scenes"][0]["extras"][EXTRAS_KEY]["measured_cm"] == pytest.approx(VALUES, rel=1e-4)
     objects = [line for line in (tmp_path / "m.obj").read_text().splitlines() if line.startswith("o ")]
     assert len(objects) == pairs + singles
     code, stdout, _ = run(["measure", str(tmp_path / "m.blend"), "--json"], capsys)
@@ -170,6 +174,25 @@ def test_synth_blender_formats_with_cushions(tmp_path, capsys, references):
     assert len(cushions) == pairs
     hidden = [o for o in bpy.data.objects if o.ellimann.kind == "ELLIPSOID" and o.hide_get()]
     assert len(hidden) == 2 * pairs
+
+
+def test_synth_mjcf_loads_in_mujoco_without_blender(tmp_path, references):
+    mujoco = pytest.importorskip("mujoco")
+    reference = synthetic.make_reference_set()
+    pairs = len(reference.topology.cushion_pairs)
+    singles = sum(1 for p in reference.topology if not p.partner)
+    out = tmp_path / "m.xml"
+    code = ("import sys\nfrom ellimann_addon.blender.cli import main\n"
+            f"code = main(['synth', *{REQUEST!r}, '--cushions', '-o', {str(out)!r}, '--references', {references!r}])\n"
+            "print('bpy loaded' if 'bpy' in sys.modules else 'bpy not loaded', code)")
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert done.stdout.strip().endswith("bpy not loaded 0"), done.stderr
+    model = mujoco.MjModel.from_xml_path(str(out))
+    kinds = [int(model.geom_type[i]) for i in range(model.ngeom) if model.geom(i).name != "floor"]
+    assert sorted(kinds) == sorted([int(mujoco.mjtGeom.mjGEOM_MESH)] * pairs
+                                   + [int(mujoco.mjtGeom.mjGEOM_ELLIPSOID)] * singles)
+    measured = {key: float(model.numeric(f"measured_{key}").data[0]) for key in MEASUREMENTS}
+    assert measured == pytest.approx(VALUES, rel=1e-4)
 
 
 # ------------------------------------------------------------------------------------------------ measure
@@ -277,6 +300,19 @@ def test_batch_refuses_bad_files_and_options(tmp_path, capsys, references, heade
     assert_one_line_error(code, err, *words)
     code, _, err = run(["batch", str(tmp_path / "missing.csv"), "-o", str(tmp_path / "out")], capsys)
     assert_one_line_error(code, err, "missing.csv")
+
+
+def test_batch_writes_mjcf_and_glb_with_extras(tmp_path, capsys, references):
+    source = write_csv(tmp_path / "in.csv", GOOD_ROWS[:1])
+    out = tmp_path / "out"
+    code, _, err = run(["batch", source, "-o", str(out), "--format", "mjcf,glb", "--references", references], capsys)
+    assert code == 0, err
+    assert sorted(p.name for p in out.iterdir()) == ["average.glb", "average.xml", "report.csv"]
+    assert read_report(out / "report.csv")[0]["files"].split() == [str(out / "average.xml"), str(out / "average.glb")]
+    assert "<mujoco" in (out / "average.xml").read_text()
+    doc = read_glb_json(out / "average.glb")
+    assert doc["scenes"][0]["extras"][EXTRAS_KEY]["name"] == "average"
+    assert len(doc["nodes"]) == len(synthetic.make_reference_set().topology)
 
 
 def test_batch_header_is_case_insensitive_and_extra_columns_are_ignored(tmp_path, capsys, references):

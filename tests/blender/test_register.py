@@ -3,11 +3,12 @@
 import bpy
 
 import ellimann_addon
-from ellimann_addon.blender import menus, operators, panels, props
+from ellimann_addon.blender import drape_panel, menus, operators, panels, props
 
 
 def all_classes():
-    return list(props.classes) + operators.classes() + list(panels.classes) + [menus.ELLIMANN_MT_object]
+    return (list(props.classes) + operators.classes() + list(panels.classes) + [menus.ELLIMANN_MT_object]
+            + list(drape_panel.classes))
 
 
 def leftovers():
@@ -16,6 +17,7 @@ def leftovers():
     found += [cls.__name__ for cls in all_classes() if cls.is_registered]
     found += [f"{owner.__name__}.ellimann" for owner in (bpy.types.Object, bpy.types.Collection, bpy.types.Scene)
               if hasattr(owner, "ellimann")]
+    found += [f"Scene.{name}" for name in ("ellimann_synthesis", "ellimann_drape") if hasattr(bpy.types.Scene, name)]
     found += [f"bpy.ops.ellimann.{name}" for name in dir(bpy.ops.ellimann) if not name.startswith("_")]
     found += [f"{menu} entry" for menu, draw in menus.MENU_ENTRIES
               if draw in getattr(bpy.types, menu)._dyn_ui_initialize()]
@@ -23,9 +25,10 @@ def leftovers():
 
 
 def test_disable_leaves_nothing_and_enable_works_again():
-    assert len(all_classes()) == 2 + 12 + 6 + 1
+    assert len(all_classes()) == 2 + 13 + 6 + 1 + 2
     assert not [c.__name__ for c in all_classes() if not c.is_registered]
-    assert {"Object.ellimann", "bpy.ops.ellimann.fit_ellipsoid", "VIEW3D_MT_add entry"} <= set(leftovers())
+    assert {"Object.ellimann", "Scene.ellimann_drape", "bpy.ops.ellimann.drape_garment",
+            "VIEW3D_MT_add entry"} <= set(leftovers())
     ellimann_addon.unregister()
     try:
         assert leftovers() == []

@@ -1,0 +1,178 @@
+"""Draping on the convex mannequin vs on the dense body mesh it stands for (Blender cloth, one run).
+
+The Average Reference Mannequin (``reference_blends/average.json``, traced over and measured like
+``../shared/refmodels/average.obj``: He 159.00, Sh 43.03, Br 116.97, Wa 103.99, Hi 117.00 cm) and
+that dense body are the two collision bodies. One garment per kind is built from the mannequin's
+m_T and moved clear of both bodies, then draped with the same cloth settings on:
+  (a) the mannequin's convex pieces as collision meshes (cushions + the ellipsoids not in one, or
+      ellipsoids only), at several icosphere levels;
+  (b) the dense body (26,692 triangles): the baseline.
+Per run: seconds per simulated frame (the mean step of frame_set, best of REPEAT runs, by the wall
+clock, with this process's CPU time beside it: Blender runs parts of the cloth step on two threads,
+so CPU time can exceed wall time; the cloth alone, with no collider, gives the floor), collider
+triangles, and the final garment against the DENSE body surface (signed distances, vertices
+inside) for both, so the comparison is fair; (a) also against its own exact pieces. "Equal fit"
+for the resolution sweep: median and 95th-percentile gap to the dense body within FIT_TOLERANCE
+(p95: twice that) of the finest mannequin colliders', no more vertices inside it, and no vertex
+more than FIT_TOLERANCE inside the exact pieces (a coarse collider lets the cloth into them).
+"""
+
+import os
+import pathlib
+import tempfile
+import time
+
+import numpy as np
+
+from ellimann_addon.core import garments
+from ellimann_addon.core.collision import collision_pieces, triangle_count
+from ellimann_addon.core.fit_metrics import BodyPieces, fit_statistics, mesh_distance
+from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.synthesis import REFERENCE_FOLDER
+from tools.bodies import load_obj
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+REFMODELS = ROOT.parent / "shared" / "refmodels"
+BODY = "average"
+FRAMES = 40
+EDGE = 0.025  # m, the garments' cloth resolution
+REPEAT = 3
+FIT_TOLERANCE = 0.001  # m
+# Collider resolutions tried for (a): (label, cushions, sphere level, cushion level).
+SWEEP = (
+    ("cushions L1/L1", True, 1, 1),
+    ("cushions L2/L1", True, 2, 1),
+    ("cushions L1/L2", True, 1, 2),
+    ("cushions L2/L2", True, 2, 2),
+    ("cushions L3/L3", True, 3, 3),
+    ("ellipsoids L1", False, 1, 0),
+    ("ellipsoids L2", False, 2, 0),
+    ("ellipsoids L3", False, 3, 0),
+)
+HEADLINE = "cushions L2/L2"
+
+
+def run():
+    source = REFERENCE_FOLDER / f"{BODY}.json"
+    body_path = REFMODELS / f"{BODY}.obj"
+    if not source.is_file() or not body_path.is_file():
+        print(f"skipped: needs {source} (the shipped Reference Mannequins) and {body_path}")
+        return
+    os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="ellimann-bench-"))
+    import ellimann_addon
+
+    ellimann_addon.register()
+    try:
+        compare(Mannequin.load(source), *load_obj(body_path))
+    finally:
+        ellimann_addon.unregister()
+
+
+def compare(mannequin, body_vertices, body_faces):
+    import bpy
+
+    from ellimann_addon.blender import drape
+    from ellimann_addon.blender.output import empty_scene, stdout_to_stderr
+
+    exact = BodyPieces(mannequin, cushions=True, subdivisions=4)
+    own = {True: exact, False: BodyPieces(mannequin)}  # the exact pieces of each kind of collider
+
+    def dense(points):
+        return mesh_distance(points, body_vertices, body_faces)[0]
+
+    print(f"mannequin: {mannequin.name} ({len(mannequin)} ellipsoids, {len(mannequin.topology.cushion_pairs)} "
+          f"cushion pairs), m_T " + ", ".join(f"{k} {v:.2f}" for k, v in mannequin.measure().items()) + " cm")
+    print(f"dense body: {BODY}.obj, {len(body_vertices):,} vertices, {len(body_faces):,} triangles")
+    gap = dense(exact_samples(mannequin))
+    print(f"mannequin surface vs dense body: median {np.median(gap) * 1e3:.1f} mm, {np.mean(gap < 0) * 100:.0f}% of "
+          "it inside the body (the pieces are fitted mostly inside the skin)")
+    print(f"cloth: {FRAMES} frames at 24 fps, edge {EDGE * 100:g} cm, settings {drape.DrapeSettings()}")
+
+    def simulate(garment, pieces):
+        settings = drape.DrapeSettings(frames=FRAMES, edge=EDGE)
+        with stdout_to_stderr():
+            empty_scene()
+            _, obj = drape.setup(garment, pieces, settings, "bench")
+            wall, cpu = drape.bake(bpy.context.scene, obj, FRAMES)
+        return float(np.mean(wall)), float(np.mean(cpu)), drape.evaluated_vertices(obj)
+
+    body_piece = [drape.mesh_piece(f"{BODY}.obj", body_vertices, body_faces)]
+    for kind in ("tube_dress", "t_shirt"):
+        garment = garments.make_garment(mannequin, kind, edge=EDGE)
+        start = time.perf_counter()
+        garment = garments.clear_of(garment, lambda p: np.minimum(exact.signed_distance(p, 0.05)[0], dense(p)))
+        print(f"\n== {garment.name}: {len(garment.vertices)} vertices, {len(garment.faces)} triangles, "
+              f"{len(garment.seams)} seams, {len(garment.pins)} pins; {garment.pattern['cleared']} vertices moved "
+              f"clear of both bodies ({time.perf_counter() - start:.1f} s)")
+        rows = {}
+        runs = [(HEADLINE, *next(s[1:] for s in SWEEP if s[0] == HEADLINE)), ("dense body", None, 0, 0)]
+        if kind == "tube_dress":
+            runs += [s for s in SWEEP if s[0] != HEADLINE]
+        # The cloth alone (no collider: it falls freely) is the floor under every collider's cost.
+        free = min(simulate(garment, [])[0] for _ in range(REPEAT))
+        for label, cushions, sphere, cushion in runs:
+            pieces = body_piece if cushions is None else collision_pieces(mannequin, cushions, sphere, cushion)
+            results = [simulate(garment, pieces) for _ in range(REPEAT)]
+            vertices = results[0][2]
+            row = {"seconds": min(r[0] for r in results), "cpu": min(r[1] for r in results),
+                   "triangles": triangle_count(pieces), "vertices": vertices,
+                   "dense": fit_statistics(dense(vertices)),
+                   "own": None if cushions is None else fit_statistics(
+                       own[cushions].signed_distance(vertices, drape.FIT_CUTOFF)[0])}
+            if len(garment.seams):
+                gaps = np.linalg.norm(vertices[garment.seams[:, 0]] - vertices[garment.seams[:, 1]], axis=1)
+                row["seams"] = (float(np.median(gaps)), float(gaps.max()))
+            rows[label] = row
+        report(rows, garment, free)
+
+
+def exact_samples(mannequin, count=100):
+    """Points on the mannequin's outer surface (ellipsoid samples not inside another piece)."""
+    from ellimann_addon.core.ellipsoid import sample_surface
+
+    points = sample_surface(mannequin.rotation, mannequin.center, mannequin.semi_axes, count).reshape(-1, 3)
+    return points[BodyPieces(mannequin).signed_distance(points)[0] > -1e-9]
+
+
+def report(rows, garment, free):
+    base = rows["dense body"]
+    print(f"cloth alone (no collider) {free:.3f} s/frame; above that, collisions cost "
+          f"{base['seconds'] - free:.3f} with the dense body and {rows[HEADLINE]['seconds'] - free:.3f} with "
+          f"{HEADLINE} ({(base['seconds'] - free) / max(rows[HEADLINE]['seconds'] - free, 1e-9):.1f}x)")
+    print("s/frame: wall (CPU); distances in mm; 'inside': garment vertices inside that surface; "
+          "speed-up = dense s/frame / this")
+    print(f"{'collider':<16}{'triangles':>10}{'s/frame':>15}{'speed-up':>9} | vs dense body: {'median':>6}{'p05':>6}"
+          f"{'p95':>6}{'inside':>7}{'deepest':>8} | vs own pieces: {'inside':>6}{'deepest':>8}"
+          + (" | seams median/max" if len(garment.seams) else ""))
+    for label, row in rows.items():
+        d, own = row["dense"], row["own"]
+        cells = (f"{label:<16}{row['triangles']:>10,}{row['seconds']:>8.3f} ({row['cpu']:.3f})"
+                 f"{base['seconds'] / row['seconds']:>8.2f}x"
+                 f" | {'':14}{d['median'] * 1e3:>6.1f}{d['p05'] * 1e3:>6.1f}{d['p95'] * 1e3:>6.1f}"
+                 f"{d['penetrating']:>7}{d['max_depth'] * 1e3:>8.1f}")
+        cells += f" | {'':14}{own['penetrating']:>6}{own['max_depth'] * 1e3:>8.1f}" if own else f" | {'(the same)':>28}"
+        if "seams" in row:
+            cells += f" | {row['seams'][0] * 1e3:6.1f} / {row['seams'][1] * 1e3:5.1f}"
+        print(cells)
+    if HEADLINE in rows:
+        shift = np.linalg.norm(rows[HEADLINE]["vertices"] - base["vertices"], axis=1)
+        print(f"same garment, {HEADLINE} vs dense body, per vertex: median {np.median(shift) * 1e3:.1f} mm, "
+              f"95th percentile {np.percentile(shift, 95) * 1e3:.1f} mm apart")
+    sweep = {label: row for label, row in rows.items() if label != "dense body"}
+    if len(sweep) > 2:
+        finest = max(sweep.values(), key=lambda r: r["triangles"])
+        equal = [label for label, row in sweep.items()
+                 if abs(row["dense"]["median"] - finest["dense"]["median"]) <= FIT_TOLERANCE
+                 and abs(row["dense"]["p95"] - finest["dense"]["p95"]) <= 2 * FIT_TOLERANCE
+                 and row["dense"]["penetrating"] <= finest["dense"]["penetrating"]
+                 and row["own"]["max_depth"] <= FIT_TOLERANCE]
+        best = min(equal, key=lambda label: sweep[label]["seconds"])
+        print(f"best speed at equal fit (median within {FIT_TOLERANCE * 1e3:g} mm, p95 within "
+              f"{2 * FIT_TOLERANCE * 1e3:g} mm of the finest colliders, no more vertices inside the dense body, "
+              f"none over {FIT_TOLERANCE * 1e3:g} mm inside the exact pieces): {best}, "
+              f"{sweep[best]['seconds']:.3f} s/frame, {sweep[best]['triangles']:,} triangles "
+              f"(equal fit: {', '.join(equal)})")
+
+
+if __name__ == "__main__":
+    run()

@@ -1,0 +1,253 @@
+"""Drape a procedural garment on a mannequin with Blender's cloth simulation, headless or in the GUI.
+
+:func:`drape` builds, in a new collection ``"Drape <garment> on <mannequin>"`` under the scene:
+- the garment (:mod:`core.garments`, sized from the mannequin's m_T) as a mesh object with a Cloth
+  modifier; the garment's ``pins`` form the vertex group "Pin" (the cloth's pin group) and its
+  ``seams`` become loose edges pulled together by sewing springs;
+- a child collection "Colliders": one object per convex piece (:mod:`core.collision`: cushions
+  and the ellipsoids not in a cushion, or every ellipsoid) with a Collision modifier, hidden in
+  the viewport and in renders. The cloth collides with that collection only.
+It then steps the frames one by one (``scene.frame_set``, timing each step) and turns the memory
+cache into a bake (``ptcache.bake_from_cache``), so a saved .blend replays the drape and opens on
+its last frame. The mannequin itself is not touched. Everything that can fail on bad input is
+computed before the scene changes.
+"""
+
+import time
+from dataclasses import dataclass, field
+
+import bpy
+import numpy as np
+from mathutils import Matrix
+
+from ..core import garments
+from ..core.collision import CollisionPiece, check_subdivisions, collision_pieces, triangle_count
+from ..core.errors import ElliMannError
+from ..core.fit_metrics import BodyPieces, fit_statistics
+from .convert import mesh_from_arrays, new_collection
+
+DRAPE_KEY = "ellimann_drape"  # ID property on a drape collection: the garment's name
+PIN_GROUP = "Pin"
+CLOTH_NAME = "Cloth"
+GARMENT_COLOR = (0.22, 0.45, 0.75, 1.0)
+FRAME_RANGE = (2, 2000)
+EXACT_SUBDIVISIONS = 4  # cushion hulls the fit statistics are measured against (finer than the colliders)
+CLEARING_SUBDIVISIONS = 3  # cushion hulls a new garment is moved clear of (inscribed in the level-4 ones)
+# Distances to a cushion beyond these (m) are only bounded from below, which spares the exact search
+# for far points: the fit's distances are exact up to FIT_CUTOFF, the clearing's near the body.
+FIT_CUTOFF = 0.2
+CLEARING_CUTOFF = 0.05
+
+
+@dataclass
+class DrapeSettings:
+    """Simulation options. Lengths in metres.
+
+    ``distance``: the cloth's collision distance (it keeps this far from the colliders);
+    ``sewing_force``: the sewing springs' force limit (0 would be unbounded, which explodes while
+    seams are far apart); ``quality``: solver steps per frame; ``collision_quality``: collision
+    passes per step.
+    """
+
+    frames: int = 60
+    edge: float = 0.025
+    cushions: bool = True
+    sphere_subdivisions: int = 2
+    cushion_subdivisions: int = 2
+    quality: int = 5
+    collision_quality: int = 3
+    distance: float = 0.005
+    sewing_force: float = 20.0
+
+    def checked(self):
+        if isinstance(self.frames, bool) or not isinstance(self.frames, (int, np.integer)) or not (
+                FRAME_RANGE[0] <= self.frames <= FRAME_RANGE[1]):
+            raise ElliMannError(f"frames: must be an integer from {FRAME_RANGE[0]} to {FRAME_RANGE[1]}, "
+                                f"got {self.frames!r}")
+        low, high = garments.EDGE_RANGE
+        if isinstance(self.edge, bool) or not isinstance(self.edge, (int, float)) or not low <= self.edge <= high:
+            raise ElliMannError(f"edge: the cloth's edge length must be from {low} to {high} m, got {self.edge!r}")
+        check_subdivisions("sphere_subdivisions", self.sphere_subdivisions)
+        check_subdivisions("cushion_subdivisions", self.cushion_subdivisions)
+        if not 1 <= self.quality <= 50:
+            raise ElliMannError(f"quality: must be from 1 to 50 steps per frame, got {self.quality!r}")
+        if not 1 <= self.collision_quality <= 20:
+            raise ElliMannError(f"collision_quality: must be from 1 to 20 passes, got {self.collision_quality!r}")
+        if not 0.001 <= self.distance <= 0.05:
+            raise ElliMannError(f"distance: must be from 0.001 to 0.05 m, got {self.distance!r}")
+        return self
+
+
+@dataclass
+class DrapeResult:
+    collection: object  # bpy Collection
+    garment_object: object  # bpy Object
+    garment: garments.Garment
+    pieces: list
+    seconds: np.ndarray  # wall-clock seconds per simulated frame
+    cpu_seconds: np.ndarray  # CPU seconds of this process per simulated frame
+    vertices: np.ndarray  # final garment vertices, world (V, 3)
+    fit: dict = field(default_factory=dict)  # fit_statistics against the exact pieces
+
+    @property
+    def seconds_per_frame(self):
+        return float(np.mean(self.seconds)) if len(self.seconds) else 0.0
+
+    @property
+    def collider_triangles(self):
+        return triangle_count(self.pieces)
+
+    def seam_gaps(self):
+        """Distance (m) between the two ends of each sewing spring, after the drape."""
+        seams = self.garment.seams
+        return np.linalg.norm(self.vertices[seams[:, 0]] - self.vertices[seams[:, 1]], axis=1)
+
+    def summary(self):
+        fit = self.fit
+        text = (f"{len(self.seconds) + 1} frames, {self.seconds_per_frame:.3f} s/frame, "
+                f"{self.collider_triangles} collider triangles; {fit['penetrating']} of {fit['count']} "
+                f"vertices inside the body (deepest {fit['max_depth'] * 1e3:.1f} mm), median gap "
+                f"{fit['median'] * 1e3:.1f} mm")
+        if len(self.garment.seams):
+            gaps = self.seam_gaps()
+            text += f"; seams closed to {np.median(gaps) * 1e3:.1f} mm (median), {gaps.max() * 1e3:.1f} mm (max)"
+        return text
+
+
+# ------------------------------------------------------------------------------------------------ objects
+
+
+def garment_object(garment, collection, settings):
+    """The garment as a mesh object with a Cloth modifier (pins, sewing springs, collisions limited later)."""
+    mesh = mesh_from_arrays(garment.name, garment.vertices, garment.faces)
+    seams = np.asarray(garment.seams, dtype=np.int32).reshape(-1, 2)
+    if len(seams):
+        edges = np.empty(len(mesh.edges) * 2, dtype=np.int32)
+        mesh.edges.foreach_get("vertices", edges)
+        mesh.edges.add(len(seams))  # loose edges: what Blender's sewing springs pull together
+        mesh.edges.foreach_set("vertices", np.concatenate([edges, seams.ravel()]))
+        mesh.update()
+    mesh.shade_smooth()
+    obj = bpy.data.objects.new(garment.name, mesh)
+    obj.color = GARMENT_COLOR
+    collection.objects.link(obj)
+    cloth = obj.modifiers.new(CLOTH_NAME, "CLOTH")
+    cloth_settings = cloth.settings
+    cloth_settings.quality = settings.quality
+    if len(garment.pins):
+        group = obj.vertex_groups.new(name=PIN_GROUP)
+        group.add([int(i) for i in garment.pins], 1.0, "REPLACE")
+        cloth_settings.vertex_group_mass = PIN_GROUP
+    if len(seams):
+        cloth_settings.use_sewing_springs = True
+        cloth_settings.sewing_force_max = settings.sewing_force
+    collision = cloth.collision_settings
+    collision.distance_min = settings.distance
+    collision.collision_quality = settings.collision_quality
+    collision.use_self_collision = False  # a single layer of cloth on a convex body: not needed, and slow
+    return obj
+
+
+def collider_objects(pieces, collection):
+    """One hidden mesh object with a Collision modifier per piece; ellipsoids share one mesh per resolution."""
+    shared = {}
+    objects = []
+    for piece in pieces:
+        key = (piece.kind, len(piece.vertices)) if piece.kind == "ELLIPSOID" else None
+        mesh = shared.get(key) if key else None
+        if mesh is None:
+            mesh = mesh_from_arrays(f"Collider {piece.name}" if key is None else f"Collider sphere {len(piece.faces)}",
+                                    piece.vertices, piece.faces)
+            if key:
+                shared[key] = mesh
+        obj = bpy.data.objects.new(f"Collider {piece.name}", mesh)
+        obj.matrix_world = Matrix(np.asarray(piece.matrix).tolist())
+        obj.display_type = "WIRE"
+        obj.hide_render = True
+        collection.objects.link(obj)
+        obj.modifiers.new("Collision", "COLLISION")
+        obj.collision.thickness_outer = 0.001  # the cloth's own distance does the spacing
+        objects.append(obj)
+    bpy.context.view_layer.update()  # new objects get their view-layer bases (hide_set needs them)
+    for obj in objects:
+        obj.hide_set(True)  # hidden, not disabled: disabled objects are not evaluated, so they would not collide
+    return objects
+
+
+def setup(garment, pieces, settings, name, parent=None):
+    """A new drape collection with the garment and its colliders; returns (collection, garment object)."""
+    collection = new_collection(name, parent)
+    colliders = new_collection("Colliders", collection)
+    obj = garment_object(garment, collection, settings)
+    obj.modifiers[CLOTH_NAME].collision_settings.collection = colliders
+    collider_objects(pieces, colliders)
+    return collection, obj
+
+
+def bake(scene, obj, frames):
+    """Simulate frames 1..frames frame by frame; returns (wall, cpu): the seconds each of frames
+    2..frames took, by the clock and in this process's CPU time (all its threads together).
+
+    Leaves the cache baked (saved with the .blend) and the scene on the last frame.
+    """
+    cache = obj.modifiers[CLOTH_NAME].point_cache
+    cache.frame_start, cache.frame_end = 1, frames
+    scene.frame_start, scene.frame_end = 1, frames
+    scene.frame_set(1)
+    wall, cpu = np.empty(frames - 1), np.empty(frames - 1)
+    for frame in range(2, frames + 1):
+        start, start_cpu = time.perf_counter(), time.process_time()
+        scene.frame_set(frame)
+        wall[frame - 2], cpu[frame - 2] = time.perf_counter() - start, time.process_time() - start_cpu
+    with bpy.context.temp_override(scene=scene, point_cache=cache):
+        bpy.ops.ptcache.bake_from_cache()
+    return wall, cpu
+
+
+def evaluated_vertices(obj):
+    """World coordinates (V, 3) of an object's evaluated mesh (the cloth at the current frame)."""
+    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    mesh = evaluated.data
+    co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+    mesh.vertices.foreach_get("co", co)
+    matrix = np.array(obj.matrix_world)
+    return co.reshape(-1, 3).astype(float) @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+# ------------------------------------------------------------------------------------------------ drape
+
+
+def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None):
+    """Drape ``garment`` (a ``core.garments.BUILDERS`` key or a core Garment) on ``mannequin`` (a core Mannequin).
+
+    A garment named by its key is built from the mannequin's m_T and moved clear of the pieces
+    (:func:`garments.clear_of`); a Garment given as such is used as it is.
+
+    Returns a :class:`DrapeResult` whose ``fit`` compares the final garment with the exact pieces
+    (ellipsoids in closed form, cushions at a fine resolution): negative distances are inside;
+    distances beyond FIT_CUTOFF (20 cm, a garment hanging far off the body) are lower bounds.
+    Raises ElliMannError (MannequinError naming the parts) before anything is built.
+    """
+    settings = (settings or DrapeSettings()).checked()
+    scene = scene or bpy.context.scene
+    mannequin.check()
+    cushions = settings.cushions and bool(mannequin.topology.cushion_pairs)
+    if isinstance(garment, str):
+        garment = garments.make_garment(mannequin, garment, edge=settings.edge)
+        # The builders wrap the ellipsoids, a few mm off; a cushion also fills the hollow between its two.
+        clearing = BodyPieces(mannequin, cushions, CLEARING_SUBDIVISIONS)
+        garment = garments.clear_of(garment, lambda points: clearing.signed_distance(points, CLEARING_CUTOFF)[0])
+    pieces = collision_pieces(mannequin, cushions, settings.sphere_subdivisions, settings.cushion_subdivisions)
+    exact = BodyPieces(mannequin, cushions, EXACT_SUBDIVISIONS)
+    collection, obj = setup(garment, pieces, settings, name or f"Drape {garment.name} on {mannequin.name}",
+                            scene.collection)
+    collection[DRAPE_KEY] = garment.name
+    wall, cpu = bake(scene, obj, settings.frames)
+    vertices = evaluated_vertices(obj)
+    distance, _ = exact.signed_distance(vertices, FIT_CUTOFF)
+    return DrapeResult(collection, obj, garment, pieces, wall, cpu, vertices, fit_statistics(distance))
+
+
+def mesh_piece(name, vertices, faces):
+    """A triangle mesh in world coordinates as a collision piece (e.g. a dense body for comparison)."""
+    return CollisionPiece(name, "MESH", np.eye(4), np.asarray(vertices, float), np.asarray(faces))

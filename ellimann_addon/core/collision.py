@@ -1,0 +1,70 @@
+"""A mannequin's convex pieces as triangle meshes for a cloth solver's collision objects.
+
+Cloth solvers (Blender's among them) collide with triangles, so each piece becomes a mesh: an
+ellipsoid is the unit icosphere at ``sphere_subdivisions`` under the ellipsoid's matrix
+``S @ diag(D, 1)`` (every ellipsoid shares one mesh), a cushion is :func:`cushion.cushion_mesh` at
+``cushion_subdivisions`` in its first ellipsoid's frame. Vertices lie on the exact surface, so the
+flat faces sit inside it by at most the chord sag of the subdivision level.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .cushion import cushion_mesh, to_frame
+from .ellipsoid import matrix_world
+from .errors import ElliMannError
+from .mesh import icosphere
+
+SUBDIVISION_RANGE = (0, 5)  # icosphere levels: 20 to 20,480 triangles per piece
+
+
+@dataclass
+class CollisionPiece:
+    """One collision mesh: ``vertices`` (V, 3) local to ``matrix`` (4x4 world matrix), ``faces`` (F, 3)."""
+
+    name: str
+    kind: str  # "ELLIPSOID" or "CUSHION"
+    matrix: np.ndarray
+    vertices: np.ndarray
+    faces: np.ndarray
+
+    def world_vertices(self):
+        return self.vertices @ self.matrix[:3, :3].T + self.matrix[:3, 3]
+
+
+def check_subdivisions(name, value):
+    low, high = SUBDIVISION_RANGE
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not low <= value <= high:
+        raise ElliMannError(f"{name}: must be an integer from {low} to {high}, got {value!r}")
+    return int(value)
+
+
+def collision_pieces(mannequin, cushions=False, sphere_subdivisions=2, cushion_subdivisions=2):
+    """The mannequin's pieces as meshes: cushions (``cushions``, one per cushion pair) and the ellipsoids
+    not in a cushion, in topology order, cushions last. Names as :class:`fit_metrics.BodyPieces`."""
+    mannequin.check()
+    sphere_subdivisions = check_subdivisions("sphere_subdivisions", sphere_subdivisions)
+    cushion_subdivisions = check_subdivisions("cushion_subdivisions", cushion_subdivisions)
+    topology = mannequin.topology
+    pairs = topology.cushion_pairs if cushions else []
+    paired = {i for pair in pairs for i in pair}
+    sphere_vertices, sphere_faces = icosphere(sphere_subdivisions)
+    pieces = []
+    frames = matrix_world(mannequin.rotation, mannequin.center, mannequin.semi_axes)
+    for i, name in enumerate(topology.names):
+        if i not in paired:
+            pieces.append(CollisionPiece(name, "ELLIPSOID", frames[i], sphere_vertices, sphere_faces))
+    for i, j in pairs:
+        first = (mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i])
+        second = (mannequin.rotation[j], mannequin.center[j], mannequin.semi_axes[j])
+        vertices, faces = cushion_mesh(first, second, cushion_subdivisions)
+        rigid = np.eye(4)
+        rigid[:3, :3], rigid[:3, 3] = first[0], first[1]
+        pieces.append(CollisionPiece(f"{topology.names[i]} + {topology.names[j]}", "CUSHION", rigid,
+                                     to_frame(vertices, first[0], first[1]), faces))
+    return pieces
+
+
+def triangle_count(pieces):
+    return int(sum(len(p.faces) for p in pieces))
