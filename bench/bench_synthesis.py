@@ -2,12 +2,17 @@
 
 243 requests: every combination of the three inner quartile points of L per measurement. Each is
 synthesized, then measured with m_T; the relative error |m_T - request| / request is summarised per
-measurement as in Table 2.4, for plain IDW (the paper's method) and for exact mode. Uses the shipped
-Reference Mannequins when ``reference_blends/`` holds them, else the synthetic set (say which).
+measurement as in Table 2.4, for the paper's IDW (``normalize="none"``), ElliMann's proportional IDW
+(the default), the height-only variant, and exact mode after each IDW, with the refinement's
+deformation factors. Latency and throughput compare the old exact mode (the paper's IDW, then a
+finite-difference Jacobian per mannequin) with the current one (proportional IDW, the RMs' mean
+Jacobian) in the same run. Uses the shipped Reference Mannequins when ``reference_blends/`` holds
+them, else the synthetic set (say which).
 """
 
 import itertools
 import os
+import subprocess
 import tempfile
 import time
 
@@ -16,8 +21,17 @@ import numpy as np
 from bench.bench_core import best_of
 from devkit.synthetic import shipped_or_synthetic
 from ellimann_addon.core import synthesis
-from ellimann_addon.core.constants import MEASUREMENTS, PAPER_TABLE_2_4, quartile_points
-from ellimann_addon.core.measure import tailor_measurements
+from ellimann_addon.core.constants import MEASUREMENTS, PAPER_TABLE_2_4, SECTION_FRACTIONS, quartile_points
+from ellimann_addon.core.ellipsoid import section_at_height
+from ellimann_addon.core.measure import hull_perimeter, section_heights, tailor_measurements
+
+VARIANTS = (  # label, synthesize_batch options
+    ("paper IDW (Eq. 2.1: normalize none, raw cm, p = 2)", {"normalize": "none"}),
+    ("proportional IDW (default)", {"normalize": "proportional"}),
+    ("height-proportional IDW", {"normalize": "height"}),
+    ("paper IDW, distances normalized by L", {"normalize": "none", "metric": "normalized"}),
+    ("proportional IDW, distances normalized by L", {"normalize": "proportional", "metric": "normalized"}),
+)
 
 
 def grid():
@@ -35,47 +49,164 @@ def table(title, error, paper=True):
         print("  (in brackets: the paper's Table 2.4)")
 
 
+def old_exact(reference, requests):
+    """Exact mode as it was: the paper's IDW, then refinement from a finite-difference Jacobian."""
+    rotation, center, semi_axes = synthesis.interpolate(reference, requests, normalize="none")
+    measured = tailor_measurements(rotation, center, semi_axes, reference.topology.girth_mask)
+    return synthesis.refine(reference.topology, rotation, center, semi_axes, requests, measured)
+
+
+def deformation(title, result, seconds):
+    spread = np.abs(result.factors - 1.0) * 100.0
+    print(f"{title}: {result.converged.sum()}/{len(result.factors)} converged (tolerance "
+          f"{synthesis.EXACT_TOLERANCE * 100:g}%) in {seconds:.2f} s; |factor - 1| % mean / max: "
+          + ", ".join(f"{k} {m:.2f}/{x:.2f}" for k, m, x in zip(MEASUREMENTS, spread.mean(0), spread.max(0))))
+
+
+def _stat(values):
+    return f"{values.mean():5.2f} /{values.max():6.2f}"
+
+
+def _section(rotation, center, semi_axes, z, parts, key):
+    """Sh (x extent over ``parts``) or a girth perimeter of the section at heights z (B,), in cm."""
+    centre, k, hit = section_at_height(rotation, center, semi_axes, z[:, None])
+    hit = hit & parts
+    if key == "Sh":
+        half = np.sqrt(k[..., 0, 0])
+        right = np.where(hit, centre[..., 0] + half, -np.inf).max(axis=-1)
+        left = np.where(hit, centre[..., 0] - half, np.inf).min(axis=-1)
+        return (right - left) * 100.0
+    return hull_perimeter(centre, k, hit) * 100.0
+
+
+def diagnose(reference, requests):
+    """Where the paper's IDW error comes from, per measurement (mean / max over the grid, in % or cm).
+
+    The parts that depend on X are placed with the IDW weights of X's sub-space; their weighted mean
+    He is the height they are built for, their weighted mean X the size. Moving the section to that
+    height takes out the vertical misplacement; comparing the weighted mean X with the request shows
+    what IDW's own averaging of the measurement misses; what is left is m_T's non-linearity (a
+    blended body does not measure as the blend of the measurements). Foreign parts: parts that do not
+    depend on X but change it (cut by its girth section, or outermost at the shoulders), and by how much.
+    """
+    topology = reference.topology
+    weights = synthesis.idw_weights(reference, requests)
+    rotation, center, semi_axes = synthesis.interpolate(reference, requests, normalize="none")
+    girth = topology.girth_mask
+    measured = tailor_measurements(rotation, center, semi_axes, girth)
+    bottom, _, z = section_heights(rotation, center, semi_axes)
+    source = list(reference._source)
+    print("\nwhy the paper's IDW misses (mean / max over the grid, % unless cm):")
+    he_only = [row for row, part in enumerate(source) if topology.dependency_mask[part].sum() == 1]
+    if he_only:
+        implied = weights[:, he_only[0]] @ reference.measurements
+        error = 100.0 * np.abs(implied[:, 0] - requests[:, 0]) / requests[:, 0]
+        print(f"  He: paper IDW {_stat(100.0 * np.abs(measured[:, 0] - requests[:, 0]) / requests[:, 0])}; "
+              f"the head (on He alone) is built for sum_j w_j He_j, off by {_stat(error)}")
+    for index, key in enumerate(MEASUREMENTS[1:], start=1):
+        own = topology.dependency_mask[:, index]
+        rows = [row for row, part in enumerate(source) if own[part]]
+        if not rows:
+            continue
+        implied = weights[:, rows[0]] @ reference.measurements  # (B, 5) what the parts of X are built for
+        placed = bottom + SECTION_FRACTIONS[key] * implied[:, 0] / 100.0
+        parts = np.ones_like(girth) if key == "Sh" else girth
+        moved = _section(rotation, center, semi_axes, placed, parts, key)
+        own_only = _section(rotation, center, semi_axes, z[key], parts & own, key)
+        foreign = np.abs(measured[:, index] - own_only) > 1e-9
+        added = 100.0 * (measured[:, index] - own_only) / measured[:, index]
+        target = requests[:, index]
+        print(f"  {key}: paper IDW {_stat(100.0 * np.abs(measured[:, index] - target) / target)}; its parts are "
+              f"built for an He off by {_stat(100.0 * np.abs(implied[:, 0] - requests[:, 0]) / requests[:, 0])} "
+              f"(section {_stat(np.abs(placed - z[key]) * 100.0)} cm off); with the section moved there "
+              f"{_stat(100.0 * np.abs(moved - target) / target)}\n"
+              f"      of which sum_j w_j {key}_j vs {key} {_stat(100.0 * np.abs(implied[:, index] - target) / target)}"
+              f" + m_T non-linearity {_stat(100.0 * np.abs(moved - implied[:, index]) / implied[:, index])}; "
+              f"parts of other measurements change it in {foreign.sum()} mannequins, by "
+              f"{_stat(added)}")
+
+
+def reference_version():
+    """The last commit that changed reference_blends/ (the numbers depend on the RMs), + local changes."""
+    def git(*args):
+        return subprocess.run(["git", *args, "--", "reference_blends"], capture_output=True, text=True, check=True,
+                              cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__)))).stdout.strip()
+
+    try:
+        commit = git("log", "-1", "--format=%h %cs") or "uncommitted"
+        return commit + (" + local changes" if git("status", "--porcelain") else "")
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
 def run():
     reference, label = shipped_or_synthetic()
     requests = grid()
     girth = reference.topology.girth_mask
     n = len(reference.topology)
-    print(f"reference set: {label}, {len(reference)} RMs x {n} ellipsoids; grid: {len(requests)} requests")
+    version = f", reference_blends at {reference_version()}" if label.startswith("shipped") else ""
+    print(f"reference set: {label}{version}, {len(reference)} RMs x {n} ellipsoids; grid: {len(requests)} requests")
 
+    diagnose(reference, requests)
     results = {}
-    for mode in synthesis.MODES:
+    for title, options in VARIANTS:
         start = time.perf_counter()
-        results[mode] = synthesis.synthesize_batch(reference, requests, mode=mode)
+        results[title] = synthesis.synthesize_batch(reference, requests, **options)
         seconds = time.perf_counter() - start
-        table(f"\nTable 2.4, {mode} (raw cm distance, p = 2), synthesized + measured in {seconds:.2f} s",
-              results[mode].relative_error())
-    exact = results["exact"]
-    spread = np.abs(exact.factors - 1.0) * 100.0
-    print(f"exact mode: {exact.converged.sum()}/{len(exact)} converged (tolerance "
-          f"{synthesis.EXACT_TOLERANCE * 100:g}%); deformation |factor - 1| % mean / max per measurement: "
-          + ", ".join(f"{k} {m:.2f}/{x:.2f}" for k, m, x in zip(MEASUREMENTS, spread.mean(0), spread.max(0))))
-    idw = results["idw"]
-    ratio = np.abs(exact.semi_axes / idw.semi_axes - 1.0) * 100.0
-    shift = np.linalg.norm(exact.center - idw.center, axis=-1) * 100.0
-    print(f"exact vs IDW, per ellipsoid: semi-axis change median {np.median(ratio):.2f}%, 99th percentile "
-          f"{np.percentile(ratio, 99):.1f}%, max {ratio.max():.1f}%; centre shift 99th percentile "
-          f"{np.percentile(shift, 99):.2f} cm, max {shift.max():.2f} cm")
-    normalized = synthesis.synthesize_batch(reference, requests, metric="normalized")
-    table("\nfor comparison, idw with distances normalized by the ranges L", normalized.relative_error(), paper=False)
+        table(f"\nTable 2.4, {title}: synthesized + measured in {seconds:.2f} s", results[title].relative_error(),
+              paper=options.get("metric", "raw") == "raw")
 
+    start = time.perf_counter()
+    exact = synthesis.synthesize_batch(reference, requests, mode="exact")
+    t_exact = time.perf_counter() - start
+    table(f"\nTable 2.4, exact mode (after proportional IDW), in {t_exact:.2f} s", exact.relative_error())
+    start = time.perf_counter()
+    old = old_exact(reference, requests)
+    t_old = time.perf_counter() - start
+    old_error = 100.0 * np.abs(old.measured - requests) / requests
+    table(f"\nTable 2.4, exact mode after the paper's IDW (finite-difference start), in {t_old:.2f} s", old_error)
+    print()
+    deformation("exact after paper IDW       ", old, t_old)
+    deformation("exact after proportional IDW", exact, t_exact)
+    now = synthesis.refine(reference.topology, *synthesis.interpolate(reference, requests), requests,
+                           jacobian=reference.refine_jacobian())
+    print(f"  iterations (slowest mannequin): {old.iterations} after paper IDW, {now.iterations} after proportional")
+    for title, start, end in (("exact vs paper IDW       ", results[VARIANTS[0][0]], old),
+                              ("exact vs proportional IDW", results[VARIANTS[1][0]], exact)):
+        ratio = np.abs(end.semi_axes / start.semi_axes - 1.0) * 100.0
+        shift = np.linalg.norm(end.center - start.center, axis=-1) * 100.0
+        print(f"{title}, per ellipsoid: semi-axis change median {np.median(ratio):.2f}%, 99th percentile "
+              f"{np.percentile(ratio, 99):.1f}%, max {ratio.max():.1f}%; centre shift 99th percentile "
+              f"{np.percentile(shift, 99):.2f} cm, max {shift.max():.2f} cm")
     print("\nthroughput (core, one process, best of 3):")
     batch = len(requests)
     t_idw = best_of(lambda: synthesis.interpolate(reference, requests), repeat=3)
+    t_paper = best_of(lambda: synthesis.interpolate(reference, requests, normalize="none"), repeat=3)
     rotation, center, semi_axes = synthesis.interpolate(reference, requests)
     t_mt = best_of(lambda: tailor_measurements(rotation, center, semi_axes, girth), repeat=3)
     t_exact = best_of(lambda: synthesis.synthesize_batch(reference, requests, mode="exact"), repeat=3)
-    print(f"  IDW synthesis, batched {batch:>4}          {batch / t_idw:10,.0f} mannequins/s  ({t_idw * 1e3:7.1f} ms)")
-    print(f"  m_T, batched {batch:>4}                   {batch / t_mt:10,.0f} mannequins/s  ({t_mt * 1e3:7.1f} ms)")
-    print(f"  exact mode (IDW + m_T + refinement) {batch / t_exact:10,.0f} mannequins/s  ({t_exact * 1e3:7.1f} ms)")
+    t_old = best_of(lambda: old_exact(reference, requests), repeat=3)
+    for name, seconds in ((f"paper IDW, batched {batch}", t_paper), (f"proportional IDW, batched {batch}", t_idw),
+                          (f"m_T, batched {batch}", t_mt), ("exact mode, before (paper IDW + FD)", t_old),
+                          ("exact mode, now", t_exact)):
+        print(f"  {name:<37}{batch / seconds:10,.0f} mannequins/s  ({seconds * 1e3:7.1f} ms)")
+    print(f"  exact mode batched: {t_old / t_exact:.1f}x faster than before")
     one = requests[121:122]
-    for mode in synthesis.MODES:
-        t = best_of(lambda mode=mode: synthesis.synthesize_batch(reference, one, mode=mode), repeat=5, number=5)
-        print(f"  one request, {mode:<5} (with m_T)        {t * 1e3:8.2f} ms")
+    t_one = {}
+    for name, fn in (("idw, paper", lambda: synthesis.synthesize_batch(reference, one, normalize="none")),
+                     ("idw, proportional", lambda: synthesis.synthesize_batch(reference, one)),
+                     ("exact, before", lambda: old_exact(reference, one)),
+                     ("exact, now", lambda: synthesis.synthesize_batch(reference, one, mode="exact"))):
+        t_one[name] = best_of(fn, repeat=5, number=5)
+        print(f"  one request, {name:<18} (with m_T) {t_one[name] * 1e3:8.2f} ms")
+    print(f"  one request, exact: {t_one['exact, before'] / t_one['exact, now']:.1f}x faster than before")
+    singles = []
+    for request in requests[::4]:
+        start = time.perf_counter()
+        synthesis.synthesize_batch(reference, request[None], mode="exact")
+        singles.append(time.perf_counter() - start)
+    print(f"  one request at a time, exact, over {len(singles)} grid requests: median "
+          f"{np.median(singles) * 1e3:.2f} ms, max {np.max(singles) * 1e3:.2f} ms")
 
     blender(reference, exact)
 

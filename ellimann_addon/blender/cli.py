@@ -28,9 +28,12 @@ from ..core.garments import BUILDERS as GARMENTS
 from ..core.mannequin import Mannequin
 from ..core.measure import as_dict
 from ..core.synthesis import (
+    DEFAULT_NORMALIZE,
     DEFAULT_POWER,
     METRICS,
     MODES,
+    NORMALIZATIONS,
+    PAPER_NORMALIZE,
     load_reference_set,
     synthesize,
     synthesize_batch,
@@ -66,6 +69,10 @@ def _add_synthesis_options(parser):
     parser.add_argument("--metric", choices=METRICS, default="raw",
                         help="IDW distance: raw cm as in the paper (default) or normalized by the ranges L")
     parser.add_argument("--power", type=_number, default=DEFAULT_POWER, help="IDW power p (default 2)")
+    parser.add_argument("--normalize", choices=NORMALIZATIONS, default=DEFAULT_NORMALIZE,
+                        help="what IDW averages: proportional (default): each part's heights in proportion to He "
+                             "and widths to its own measurement; height: heights only; none: the RMs' geometry "
+                             "as it is (the paper)")
     parser.add_argument("--cushions", action="store_true",
                         help="cushions (convex hulls of the cushion pairs) instead of their ellipsoids: shown in "
                              ".blend/.glb/.obj outputs, convex mesh geoms in MJCF")
@@ -224,7 +231,8 @@ def run_synth(args):
     kind = _output_kind(args.output)
     request = {key: getattr(args, key) for key in MEASUREMENTS}
     reference = _references(args)
-    mannequin, measured, warnings = synthesize(reference, request, args.mode, args.metric, args.power, args.name)
+    mannequin, measured, warnings = synthesize(reference, request, args.mode, args.metric, args.power, args.name,
+                                               args.normalize)
     for warning in warnings:
         print(f"{PROG} synth: warning: {warning}", file=sys.stderr)
     _write(mannequin, [args.output], measured, args.cushions and kind != "json")
@@ -328,7 +336,7 @@ def run_batch(args):
     for start in range(0, len(jobs), CHUNK):
         chunk = jobs[start:start + CHUNK]
         result = synthesize_batch(reference, [values for _, _, values, _ in chunk], args.mode, args.metric,
-                                  args.power)
+                                  args.power, normalize=args.normalize)
         for i, (line, name, values, warnings) in enumerate(chunk):
             mannequin = result.mannequin(i, name)
             paths = [os.path.join(args.output, f"{name}.{_extension(kind)}") for kind in formats]
@@ -455,7 +463,8 @@ def run_demo(args):
     reference = _references(args)
     out = args.output
     os.makedirs(out, exist_ok=True)
-    result = synthesize_batch(reference, [list(row) for row in TABLE_2_5], args.mode, args.metric, args.power)
+    result = synthesize_batch(reference, [list(row) for row in TABLE_2_5], args.mode, args.metric, args.power,
+                              normalize=args.normalize)
     _ensure_registered()
     from .output import write_mannequin
 
@@ -482,21 +491,23 @@ def run_demo(args):
 
 
 def _report_markdown(result, reference, args):
-    """Requested vs m_T per mannequin, and the error summary beside plain IDW's (the paper's method)."""
-    idw = result if args.mode == "idw" else synthesize_batch(reference, result.requests, "idw", args.metric,
-                                                              args.power)
+    """Requested vs m_T per mannequin, and the error summary beside the paper's IDW."""
+    paper = (args.mode, args.normalize, args.metric, args.power) == ("idw", PAPER_NORMALIZE, "raw", DEFAULT_POWER)
+    idw = result if paper else synthesize_batch(reference, result.requests, "idw", "raw", DEFAULT_POWER,
+                                                normalize=PAPER_NORMALIZE)
     error, idw_error = result.relative_error(), idw.relative_error()
     lines = [
         "# ElliMann demo: the ten mannequins of the paper's Table 2.5",
         "",
-        f"Mode `{args.mode}`, IDW distance `{args.metric}`, p = {args.power:g}. Reference Mannequins: "
+        f"Mode `{args.mode}`, IDW `{args.normalize}`, distance `{args.metric}`, p = {args.power:g}. Reference "
+        "Mannequins: "
         f"{', '.join(reference.names)} ({len(reference.topology)} ellipsoids each).",
         "",
         "Requested measurements and m_T of the synthesized mannequin (cm); largest relative error (%) of this "
-        "mode and of plain IDW.",
+        "mode and of the paper's IDW (normalize `none`, distance `raw`, p = 2).",
         "",
         "| # | " + " | ".join(MEASUREMENTS) + " | " + " | ".join(f"m_T {k}" for k in MEASUREMENTS)
-        + f" | max error % ({args.mode}) | max error % (IDW) |",
+        + f" | max error % ({args.mode}) | max error % (paper IDW) |",
         "|---|" + "---:|" * (2 * len(MEASUREMENTS) + 2),
     ]
     for i in range(len(result)):
@@ -506,8 +517,8 @@ def _report_markdown(result, reference, args):
     lines += ["", "Relative error (%) over the ten:", "", "| | " + " | ".join(MEASUREMENTS) + " |",
               "|---|" + "---:|" * len(MEASUREMENTS)]
     for label, values in ((f"mean, {args.mode}", error.mean(axis=0)), (f"max, {args.mode}", error.max(axis=0)),
-                          ("mean, IDW", idw_error.mean(axis=0)), ("max, IDW", idw_error.max(axis=0))):
-        if args.mode == "idw" and label.endswith("IDW"):
+                          ("mean, paper IDW", idw_error.mean(axis=0)), ("max, paper IDW", idw_error.max(axis=0))):
+        if paper and label.endswith("IDW"):
             continue
         lines.append(f"| {label} | " + " | ".join(f"{v:.3f}" for v in values) + " |")
     return "\n".join(lines) + "\n"

@@ -17,7 +17,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, PointerProperty
 
 from ..core.constants import ABSURD_LIMITS, MEASUREMENT_LABELS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS
 from ..core.errors import ElliMannError
-from ..core.synthesis import DEFAULT_POWER, POWER_LIMITS, cached_reference_set, synthesize
+from ..core.synthesis import DEFAULT_NORMALIZE, DEFAULT_POWER, POWER_LIMITS, cached_reference_set, synthesize
 from .convert import ellipsoid_objects, update_collection_geometry, write_measured
 from .output import add_mannequin, objects_recursive, refresh_cushions
 
@@ -52,11 +52,17 @@ class ELLIMANN_PG_synthesis(bpy.types.PropertyGroup):
     mode: EnumProperty(
         name="Mode", default="EXACT", update=_on_request_change,
         items=(("EXACT", "Exact", "IDW, then a gentle refinement until m_T matches the request (beyond the paper)"),
-               ("IDW", "IDW", "The paper's segmented inverse-distance weighting alone (m_T off by a few %)")))
+               ("IDW", "IDW", "Segmented inverse-distance weighting alone (m_T off by up to a few %)")))
     output: EnumProperty(
         name="Pieces", default="ELLIPSOIDS",
         items=(("ELLIPSOIDS", "Ellipsoids", "One ellipsoid object per part"),
                ("CUSHIONS", "Cushions", "Cushions (convex hulls) for the cushion pairs, ellipsoids for the rest")))
+    normalize: EnumProperty(
+        name="Interpolate", default=DEFAULT_NORMALIZE.upper(), update=_on_request_change,
+        items=(("PROPORTIONAL", "Proportions", "Average each part in proportion to its RM's measurements: heights "
+                "to He, widths to the part's own measurement, then scale to the request"),
+               ("HEIGHT", "Height Proportions", "Average heights in proportion to each RM's He, widths as they are"),
+               ("NONE", "Geometry (Paper)", "Average the RMs' geometry as it is, as in the paper (Eq. 2.1)")))
     metric: EnumProperty(
         name="Distance", default="RAW", update=_on_request_change,
         items=(("RAW", "cm", "IDW distances in cm, as in the paper"),
@@ -82,7 +88,8 @@ def request_of(props):
 def _synthesize(props):
     folder = bpy.path.abspath(props.references) if props.references else None
     reference = cached_reference_set(folder)
-    return synthesize(reference, request_of(props), props.mode.lower(), props.metric.lower(), props.power)
+    return synthesize(reference, request_of(props), props.mode.lower(), props.metric.lower(), props.power,
+                      normalize=props.normalize.lower())
 
 
 def _has_cushions(collection):

@@ -45,6 +45,7 @@ class ELLIMANN_PT_synthesize(ElliMannPanel, bpy.types.Panel):
         layout.row().prop(props, "mode", expand=True)
         layout.row().prop(props, "output", expand=True)
         options = layout.column(align=True)
+        options.prop(props, "normalize")
         options.prop(props, "metric")
         options.prop(props, "power")
         options.prop(props, "references")

@@ -16,9 +16,25 @@ it reproduce every RM exactly, head included.
 Only the left and central ellipsoids are interpolated; the right ones are their sagittal mirrors with
 the axis signs the RMs use, so every result is exactly symmetric and exact at the RMs.
 
+**Proportional IDW** (``normalize="proportional"``, the default; ``"none"`` is the paper's Eq. 2.1).
+Plain IDW places a part that depends on (He, Br) as the RMs nearest in (He, Br) are, so its height is
+their weighted mean He, not the request's (about 2% off on the 243 grid), and the section at
+0.72 He cuts the chest in the wrong place; and a weighted mean of the RMs' Br is not the requested Br
+(IDW does not reproduce linear functions). So each RM's part is first divided by that RM's own
+scales, the same IDW weights average these proportions, and the mean is multiplied by the request's
+scales: heights (centre z above the floor, vertical semi-axes) by He, widths (centre x and y about
+the registration origin, horizontal semi-axes) by the part's own measurement (Br for the chest, Sh
+for shoulders and arms, ...; parts on He alone keep their widths). Scales are relative to the mean
+of the RMs' measurements; a semi-axis tilted from the vertical takes vertical^v * horizontal^(1-v),
+v its share along z, so rotations are untouched (the same mean rotations as the paper's).
+``"height"`` scales heights only. At an RM's measurements the scales cancel and the result is the RM;
+the weights are the paper's; what is bounded by the RMs is the proportions, not the geometry itself
+(a request outside L is scaled beyond the RMs).
+
 **Exact mode** (beyond the paper): IDW is a weighted mean, so m_T of its result misses the request
-by a few percent (Table 2.4). ``refine`` then deforms the mannequin gently until m_T matches: five
-factors, solved by Newton's method on log m_T with a finite-difference Jacobian:
+(the paper's by a few percent, Table 2.4; proportional IDW by less). ``refine`` then deforms the
+mannequin gently until m_T matches: five factors, solved by quasi-Newton steps on log m_T (starting
+from the RMs' mean Jacobian, Broyden updates):
 
 - He: vertical stretch about the floor (centres' z, and each semi-axis by its vertical share);
 - Br, Wa, Hi: horizontal scaling of the girth ellipsoids about the body's vertical axis, blended
@@ -48,6 +64,10 @@ REFERENCE_NAMES = tuple(REFERENCE_MEASUREMENTS)  # small_slim, tall_slim, small_
 REFERENCE_FOLDER = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"
 METRICS = ("raw", "normalized")
 MODES = ("idw", "exact")
+# What IDW averages: the RMs' geometry (the paper), or their proportions ("Proportional IDW" above).
+NORMALIZATIONS = ("none", "height", "proportional")
+PAPER_NORMALIZE = "none"
+DEFAULT_NORMALIZE = "proportional"
 DEFAULT_POWER = 2.0
 POWER_LIMITS = (0.5, 16.0)
 ZERO_DISTANCE = 1e-9  # closer than this (cm, or range units) is the RM's own point
@@ -110,7 +130,8 @@ def validate_request(me):
             bound = lo if value < lo else hi
             by = abs(value - bound)
             warnings.append(f"{key} = {value:g} cm is outside the reference range {lo:g}-{hi:g} cm by {by:.4g} cm "
-                            f"({100.0 * by / bound:.1f}%): plain IDW stays inside the range, exact mode extrapolates")
+                            f"({100.0 * by / bound:.1f}%): the paper's IDW stays inside the range, proportional "
+                            "IDW and exact mode extrapolate")
     return warnings
 
 
@@ -147,9 +168,11 @@ def mannequin_name(me):
     return "ElliMann " + "-".join(f"{v:.6g}" for v in values)
 
 
-def check_options(mode="idw", metric="raw", power=DEFAULT_POWER):
+def check_options(mode="idw", metric="raw", power=DEFAULT_POWER, normalize=DEFAULT_NORMALIZE):
     if mode not in MODES:
         raise ElliMannError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
+    if normalize not in NORMALIZATIONS:
+        raise ElliMannError(f"normalize must be one of {', '.join(NORMALIZATIONS)}, got {normalize!r}")
     if metric not in METRICS:
         raise ElliMannError(f"metric must be one of {', '.join(METRICS)}, got {metric!r}")
     if not _number(power) or not POWER_LIMITS[0] <= power <= POWER_LIMITS[1]:
@@ -215,9 +238,59 @@ class ReferenceSet:
         # coincide[s, j, l]: RMs j and l have the same measurements in part s's sub-space.
         diff = np.abs(self.measurements[:, None, :] - self.measurements[None, :, :])  # (k, k, 5)
         self._coincide = np.all((diff[None] <= ZERO_DISTANCE) | (mask[:, None, None, :] == 0.0), axis=-1)
+        # Proportional IDW: a part's heights go with He, its widths with the geometric mean of the
+        # other measurements it depends on (one for every part of the shipped topology); only with
+        # measurements it depends on, so it stays a function of its own sub-space.
+        he = _INDEX["He"]
+        self._height_exponent = np.zeros_like(mask)
+        self._height_exponent[:, he] = mask[:, he]
+        widths = mask.copy()
+        widths[:, he] = 0.0
+        self._width_exponent = widths / np.maximum(widths.sum(axis=1, keepdims=True), 1.0)
+        self._size_origin = self.measurements.mean(axis=0)  # scales are relative to the RMs' mean
+        self._normalized = {}
+        self._jacobian = None
 
     def __len__(self):
         return len(self.mannequins)
+
+    def size_scales(self, measurements, normalize):
+        """Horizontal and vertical scale (..., s) of each interpolated part at ``measurements`` (..., 5) cm.
+
+        1 at the mean of the RMs' measurements; ones throughout for ``normalize="none"``.
+        """
+        log = np.log(np.asarray(measurements, dtype=float) / self._size_origin)
+        ones = np.ones(log.shape[:-1] + (len(self._source),))
+        if normalize == "none":
+            return ones, ones
+        vertical = np.exp(log @ self._height_exponent.T)
+        horizontal = np.exp(log @ self._width_exponent.T) if normalize == "proportional" else ones
+        return horizontal, vertical
+
+    def refine_jacobian(self):
+        """(5, 5) d log m_T / d log factor of the refinement, the mean over the RMs (computed once).
+
+        Exact mode starts its Broyden updates from it instead of five m_T per mannequin: the
+        deformation acts alike on every body (its entries vary by a few hundredths between the RMs).
+        """
+        if self._jacobian is None:
+            girth = self.topology.girth_mask
+            measured = tailor_measurements(self.rotation, self.center, self.semi_axes, girth)
+            basis = _deform_basis(self.topology, self.rotation, self.center, self.semi_axes, measured)
+            each = _fd_jacobian(basis, np.arange(len(self)), self.rotation, self.center, self.semi_axes,
+                                np.zeros((len(self), len(MEASUREMENTS))), np.log(measured), girth)
+            self._jacobian = each.mean(axis=0)
+        return self._jacobian
+
+    def normalized_geometry(self, normalize):
+        """The RMs' centres and semi-axes (k, s, 3) of the interpolated parts, divided by their own scales."""
+        if normalize not in self._normalized:
+            src = self._source
+            horizontal, vertical = self.size_scales(self.measurements, normalize)
+            center = self.center[:, src] / _center_scale(horizontal, vertical)
+            semi_axes = self.semi_axes[:, src] / _axis_scale(self.rotation[:, src], horizontal, vertical)
+            self._normalized[normalize] = (center, semi_axes)
+        return self._normalized[normalize]
 
     def _find_mirror_signs(self):
         """Per left part, the axis signs that turn its sagittal reflection into the right twin's frame.
@@ -336,8 +409,29 @@ def idw_weights(reference, requests, metric="raw", power=DEFAULT_POWER):
     return weights / weights.sum(axis=-1, keepdims=True)
 
 
-def interpolate(reference, requests, metric="raw", power=DEFAULT_POWER):
-    """Segmented IDW for a batch (B, 5) cm -> rotation (B, n, 3, 3), center (B, n, 3), semi_axes (B, n, 3)."""
+def _center_scale(horizontal, vertical):
+    """(..., 3) scale of a centre: x and y (about the registration origin) by the width, z (about the floor)
+    by the height."""
+    return np.stack([horizontal, horizontal, vertical], axis=-1)
+
+
+def _axis_scale(rotation, horizontal, vertical):
+    """(..., 3) scale of each semi-axis: vertical^v * horizontal^(1 - v), v = the axis' share along world z.
+
+    The rotation is kept; for an upright ellipsoid (one axis along z) this is exactly the ellipsoid
+    scaled by diag(horizontal, horizontal, vertical).
+    """
+    v = rotation[..., 2, :] ** 2
+    return vertical[..., None] ** v * horizontal[..., None] ** (1.0 - v)
+
+
+def interpolate(reference, requests, metric="raw", power=DEFAULT_POWER, normalize=DEFAULT_NORMALIZE):
+    """Segmented IDW for a batch (B, 5) cm -> rotation (B, n, 3, 3), center (B, n, 3), semi_axes (B, n, 3).
+
+    ``normalize="none"`` is the paper's Eq. 2.1 on the RMs' geometry; "height" and "proportional"
+    average the geometry divided by each RM's scales and multiply the mean by the request's
+    (module docstring). Rotations and weights are the same in all three.
+    """
     requests = np.atleast_2d(np.asarray(requests, dtype=float))
     weights = idw_weights(reference, requests, metric, power)  # (B, s, k)
     src = reference._source
@@ -347,8 +441,15 @@ def interpolate(reference, requests, metric="raw", power=DEFAULT_POWER):
     semi_axes = np.empty((batch, n, 3))
     # rotation_mean takes the k items on axis 0: rotations (k, 1, s, 3, 3), weights (k, B, s).
     rotation[:, src] = rotation_mean(reference.rotation[:, None, src], np.moveaxis(weights, -1, 0))
-    center[:, src] = np.einsum("bsk,ksi->bsi", weights, reference.center[:, src])
-    semi_axes[:, src] = np.einsum("bsk,ksi->bsi", weights, reference.semi_axes[:, src])
+    if normalize == "none":
+        center[:, src] = np.einsum("bsk,ksi->bsi", weights, reference.center[:, src])
+        semi_axes[:, src] = np.einsum("bsk,ksi->bsi", weights, reference.semi_axes[:, src])
+    else:
+        ref_center, ref_semi = reference.normalized_geometry(normalize)
+        horizontal, vertical = reference.size_scales(requests, normalize)  # (B, s)
+        center[:, src] = np.einsum("bsk,ksi->bsi", weights, ref_center) * _center_scale(horizontal, vertical)
+        semi_axes[:, src] = (np.einsum("bsk,ksi->bsi", weights, ref_semi)
+                             * _axis_scale(rotation[:, src], horizontal, vertical))
     central, left, right = reference._central, reference._left, reference._right
     if len(central):
         rotation[:, central], center[:, central] = symmetrize_central(rotation[:, central], center[:, central])
@@ -484,15 +585,16 @@ class Refinement:
 
 
 def refine(topology, rotation, center, semi_axes, targets, measured=None, tolerance=EXACT_TOLERANCE,
-           max_iterations=EXACT_MAX_ITERATIONS):
+           max_iterations=EXACT_MAX_ITERATIONS, jacobian=None):
     """Deform mannequins (B, n, ...) so that m_T matches ``targets`` (B, 5) cm (exact mode).
 
     Solves r(x) = log m_T(deform(exp x)) - log target = 0 for the log factors x, Levenberg-Marquardt
-    style: a forward-difference Jacobian at the start (5 m_T per mannequin), Broyden updates after
-    every step (one m_T each), a step kept only if it lowers |r| (else more damping), the Jacobian
-    recomputed if a mannequin is slow to converge. The result is never further from the request than
-    the IDW mannequin it starts from. All batched; mannequins already within ``tolerance`` are
-    returned unchanged.
+    style: starting from ``jacobian`` ((5, 5) or (B, 5, 5), e.g. ``ReferenceSet.refine_jacobian``)
+    or, without one, a forward-difference Jacobian (5 m_T per mannequin); Broyden updates after
+    every step (one m_T each), a step kept only if it lowers |r| (else more damping), a
+    forward-difference Jacobian if a mannequin is slow to converge. The result is never further from
+    the request than the IDW mannequin it starts from. All batched; mannequins already within
+    ``tolerance`` are returned unchanged.
     """
     girth = topology.girth_mask
     targets = np.atleast_2d(np.asarray(targets, dtype=float))
@@ -503,8 +605,12 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
     x = np.zeros((len(targets), count))
     current = measured.copy()
     residual = np.log(np.maximum(current, 1e-12) / targets)
-    jacobian = np.zeros((len(targets), count, count))
-    age = np.full(len(targets), -1)  # steps since the Jacobian was computed (-1: never)
+    if jacobian is None:
+        jacobian = np.zeros((len(targets), count, count))
+        age = np.full(len(targets), -1)  # steps since the Jacobian was computed (-1: never)
+    else:
+        jacobian = np.broadcast_to(np.asarray(jacobian, dtype=float), (len(targets), count, count)).copy()
+        age = np.zeros(len(targets), dtype=int)
     damping = np.full(len(targets), _DAMPING)
     # A factor that reaches FACTOR_LIMITS is frozen there and its measurement left as close as that
     # allows; the other factors keep solving their own measurements (no trading one for another).
@@ -612,26 +718,31 @@ def validate_requests(requests):
 
 
 def synthesize_batch(reference, requests, mode="idw", metric="raw", power=DEFAULT_POWER, measure=True,
-                     tolerance=EXACT_TOLERANCE):
-    """Synthesize many mannequins at once: requests (B, 5) cm -> Synthesis with (B, n, ...) arrays."""
-    check_options(mode, metric, power)
+                     tolerance=EXACT_TOLERANCE, normalize=DEFAULT_NORMALIZE):
+    """Synthesize many mannequins at once: requests (B, 5) cm -> Synthesis with (B, n, ...) arrays.
+
+    The paper's method is ``mode="idw", normalize="none"`` (with the default raw metric and p = 2).
+    """
+    check_options(mode, metric, power, normalize)
     requests = validate_requests(requests)
-    rotation, center, semi_axes = interpolate(reference, requests, metric, power)
+    rotation, center, semi_axes = interpolate(reference, requests, metric, power, normalize)
     girth = reference.topology.girth_mask
     measured = tailor_measurements(rotation, center, semi_axes, girth) if (measure or mode == "exact") else None
     factors = np.ones_like(requests)
     converged = np.ones(len(requests), dtype=bool)
     if mode == "exact":
-        result = refine(reference.topology, rotation, center, semi_axes, requests, measured, tolerance)
+        result = refine(reference.topology, rotation, center, semi_axes, requests, measured, tolerance,
+                        jacobian=reference.refine_jacobian())
         center, semi_axes, measured = result.center, result.semi_axes, result.measured
         factors, converged = result.factors, result.converged
     return Synthesis(reference.topology, requests, rotation, center, semi_axes, measured, factors, converged, mode)
 
 
-def synthesize(reference, request, mode="idw", metric="raw", power=DEFAULT_POWER, name=None):
+def synthesize(reference, request, mode="idw", metric="raw", power=DEFAULT_POWER, name=None,
+               normalize=DEFAULT_NORMALIZE):
     """One mannequin from a request (dict or 5 numbers, cm). Returns (Mannequin, measured dict, warnings)."""
     warnings = validate_request(request)
-    batch = synthesize_batch(reference, [request_array(request)], mode, metric, power)
+    batch = synthesize_batch(reference, [request_array(request)], mode, metric, power, normalize=normalize)
     if not batch.converged[0]:
         worst = MEASUREMENTS[int(np.argmax(batch.relative_error()[0]))]
         warnings.append(f"exact mode did not fully converge: {worst} is off by {batch.relative_error()[0].max():.2f}%")

@@ -56,13 +56,14 @@ def test_synthesize_makes_a_new_collection_named_after_the_measurements(props):
 
 def test_idw_mode_and_cushions(props):
     props.mode, props.output, props.metric, props.power = "IDW", "CUSHIONS", "NORMALIZED", 3.0
+    props.normalize = "NONE"
     assert bpy.ops.ellimann.synthesize_mannequin() == {"FINISHED"}
     collection = props.target
     cushions = [o for o in bpy.data.objects if o.ellimann.kind == "CUSHION"]
     reference = synthetic.make_reference_set()
     assert len(cushions) == len(reference.topology.cushion_pairs)
     expected, _, _ = core_synthesize(reference, dict(zip(MEASUREMENTS, collection.ellimann.target)), "idw",
-                                     "normalized", 3.0)
+                                     "normalized", 3.0, normalize="none")
     got = convert.collection_to_mannequin(collection).reordered(expected.topology)
     np.testing.assert_allclose(got.center, expected.center, atol=1e-6)
 
@@ -179,7 +180,7 @@ def registered_panel():
 def test_the_panel_draws_request_options_and_measured_values(props, registered_panel):
     recorder = draw_panel(panel.ELLIMANN_PT_synthesize)
     assert [p for p in recorder.props() if p in ("he", "sh", "br", "wa", "hi")] == ["he", "sh", "br", "wa", "hi"]
-    for name in ("mode", "output", "metric", "power", "live", "references"):
+    for name in ("mode", "output", "normalize", "metric", "power", "live", "references"):
         assert name in recorder.props()
     assert "ellimann.synthesize_mannequin" in recorder.operators()
     assert "ellimann.add_measurement_preset" in recorder.operators()

@@ -42,10 +42,12 @@ def random_requests(seed, count, widen=0.0):
 # ---------------------------------------------------------------------------------------------- IDW
 
 
+@pytest.mark.parametrize("normalize", synthesis.NORMALIZATIONS)
 @pytest.mark.parametrize("metric", synthesis.METRICS)
 @pytest.mark.parametrize("power", [1.0, 2.0, 4.0])
-def test_each_reference_mannequin_is_reproduced_exactly(reference, metric, power):
-    result = synthesis.synthesize_batch(reference, reference.measurements, metric=metric, power=power, measure=False)
+def test_each_reference_mannequin_is_reproduced_exactly(reference, metric, power, normalize):
+    result = synthesis.synthesize_batch(reference, reference.measurements, metric=metric, power=power, measure=False,
+                                        normalize=normalize)
     np.testing.assert_allclose(shape_matrix(result.rotation, result.semi_axes),
                                shape_matrix(reference.rotation, reference.semi_axes), atol=1e-12)
     np.testing.assert_allclose(result.center, reference.center, atol=1e-12)
@@ -54,8 +56,10 @@ def test_each_reference_mannequin_is_reproduced_exactly(reference, metric, power
     np.testing.assert_allclose(result.semi_axes[:, labelled], reference.semi_axes[:, labelled], atol=1e-12)
 
 
-def test_a_part_is_exact_when_only_its_sub_space_matches_a_reference(reference):
-    """Legs depend on He and Hi: at an RM's He and Hi they are that RM's legs, whatever Sh, Br, Wa are."""
+@pytest.mark.parametrize("normalize", synthesis.NORMALIZATIONS)
+def test_a_part_is_exact_when_only_its_sub_space_matches_a_reference(reference, normalize):
+    """Legs depend on He and Hi: at an RM's He and Hi they are that RM's legs, whatever Sh, Br, Wa are
+    (proportional IDW scales a part only by the measurements it depends on)."""
     mask = reference.topology.dependency_mask
     coincide = reference._coincide
     source = reference._source
@@ -64,7 +68,7 @@ def test_a_part_is_exact_when_only_its_sub_space_matches_a_reference(reference):
     for row, part in enumerate(source):
         for j in range(len(reference)):
             request = np.where(mask[part], reference.measurements[j], others)
-            result = synthesis.interpolate(reference, request[None])
+            result = synthesis.interpolate(reference, request[None], normalize=normalize)
             group = np.nonzero(coincide[row, j])[0]
             if len(group) == 1:
                 np.testing.assert_allclose(result[0][0, part], reference.rotation[j, part], atol=1e-12)
@@ -77,14 +81,15 @@ def test_a_part_is_exact_when_only_its_sub_space_matches_a_reference(reference):
     assert checked > 0
 
 
-def test_parts_shared_by_coinciding_references_are_continuous(reference):
+@pytest.mark.parametrize("normalize", synthesis.NORMALIZATIONS)
+def test_parts_shared_by_coinciding_references_are_continuous(reference, normalize):
     """He-only parts cannot tell Small Slim from Small Chubby (both He = 148): approaching the point
     where they meet changes the result continuously."""
     base = reference.measurements[0].copy()
     base[1:] = [RANGES[k][0] + 0.3 * (RANGES[k][1] - RANGES[k][0]) for k in MEASUREMENTS[1:]]
     near = base + np.array([1e-7, 0, 0, 0, 0])
-    a = synthesis.interpolate(reference, base[None])
-    b = synthesis.interpolate(reference, near[None])
+    a = synthesis.interpolate(reference, base[None], normalize=normalize)
+    b = synthesis.interpolate(reference, near[None], normalize=normalize)
     for x, y in zip(a, b):
         assert np.abs(x - y).max() < 1e-6
 
@@ -104,18 +109,79 @@ _SYNTHETIC = synthetic.make_reference_set()
 
 
 @pytest.mark.parametrize("metric", synthesis.METRICS)
-def test_results_stay_within_the_references_and_are_valid_symmetric_mannequins(reference, metric):
+def test_the_papers_results_stay_within_the_references(reference, metric):
+    """normalize="none": every centre and semi-axis component lies within the RMs' own values."""
     requests = random_requests(3, 40, widen=0.3)
-    result = synthesis.synthesize_batch(reference, requests, metric=metric, measure=False)
+    result = synthesis.synthesize_batch(reference, requests, metric=metric, measure=False, normalize="none")
     tol = 1e-12
     for array, stack in ((result.center, reference.center), (result.semi_axes, reference.semi_axes)):
         assert np.all(array >= stack.min(axis=0) - tol)
         assert np.all(array <= stack.max(axis=0) + tol)
+
+
+@pytest.mark.parametrize("normalize", ["height", "proportional"])
+@pytest.mark.parametrize("metric", synthesis.METRICS)
+def test_proportions_stay_within_the_references(reference, metric, normalize):
+    """Normalized IDW: a part's centre divided by the request's scales and its semi-axes divided by
+    their axis scales lie within the RMs' same proportions (the geometry itself may leave them)."""
+    requests = random_requests(4, 40, widen=0.3)
+    result = synthesis.synthesize_batch(reference, requests, metric=metric, measure=False, normalize=normalize)
+    src = reference._source
+    horizontal, vertical = reference.size_scales(requests, normalize)
+    center = result.center[:, src] / synthesis._center_scale(horizontal, vertical)
+    semi = result.semi_axes[:, src] / synthesis._axis_scale(result.rotation[:, src], horizontal, vertical)
+    ref_center, ref_semi = reference.normalized_geometry(normalize)
+    tol = 1e-12
+    for array, stack in ((center, ref_center), (semi, ref_semi)):
+        assert np.all(array >= stack.min(axis=0) - tol)
+        assert np.all(array <= stack.max(axis=0) + tol)
+    if normalize == "height":  # widths are not scaled
+        np.testing.assert_array_equal(horizontal, 1.0)
+
+
+@pytest.mark.parametrize("normalize", synthesis.NORMALIZATIONS)
+def test_results_are_valid_symmetric_mannequins_with_the_papers_rotations(reference, normalize):
+    requests = random_requests(3, 40, widen=0.3)
+    result = synthesis.synthesize_batch(reference, requests, measure=False, normalize=normalize)
+    paper = synthesis.synthesize_batch(reference, requests, measure=False, normalize="none")
+    np.testing.assert_array_equal(result.rotation, paper.rotation)
     assert np.all(is_rotation(result.rotation, tol=1e-9))
     for i in range(len(result)):
         mannequin = result.mannequin(i)
         assert mannequin.problems() == []
         assert asymmetry(mannequin) < 1e-12
+
+
+def _scaled(reference, base, me):
+    """RM ``base`` scaled part by part to measurements ``me``: heights by He, widths by the part's other
+    measurement (written out independently of the module)."""
+    mask = reference.topology.dependency_mask
+    ratio = np.log(me / reference.measurements[base])
+    widths = mask[:, 1:]
+    horizontal = np.exp((widths * ratio[1:]).sum(axis=1) / np.maximum(widths.sum(axis=1), 1))
+    vertical = np.exp(mask[:, 0] * ratio[0])
+    rotation = reference.rotation[base]
+    v = rotation[:, 2, :] ** 2
+    center = reference.center[base] * np.stack([horizontal, horizontal, vertical], axis=-1)
+    semi_axes = reference.semi_axes[base] * vertical[:, None] ** v * horizontal[:, None] ** (1 - v)
+    return Mannequin(reference.topology, rotation, center, semi_axes, role="reference",
+                     measurements=dict(zip(MEASUREMENTS, me)))
+
+
+def test_proportional_idw_reproduces_proportionally_scaled_bodies_exactly(reference):
+    """If the RMs differ only by these scales, proportional IDW returns the body scaled to any request,
+    outside L too; the paper's IDW does not."""
+    scaled = synthesis.ReferenceSet([_scaled(reference, 4, me) for me in reference.measurements],
+                                    names=reference.names)
+    requests = random_requests(9, 12, widen=0.3)
+    result = synthesis.synthesize_batch(scaled, requests, measure=False, normalize="proportional")
+    paper = synthesis.synthesize_batch(scaled, requests, measure=False, normalize="none")
+    for i, me in enumerate(requests):
+        expected = _scaled(scaled, 4, me)
+        np.testing.assert_allclose(result.rotation[i], expected.rotation, atol=1e-12)
+        np.testing.assert_allclose(result.center[i], expected.center, atol=1e-12)
+        np.testing.assert_allclose(result.semi_axes[i], expected.semi_axes, atol=1e-12)
+    assert np.abs(paper.center - result.center).max() > 1e-3
 
 
 def test_rotations_are_averaged_then_projected():
@@ -158,6 +224,21 @@ def test_exact_mode_meets_its_target_on_a_sample_of_the_grid(reference):
     assert np.all((exact.factors >= synthesis.FACTOR_LIMITS[0]) & (exact.factors <= synthesis.FACTOR_LIMITS[1]))
     for i in range(0, len(sample), 6):
         assert asymmetry(exact.mannequin(i)) < 1e-12
+    # synthesize_batch starts from the RMs' mean Jacobian; from forward differences it meets the same target.
+    assert reference.refine_jacobian() is reference.refine_jacobian()
+    fd = synthesis.refine(reference.topology, idw.rotation, idw.center, idw.semi_axes, sample)
+    assert fd.converged.all()
+    np.testing.assert_allclose(fd.measured, exact.measured, rtol=3 * synthesis.EXACT_TOLERANCE)
+
+
+def test_proportional_idw_starts_exact_mode_closer_than_the_papers(reference):
+    sample = GRID[::7]
+    paper = synthesis.synthesize_batch(reference, sample, mode="exact", normalize="none")
+    proportional = synthesis.synthesize_batch(reference, sample, mode="exact")
+    idw = synthesis.synthesize_batch(reference, sample)
+    assert np.all(idw.relative_error().mean(axis=0) < synthesis.synthesize_batch(
+        reference, sample, normalize="none").relative_error().mean(axis=0))
+    assert np.all(np.abs(np.log(proportional.factors)).max(axis=0) < np.abs(np.log(paper.factors)).max(axis=0))
 
 
 def test_exact_mode_changes_nothing_when_m_T_already_matches(reference):
@@ -173,15 +254,16 @@ def test_exact_mode_changes_nothing_when_m_T_already_matches(reference):
 
 
 def test_an_unreachable_measurement_stops_at_the_factor_limit_without_spoiling_the_others():
-    request = [[159.0, 43.0, 250.0, 104.0, 117.0]]  # Br far outside L: would need the chest doubled
-    idw = synthesis.synthesize_batch(_SYNTHETIC, request)
-    exact = synthesis.synthesize_batch(_SYNTHETIC, request, mode="exact")
+    # Br far outside L: from the paper's IDW (which stays inside L) it would need the chest doubled.
+    request = [[159.0, 43.0, 250.0, 104.0, 117.0]]
+    idw = synthesis.synthesize_batch(_SYNTHETIC, request, normalize="none")
+    exact = synthesis.synthesize_batch(_SYNTHETIC, request, mode="exact", normalize="none")
     assert not exact.converged[0]
     assert exact.factors[0, 2] == pytest.approx(synthesis.FACTOR_LIMITS[1])
     assert exact.relative_error()[0, 2] < idw.relative_error()[0, 2]
     others = [0, 1, 3, 4]
     assert exact.relative_error()[0, others].max() < 100 * synthesis.EXACT_TOLERANCE
-    _, _, warnings = synthesis.synthesize(_SYNTHETIC, request[0], mode="exact")
+    _, _, warnings = synthesis.synthesize(_SYNTHETIC, request[0], mode="exact", normalize="none")
     assert warnings[-1].startswith("exact mode did not fully converge: Br is off by")
 
 
@@ -250,7 +332,8 @@ def test_values_outside_L_are_allowed_with_a_warning_saying_how_far():
 
 
 def test_bad_options_are_refused():
-    for options in ({"mode": "magic"}, {"metric": "manhattan"}, {"power": 0.0}, {"power": float("nan")}):
+    for options in ({"mode": "magic"}, {"metric": "manhattan"}, {"power": 0.0}, {"power": float("nan")},
+                    {"normalize": "width"}):
         with pytest.raises(synthesis.ElliMannError):
             synthesis.synthesize_batch(_SYNTHETIC, [list(GOOD.values())], **options)
 
