@@ -7,6 +7,7 @@ traced over); several slots stand side by side along X for a line-up.
 
     python -m tools.render trace-example --mesh BODY.obj --regions BODY_regions.json --out PNG
     python -m tools.render mannequins A.json [B.json ...] [--ghost A.obj ...] --out PNG [--view SIDE]
+        [--ghost-shift X Y Z] [--side-too]
 """
 
 import argparse
@@ -61,17 +62,20 @@ def _bounds(objects):
     return points.min(axis=0), points.max(axis=0)
 
 
-def render(path, slots, resolution=(800, 1000), view="FRONT", spacing=None, margin=1.08, aa_samples="8"):
+def render(path, slots, resolution=(800, 1000), view="FRONT", spacing=None, margin=1.08, aa_samples="8",
+           focus=None):
     """Render ``slots`` (a Slot or a list of them, side by side) with Workbench to ``path`` (PNG).
 
-    ``spacing`` is the gap between slots in metres (default 15% of the widest); returns the path.
+    ``spacing`` is the gap between slots in metres (default 15% of the widest); ``focus`` (lo, hi):
+    a box (m, in the first slot's own coordinates) the camera frames instead of everything, for a
+    close-up. Returns the path.
     """
     slots = [slots] if isinstance(slots, Slot) else list(slots)
     scene = bpy.data.scenes.new("ElliMann render")
     made_objects, made_data = [], []
     try:
         # Copy each slot centred on the origin and turned, then move the slots side by side along X.
-        placed = []
+        placed, placements = [], []
         for slot in slots:
             lo, hi = _bounds([o for item in slot.solid + slot.ghosts for o in _objects(item)])
             centre = Matrix.Translation((-(lo[0] + hi[0]) / 2.0, -(lo[1] + hi[1]) / 2.0, 0.0))
@@ -80,16 +84,22 @@ def render(path, slots, resolution=(800, 1000), view="FRONT", spacing=None, marg
             copies += [_copy(o, scene.collection, placement, GHOST_COLOR) for item in slot.ghosts
                        for o in _objects(item)]
             placed.append(copies)
+            placements.append(placement)
             made_objects += copies
         widths = [np.ptp(np.array(_bounds(copies))[:, 0]) for copies in placed]
         gap = spacing if spacing is not None else 0.15 * max(widths)
         x = 0.0
-        for copies, width in zip(placed, widths):
+        for i, (copies, width) in enumerate(zip(placed, widths)):
             shift = Matrix.Translation((x + width / 2.0, 0.0, 0.0))
+            placements[i] = shift @ placements[i]
             for copy in copies:
                 copy.matrix_world = shift @ copy.matrix_world
             x += width + gap
         lo, hi = _bounds(made_objects)
+        if focus is not None:
+            corners = np.array([[a, b, c, 1.0] for a in (focus[0][0], focus[1][0]) for b in (focus[0][1], focus[1][1])
+                                for c in (focus[0][2], focus[1][2])]) @ np.array(placements[0]).T
+            lo, hi = corners[:, :3].min(axis=0), corners[:, :3].max(axis=0)
         center = (lo + hi) / 2.0
 
         turn = math.radians(VIEWS[view])
@@ -187,15 +197,22 @@ def trace_example(mesh_path, regions_path, out, mode="moments", view="FRONT"):
     return render(out, [front, side], resolution=(1000, 900), view=view)
 
 
-def mannequins(files, ghosts, out, view="FRONT"):
-    """Mannequin JSON files side by side, each over its ghost mesh (OBJ) if given."""
+def mannequins(files, ghosts, out, view="FRONT", ghost_shift=(0.0, 0.0, 0.0), side_too=False):
+    """Mannequin JSON files side by side, each over its ghost mesh (OBJ) if given, moved by
+    ``ghost_shift`` (m: e.g. the registration that moved the mannequin off its body); with
+    ``side_too`` each also turned 90 degrees beside it (a front and a side view in one picture)."""
     bpy.ops.wm.read_homefile(use_empty=True)
     if ghosts and len(ghosts) != len(files):
         raise SystemExit(f"give one --ghost per mannequin ({len(files)}), or none")
     slots = []
     for i, path in enumerate(files):
         collection = mannequin_to_collection(Mannequin.load(path))
-        slots.append(Slot(solid=[collection], ghosts=import_obj(ghosts[i]) if ghosts else []))
+        body = import_obj(ghosts[i]) if ghosts else []
+        for obj in body:
+            obj.matrix_world = Matrix.Translation(ghost_shift) @ obj.matrix_world
+        slots.append(Slot(solid=[collection], ghosts=body))
+        if side_too:
+            slots.append(Slot(solid=[collection], ghosts=body, turn=90.0))
     return render(out, slots, resolution=(max(800, 420 * len(slots)), 1000), view=view)
 
 
@@ -209,6 +226,9 @@ def main(argv=None):
     lineup = sub.add_parser("mannequins", help="mannequin JSON files side by side")
     lineup.add_argument("files", nargs="+", type=Path)
     lineup.add_argument("--ghost", action="append", default=[], type=Path)
+    lineup.add_argument("--ghost-shift", nargs=3, type=float, default=(0.0, 0.0, 0.0), metavar=("X", "Y", "Z"),
+                        help="move the ghost meshes by this much (m), e.g. by the mannequin's registration")
+    lineup.add_argument("--side-too", action="store_true", help="each mannequin also seen from the side")
     for p in (trace, lineup):
         p.add_argument("--out", required=True, type=Path)
         p.add_argument("--view", default="FRONT", choices=sorted(VIEWS))
@@ -218,7 +238,7 @@ def main(argv=None):
         if args.command == "trace-example":
             trace_example(args.mesh, args.regions, args.out, args.mode, args.view)
         else:
-            mannequins(args.files, args.ghost, args.out, args.view)
+            mannequins(args.files, args.ghost, args.out, args.view, args.ghost_shift, args.side_too)
     finally:
         ellimann_addon.unregister()
     print(f"wrote {args.out}")
