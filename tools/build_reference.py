@@ -5,13 +5,16 @@
 
 Reads the body meshes of ``<repo>/../shared/refmodels`` (see its README) and writes
 ``reference_blends/base_mannequin.json`` and the five ``<name>.json`` Reference Mannequins, their
-.blend twins and a Workbench line-up ``docs/images/reference_lineup.png`` (both with the bpy module),
-``docs/topology.md`` and ``docs/reference_mannequins.md``.
+.blend twins, a Workbench line-up ``docs/images/reference_lineup.png`` and the Base Mannequin over
+its body ``docs/images/base_mannequin_trace.png`` (with the bpy module), ``docs/topology.md`` and
+``docs/reference_mannequins.md`` (with how much of its body each mannequin fills, tools/coverage.py).
 
 Steps (paper, Sections 2.3.2-2.3.4):
-1. Trace: every part of tools/reference_topology.py is fitted to its vertices on a body
-   (tools/fitting.py). The selections are made once on the neutral reference body; all bodies share
-   its vertex order, so the same vertices trace the same part on each body.
+1. Trace: every left and central part of tools/reference_topology.py is fitted to its vertices on a
+   body (tools/fitting.py), placed to fill the body's volume in its box, twice: the second time around
+   the others, so the parts spread into the gaps between them; the right parts are mirror images. The
+   selections are made once on the neutral reference body; all bodies share its vertex order, so the
+   same vertices trace the same part on each body.
 2. Base Mannequin: the parts fitted over ``reference_female.obj``, registered and made symmetric.
 3. Reference Mannequins: the parts fitted over each of the five bodies (axes labelled against the
    Base Mannequin's), registered and made symmetric, then deformed by synthesis' exact-mode
@@ -34,7 +37,6 @@ from ellimann_addon.core.clean import (
     asymmetry,
     clean,
     landmark_indices,
-    mirror_side,
     register,
     registration_offset,
     relabel,
@@ -43,7 +45,7 @@ from ellimann_addon.core.clean import (
 from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 from ellimann_addon.core.ellipsoid import section_at_height
 from ellimann_addon.core.files import atomic_write_text
-from ellimann_addon.core.frames import axis_agreement, is_rotation
+from ellimann_addon.core.frames import axis_agreement, is_rotation, mirror_frame
 from ellimann_addon.core.mannequin import Mannequin, Topology
 from ellimann_addon.core.measure import as_dict, section_heights
 from ellimann_addon.core.synthesis import refine
@@ -71,8 +73,9 @@ ADJUST_ITERATIONS = 40
 FILL_SPACING = 0.008  # m: grid sampling each body's volume, which the parts are placed to fill
 FILL_PASSES = 2  # placements of every part: the first alone, the others around the rest
 FILL_SHARED = 0.25  # what covering volume another part covers too is worth, after the first pass
-SLAB, SLAB_WEIGHT = 0.01, 3.0  # fraction of the height about each section it depends on where a part's cover counts
-# this many times more: the parts that make a measurement reach the body's outline there
+# Volume within SLAB (fraction of the height) of the section of a measurement a part depends on
+# counts SLAB_WEIGHT times more: the parts that make a measurement reach the body's outline there.
+SLAB, SLAB_WEIGHT = 0.01, 3.0
 ACCEPT_TOLERANCE = 5e-3  # what every shipped RM must meet (issue: 0.5% of Table 2.3)
 LINEUP_ORDER = ("small_chubby", "small_slim", "average", "tall_slim", "tall_chubby")  # the paper's Figure 2.9
 DISPLAY_NAMES = {"small_slim": "Small Slim", "tall_slim": "Tall Slim", "small_chubby": "Small Chubby",
@@ -107,21 +110,22 @@ class Tracing:
             if len(idx) < 8:
                 raise ValueError(f"'{rt.part_name(spec, side)}' selects only {len(idx)} vertices: widen its selection")
             selected.append(idx)
-            obstacles.append(rt.obstacle_vertices(spec, side, labels, hidden))
+            obstacles.append(rt.obstacle_vertices(spec, hidden))
         return cls(rt.topology(), selected, obstacles, hidden)
 
 
-def fit_mannequin(body, tracing, reference=None, kept=None, passes=None, **fields):
+def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
     """Fit every part over ``body``. Returns (mannequin, kept axis index per part).
 
     Without ``reference`` the frames take their roll from the world axes (the Base Mannequin);
     with it (a mannequin of the same topology, and the ``kept`` axes of its fit) each part keeps
     the axis closest to the reference part's kept axis and the reference's roll about it.
-    Every part is placed to cover the body's volume in its box; in the passes after the first, each
-    is placed again, in turn, valuing the volume no other part covers above the rest (FILL_SHARED),
-    so parts spread into the gaps between them. ``fields``: name, role, measurements of the mannequin.
+    Every left and central part is placed to cover the body's volume in its box (more so near the
+    sections of the measurements it depends on, SLAB), the right ones are its mirror images; in the
+    passes after the first, each is placed again, in turn, valuing the volume no other part covers
+    above the rest (FILL_SHARED), so parts spread into the gaps between them. ``fields``: name, role,
+    measurements of the mannequin.
     """
-    passes = FILL_PASSES if passes is None else passes
     areas = vertex_areas(body.vertices, body.faces)
     normals = vertex_normals(body.vertices, body.faces)
     volume = coverage.BodyVolume(body.vertices, body.faces).grid(FILL_SPACING)
@@ -131,7 +135,8 @@ def fit_mannequin(body, tracing, reference=None, kept=None, passes=None, **field
     n = len(topology)
     rotation, center, semi_axes = np.tile(np.eye(3), (n, 1, 1)), np.zeros((n, 3)), np.ones((n, 3))
     kept_out = [None] * n
-    fitted = [i for i, (_, side) in enumerate(rt.expanded()) if side != "R"]  # right parts: mirror images
+    specs = [spec for spec, _ in rt.expanded()]
+    fitted = [i for i, part in enumerate(topology) if part.side != "R"]
     twins = topology.twin_indices
     covers = np.zeros((n, len(inside)), dtype=bool)
 
@@ -139,9 +144,9 @@ def fit_mannequin(body, tracing, reference=None, kept=None, passes=None, **field
         local = (inside - center[i]) @ rotation[i] / semi_axes[i]
         return np.einsum("pk,pk->p", local, local) < 1.0
 
-    for round_ in range(passes):
+    for round_ in range(FILL_PASSES):
         for i in fitted:
-            spec, side = rt.expanded()[i]
+            spec = specs[i]
             idx, walls = tracing.selected[i], tracing.obstacles[i]
             points, weights = body.vertices[idx], areas[idx]
             if spec.inward is not None:
@@ -155,7 +160,7 @@ def fit_mannequin(body, tracing, reference=None, kept=None, passes=None, **field
             floor, ceiling = rt.section_bounds(spec, (weights @ points[:, 2] / weights.sum() - bottom) / height)
             floor, ceiling = bottom + floor * height, bottom + ceiling * height
             level = None if spec.level is None else bottom + spec.level * height
-            if spec.obstacles == "hull":
+            if spec.mitten:
                 walls, wall_areas = hull_surface(body.vertices[idx], spec.depth)
             else:
                 # the surface moved out by depth: the part may reach that far outside the body
@@ -172,9 +177,9 @@ def fit_mannequin(body, tracing, reference=None, kept=None, passes=None, **field
                 points, weights, walls, wall_areas, ref_rotation, margin=spec.margin, inside_fraction=spec.inside,
                 frame=spec.frame, match=match, floor=floor, ceiling=ceiling, level=level, span=spec.span,
                 fill=inside, fill_weight=weight)
-            mirrored = mirror_side(Mannequin(topology, rotation, center, semi_axes))
-            rotation[twins[i]], center[twins[i]] = mirrored.rotation[twins[i]], mirrored.center[twins[i]]
-            semi_axes[twins[i]] = semi_axes[i]
+            if twins[i] != i:
+                rotation[twins[i]], center[twins[i]] = mirror_frame(rotation[i], center[i])
+                semi_axes[twins[i]] = semi_axes[i]
             covers[i], covers[twins[i]] = cover(i), cover(twins[i])
     return Mannequin(topology, rotation, center, semi_axes, **fields).check(), [
         kept_out[twins[i]] if part.side == "R" else kept_out[i] for i, part in enumerate(topology)]
@@ -230,6 +235,7 @@ def build(refmodels=DEFAULT_REFMODELS, log=print):
     report = {
         "seconds": time.perf_counter() - started,
         "fill": fill,
+        "shifts": shifts,
         "body_measurements": {name: body_measurements(body, labels)
                               for name, body in [(REFERENCE_BODY, reference_body), *bodies.items()]},
         "fitted_measurements": {name: m.measure() for name, m in raw.items()},
@@ -327,6 +333,7 @@ def write_blends(mannequins, folder):
     from ellimann_addon.blender import convert
 
     folder = pathlib.Path(folder)
+    bpy.context.preferences.filepaths.save_version = 0  # no .blend1 backups of the files it replaces
     ellimann_addon.register()
     try:
         for stem, mannequin in mannequins.items():
@@ -343,6 +350,16 @@ def write_lineup(files, path):
 
     path.parent.mkdir(parents=True, exist_ok=True)
     render.main(["mannequins", *map(str, files), "--out", str(path)])
+
+
+def write_trace(mannequin_file, body_file, shift, path):
+    """Workbench render of a mannequin over the semi-transparent body it was traced from (moved by
+    ``shift``, the mannequin's registration), front and side. Needs the bpy module."""
+    from . import render
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    render.main(["mannequins", str(mannequin_file), "--ghost", str(body_file), "--ghost-shift",
+                 *(f"{v:.9g}" for v in shift), "--side-too", "--out", str(path)])
 
 
 def check_shipped(base, rms, folder, atol=1e-9):
@@ -451,10 +468,8 @@ def _fit_notes(spec):
             items.append(f"{attr} {getattr(spec, attr):g}{unit}")
     if spec.span:
         items.append("spans its selection")
-    if spec.obstacles == "hull":
-        items.append("inside the hull of its vertices")
-    elif spec.obstacles is not None:
-        items.append("kept inside the " + "/".join(spec.obstacles) + " surface only")
+    if spec.mitten:
+        items.append("inside the hull of its vertices (a mitten)")
     if spec.cavities:
         items.append("fills the mesh's open mouth and eye sockets")
     if spec.level is not None:
@@ -489,7 +504,7 @@ def measurements_doc(base, rms, report):
         "## How far each body and fit were from the table",
         "",
         "The body is the mesh in `refmodels/` (measured like m_T on the mesh, as its README says); the fit "
-        "is the RM before the adjustment (inscribed ellipsoids, so a little smaller than the body); the "
+        "is the RM before the adjustment (ellipsoids fitted in the body, reaching at most a few mm out); the "
         "factors are those of the refinement (He: vertical stretch; Sh: shoulders widened, arms carried "
         "out; Br, Wa, Hi: girth parts scaled horizontally, blended with height around each section).",
         "",
@@ -509,7 +524,7 @@ def measurements_doc(base, rms, report):
         "",
         "## Base Mannequin vs the reference body",
         "",
-        "The Base Mannequin is traced, not adjusted: its m_T is that of inscribed ellipsoids.",
+        "The Base Mannequin is traced, not adjusted: its m_T is that of the fitted ellipsoids.",
         "",
         "| | He | Sh | Br | Wa | Hi |",
         "|---|---|---|---|---|---|",
@@ -541,9 +556,13 @@ def fill_doc(fill):
         "Measured by `tools/coverage.py` against the body each mannequin was traced from (moved by the same "
         f"registration), on a regular {spacing:g} mm grid: **coverage** is the share of the body's volume "
         "inside the union of the pieces, **excess** the share of the pieces' volume outside the body, "
-        "**depth** how far (mm) a piece reaches outside the body surface at most. *Ellipsoids*: the "
-        "ellipsoid mannequin; *cushions*: every cushion pair replaced by its hull. The Reference Mannequins "
-        "are measured after their adjustment to Table 2.3, so they may differ from their bodies.",
+        "**depth** how far (mm) a piece reaches outside the body surface at most, and which. *Ellipsoids*: "
+        "the ellipsoid mannequin; *cushions*: every cushion pair replaced by its hull. The parts may reach "
+        f"{rt.Spec.depth * 1e3:g} mm outside the skin by design (`depth` in `docs/topology.md`); the mitten over "
+        "the spread fingers reaches further, between them. The points in the mesh's open mouth and eye sockets "
+        "(no eyes or teeth), which the solid head fills, are not counted in the depth. The Reference Mannequins "
+        "are measured after their adjustment to Table 2.3, which moves and scales parts off their bodies (girth "
+        "parts widened or narrowed, the arms carried sideways with the shoulder width).",
         "",
         "| mannequin | coverage | excess | depth (mm) | cushions: coverage | excess | depth (mm) |",
         "|---|---|---|---|---|---|---|",
@@ -633,6 +652,10 @@ def main(argv=None):
         lineup = args.docs / "images" / "reference_lineup.png"
         if set(changed) & set(RM_BODIES) or not lineup.is_file():
             write_lineup([args.out / f"{stem}.json" for stem in LINEUP_ORDER], lineup)
+        trace = args.docs / "images" / "base_mannequin_trace.png"
+        if BASE_FILE in changed or not trace.is_file():
+            write_trace(args.out / f"{BASE_FILE}.json", args.refmodels / f"{REFERENCE_BODY}.obj",
+                        report["shifts"][BASE_FILE], trace)
     return 0
 
 

@@ -1,14 +1,16 @@
 """How well a mannequin fills the body it was traced from: coverage, excess and gaps along the limbs.
 
 - **coverage**: share of the body's volume inside the union of the mannequin's pieces;
-- **excess**: share of the mannequin's volume outside the body, and the largest depth (m) a piece
-  reaches outside the body surface;
-- **gaps**: along each limb chain (e.g. thigh, knee, calf, ankle, foot, toes), the largest distance
-  between consecutive links (0 where they touch or overlap).
+- **excess**: share of the pieces' volume outside the body; **depth**: how far (m) a piece reaches
+  outside the body surface at most (leaving out the mesh's open mouth and eye sockets, if given);
+- **gaps**: along each chain of CHAINS (e.g. thigh, knee, calf, ankle, foot, toes), the distance
+  between each two consecutive links (0 where they touch or overlap).
 
-Volumes are counted on a regular grid (``GRID_SPACING``); a grid point is inside the closed body
-mesh when a vertical ray from it crosses the surface an odd number of times. Pieces are the
-ellipsoids, or with ``cushions`` the hulls of the cushion pairs (and the single ellipsoids).
+Pieces are the ellipsoids or, with ``cushions``, the hulls of the cushion pairs (and the single
+ellipsoids). Volumes are counted on a regular grid: a point is inside the closed body mesh when a
+vertical line through it crosses the surface an odd number of times above it; a piece, being convex,
+meets each vertical line in one interval (closed form for an ellipsoid, from the face planes of a
+hull mesh of 642 support points per ellipsoid, a little inside the true hull, for a cushion).
 """
 
 from dataclasses import dataclass
@@ -90,7 +92,7 @@ class BodyVolume:
         with np.errstate(divide="ignore", invalid="ignore"):
             u = ((p[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (p[:, 1] - a[:, 1])) / det
             v = ((b[:, 0] - a[:, 0]) * (p[:, 1] - a[:, 1]) - (p[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])) / det
-        hit = (det != 0.0) & (u >= 0.0) & (v >= 0.0) & (u + v <= 1.0)
+            hit = (det != 0.0) & (u >= 0.0) & (v >= 0.0) & (u + v <= 1.0)
         z = a[hit, 2] + u[hit] * (b[hit, 2] - a[hit, 2]) + v[hit] * (c[hit, 2] - a[hit, 2])
         return line[hit], z
 

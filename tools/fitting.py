@@ -26,7 +26,7 @@ from ellimann_addon.core.frames import relabel_to_reference
 
 DEGENERATE = 0.12  # relative gap below which two principal variances do not fix their axes
 GROWTH = 1.15  # largest growth of a semi-axis per round: keeps the ascent from favouring one axis
-ROUNDS = 60
+ROUNDS = 60  # of the growth towards a maximal ellipsoid, at most
 CONVERGED = 1e-3  # relative growth below which the ascent stops
 _FRACTIONS = np.linspace(0.0, 1.0, 33)[1:]  # how far towards a round's proposal to grow: all tried at once
 PATTERN_STEPS = 5  # halvings of the centre search step
@@ -153,7 +153,7 @@ def _grow(local, area, limit, start, allowed, up=None, reach=np.inf):
 def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=None, margin=0.1,
                         inside_fraction=0.002, frame="main", match=None, floor=-np.inf,
                         ceiling=np.inf, level=None, span=False, fill=None, fill_weight=None):
-    """The largest ellipsoid, in the part's frame, inside the body and the selection's box.
+    """A maximal ellipsoid, in the part's frame, inside the body and the selection's box.
 
     ``selected`` (k, 3) vertices of the part with area ``weights``; ``obstacles`` (m, 3) body
     vertices that must stay outside, with ``obstacle_area`` (m,), except vertices of total area
@@ -163,9 +163,10 @@ def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=N
     clear of a section it must not cut. ``level``: world z of the centre, if given: a part centred on
     the section it makes is cut where its girth changes least with height, so interpolated
     mannequins whose parts sit a little higher or lower still measure what their references do.
-    ``span``: the semi-axis along the axis taken from the points is the box's half-length along it,
-    and the centre the box's middle there: a limb's part reaches from one end of its segment to the
-    other, however the limb tapers (only the cross-section grows). ``fill``: points (p, 3) sampling
+    ``span``: the semi-axis along the axis taken from the points is the box's half-length along it
+    (less if ``floor`` or ``ceiling`` allow less), and the centre the box's middle there: a limb's
+    part reaches from one end of its segment to the other, however the limb tapers (only the
+    cross-section grows). ``fill``: points (p, 3) sampling
     the body's volume (e.g. a regular grid inside it); if given, the centre is chosen for the
     ellipsoid to cover most of them within the box, instead of for the largest ellipsoid: a part
     fills its region rather than settling where the body is thickest. ``fill_weight`` (p,): what
@@ -174,7 +175,7 @@ def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=N
     """
     rotation, centroid, kept = principal_frame(selected, weights, reference, frame, match)
     if span and kept is None:
-        raise ValueError("span needs an axis taken from the points (a 'limb' or 'main' frame that finds one)")
+        raise ValueError("span needs an axis taken from the points (a 'limb', 'axis' or 'main' frame that finds one)")
     local_sel = (selected - centroid) @ rotation
     lo, hi = local_sel.min(axis=0), local_sel.max(axis=0)
     half = 0.5 * (hi - lo)

@@ -45,13 +45,12 @@ class Spec:
     depends: tuple
     select: Select
     margin: float = 0.3  # box enlargement, fraction of the selection's half-extent
-    depth: float = 0.005  # m: how far the part may reach outside the body surface
-    inside: float = 0.003  # share of the nearby body surface (by area) allowed deeper inside than that
+    depth: float = 0.005  # m: how far the part may reach outside the body surface (or a mitten's hull)
+    inside: float = 0.003  # share of the nearby body surface (by area) that may lie inside it anyway
     span: bool = False  # the part reaches from one end of its selection to the other along its axis
     inward: tuple = None  # extrude a surface patch by this vector (m) into the body before fitting
     frame: str = "main"  # the axis the frame takes from the points: "limb", "main", "axis" (``axis``) or "fixed"
-    obstacles: object = None  # regions (without side) whose surface the part must stay inside; None: all;
-    # "hull": the convex hull of its own selection (a mitten)
+    mitten: bool = False  # kept inside the convex hull of its own vertices instead of the body surface
     level: float = None  # height (fraction of the body's) of the centre: centres a part on its section
     axis: tuple = None  # world direction of a limb, when its longest extent is not along it (a short neck)
     clear: tuple = ()  # sections it keeps clear of, besides those section_bounds finds (the neck: Sh)
@@ -59,17 +58,14 @@ class Spec:
     # may fill them, as a solid head does
 
 
-ARM = ("upper_arm", "forearm", "hand")  # an arm pressed against the torso may overlap it
-
 # A girth part stays this far (fraction of the body's height) above or below every girth section of
 # a measurement it does not depend on, so that each section cuts only parts that follow its
 # measurement in synthesis, with room for the Reference Mannequins' adjustment, which may lengthen
 # parts a little.
-SECTION_CLEARANCE = 0.015
+SECTION_CLEARANCE = 0.025
 # The waist's sides and back are centred on its section (see fitting.inscribed_ellipsoid's ``level``);
 # the front is left to the belly, which on the chubby bodies bulges below a crease at the waist.
 WAIST_LEVEL = SECTION_FRACTIONS["Wa"]
-
 
 HEAD = ("He",)
 SHOULDERS = ("He", "Sh")
@@ -86,13 +82,12 @@ SPECS = (
          Select(regions=("neck",), h=(0.83, 0.905), x=(0.0, 0.06), y=(-0.075, 1)), frame="axis", span=True,
          axis=(0.0, 0.0, 1.0), margin=1.0, clear=("Sh",)),
     Spec(3, "a", "Upper Arm", "L", "arms", False, SHOULDERS,
-         Select(bones=("upperarm01", "upperarm02"), h=(0, 0.84)), frame="limb", obstacles=ARM,
-         margin=0.15),
+         Select(bones=("upperarm01", "upperarm02"), h=(0, 0.84)), frame="limb", margin=0.15),
     Spec(3, "b", "Forearm", "L", "arms", False, SHOULDERS, Select(bones=("lowerarm",)), frame="limb", span=True),
     Spec(4, "a", "Hand", "L", "hands", False, SHOULDERS, Select(bones=("wrist", "metacarpal", "finger1-1")),
-         obstacles="hull", depth=0.0),
+         mitten=True, depth=0.0),
     Spec(4, "b", "Fingers", "L", "hands", False, SHOULDERS,
-         Select(bones=("finger2", "finger3", "finger4", "finger5")), obstacles="hull", depth=0.0),
+         Select(bones=("finger2", "finger3", "finger4", "finger5")), mitten=True, depth=0.0),
     Spec(5, "a", "Thigh", "L", "legs", True, HIPS, Select(bones=("upperleg",), h=(0.30, 0.50)), frame="limb",
          margin=0.15),
     Spec(5, "b", "Knee", "L", "legs", True, HIPS, Select(bones=("upperleg02", "lowerleg01"), h=(0.20, 0.38)),
@@ -103,12 +98,12 @@ SPECS = (
          frame="limb", margin=0.15),
     Spec(7, "a", "Foot", "L", "feet", True, HIPS, Select(bones=("foot",), h=(0, 0.05)), frame="limb"),
     Spec(7, "b", "Toes", "L", "feet", True, HIPS, Select(bones=("toe", "foot"), y=(-1, -0.09)), frame="limb",
-         obstacles="hull", depth=0.0),
+         mitten=True, depth=0.0),
     Spec(8, "a", "Deltoid", "L", "shoulders", False, SHOULDERS,
          Select(bones=("upperarm01", "shoulder01"), h=(0.765, 1.0))),
     Spec(9, "a", "Breast", "L", "chest", True, BUST,
          Select(regions=("chest",), h=(0.68, 0.77), x=(0.03, 0.13), y=(-1, -0.11)), margin=0.2,
-         inward=(0.0, 0.05, 0.0), frame="fixed"),
+         inward=(0.0, 0.05, 0.0), frame="fixed", level=SECTION_FRACTIONS["Br"]),
     Spec(10, "a", "Trapezius", "L", "shoulders", True, SHOULDERS,
          Select(bones=("spine01", "clavicle", "shoulder01", "neck01"), h=(0.81, 0.88), x=(0.02, 0.14)),
          inward=(0.0, 0.0, -0.04)),
@@ -124,13 +119,12 @@ SPECS = (
     Spec(13, "a", "Rectus Abdominalis", "C", "abdomen", True, WAIST,
          Select(regions=("abdomen",), h=(0.56, 0.70), y=(-1, -0.03)), inward=(0.0, 0.05, 0.0), frame="fixed"),
     Spec(13, "b", "Lower Back", "C", "abdomen", True, WAIST,
-         Select(regions=("abdomen",), h=(0.56, 0.70), y=(-0.03, 1)), inward=(0.0, -0.05, 0.0), frame="fixed",
-         level=WAIST_LEVEL),
+         Select(regions=("abdomen",), h=(0.56, 0.70), y=(-0.03, 1)), inward=(0.0, -0.05, 0.0), frame="fixed"),
     Spec(14, "a", "Pelvis", "C", "hips", True, HIPS, Select(regions=("pelvis",), h=(0.45, 0.62)), inside=0.001,
          frame="fixed"),
     Spec(15, "a", "Gluteus", "L", "hips", True, HIPS,
          Select(bones=("pelvis", "upperleg01", "spine05"), h=(0.44, 0.56), x=(0.02, 1), y=(0.03, 1)),
-         inward=(0.0, -0.06, 0.0)),
+         inward=(0.0, -0.06, 0.0), frame="fixed"),
 )
 
 
@@ -183,17 +177,13 @@ def topology():
     return Topology(parts)
 
 
-def obstacle_vertices(spec, side, labels, hidden):
-    """Indices of the body vertices that must stay outside the part: all, or those of its regions;
-    with ``spec.cavities`` not the ``hidden`` ones (bool per vertex: the walls of the mesh's cavities)."""
-    if spec.obstacles == "hull":
+def obstacle_vertices(spec, hidden):
+    """Indices of the body vertices that must stay outside the part: all of them (none for a mitten),
+    and with ``spec.cavities`` all but the ``hidden`` ones (bool per vertex: the walls of the mesh's
+    cavities)."""
+    if spec.mitten:
         return np.zeros(0, dtype=int)
-    keep = np.ones(len(labels.region), dtype=bool)
-    if spec.obstacles is not None:
-        keep = np.isin(labels.region, [f"{r}_{side}" for r in spec.obstacles] + list(spec.obstacles))
-    if spec.cavities:
-        keep &= ~hidden
-    return np.nonzero(keep)[0]
+    return np.nonzero(~hidden if spec.cavities else np.ones(len(hidden), dtype=bool))[0]
 
 
 def select_vertices(select, side, vertices, labels, height):
