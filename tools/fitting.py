@@ -21,6 +21,7 @@ ellipsoids are inscribed" in the reference 3D model. Here that is an optimisatio
 """
 
 import numpy as np
+from scipy.spatial import ConvexHull
 
 from ellimann_addon.core.frames import relabel_to_reference
 
@@ -251,8 +252,6 @@ def hull_surface(points, depth=0.0, spacing=0.003):
     As obstacles they keep a part inside the hull of its own vertices: a mitten over spread fingers,
     which no ellipsoid inside the body surface could fill.
     """
-    from scipy.spatial import ConvexHull
-
     hull = ConvexHull(points)
     out, areas = [], []
     for simplex, equation in zip(hull.simplices, hull.equations):

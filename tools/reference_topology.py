@@ -63,8 +63,9 @@ class Spec:
 # measurement in synthesis, with room for the Reference Mannequins' adjustment, which may lengthen
 # parts a little.
 SECTION_CLEARANCE = 0.025
-# The waist's sides and back are centred on its section (see fitting.inscribed_ellipsoid's ``level``);
-# the front is left to the belly, which on the chubby bodies bulges below a crease at the waist.
+# The waist's sides are centred on its section (see fitting.inscribed_ellipsoid's ``level``); the
+# front is left to the belly, which on the chubby bodies bulges below a crease at the waist, and the
+# back free to reach down to the hips.
 WAIST_LEVEL = SECTION_FRACTIONS["Wa"]
 
 HEAD = ("He",)

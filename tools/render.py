@@ -62,20 +62,17 @@ def _bounds(objects):
     return points.min(axis=0), points.max(axis=0)
 
 
-def render(path, slots, resolution=(800, 1000), view="FRONT", spacing=None, margin=1.08, aa_samples="8",
-           focus=None):
+def render(path, slots, resolution=(800, 1000), view="FRONT", spacing=None, margin=1.08, aa_samples="8"):
     """Render ``slots`` (a Slot or a list of them, side by side) with Workbench to ``path`` (PNG).
 
-    ``spacing`` is the gap between slots in metres (default 15% of the widest); ``focus`` (lo, hi):
-    a box (m, in the first slot's own coordinates) the camera frames instead of everything, for a
-    close-up. Returns the path.
+    ``spacing`` is the gap between slots in metres (default 15% of the widest); returns the path.
     """
     slots = [slots] if isinstance(slots, Slot) else list(slots)
     scene = bpy.data.scenes.new("ElliMann render")
     made_objects, made_data = [], []
     try:
         # Copy each slot centred on the origin and turned, then move the slots side by side along X.
-        placed, placements = [], []
+        placed = []
         for slot in slots:
             lo, hi = _bounds([o for item in slot.solid + slot.ghosts for o in _objects(item)])
             centre = Matrix.Translation((-(lo[0] + hi[0]) / 2.0, -(lo[1] + hi[1]) / 2.0, 0.0))
@@ -84,22 +81,16 @@ def render(path, slots, resolution=(800, 1000), view="FRONT", spacing=None, marg
             copies += [_copy(o, scene.collection, placement, GHOST_COLOR) for item in slot.ghosts
                        for o in _objects(item)]
             placed.append(copies)
-            placements.append(placement)
             made_objects += copies
         widths = [np.ptp(np.array(_bounds(copies))[:, 0]) for copies in placed]
         gap = spacing if spacing is not None else 0.15 * max(widths)
         x = 0.0
-        for i, (copies, width) in enumerate(zip(placed, widths)):
+        for copies, width in zip(placed, widths):
             shift = Matrix.Translation((x + width / 2.0, 0.0, 0.0))
-            placements[i] = shift @ placements[i]
             for copy in copies:
                 copy.matrix_world = shift @ copy.matrix_world
             x += width + gap
         lo, hi = _bounds(made_objects)
-        if focus is not None:
-            corners = np.array([[a, b, c, 1.0] for a in (focus[0][0], focus[1][0]) for b in (focus[0][1], focus[1][1])
-                                for c in (focus[0][2], focus[1][2])]) @ np.array(placements[0]).T
-            lo, hi = corners[:, :3].min(axis=0), corners[:, :3].max(axis=0)
         center = (lo + hi) / 2.0
 
         turn = math.radians(VIEWS[view])
