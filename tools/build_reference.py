@@ -5,13 +5,16 @@
 
 Reads the body meshes of ``<repo>/../shared/refmodels`` (see its README) and writes
 ``reference_blends/base_mannequin.json`` and the five ``<name>.json`` Reference Mannequins, their
-.blend twins and a Workbench line-up ``docs/images/reference_lineup.png`` (both with the bpy module),
-``docs/topology.md`` and ``docs/reference_mannequins.md``.
+.blend twins, a Workbench line-up ``docs/images/reference_lineup.png`` and the Base Mannequin over
+its body ``docs/images/base_mannequin_trace.png`` (with the bpy module), ``docs/topology.md`` and
+``docs/reference_mannequins.md`` (with how much of its body each mannequin fills, tools/coverage.py).
 
 Steps (paper, Sections 2.3.2-2.3.4):
-1. Trace: every part of tools/reference_topology.py is fitted to its vertices on a body
-   (tools/fitting.py). The selections are made once on the neutral reference body; all bodies share
-   its vertex order, so the same vertices trace the same part on each body.
+1. Trace: every left and central part of tools/reference_topology.py is fitted to its vertices on a
+   body (tools/fitting.py), placed to fill the body's volume in its box, twice: the second time around
+   the others, so the parts spread into the gaps between them; the right parts are mirror images. The
+   selections are made once on the neutral reference body; all bodies share its vertex order, so the
+   same vertices trace the same part on each body.
 2. Base Mannequin: the parts fitted over ``reference_female.obj``, registered and made symmetric.
 3. Reference Mannequins: the parts fitted over each of the five bodies (axes labelled against the
    Base Mannequin's), registered and made symmetric, then deformed by synthesis' exact-mode
@@ -30,18 +33,36 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ellimann_addon.core.clean import asymmetry, clean, landmark_indices, register, relabel, symmetrize
+from ellimann_addon.core.clean import (
+    asymmetry,
+    clean,
+    landmark_indices,
+    register,
+    registration_offset,
+    relabel,
+    symmetrize,
+)
 from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 from ellimann_addon.core.ellipsoid import section_at_height
 from ellimann_addon.core.files import atomic_write_text
-from ellimann_addon.core.frames import axis_agreement, is_rotation
+from ellimann_addon.core.frames import axis_agreement, is_rotation, mirror_frame
 from ellimann_addon.core.mannequin import Mannequin, Topology
 from ellimann_addon.core.measure import as_dict, section_heights
 from ellimann_addon.core.synthesis import refine
 
+from . import coverage
 from . import reference_topology as rt
-from .bodies import REFERENCE_BODY, RM_BODIES, body_measurements, load_body, load_labels, vertex_areas
-from .fitting import inscribed_ellipsoid, moments_ellipsoid
+from .bodies import (
+    REFERENCE_BODY,
+    RM_BODIES,
+    body_measurements,
+    hidden_vertices,
+    load_body,
+    load_labels,
+    vertex_areas,
+    vertex_normals,
+)
+from .fitting import hull_surface, inscribed_ellipsoid
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 DEFAULT_REFMODELS = REPO.parent / "shared" / "refmodels"
@@ -49,6 +70,12 @@ BASE_FILE = "base_mannequin"
 REFERENCE_RM = "average"  # the RM whose axes the others are relabelled against
 ADJUST_TOLERANCE = 1e-5  # relative m_T error the adjustment aims at
 ADJUST_ITERATIONS = 40
+FILL_SPACING = 0.008  # m: grid sampling each body's volume, which the parts are placed to fill
+FILL_PASSES = 2  # placements of every part: the first alone, the others around the rest
+FILL_SHARED = 0.25  # what covering volume another part covers too is worth, after the first pass
+# Volume within SLAB (fraction of the height) of the section of a measurement a part depends on
+# counts SLAB_WEIGHT times more: the parts that make a measurement reach the body's outline there.
+SLAB, SLAB_WEIGHT = 0.01, 3.0
 ACCEPT_TOLERANCE = 5e-3  # what every shipped RM must meet (issue: 0.5% of Table 2.3)
 LINEUP_ORDER = ("small_chubby", "small_slim", "average", "tall_slim", "tall_chubby")  # the paper's Figure 2.9
 DISPLAY_NAMES = {"small_slim": "Small Slim", "tall_slim": "Tall Slim", "small_chubby": "Small Chubby",
@@ -65,19 +92,26 @@ class Tracing:
     topology: Topology
     selected: list
     obstacles: list
+    cavity: np.ndarray  # bool per vertex: walls of the mesh's open mouth and eye sockets (bodies.hidden_vertices)
 
     @classmethod
     def on(cls, reference_body, labels):
         vertices = reference_body.vertices
         height = vertices[:, 2].max() - vertices[:, 2].min()
+        hidden = np.zeros(len(vertices), dtype=bool)
+        if any(spec.cavities for spec in rt.SPECS):
+            # cavities are looked for in the head only: elsewhere every vertex is skin
+            head = np.nonzero(labels.region == "head")[0]
+            normals = vertex_normals(vertices, reference_body.faces)
+            hidden[head] = hidden_vertices(vertices, reference_body.faces, normals, head)
         selected, obstacles = [], []
         for spec, side in rt.expanded():
             idx = rt.select_vertices(spec.select, side, vertices, labels, height)
             if len(idx) < 8:
                 raise ValueError(f"'{rt.part_name(spec, side)}' selects only {len(idx)} vertices: widen its selection")
             selected.append(idx)
-            obstacles.append(rt.obstacle_vertices(spec, side, labels))
-        return cls(rt.topology(), selected, obstacles)
+            obstacles.append(rt.obstacle_vertices(spec, hidden))
+        return cls(rt.topology(), selected, obstacles, hidden)
 
 
 def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
@@ -86,31 +120,69 @@ def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
     Without ``reference`` the frames take their roll from the world axes (the Base Mannequin);
     with it (a mannequin of the same topology, and the ``kept`` axes of its fit) each part keeps
     the axis closest to the reference part's kept axis and the reference's roll about it.
-    ``fields``: name, role, measurements of the mannequin.
+    Every left and central part is placed to cover the body's volume in its box (more so near the
+    sections of the measurements it depends on, SLAB), the right ones are its mirror images; in the
+    passes after the first, each is placed again, in turn, valuing the volume no other part covers
+    above the rest (FILL_SHARED), so parts spread into the gaps between them. ``fields``: name, role,
+    measurements of the mannequin.
     """
     areas = vertex_areas(body.vertices, body.faces)
-    n = len(tracing.topology)
-    rotation, center, semi_axes = np.zeros((n, 3, 3)), np.zeros((n, 3)), np.zeros((n, 3))
-    kept_out = []
-    for i, ((spec, _), idx, walls) in enumerate(zip(rt.expanded(), tracing.selected, tracing.obstacles)):
-        points, weights = body.vertices[idx], areas[idx]
-        if spec.inward is not None:
-            points = np.concatenate([points, points + np.asarray(spec.inward)])
-            weights = np.concatenate([weights, weights])
-        ref_rotation = np.eye(3) if reference is None else reference.rotation[i]
-        match = None if reference is None or kept[i] is None else reference.rotation[i][:, kept[i]]
-        bottom, height = body.vertices[:, 2].min(), np.ptp(body.vertices[:, 2])
-        floor = -np.inf if spec.floor is None else bottom + spec.floor * height
-        level = None if spec.level is None else bottom + spec.level * height
-        if spec.mode == "moments":
-            fit = moments_ellipsoid(points, weights, ref_rotation, spec.frame, match)
-        else:
-            fit = inscribed_ellipsoid(points, weights, body.vertices[walls], areas[walls], ref_rotation,
-                                      margin=spec.margin, inside_fraction=spec.inside, slack=spec.slack,
-                                      frame=spec.frame, match=match, floor=floor, level=level)
-        rotation[i], center[i], semi_axes[i], k = fit
-        kept_out.append(k)
-    return Mannequin(tracing.topology, rotation, center, semi_axes, **fields).check(), kept_out
+    normals = vertex_normals(body.vertices, body.faces)
+    volume = coverage.BodyVolume(body.vertices, body.faces).grid(FILL_SPACING)
+    inside = volume.origin + FILL_SPACING * np.argwhere(volume.inside)
+    bottom, height = body.vertices[:, 2].min(), np.ptp(body.vertices[:, 2])
+    topology = tracing.topology
+    n = len(topology)
+    rotation, center, semi_axes = np.tile(np.eye(3), (n, 1, 1)), np.zeros((n, 3)), np.ones((n, 3))
+    kept_out = [None] * n
+    specs = [spec for spec, _ in rt.expanded()]
+    fitted = [i for i, part in enumerate(topology) if part.side != "R"]
+    twins = topology.twin_indices
+    covers = np.zeros((n, len(inside)), dtype=bool)
+
+    def cover(i):
+        local = (inside - center[i]) @ rotation[i] / semi_axes[i]
+        return np.einsum("pk,pk->p", local, local) < 1.0
+
+    for round_ in range(FILL_PASSES):
+        for i in fitted:
+            spec = specs[i]
+            idx, walls = tracing.selected[i], tracing.obstacles[i]
+            points, weights = body.vertices[idx], areas[idx]
+            if spec.inward is not None:
+                points = np.concatenate([points, points + np.asarray(spec.inward)])
+                weights = np.concatenate([weights, weights])
+            ref_rotation = np.eye(3) if reference is None else reference.rotation[i]
+            if reference is None:
+                match = None if spec.axis is None else np.asarray(spec.axis, dtype=float)
+            else:
+                match = None if kept[i] is None else reference.rotation[i][:, kept[i]]
+            floor, ceiling = rt.section_bounds(spec, (weights @ points[:, 2] / weights.sum() - bottom) / height)
+            floor, ceiling = bottom + floor * height, bottom + ceiling * height
+            level = None if spec.level is None else bottom + spec.level * height
+            if spec.mitten:
+                walls, wall_areas = hull_surface(body.vertices[idx], spec.depth)
+            else:
+                # the surface moved out by depth: the part may reach that far outside the body
+                walls, wall_areas = body.vertices[walls] + spec.depth * normals[walls], areas[walls]
+            weight = np.ones(len(inside))
+            if round_:
+                others = np.delete(covers, [i, twins[i]], axis=0).any(axis=0)
+                weight = np.where(others, FILL_SHARED, 1.0)
+            for key in spec.depends:
+                if key in SECTION_FRACTIONS and (spec.girth or key == "Sh"):
+                    near = np.abs(inside[:, 2] - bottom - SECTION_FRACTIONS[key] * height) < SLAB * height
+                    weight = np.where(near, weight * SLAB_WEIGHT, weight)
+            rotation[i], center[i], semi_axes[i], kept_out[i] = inscribed_ellipsoid(
+                points, weights, walls, wall_areas, ref_rotation, margin=spec.margin, inside_fraction=spec.inside,
+                frame=spec.frame, match=match, floor=floor, ceiling=ceiling, level=level, span=spec.span,
+                fill=inside, fill_weight=weight)
+            if twins[i] != i:
+                rotation[twins[i]], center[twins[i]] = mirror_frame(rotation[i], center[i])
+                semi_axes[twins[i]] = semi_axes[i]
+            covers[i], covers[twins[i]] = cover(i), cover(twins[i])
+    return Mannequin(topology, rotation, center, semi_axes, **fields).check(), [
+        kept_out[twins[i]] if part.side == "R" else kept_out[i] for i, part in enumerate(topology)]
 
 
 def build(refmodels=DEFAULT_REFMODELS, log=print):
@@ -121,10 +193,10 @@ def build(refmodels=DEFAULT_REFMODELS, log=print):
     tracing = Tracing.on(reference_body, labels)
 
     base, kept = fit_mannequin(reference_body, tracing, name=DISPLAY_NAMES[BASE_FILE], role="base")
-    # the right side is fitted too, as a check: mirror-image selections give near-mirror-image parts
-    # (the optimisation can settle a few mm apart); cleaning keeps the left side
-    log(f"base mannequin fitted ({len(base)} parts; asymmetry before mirroring {asymmetry(base):.1e} m)")
-    base = register(symmetrize(base))  # symmetric first: mirroring may move the lowest point
+    log(f"base mannequin fitted ({len(base)} parts)")
+    base = symmetrize(base)  # symmetric first: mirroring may move the lowest point
+    shifts = {BASE_FILE: registration_offset(base)}  # body -> mannequin translation, to compare them
+    base = register(base)
 
     bodies, raw, adjusted, factors = {}, {}, [], {}
     for name in RM_BODIES:
@@ -132,13 +204,18 @@ def build(refmodels=DEFAULT_REFMODELS, log=print):
         targets = REFERENCE_MEASUREMENTS[name]
         fitted, _ = fit_mannequin(bodies[name], tracing, base, kept, name=DISPLAY_NAMES[name], role="reference",
                                   measurements=dict(targets))
-        raw[name] = register(symmetrize(fitted))
+        fitted = symmetrize(fitted)
+        shifts[name] = registration_offset(fitted)
+        raw[name] = register(fitted)
         adjusted.append(adjust(raw[name], targets))
         factors[name] = adjusted[-1].factors
         log(f"{name}: fitted and adjusted")
 
     cleaned = clean([a.mannequin for a in adjusted], reference_index=RM_BODIES.index(REFERENCE_RM))
     rms = dict(zip(RM_BODIES, cleaned))
+    for name, before in zip(RM_BODIES, adjusted):
+        # cleaning a symmetric mannequin only translates it
+        shifts[name] = shifts[name] + (rms[name].center - before.mannequin.center).mean(axis=0)
     base = relabel(base, rms[REFERENCE_RM])
     for name, rm in rms.items():
         errors = relative_errors(rm.measure(), REFERENCE_MEASUREMENTS[name])
@@ -150,8 +227,15 @@ def build(refmodels=DEFAULT_REFMODELS, log=print):
         if problems:
             raise RuntimeError(f"{name}: {'; '.join(problems)}")
 
+    fill = {}
+    for name, m in [(BASE_FILE, base), *rms.items()]:
+        body = reference_body if name == BASE_FILE else bodies[name]
+        fill[name] = coverage.report(m, body.vertices + shifts[name], body.faces, tracing.cavity)
+    log("coverage measured")
     report = {
         "seconds": time.perf_counter() - started,
+        "fill": fill,
+        "shifts": shifts,
         "body_measurements": {name: body_measurements(body, labels)
                               for name, body in [(REFERENCE_BODY, reference_body), *bodies.items()]},
         "fitted_measurements": {name: m.measure() for name, m in raw.items()},
@@ -249,6 +333,7 @@ def write_blends(mannequins, folder):
     from ellimann_addon.blender import convert
 
     folder = pathlib.Path(folder)
+    bpy.context.preferences.filepaths.save_version = 0  # no .blend1 backups of the files it replaces
     ellimann_addon.register()
     try:
         for stem, mannequin in mannequins.items():
@@ -265,6 +350,16 @@ def write_lineup(files, path):
 
     path.parent.mkdir(parents=True, exist_ok=True)
     render.main(["mannequins", *map(str, files), "--out", str(path)])
+
+
+def write_trace(mannequin_file, body_file, shift, path):
+    """Workbench render of a mannequin over the semi-transparent body it was traced from (moved by
+    ``shift``, the mannequin's registration), front and side. Needs the bpy module."""
+    from . import render
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    render.main(["mannequins", str(mannequin_file), "--ghost", str(body_file), "--ghost-shift",
+                 *(f"{v:.9g}" for v in shift), "--side-too", "--out", str(path)])
 
 
 def check_shipped(base, rms, folder, atol=1e-9):
@@ -317,14 +412,19 @@ def topology_doc(base):
         "`refmodels/reference_female_regions.json`, heights `h` as fractions of the body's height, "
         "`x` lateral and `y` front(-)/back(+) bands in metres).",
         "",
-        "- **fit**: how the part is fitted (`tools/fitting.py`): the largest ellipsoid, by volume, inside "
-        "the body surface and within the selection's box enlarged by `margin` of its half-size (default "
-        f"{rt.Spec.margin:g}); a body vertex may lie inside it down to `slack` of its radius (default "
-        f"{rt.Spec.slack:g}) and vertices of total area `inside` of the nearby surface (default "
-        f"{rt.Spec.inside:g}) deeper. The frame takes one axis from the vertices (*limb*: the line through "
-        "the centroids of the two ends; *main*: the principal axis that stands most apart) and the rest from "
-        "the world axes (on the Reference Mannequins: from the Base Mannequin's part); *fixed*: world axes. "
-        "A *moments* fit is the envelope of the vertices (for spread fingers, which no inscribed ellipsoid fills).",
+        "- **fit**: how the part is fitted (`tools/fitting.py`): an ellipsoid inside the body surface moved out "
+        f"by `depth` (default {rt.Spec.depth * 1e3:g} mm, so a part may reach that far outside the skin rather than "
+        "leave a gap) and within the selection's box enlarged by `margin` of its half-size (default "
+        f"{rt.Spec.margin:g}); vertices of total area `inside` of the nearby surface (default {rt.Spec.inside:g}) "
+        "may lie inside it. Among such ellipsoids, each as large as the body lets it grow from its centre, the "
+        "one that covers most of the body's volume within the box (sampled on a "
+        f"{FILL_SPACING * 1e3:g} mm grid) is chosen: a part fills its region instead of settling where the body is "
+        "thickest. The frame takes one axis from the vertices (*limb*: the line through the centroids of the "
+        "two ends; *main*: the principal axis that stands most apart; *axis*: the direction given) and the rest "
+        "from the world axes (on the Reference Mannequins: from the Base Mannequin's part); *fixed*: world axes. "
+        "A part that *spans its selection* reaches from one end of it to the other along that axis. A girth "
+        f"part keeps {rt.SECTION_CLEARANCE:g} of the height clear of the girth sections of the measurements it "
+        "does not depend on, so each section cuts only parts that follow its measurement (table below).",
         "",
         "| part | side | cushion partner | region | girth | depends | traced from | fit |",
         "|---|---|---|---|---|---|---|---|",
@@ -362,16 +462,16 @@ def _describe(spec):
 
 def _fit_notes(spec):
     defaults = rt.Spec(0, "a", "", "C", "", True, ("He",), rt.Select())
-    items = [f"{spec.frame} frame"]
-    if spec.mode != defaults.mode:
-        items.append(f"{spec.mode} fit")
-    for attr in ("margin", "slack", "inside"):
+    items = [f"{spec.frame} frame" + (" ({})".format(", ".join(f"{v:g}" for v in spec.axis)) if spec.axis else "")]
+    for attr, unit in (("margin", ""), ("depth", " m"), ("inside", "")):
         if getattr(spec, attr) != getattr(defaults, attr):
-            items.append(f"{attr} {getattr(spec, attr):g}")
-    if spec.obstacles is not None:
-        items.append("kept inside the " + "/".join(spec.obstacles) + " surface only")
-    if spec.floor is not None:
-        items.append(f"kept above h = {spec.floor:g}")
+            items.append(f"{attr} {getattr(spec, attr):g}{unit}")
+    if spec.span:
+        items.append("spans its selection")
+    if spec.mitten:
+        items.append("inside the hull of its vertices (a mitten)")
+    if spec.cavities:
+        items.append("fills the mesh's open mouth and eye sockets")
     if spec.level is not None:
         items.append(f"centred at h = {spec.level:g}")
     return ", ".join(items)
@@ -404,7 +504,7 @@ def measurements_doc(base, rms, report):
         "## How far each body and fit were from the table",
         "",
         "The body is the mesh in `refmodels/` (measured like m_T on the mesh, as its README says); the fit "
-        "is the RM before the adjustment (inscribed ellipsoids, so a little smaller than the body); the "
+        "is the RM before the adjustment (ellipsoids fitted in the body, reaching at most a few mm out); the "
         "factors are those of the refinement (He: vertical stretch; Sh: shoulders widened, arms carried "
         "out; Br, Wa, Hi: girth parts scaled horizontally, blended with height around each section).",
         "",
@@ -424,7 +524,7 @@ def measurements_doc(base, rms, report):
         "",
         "## Base Mannequin vs the reference body",
         "",
-        "The Base Mannequin is traced, not adjusted: its m_T is that of inscribed ellipsoids.",
+        "The Base Mannequin is traced, not adjusted: its m_T is that of the fitted ellipsoids.",
         "",
         "| | He | Sh | Br | Wa | Hi |",
         "|---|---|---|---|---|---|",
@@ -432,6 +532,7 @@ def measurements_doc(base, rms, report):
         "| Base Mannequin m_T | " + _row(measured) + " |",
         "| relative difference | " + " | ".join(f"{measured[k] / body[k] - 1.0:+.1%}" for k in MEASUREMENTS) + " |",
         "",
+        *fill_doc(report["fill"]),
         "## Consistency of axis labels",
         "",
         "Smallest cosine between an ellipsoid's axis and the same axis of the same ellipsoid in the "
@@ -444,6 +545,50 @@ def measurements_doc(base, rms, report):
     for name, value in sorted(report["agreement"].items(), key=lambda item: item[1])[:5]:
         lines.append(f"| {name} | {value:.4f} |")
     return "\n".join(lines) + "\n"
+
+
+def fill_doc(fill):
+    """Markdown lines: how each mannequin fills its body (tools/coverage.py)."""
+    spacing = coverage.GRID_SPACING * 1e3
+    lines = [
+        "## How much of its body each mannequin fills",
+        "",
+        "Measured by `tools/coverage.py` against the body each mannequin was traced from (moved by the same "
+        f"registration), on a regular {spacing:g} mm grid: **coverage** is the share of the body's volume "
+        "inside the union of the pieces, **excess** the share of the pieces' volume outside the body, "
+        "**depth** how far (mm) a piece reaches outside the body surface at most, and which. *Ellipsoids*: "
+        "the ellipsoid mannequin; *cushions*: every cushion pair replaced by its hull. The parts may reach "
+        f"{rt.Spec.depth * 1e3:g} mm outside the skin by design (`depth` in `docs/topology.md`); the mitten over "
+        "the spread fingers reaches further, between them. The points in the mesh's open mouth and eye sockets "
+        "(no eyes or teeth), which the solid head fills, are not counted in the depth. The Reference Mannequins "
+        "are measured after their adjustment to Table 2.3, which moves and scales parts off their bodies (girth "
+        "parts widened or narrowed, the arms carried sideways with the shoulder width).",
+        "",
+        "| mannequin | coverage | excess | depth (mm) | cushions: coverage | excess | depth (mm) |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for name, metrics in fill.items():
+        e, c = metrics["ellipsoids"], metrics["cushions"]
+        lines.append(f"| {DISPLAY_NAMES[name]} | {e['coverage']:.1%} | {e['excess']:.1%} | {e['depth'] * 1e3:.1f} "
+                     f"({e['deepest']}) | {c['coverage']:.1%} | {c['excess']:.1%} | {c['depth'] * 1e3:.1f} "
+                     f"({c['deepest']}) |")
+    chains = list(coverage.CHAINS)
+    lines += [
+        "",
+        "Largest gap (mm) between consecutive links of each chain (0: every link touches the next), "
+        "ellipsoids / cushions. The chains, link by link (left side; the first link of a limb is where it "
+        "hangs from the trunk): "
+        + "; ".join(f"*{chain}*: " + " → ".join("/".join(link) for link in coverage.CHAINS[chain]) for chain in chains)
+        + ".",
+        "",
+        "| mannequin | " + " | ".join(chains) + " |",
+        "|---|" + "---|" * len(chains),
+    ]
+    for name, metrics in fill.items():
+        cells = [f"{max(metrics['ellipsoids']['gaps'][chain]) * 1e3:.0f} / "
+                 f"{max(metrics['cushions']['gaps'][chain]) * 1e3:.0f}" for chain in chains]
+        lines.append(f"| {DISPLAY_NAMES[name]} | " + " | ".join(cells) + " |")
+    return lines + [""]
 
 
 def summary(base, rms):
@@ -477,6 +622,14 @@ def main(argv=None):
     for line in summary(base, rms):
         print(line)
     print(f"smallest axis agreement with the {REFERENCE_RM} RM: {min(report['agreement'].values()):.4f}")
+    for name, metrics in report["fill"].items():
+        e, c = metrics["ellipsoids"], metrics["cushions"]
+        print(f"{name:15s} fill: coverage {e['coverage']:.1%} (cushions {c['coverage']:.1%}), excess {e['excess']:.1%} "
+              f"({c['excess']:.1%}), depth {e['depth'] * 1e3:.1f} mm at {e['deepest']} "
+              f"({c['depth'] * 1e3:.1f} at {c['deepest']})")
+        print(" " * 16 + "gaps (mm, ellipsoids / cushions): " + "; ".join(
+            f"{chain} " + " ".join(f"{a * 1e3:.0f}/{b * 1e3:.0f}" for a, b in zip(e["gaps"][chain], c["gaps"][chain]))
+            for chain in coverage.CHAINS))
     print(f"built in {report['seconds']:.1f} s")
     if args.check:
         problems = check_shipped(base, rms, args.out)
@@ -499,6 +652,10 @@ def main(argv=None):
         lineup = args.docs / "images" / "reference_lineup.png"
         if set(changed) & set(RM_BODIES) or not lineup.is_file():
             write_lineup([args.out / f"{stem}.json" for stem in LINEUP_ORDER], lineup)
+        trace = args.docs / "images" / "base_mannequin_trace.png"
+        if BASE_FILE in changed or not trace.is_file():
+            write_trace(args.out / f"{BASE_FILE}.json", args.refmodels / f"{REFERENCE_BODY}.obj",
+                        report["shifts"][BASE_FILE], trace)
     return 0
 
 

@@ -1,34 +1,40 @@
-"""Fitting one ellipsoid inside a body mesh: a frame from a vertex selection, then the largest
-ellipsoid (by volume) that stays inside the body surface and within the selection's extent.
+"""Fitting one ellipsoid inside a body mesh: a frame from a vertex selection, then an ellipsoid that
+stays inside the body surface and within the selection's extent and fills as much of it as it can.
 
-The paper traces each part so that it "fills as much space as possible while inscribed in the
-reference 3D model surface". Here that is an optimisation per part:
+The paper traces each part so that it "fills up as much space as possible while making sure the
+ellipsoids are inscribed" in the reference 3D model. Here that is an optimisation per part:
 
 1. Frame (:func:`principal_frame`): one axis from the area-weighted selected vertices (a limb's
    direction, or the principal axis that stands apart), the roll about it from a reference frame
    (world axes for the Base Mannequin, the Base Mannequin's part for the others), so corresponding
    parts of different bodies get consistent axes.
-2. Centre and semi-axes (:func:`inscribed_ellipsoid`): maximise the volume subject to (a) no body
-   vertex inside the ellipsoid, up to a slack and a small share of the surface (the odd interior
-   vertex of eyes or mouth, a skin fold), and (b) the ellipsoid inside the selection's bounding box
-   in that frame, enlarged by a margin so that neighbouring parts overlap. For a fixed centre,
-   growing one semi-axis while the others are fixed has a closed-form limit per vertex; growing
-   all three together in small steps converges to a maximal ellipsoid. The centre is improved by a
-   deterministic pattern search.
+2. Centre and semi-axes (:func:`inscribed_ellipsoid`): subject to (a) no obstacle point inside the
+   ellipsoid but a small share of the surface (the caller passes the body's vertices moved out by
+   a few mm, so that a part may bulge that far rather than leave a gap), (b) the ellipsoid inside
+   the selection's bounding box in that frame, enlarged by a margin so that neighbouring parts
+   overlap, and (c) optionally clear of given heights. For a fixed centre, growing one semi-axis
+   while the others are fixed has a closed-form limit per point; growing all three together in
+   small steps converges to a maximal ellipsoid, whose shape depends on the shape it starts from.
+   A deterministic pattern search over the centre and that starting shape then keeps the maximal
+   ellipsoid that covers most of the body's volume inside the box (or, without volume samples,
+   the largest one).
 """
 
 import numpy as np
+from scipy.spatial import ConvexHull
 
 from ellimann_addon.core.frames import relabel_to_reference
 
 DEGENERATE = 0.12  # relative gap below which two principal variances do not fix their axes
 GROWTH = 1.15  # largest growth of a semi-axis per round: keeps the ascent from favouring one axis
-ROUNDS = 60
-BISECTIONS = 12  # to find how far a round's growth stays feasible
+ROUNDS = 60  # of the growth towards a maximal ellipsoid, at most
+CONVERGED = 1e-3  # relative growth below which the ascent stops
+_FRACTIONS = np.linspace(0.0, 1.0, 33)[1:]  # how far towards a round's proposal to grow: all tried at once
 PATTERN_STEPS = 5  # halvings of the centre search step
+SHAPE_STEP = 0.4  # first step of the search over the starting shape (log ratio of semi-axes)
 
 
-FRAMES = ("limb", "main", "fixed")
+FRAMES = ("limb", "main", "axis", "fixed")
 LIMB_END = 1.0 / 3.0  # share of the points (by area) at each end of a limb whose centroids give its axis
 
 
@@ -45,6 +51,7 @@ def principal_frame(points, weights, reference=None, frame="main", match=None):
       distributed (a principal axis of a thick, short thigh is not);
     - "main": the principal axis whose variance stands most apart from the other two (with
       ``match``, the well-separated principal axis closest to it);
+    - "axis": ``match`` itself (a limb whose longest extent is not along it: a short, thick neck);
     - "fixed": none, the frame is the reference; also when no principal axis is separated from the
       others by DEGENERATE.
 
@@ -60,9 +67,13 @@ def principal_frame(points, weights, reference=None, frame="main", match=None):
     variances, axes = np.linalg.eigh((offsets * weights[:, None]).T @ offsets)
     gaps = np.diff(variances) / np.maximum(variances[1:], 1e-300)
     separated = np.minimum(np.append(gaps, np.inf), np.insert(gaps, 0, np.inf)) >= DEGENERATE
-    if frame == "fixed" or not separated.any():
+    if frame == "axis":
+        if match is None:
+            raise ValueError("an 'axis' frame needs the axis (match)")
+        kept = np.asarray(match, dtype=float) / np.linalg.norm(match)
+    elif frame == "fixed" or not separated.any():
         return reference.copy(), centroid, None
-    if frame == "limb":
+    elif frame == "limb":
         along = offsets @ (axes[:, 2] if match is None else match)
         order = np.argsort(along, kind="stable")
         share = np.cumsum(weights[order])
@@ -82,121 +93,174 @@ def principal_frame(points, weights, reference=None, frame="main", match=None):
     return rotation, centroid, int(np.argmax(np.abs(q[0])))
 
 
-def _grow(local, area, limit, start, allowed):
+def _grow(local, area, limit, start, allowed, up=None, reach=np.inf):
     """Largest semi-axes (3,) by simultaneous growth, for points ``local`` (m, 3) relative to the centre.
 
     ``limit`` (3,) caps each semi-axis; points of total ``area`` up to ``allowed`` may end up inside
-    (area, not count, so that a densely meshed face and a sparsely meshed back weigh alike). Each
-    round proposes, for every axis, its largest feasible value with the other two fixed, then moves
-    all three towards the proposal as far as stays feasible: the result does not depend on the
-    order of the axes.
+    (area, not count, so that a densely meshed face and a sparsely meshed back weigh alike). With
+    ``up`` (3,), the world-z component of each local axis, the ellipsoid's half-height
+    sqrt(sum (up_k D_k)^2) may not exceed ``reach``. Each round proposes, for every axis, its largest
+    feasible value with the other two fixed, then moves all three towards the proposal as far as
+    stays feasible: the result does not depend on the order of the axes.
     """
     sq = local * local
+    up2 = np.zeros(3) if up is None else np.asarray(up) ** 2
+    bounded = np.isfinite(reach) and np.any(up2 > 0.0)
+    reach2 = reach ** 2 * (1.0 + 1e-12)
+    axes = np.arange(3)
 
-    def feasible(semi):
-        return area[sq @ (1.0 / semi ** 2) < 1.0].sum() <= allowed
+    def feasible(sq, area, semis):  # (k, 3) candidates -> (k,) bool
+        inside = sq @ (1.0 / semis.T ** 2) < 1.0
+        return (area @ inside <= allowed) & (semis ** 2 @ up2 <= reach2)
 
     semi = np.minimum(start, limit)
-    if not feasible(semi):
+    if not feasible(sq, area, semi[None])[0]:
         return np.zeros(3)
-    for _ in range(ROUNDS):
-        proposal = semi.copy()
-        for i in range(3):
-            room = 1.0 - sq @ np.where(np.arange(3) == i, 0.0, 1.0 / semi ** 2)
-            # a point with room > 0 stays outside while semi_i <= |p_i| / sqrt(room)
-            bound = np.sqrt(sq[room > 0.0, i] / room[room > 0.0])
-            order = np.argsort(bound, kind="stable")
-            over = np.nonzero(np.cumsum(area[room > 0.0][order]) > allowed)[0]
-            cap = bound[order[over[0]]] if len(over) else np.inf
-            proposal[i] = max(semi[i], min(semi[i] * GROWTH, cap, limit[i]))
-        if np.allclose(proposal, semi, rtol=1e-6, atol=0.0):
-            break
-        ratio = proposal / semi
-        low, high = 0.0, 1.0
-        if feasible(proposal):
-            low = 1.0
-        else:
-            for _ in range(BISECTIONS):
-                mid = 0.5 * (low + high)
-                if feasible(semi * ratio ** mid):
-                    low = mid
+    all_sq, all_area = sq, area
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for _ in range(ROUNDS):
+            inv = 1.0 / semi ** 2
+            radius = all_sq @ inv
+            # a round grows no axis by more than GROWTH: points this far out stay out whatever it does
+            near = radius < GROWTH ** 2
+            sq, area, radius = all_sq[near], all_area[near], radius[near]
+            cap = limit.copy()
+            if len(sq):
+                room = 1.0 - radius[:, None] + sq * inv  # (m, 3): with the other two axes as they are
+                # a point with room > 0 stays outside while semi_i <= |p_i| / sqrt(room)
+                bound = np.where(room > 0.0, np.sqrt(sq / room), np.inf)
+                if allowed > 0.0:
+                    order = np.argsort(bound, axis=0)
+                    over = np.cumsum(area[order], axis=0) > allowed
+                    first = np.argmax(over, axis=0)
+                    cap = np.minimum(cap, np.where(over[first, axes], bound[order[first, axes], axes], np.inf))
                 else:
-                    high = mid
-        if low == 0.0:
-            break
-        semi = semi * ratio ** low
+                    cap = np.minimum(cap, bound.min(axis=0))
+            if bounded:
+                rest = reach ** 2 - up2 @ semi ** 2 + up2 * semi ** 2
+                cap = np.where(up2 > 0.0, np.minimum(cap, np.sqrt(np.maximum(rest, 0.0) / up2)), cap)
+            proposal = np.maximum(semi, np.minimum(semi * GROWTH, cap))
+            if np.all(proposal <= semi * (1.0 + CONVERGED)):
+                break
+            # as far towards the proposal as stays feasible (geometric steps, all tried at once)
+            candidates = semi * (proposal / semi) ** _FRACTIONS[:, None]
+            ok = feasible(sq, area, candidates)
+            if not ok[0]:
+                break
+            semi = candidates[-1] if ok.all() else candidates[np.argmin(ok) - 1]
     return semi
 
 
 def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=None, margin=0.1,
-                        inside_fraction=0.002, slack=0.0, frame="main", match=None, floor=-np.inf, level=None):
-    """The largest ellipsoid, in the part's frame, inside the body and the selection's box.
+                        inside_fraction=0.002, frame="main", match=None, floor=-np.inf,
+                        ceiling=np.inf, level=None, span=False, fill=None, fill_weight=None):
+    """A maximal ellipsoid, in the part's frame, inside the body and the selection's box.
 
     ``selected`` (k, 3) vertices of the part with area ``weights``; ``obstacles`` (m, 3) body
-    vertices that must stay outside, with ``obstacle_area`` (m,). A vertex may lie inside down to
-    (1 - ``slack``) of the normalised radius, and vertices of total area ``inside_fraction`` of the
-    nearby surface deeper still. ``margin`` enlarges the selection's box on every side, as a
+    vertices that must stay outside, with ``obstacle_area`` (m,), except vertices of total area
+    ``inside_fraction`` of the nearby surface. ``margin`` enlarges the selection's box on every side, as a
     fraction of its half-extent. ``reference``, ``frame``, ``match``: see :func:`principal_frame`.
-    ``floor``: world z the box may not reach below (along the local axis closest to vertical; exact
-    for a "fixed" frame), to keep a part clear of a section it must not cut. ``level``: world z of the
-    centre, if given (same axis): a part centred on the section it makes is cut where its girth
-    changes least with height, so interpolated mannequins whose parts sit a little higher or lower
-    still measure what their references do.
+    ``floor``, ``ceiling``: world heights the ellipsoid may not reach below or above, to keep a part
+    clear of a section it must not cut. ``level``: world z of the centre, if given: a part centred on
+    the section it makes is cut where its girth changes least with height, so interpolated
+    mannequins whose parts sit a little higher or lower still measure what their references do.
+    ``span``: the semi-axis along the axis taken from the points is the box's half-length along it
+    (less if ``floor`` or ``ceiling`` allow less), and the centre the box's middle there: a limb's
+    part reaches from one end of its segment to the other, however the limb tapers (only the
+    cross-section grows). ``fill``: points (p, 3) sampling
+    the body's volume (e.g. a regular grid inside it); if given, the centre is chosen for the
+    ellipsoid to cover most of them within the box, instead of for the largest ellipsoid: a part
+    fills its region rather than settling where the body is thickest. ``fill_weight`` (p,): what
+    covering each point is worth (default 1), e.g. less where other parts already cover it.
     Returns (rotation, center, semi_axes, kept axis index).
     """
     rotation, centroid, kept = principal_frame(selected, weights, reference, frame, match)
+    if span and kept is None:
+        raise ValueError("span needs an axis taken from the points (a 'limb', 'axis' or 'main' frame that finds one)")
     local_sel = (selected - centroid) @ rotation
     lo, hi = local_sel.min(axis=0), local_sel.max(axis=0)
     half = 0.5 * (hi - lo)
     lo, hi = lo - margin * half, hi + margin * half
     up = int(np.argmax(np.abs(rotation[2])))
-    if np.isfinite(floor):
-        bound = (floor - centroid[2]) / rotation[2, up]
-        if rotation[2, up] > 0.0:
-            lo[up] = max(lo[up], bound)
-        else:
-            hi[up] = min(hi[up], bound)
     box_centre = 0.5 * (lo + hi)
     local_obs = (obstacles - centroid) @ rotation
     near = np.all((local_obs > lo) & (local_obs < hi), axis=1)
     local_obs, area = local_obs[near], obstacle_area[near]
     allowed = inside_fraction * area.sum()
+    if fill is not None:
+        fill = (np.asarray(fill) - centroid) @ rotation
+        in_box = np.all((fill > lo) & (fill < hi), axis=1)
+        fill = fill[in_box]
+        fill_weight = np.ones(len(fill)) if fill_weight is None else np.asarray(fill_weight)[in_box]
 
-    def solve(centre):
+    def solve(centre, shape):
         limit = np.minimum(centre - lo, hi - centre)
-        if np.any(limit <= 0.0):
+        z = centroid[2] + rotation[2] @ centre
+        reach = min(z - floor, ceiling - z)
+        if np.any(limit <= 0.0) or reach <= 0.0:
             return 0.0, np.zeros(3)
-        # a vertex may lie inside the ellipsoid down to (1 - slack) of its normalised radius
-        semi = _grow((local_obs - centre) / (1.0 - slack), area, limit, 0.05 * half + 1e-4, allowed)
-        return float(np.prod(semi)), semi
+        start = 0.05 * half * shape + 1e-4
+        if span:  # as long as the box and the heights it must keep clear of let it be
+            start[kept] = min(limit[kept], reach / max(abs(rotation[2, kept]), 1e-12))
+        semi = _grow(local_obs - centre, area, limit, start, allowed, rotation[2], reach)
+        if fill is None or not np.all(semi > 0.0):
+            return float(np.prod(semi)), semi
+        # covered volume; the ellipsoid's own volume (tiny weight) breaks ties
+        covered = fill_weight @ (np.sum(((fill - centre) / semi) ** 2, axis=1) < 1.0)
+        return covered + 1e-3 * float(np.prod(semi)) / float(np.prod(half)), semi
 
     centre = box_centre.copy()
     free = [0, 1, 2]
-    if level is not None:
-        centre[up] = (level - centroid[2]) / rotation[2, up]
+    if span:
+        free.remove(kept)
+    if level is not None and up in free:
         free.remove(up)
-    best, semi = solve(centre)
-    step = 0.25 * (hi - lo) / 2.0
+    # Searched: the free coordinates of the centre and, when filling, the shape the growth starts
+    # from (log ratios of two semi-axes to the third), which decides the maximal ellipsoid it reaches.
+    shaped = [] if fill is None else [k for k in range(3) if k != kept][1:] if span else [1, 2]
+
+    def unpack(x):
+        c = centre.copy()
+        c[free] = x[:len(free)]
+        if level is not None:  # the centre's height stays the level whatever the other coordinates
+            c[up] = (level - centroid[2] - rotation[2] @ (c * (np.arange(3) != up))) / rotation[2, up]
+        shape = np.ones(3)
+        shape[shaped] = np.exp(x[len(free):])
+        return c, shape
+
+    x = np.concatenate([centre[free], np.zeros(len(shaped))])
+    step = np.concatenate([0.25 * (hi - lo)[free] / 2.0, np.full(len(shaped), SHAPE_STEP)])
+    best, semi = solve(*unpack(x))
     for _ in range(PATTERN_STEPS):
         while True:
             # best of the moves (not the first improving one), so the search has no preferred axis or sign
-            trials = [centre + sign * step * np.eye(3)[axis] for axis in free for sign in (1.0, -1.0)]
-            results = [solve(trial) for trial in trials]
+            trials = [x + sign * step[k] * np.eye(len(x))[k] for k in range(len(x)) for sign in (1.0, -1.0)]
+            results = [solve(*unpack(trial)) for trial in trials]
             k = int(np.argmax([value for value, _ in results]))
             if results[k][0] <= best * (1.0 + 1e-9):
                 break
-            centre, (best, semi) = trials[k], results[k]
+            x, (best, semi) = trials[k], results[k]
         step = 0.5 * step
+    centre, _ = unpack(x)
     return rotation, centroid + rotation @ centre, semi, kept
 
 
-def moments_ellipsoid(selected, weights, reference=None, frame="main", match=None):
-    """The ellipsoid with the selection's area-weighted second moments (D_i = sqrt(3 var_i)).
+def hull_surface(points, depth=0.0, spacing=0.003):
+    """Points on the convex hull of ``points``, moved out by ``depth``, about ``spacing`` apart, with
+    the area each stands for: (points (m, 3), areas (m,)).
 
-    For parts that no ellipsoid can fill while inscribed, e.g. spread fingers: this one is the
-    envelope of the part, as a mitten is of a hand.
+    As obstacles they keep a part inside the hull of its own vertices: a mitten over spread fingers,
+    which no ellipsoid inside the body surface could fill.
     """
-    rotation, centroid, kept = principal_frame(selected, weights, reference, frame, match)
-    local = (selected - centroid) @ rotation
-    variance = (weights / weights.sum()) @ (local * local)
-    return rotation, centroid, np.sqrt(3.0 * variance), kept
+    hull = ConvexHull(points)
+    out, areas = [], []
+    for simplex, equation in zip(hull.simplices, hull.equations):
+        a, b, c = points[simplex]
+        area = 0.5 * np.linalg.norm(np.cross(b - a, c - a))
+        k = max(1, int(np.ceil(np.sqrt(2.0 * area) / spacing)))
+        i, j = np.meshgrid(np.arange(k + 1), np.arange(k + 1), indexing="ij")
+        keep = i + j <= k
+        u, v = i[keep] / k, j[keep] / k
+        out.append(a + u[:, None] * (b - a) + v[:, None] * (c - a) + depth * equation[:3])
+        areas.append(np.full(len(u), area / len(u)))
+    return np.concatenate(out), np.concatenate(areas)

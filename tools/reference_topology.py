@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ellimann_addon.core.constants import SECTION_FRACTIONS
+from ellimann_addon.core.constants import GIRTHS, SECTION_FRACTIONS
 from ellimann_addon.core.mannequin import Part, Topology
 
 
@@ -45,23 +45,27 @@ class Spec:
     depends: tuple
     select: Select
     margin: float = 0.3  # box enlargement, fraction of the selection's half-extent
-    slack: float = 0.03  # how far (fraction of its radius) a body vertex may lie inside the ellipsoid
-    inside: float = 0.003  # share of the nearby body surface (by area) allowed deeper inside than that
+    depth: float = 0.005  # m: how far the part may reach outside the body surface (or a mitten's hull)
+    inside: float = 0.003  # share of the nearby body surface (by area) that may lie inside it anyway
+    span: bool = False  # the part reaches from one end of its selection to the other along its axis
     inward: tuple = None  # extrude a surface patch by this vector (m) into the body before fitting
-    mode: str = "inscribed"  # or "moments": the envelope, for parts no inscribed ellipsoid can fill
-    frame: str = "main"  # the axis the frame takes from the points: "limb", "main" or "fixed" (none)
-    obstacles: tuple = None  # regions (without side) whose vertices the part must stay inside; None: all
-    floor: float = None  # lowest height (fraction of the body's) the part may reach: keeps it off a section
+    frame: str = "main"  # the axis the frame takes from the points: "limb", "main", "axis" (``axis``) or "fixed"
+    mitten: bool = False  # kept inside the convex hull of its own vertices instead of the body surface
     level: float = None  # height (fraction of the body's) of the centre: centres a part on its section
+    axis: tuple = None  # world direction of a limb, when its longest extent is not along it (a short neck)
+    clear: tuple = ()  # sections it keeps clear of, besides those section_bounds finds (the neck: Sh)
+    cavities: bool = False  # the walls of the mesh's open eye sockets and mouth are no obstacles: the part
+    # may fill them, as a solid head does
 
 
-ARM = ("upper_arm", "forearm", "hand")  # an arm pressed against the torso may overlap it
-
-# The chest parts depend on Br, not Wa: they must stay above the waist section (0.645 He), with room
-# for the Reference Mannequins' adjustment, which may lengthen them downwards.
-CHEST_FLOOR = 0.67
-# The waist's sides and back are centred on its section (see fitting.inscribed_ellipsoid's ``level``);
-# the front is left to the belly, which on the chubby bodies bulges below a crease at the waist.
+# A girth part stays this far (fraction of the body's height) above or below every girth section of
+# a measurement it does not depend on, so that each section cuts only parts that follow its
+# measurement in synthesis, with room for the Reference Mannequins' adjustment, which may lengthen
+# parts a little.
+SECTION_CLEARANCE = 0.025
+# The waist's sides are centred on its section (see fitting.inscribed_ellipsoid's ``level``); the
+# front is left to the belly, which on the chubby bodies bulges below a crease at the waist, and the
+# back free to reach down to the hips.
 WAIST_LEVEL = SECTION_FRACTIONS["Wa"]
 
 HEAD = ("He",)
@@ -71,55 +75,72 @@ WAIST = ("He", "Wa")
 HIPS = ("He", "Hi")
 
 SPECS = (
-    Spec(1, "a", "Cranium", "C", "head", True, HEAD, Select(regions=("head",), h=(0.90, 1.01)), frame="fixed"),
-    Spec(1, "b", "Face", "C", "head", True, HEAD, Select(regions=("head",), h=(0.86, 0.925), y=(-1, -0.06)),
-         inward=(0.0, 0.05, 0.0), frame="fixed"),
+    Spec(1, "a", "Cranium", "C", "head", True, HEAD, Select(regions=("head",), h=(0.88, 1.01)), frame="fixed",
+         cavities=True),
+    Spec(1, "b", "Face", "C", "head", True, HEAD, Select(regions=("head",), h=(0.855, 0.91), y=(-1, -0.07)),
+         inward=(0.0, 0.03, 0.0), frame="fixed", cavities=True),
     Spec(2, "a", "Neck", "C", "neck", True, HEAD,
-         Select(regions=("neck",), h=(0.83, 0.905), x=(0.0, 0.06), y=(-0.075, 1)), frame="limb"),
+         Select(regions=("neck",), h=(0.83, 0.905), x=(0.0, 0.06), y=(-0.075, 1)), frame="axis", span=True,
+         axis=(0.0, 0.0, 1.0), margin=1.0, clear=("Sh",)),
     Spec(3, "a", "Upper Arm", "L", "arms", False, SHOULDERS,
-         Select(bones=("upperarm01", "upperarm02"), h=(0, 0.84)), slack=0.06, frame="limb", obstacles=ARM),
-    Spec(3, "b", "Forearm", "L", "arms", False, SHOULDERS, Select(bones=("lowerarm",)), frame="limb"),
+         Select(bones=("upperarm01", "upperarm02"), h=(0, 0.84)), frame="limb", margin=0.15),
+    Spec(3, "b", "Forearm", "L", "arms", False, SHOULDERS, Select(bones=("lowerarm",)), frame="limb", span=True),
     Spec(4, "a", "Hand", "L", "hands", False, SHOULDERS, Select(bones=("wrist", "metacarpal", "finger1-1")),
-         slack=0.08),
+         mitten=True, depth=0.0),
     Spec(4, "b", "Fingers", "L", "hands", False, SHOULDERS,
-         Select(bones=("finger2", "finger3", "finger4", "finger5")), mode="moments"),
-    Spec(5, "a", "Thigh", "L", "legs", True, HIPS, Select(bones=("upperleg",), h=(0.30, 0.50)), frame="limb"),
-    Spec(5, "b", "Knee", "L", "legs", True, HIPS, Select(bones=("upperleg02", "lowerleg01"), h=(0.22, 0.32)),
-         frame="limb"),
-    Spec(6, "a", "Calf", "L", "legs", True, HIPS, Select(bones=("lowerleg",), h=(0.09, 0.28)), frame="limb"),
+         Select(bones=("finger2", "finger3", "finger4", "finger5")), mitten=True, depth=0.0),
+    Spec(5, "a", "Thigh", "L", "legs", True, HIPS, Select(bones=("upperleg",), h=(0.30, 0.50)), frame="limb",
+         margin=0.15),
+    Spec(5, "b", "Knee", "L", "legs", True, HIPS, Select(bones=("upperleg02", "lowerleg01"), h=(0.20, 0.38)),
+         frame="limb", margin=0.15),
+    Spec(6, "a", "Calf", "L", "legs", True, HIPS, Select(bones=("lowerleg",), h=(0.09, 0.28)), frame="limb",
+         margin=0.15),
     Spec(6, "b", "Ankle", "L", "legs", True, HIPS, Select(bones=("lowerleg02", "foot"), h=(0.035, 0.12)),
-         frame="limb"),
-    Spec(7, "a", "Foot", "L", "feet", True, HIPS, Select(bones=("foot",), h=(0, 0.05)), slack=0.1, frame="limb"),
-    Spec(7, "b", "Toes", "L", "feet", True, HIPS, Select(bones=("toe", "foot"), y=(-1, -0.09)), slack=0.1,
-         inside=0.03, frame="limb"),
+         frame="limb", margin=0.15),
+    Spec(7, "a", "Foot", "L", "feet", True, HIPS, Select(bones=("foot",), h=(0, 0.05)), frame="limb"),
+    Spec(7, "b", "Toes", "L", "feet", True, HIPS, Select(bones=("toe", "foot"), y=(-1, -0.09)), frame="limb",
+         mitten=True, depth=0.0),
     Spec(8, "a", "Deltoid", "L", "shoulders", False, SHOULDERS,
          Select(bones=("upperarm01", "shoulder01"), h=(0.765, 1.0))),
     Spec(9, "a", "Breast", "L", "chest", True, BUST,
-         Select(regions=("chest",), h=(0.69, 0.765), x=(0.03, 0.13), y=(-1, -0.10)), margin=0.1,
-         inward=(0.0, 0.04, 0.0)),
+         Select(regions=("chest",), h=(0.68, 0.77), x=(0.03, 0.13), y=(-1, -0.11)), margin=0.2,
+         inward=(0.0, 0.05, 0.0), frame="fixed", level=SECTION_FRACTIONS["Br"]),
     Spec(10, "a", "Trapezius", "L", "shoulders", True, SHOULDERS,
-         Select(bones=("spine01", "clavicle", "shoulder01", "neck01"), h=(0.81, 0.88), x=(0.035, 0.14)),
+         Select(bones=("spine01", "clavicle", "shoulder01", "neck01"), h=(0.81, 0.88), x=(0.02, 0.14)),
          inward=(0.0, 0.0, -0.04)),
     Spec(11, "a", "Thorax", "C", "chest", True, BUST, Select(regions=("chest",), h=(0.685, 0.80), y=(-1, -0.02)),
-         inward=(0.0, 0.06, 0.0), frame="fixed", floor=CHEST_FLOOR),
+         inward=(0.0, 0.06, 0.0), frame="fixed"),
     Spec(11, "b", "Upper Back", "C", "chest", True, BUST,
-         Select(regions=("chest",), h=(0.685, 0.80), x=(0, 0.11), y=(-0.04, 1)), inward=(0.0, -0.06, 0.0),
-         frame="fixed", floor=CHEST_FLOOR),
+         Select(regions=("chest",), h=(0.685, 0.83), x=(0, 0.11), y=(-0.04, 1)), inward=(0.0, -0.06, 0.0),
+         frame="fixed"),
     Spec(12, "a", "Oblique", "L", "abdomen", True, WAIST,
-         Select(regions=("abdomen",), h=(0.59, 0.70), x=(0.07, 1)), frame="fixed", level=WAIST_LEVEL),
+         Select(regions=("abdomen",), h=(0.56, 0.70), x=(0.03, 1)), frame="fixed", level=WAIST_LEVEL),
+    Spec(12, "b", "Hip", "L", "hips", True, HIPS,
+         Select(bones=("pelvis", "upperleg01"), h=(0.44, 0.60), x=(0.07, 1)), frame="fixed"),
     Spec(13, "a", "Rectus Abdominalis", "C", "abdomen", True, WAIST,
-         Select(regions=("abdomen",), h=(0.59, 0.70), y=(-1, -0.03)), inward=(0.0, 0.05, 0.0), frame="fixed"),
+         Select(regions=("abdomen",), h=(0.56, 0.70), y=(-1, -0.03)), inward=(0.0, 0.05, 0.0), frame="fixed"),
     Spec(13, "b", "Lower Back", "C", "abdomen", True, WAIST,
-         Select(regions=("abdomen",), h=(0.59, 0.70), y=(-0.03, 1)), inward=(0.0, -0.05, 0.0), frame="fixed",
-         level=WAIST_LEVEL),
-    Spec(14, "a", "Pelvis", "C", "hips", True, HIPS, Select(regions=("pelvis",), h=(0.47, 0.57)), inside=0.001,
+         Select(regions=("abdomen",), h=(0.56, 0.70), y=(-0.03, 1)), inward=(0.0, -0.05, 0.0), frame="fixed"),
+    Spec(14, "a", "Pelvis", "C", "hips", True, HIPS, Select(regions=("pelvis",), h=(0.45, 0.62)), inside=0.001,
          frame="fixed"),
     Spec(15, "a", "Gluteus", "L", "hips", True, HIPS,
-         Select(bones=("pelvis", "upperleg01", "spine05"), h=(0.42, 0.56), x=(0.0, 1), y=(0.0, 1)),
-         inward=(0.0, -0.05, 0.0)),
-    Spec(16, "a", "Hip", "L", "hips", True, HIPS,
-         Select(bones=("pelvis", "upperleg01"), h=(0.44, 0.56), x=(0.07, 1)), frame="fixed"),
+         Select(bones=("pelvis", "upperleg01", "spine05"), h=(0.44, 0.56), x=(0.02, 1), y=(0.03, 1)),
+         inward=(0.0, -0.06, 0.0), frame="fixed"),
 )
+
+
+def section_bounds(spec, centre):
+    """(floor, ceiling) heights (fractions of the body's) a part centred at height ``centre`` may reach:
+    clear, by SECTION_CLEARANCE, of the girth sections of measurements it does not depend on (if it
+    is a girth part) and of the sections in ``spec.clear``."""
+    floor, ceiling = -np.inf, np.inf
+    keys = [key for key in GIRTHS if key not in spec.depends] if spec.girth else []
+    for key in keys + list(spec.clear):
+        if centre > SECTION_FRACTIONS[key]:
+            floor = max(floor, SECTION_FRACTIONS[key] + SECTION_CLEARANCE)
+        else:
+            ceiling = min(ceiling, SECTION_FRACTIONS[key] - SECTION_CLEARANCE)
+    return floor, ceiling
 
 
 def _partners():
@@ -157,12 +178,13 @@ def topology():
     return Topology(parts)
 
 
-def obstacle_vertices(spec, side, labels):
-    """Indices of the body vertices that must stay outside the part (all, or those of its regions)."""
-    if spec.obstacles is None:
-        return np.arange(len(labels.region))
-    names = [f"{r}_{side}" for r in spec.obstacles] + list(spec.obstacles)
-    return np.nonzero(np.isin(labels.region, names))[0]
+def obstacle_vertices(spec, hidden):
+    """Indices of the body vertices that must stay outside the part: all of them (none for a mitten),
+    and with ``spec.cavities`` all but the ``hidden`` ones (bool per vertex: the walls of the mesh's
+    cavities)."""
+    if spec.mitten:
+        return np.zeros(0, dtype=int)
+    return np.nonzero(~hidden if spec.cavities else np.ones(len(hidden), dtype=bool))[0]
 
 
 def select_vertices(select, side, vertices, labels, height):

@@ -7,6 +7,7 @@ traced over); several slots stand side by side along X for a line-up.
 
     python -m tools.render trace-example --mesh BODY.obj --regions BODY_regions.json --out PNG
     python -m tools.render mannequins A.json [B.json ...] [--ghost A.obj ...] --out PNG [--view SIDE]
+        [--ghost-shift X Y Z] [--side-too]
 """
 
 import argparse
@@ -187,15 +188,22 @@ def trace_example(mesh_path, regions_path, out, mode="moments", view="FRONT"):
     return render(out, [front, side], resolution=(1000, 900), view=view)
 
 
-def mannequins(files, ghosts, out, view="FRONT"):
-    """Mannequin JSON files side by side, each over its ghost mesh (OBJ) if given."""
+def mannequins(files, ghosts, out, view="FRONT", ghost_shift=(0.0, 0.0, 0.0), side_too=False):
+    """Mannequin JSON files side by side, each over its ghost mesh (OBJ) if given, moved by
+    ``ghost_shift`` (m: e.g. the registration that moved the mannequin off its body); with
+    ``side_too`` each also turned 90 degrees beside it (a front and a side view in one picture)."""
     bpy.ops.wm.read_homefile(use_empty=True)
     if ghosts and len(ghosts) != len(files):
         raise SystemExit(f"give one --ghost per mannequin ({len(files)}), or none")
     slots = []
     for i, path in enumerate(files):
         collection = mannequin_to_collection(Mannequin.load(path))
-        slots.append(Slot(solid=[collection], ghosts=import_obj(ghosts[i]) if ghosts else []))
+        body = import_obj(ghosts[i]) if ghosts else []
+        for obj in body:
+            obj.matrix_world = Matrix.Translation(ghost_shift) @ obj.matrix_world
+        slots.append(Slot(solid=[collection], ghosts=body))
+        if side_too:
+            slots.append(Slot(solid=[collection], ghosts=body, turn=90.0))
     return render(out, slots, resolution=(max(800, 420 * len(slots)), 1000), view=view)
 
 
@@ -209,6 +217,9 @@ def main(argv=None):
     lineup = sub.add_parser("mannequins", help="mannequin JSON files side by side")
     lineup.add_argument("files", nargs="+", type=Path)
     lineup.add_argument("--ghost", action="append", default=[], type=Path)
+    lineup.add_argument("--ghost-shift", nargs=3, type=float, default=(0.0, 0.0, 0.0), metavar=("X", "Y", "Z"),
+                        help="move the ghost meshes by this much (m), e.g. by the mannequin's registration")
+    lineup.add_argument("--side-too", action="store_true", help="each mannequin also seen from the side")
     for p in (trace, lineup):
         p.add_argument("--out", required=True, type=Path)
         p.add_argument("--view", default="FRONT", choices=sorted(VIEWS))
@@ -218,7 +229,7 @@ def main(argv=None):
         if args.command == "trace-example":
             trace_example(args.mesh, args.regions, args.out, args.mode, args.view)
         else:
-            mannequins(args.files, args.ghost, args.out, args.view)
+            mannequins(args.files, args.ghost, args.out, args.view, args.ghost_shift, args.side_too)
     finally:
         ellimann_addon.unregister()
     print(f"wrote {args.out}")

@@ -1,4 +1,4 @@
-"""The build tool's ellipsoid fits, on meshes whose answer is known."""
+"""The build tool's ellipsoid fits and body helpers, on meshes whose answer is known."""
 
 import numpy as np
 import pytest
@@ -6,8 +6,8 @@ import pytest
 from devkit.toy import rotation_from_vector
 from ellimann_addon.core.frames import is_rotation
 from ellimann_addon.core.mesh import icosphere
-from tools.bodies import vertex_areas
-from tools.fitting import inscribed_ellipsoid, moments_ellipsoid, principal_frame
+from tools.bodies import hidden_vertices, vertex_areas, vertex_normals
+from tools.fitting import hull_surface, inscribed_ellipsoid, principal_frame
 
 ROTATION = rotation_from_vector([0.3, -0.2, 0.5])
 SEMI = np.array([0.05, 0.08, 0.12])
@@ -25,7 +25,7 @@ def test_the_inscribed_fit_of_an_ellipsoid_mesh_is_that_ellipsoid(frame):
     # one axis comes from the points, the roll about it from the reference (here a relabelled true frame)
     reference = ROTATION[:, [1, 2, 0]]
     rotation, center, semi, kept = inscribed_ellipsoid(vertices, areas, vertices, areas, reference,
-                                                       inside_fraction=0.0, slack=0.0, frame=frame)
+                                                       inside_fraction=0.0, frame=frame)
     assert is_rotation(rotation)
     assert np.allclose(np.abs(rotation.T @ reference), np.eye(3), atol=2e-3)
     assert np.allclose(center, (0.1, -0.2, 0.9), atol=2e-3)
@@ -34,13 +34,17 @@ def test_the_inscribed_fit_of_an_ellipsoid_mesh_is_that_ellipsoid(frame):
     assert np.sqrt((local ** 2).sum(axis=1)).min() >= 1.0 - 1e-9  # no vertex inside
 
 
-def test_slack_lets_vertices_in_only_that_deep():
-    vertices, faces = ellipsoid_mesh()
+def test_obstacles_moved_out_let_the_ellipsoid_reach_that_far():
+    # the build tool moves the body's vertices out along their normals by the allowed depth
+    vertices, faces = ellipsoid_mesh(np.eye(3), np.full(3, 0.1), (0.0, 0.0, 0.0))
     areas = vertex_areas(vertices, faces)
-    rotation, center, semi, _ = inscribed_ellipsoid(vertices, areas, vertices, areas, inside_fraction=0.0,
-                                                    slack=0.05)
-    radius = np.sqrt((((vertices - center) @ rotation / semi) ** 2).sum(axis=1))
-    assert radius.min() >= 0.95 - 1e-9 and radius.min() < 1.0
+    normals = vertex_normals(vertices, faces)
+    assert np.allclose(normals, vertices / np.linalg.norm(vertices, axis=1, keepdims=True), atol=1e-2)
+    walls = vertices + 0.005 * normals
+    _, center, semi, _ = inscribed_ellipsoid(vertices, areas, walls, areas, frame="fixed", inside_fraction=0.0)
+    radius = np.linalg.norm(walls, axis=1).min()
+    assert np.all(semi <= radius + 1e-9) and np.all(semi >= 0.0985 + 0.005 * 0.95)
+    assert np.allclose(center, 0.0, atol=1e-3)
 
 
 def test_a_fixed_frame_is_the_reference_and_the_box_caps_the_size():
@@ -81,12 +85,81 @@ def test_match_picks_the_principal_axis_closest_to_the_other_body_s():
         assert abs(rotation[:, kept] @ ROTATION[:, column]) > 0.999
 
 
-def test_moments_fit_of_a_sphere_is_the_sphere():
-    vertices, faces = ellipsoid_mesh(np.eye(3), np.full(3, 0.07), (0.0, 0.0, 1.0), subdivisions=5)
+def test_floor_and_ceiling_bound_the_ellipsoid_s_height_exactly():
+    vertices, faces = ellipsoid_mesh()  # tilted: the bound is on the world-z extent, not a local axis
     areas = vertex_areas(vertices, faces)
-    _, center, semi, _ = moments_ellipsoid(vertices, areas)
-    assert np.allclose(center, (0.0, 0.0, 1.0), atol=1e-9)
-    assert semi == pytest.approx(np.full(3, 0.07), rel=1e-3)
+    rotation, center, semi, _ = inscribed_ellipsoid(vertices, areas, vertices, areas, inside_fraction=0.0,
+                                                    floor=0.86, ceiling=0.95)
+    half_height = np.sqrt(np.sum((rotation[2] * semi) ** 2))
+    assert center[2] - half_height >= 0.86 - 1e-9 and center[2] + half_height <= 0.95 + 1e-9
+    assert 0.95 - 0.86 - 2.0 * half_height < 0.01  # and it uses the height it has
+
+
+def test_level_fixes_the_centre_height():
+    vertices, faces = ellipsoid_mesh()
+    areas = vertex_areas(vertices, faces)
+    _, center, _, _ = inscribed_ellipsoid(vertices, areas, vertices, areas, inside_fraction=0.0, level=0.93)
+    assert center[2] == pytest.approx(0.93, abs=1e-12)
+
+
+def tube(radius, half_length=0.2, count=6000):
+    """Points on the side of a tube along x whose radius is ``radius(x)``: a limb, open at its ends
+    (which join the rest of a body)."""
+    rng = np.random.default_rng(1)
+    x = rng.uniform(-half_length, half_length, count)
+    angle = rng.uniform(0.0, 2.0 * np.pi, count)
+    r = radius(x)
+    return np.stack([x, r * np.cos(angle), r * np.sin(angle)], axis=1)
+
+
+def test_span_reaches_from_one_end_of_the_limb_to_the_other():
+    points = tube(lambda x: 0.055 - 0.1 * x)  # tapering from 7.5 cm to 3.5 cm
+    weights = np.ones(len(points))
+    fit = dict(frame="limb", inside_fraction=0.0, margin=0.0)
+    rotation, center, semi, kept = inscribed_ellipsoid(points, weights, points, weights, span=True, **fit)
+    assert abs(rotation[:, kept] @ [1.0, 0.0, 0.0]) > 0.99
+    assert semi[kept] == pytest.approx(np.ptp(points @ rotation[:, kept]) / 2.0, rel=1e-6)
+    assert abs(center[0]) < 1e-3
+    # the largest ellipsoid settles in the thick end instead, and is shorter
+    _, plain_center, plain, _ = inscribed_ellipsoid(points, weights, points, weights, **fit)
+    assert plain[kept] < 0.9 * semi[kept] and plain_center[0] < -0.02
+
+
+def test_fill_weights_draw_the_part_to_the_volume_that_counts():
+    points = tube(lambda x: np.full_like(x, 0.05), half_length=0.3)
+    weights = np.ones(len(points))
+    grid = np.stack(np.meshgrid(np.linspace(-0.3, 0.3, 61), np.linspace(-0.05, 0.05, 11),
+                                np.linspace(-0.05, 0.05, 11), indexing="ij"), axis=-1).reshape(-1, 3)
+    inside = grid[np.hypot(grid[:, 1], grid[:, 2]) < 0.05]
+    fit = dict(frame="fixed", inside_fraction=0.0, margin=0.0, fill=inside)
+    _, even, _, _ = inscribed_ellipsoid(points, weights, points, weights, **fit)
+    _, right, _, _ = inscribed_ellipsoid(points, weights, points, weights, **fit,
+                                         fill_weight=(inside[:, 0] > 0.1).astype(float))
+    assert abs(even[0]) < 0.02 and right[0] > 0.1
+
+
+def test_hull_surface_samples_the_hull_and_its_area():
+    corners = np.array([[x, y, z] for x in (-1.0, 1.0) for y in (-1.0, 1.0) for z in (-1.0, 1.0)])
+    inner = np.random.default_rng(2).uniform(-0.9, 0.9, (50, 3))
+    points, areas = hull_surface(np.concatenate([corners, inner]), depth=0.0, spacing=0.2)
+    assert np.allclose(np.abs(points).max(axis=1), 1.0)  # on the cube's faces
+    assert areas.sum() == pytest.approx(24.0)
+    moved, _ = hull_surface(corners, depth=0.1, spacing=0.2)
+    assert np.allclose(np.abs(moved).max(axis=1), 1.1)
+
+
+def test_hidden_vertices_are_those_that_cannot_see_out():
+    # a sphere inside a sphere: the inner one's outward rays meet the outer one, the outer's escape
+    outer, outer_faces = ellipsoid_mesh(np.eye(3), np.full(3, 1.0), (0.0, 0.0, 0.0), subdivisions=3)
+    # (turned, so that no ray runs exactly through a vertex of the outer one)
+    inner, inner_faces = ellipsoid_mesh(ROTATION, np.full(3, 0.5), (0.0, 0.0, 0.0), subdivisions=2)
+    vertices = np.concatenate([outer, inner])
+    faces = np.concatenate([outer_faces, inner_faces + len(outer)])
+    normals = vertex_normals(vertices, faces)
+    hidden = hidden_vertices(vertices, faces, normals, np.arange(len(vertices)), reach=0.6, cell=0.1)
+    assert not hidden[:len(outer)].any() and hidden[len(outer):].all()
+    # beyond reach nothing is met
+    assert not hidden_vertices(vertices, faces, normals, np.arange(len(vertices)), reach=0.4, cell=0.1).any()
 
 
 def test_unknown_frame_is_refused():
