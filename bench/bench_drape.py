@@ -12,9 +12,10 @@ clock, with this process's CPU time beside it: Blender runs parts of the cloth s
 so CPU time can exceed wall time; the cloth alone, with no collider, gives the floor), collider
 triangles, and the final garment against the DENSE body surface (signed distances, vertices
 inside) for both, so the comparison is fair; (a) also against its own exact pieces. "Equal fit"
-for the resolution sweep: median and 95th-percentile gap to the dense body within FIT_TOLERANCE
-(p95: twice that) of the finest mannequin colliders', no more vertices inside it, and no vertex
-more than FIT_TOLERANCE inside the exact pieces (a coarse collider lets the cloth into them).
+for the resolution sweep (both garments, cushion and ellipsoid colliders each against the finest of
+their own kind): median and 95th-percentile gap to the dense body within FIT_TOLERANCE (p95: twice
+that) of the finest colliders', no more vertices inside it, and no vertex more than FIT_TOLERANCE
+inside the exact pieces (a coarse collider lets the cloth into them).
 """
 
 import os
@@ -52,7 +53,7 @@ SWEEP = (
 HEADLINE = "cushions L2/L2"
 
 
-def run():
+def run(frames=FRAMES, repeat=REPEAT, sweep=SWEEP, kinds=("tube_dress", "t_shirt")):
     source = REFERENCE_FOLDER / f"{BODY}.json"
     body_path = REFMODELS / f"{BODY}.obj"
     if not source.is_file() or not body_path.is_file():
@@ -63,12 +64,14 @@ def run():
 
     ellimann_addon.register()
     try:
-        compare(Mannequin.load(source), *load_obj(body_path))
+        compare(Mannequin.load(source), *load_obj(body_path), frames=frames, repeat=repeat, sweep=sweep, kinds=kinds)
     finally:
         ellimann_addon.unregister()
 
 
-def compare(mannequin, body_vertices, body_faces):
+def compare(mannequin, body_vertices, body_faces, frames=FRAMES, repeat=REPEAT, sweep=SWEEP,
+            kinds=("tube_dress", "t_shirt")):
+    """Drape each garment of ``kinds`` on every collider of ``sweep`` and on the dense body; print the table."""
     import bpy
 
     from ellimann_addon.blender import drape
@@ -86,18 +89,18 @@ def compare(mannequin, body_vertices, body_faces):
     gap = dense(exact_samples(mannequin))
     print(f"mannequin surface vs dense body: median {np.median(gap) * 1e3:.1f} mm, {np.mean(gap < 0) * 100:.0f}% of "
           "it inside the body (the pieces are fitted mostly inside the skin)")
-    print(f"cloth: {FRAMES} frames at 24 fps, edge {EDGE * 100:g} cm, settings {drape.DrapeSettings()}")
+    print(f"cloth: settings {drape.DrapeSettings(frames=frames, edge=EDGE)}")
 
     def simulate(garment, pieces):
-        settings = drape.DrapeSettings(frames=FRAMES, edge=EDGE)
+        settings = drape.DrapeSettings(frames=frames, edge=EDGE)
         with stdout_to_stderr():
             empty_scene()
             _, obj = drape.setup(garment, pieces, settings, "bench")
-            wall, cpu = drape.bake(bpy.context.scene, obj, FRAMES)
+            wall, cpu = drape.bake(bpy.context.scene, obj, frames)
         return float(np.mean(wall)), float(np.mean(cpu)), drape.evaluated_vertices(obj)
 
     body_piece = [drape.mesh_piece(f"{BODY}.obj", body_vertices, body_faces)]
-    for kind in ("tube_dress", "t_shirt"):
+    for kind in kinds:
         garment = garments.make_garment(mannequin, kind, edge=EDGE)
         start = time.perf_counter()
         garment = garments.clear_of(garment, lambda p: np.minimum(exact.signed_distance(p, 0.05)[0], dense(p)))
@@ -105,14 +108,12 @@ def compare(mannequin, body_vertices, body_faces):
               f"{len(garment.seams)} seams, {len(garment.pins)} pins; {garment.pattern['cleared']} vertices moved "
               f"clear of both bodies ({time.perf_counter() - start:.1f} s)")
         rows = {}
-        runs = [(HEADLINE, *next(s[1:] for s in SWEEP if s[0] == HEADLINE)), ("dense body", None, 0, 0)]
-        if kind == "tube_dress":
-            runs += [s for s in SWEEP if s[0] != HEADLINE]
+        runs = [("dense body", None, 0, 0), *sweep]
         # The cloth alone (no collider: it falls freely) is the floor under every collider's cost.
-        free = min(simulate(garment, [])[0] for _ in range(REPEAT))
+        free = min(simulate(garment, [])[0] for _ in range(repeat))
         for label, cushions, sphere, cushion in runs:
             pieces = body_piece if cushions is None else collision_pieces(mannequin, cushions, sphere, cushion)
-            results = [simulate(garment, pieces) for _ in range(REPEAT)]
+            results = [simulate(garment, pieces) for _ in range(repeat)]
             vertices = results[0][2]
             row = {"seconds": min(r[0] for r in results), "cpu": min(r[1] for r in results),
                    "triangles": triangle_count(pieces), "vertices": vertices,
@@ -136,9 +137,10 @@ def exact_samples(mannequin, count=100):
 
 def report(rows, garment, free):
     base = rows["dense body"]
+    headline = HEADLINE if HEADLINE in rows else next(label for label in rows if label != "dense body")
     print(f"cloth alone (no collider) {free:.3f} s/frame; above that, collisions cost "
-          f"{base['seconds'] - free:.3f} with the dense body and {rows[HEADLINE]['seconds'] - free:.3f} with "
-          f"{HEADLINE} ({(base['seconds'] - free) / max(rows[HEADLINE]['seconds'] - free, 1e-9):.1f}x)")
+          f"{base['seconds'] - free:.3f} with the dense body and {rows[headline]['seconds'] - free:.3f} with "
+          f"{headline} ({(base['seconds'] - free) / max(rows[headline]['seconds'] - free, 1e-9):.1f}x)")
     print("s/frame: wall (CPU); distances in mm; 'inside': garment vertices inside that surface; "
           "speed-up = dense s/frame / this")
     print(f"{'collider':<16}{'triangles':>10}{'s/frame':>15}{'speed-up':>9} | vs dense body: {'median':>6}{'p05':>6}"
@@ -154,24 +156,32 @@ def report(rows, garment, free):
         if "seams" in row:
             cells += f" | {row['seams'][0] * 1e3:6.1f} / {row['seams'][1] * 1e3:5.1f}"
         print(cells)
-    if HEADLINE in rows:
-        shift = np.linalg.norm(rows[HEADLINE]["vertices"] - base["vertices"], axis=1)
-        print(f"same garment, {HEADLINE} vs dense body, per vertex: median {np.median(shift) * 1e3:.1f} mm, "
-              f"95th percentile {np.percentile(shift, 95) * 1e3:.1f} mm apart")
-    sweep = {label: row for label, row in rows.items() if label != "dense body"}
-    if len(sweep) > 2:
-        finest = max(sweep.values(), key=lambda r: r["triangles"])
-        equal = [label for label, row in sweep.items()
-                 if abs(row["dense"]["median"] - finest["dense"]["median"]) <= FIT_TOLERANCE
-                 and abs(row["dense"]["p95"] - finest["dense"]["p95"]) <= 2 * FIT_TOLERANCE
-                 and row["dense"]["penetrating"] <= finest["dense"]["penetrating"]
-                 and row["own"]["max_depth"] <= FIT_TOLERANCE]
-        best = min(equal, key=lambda label: sweep[label]["seconds"])
-        print(f"best speed at equal fit (median within {FIT_TOLERANCE * 1e3:g} mm, p95 within "
-              f"{2 * FIT_TOLERANCE * 1e3:g} mm of the finest colliders, no more vertices inside the dense body, "
-              f"none over {FIT_TOLERANCE * 1e3:g} mm inside the exact pieces): {best}, "
-              f"{sweep[best]['seconds']:.3f} s/frame, {sweep[best]['triangles']:,} triangles "
-              f"(equal fit: {', '.join(equal)})")
+    shift = np.linalg.norm(rows[headline]["vertices"] - base["vertices"], axis=1)
+    print(f"same garment, {headline} vs dense body, per vertex: median {np.median(shift) * 1e3:.1f} mm, "
+          f"95th percentile {np.percentile(shift, 95) * 1e3:.1f} mm apart")
+    for kind in ("cushions", "ellipsoids"):
+        print(best_at_equal_fit({label: row for label, row in rows.items() if label.startswith(kind)}, kind))
+
+
+def best_at_equal_fit(sweep, kind):
+    """The fastest collider of one kind whose drape fits as the finest collider of that kind does."""
+    if len(sweep) < 2:
+        return f"{kind}: fewer than two resolutions, no comparison"
+    finest_label = max(sweep, key=lambda label: sweep[label]["triangles"])
+    finest = sweep[finest_label]["dense"]
+    equal = [label for label, row in sweep.items()
+             if abs(row["dense"]["median"] - finest["median"]) <= FIT_TOLERANCE
+             and abs(row["dense"]["p95"] - finest["p95"]) <= 2 * FIT_TOLERANCE
+             and row["dense"]["penetrating"] <= finest["penetrating"]
+             and row["own"]["max_depth"] <= FIT_TOLERANCE]
+    criteria = (f"median within {FIT_TOLERANCE * 1e3:g} mm, p95 within {2 * FIT_TOLERANCE * 1e3:g} mm of "
+                f"{finest_label}'s, no more vertices inside the dense body, none over {FIT_TOLERANCE * 1e3:g} mm "
+                "inside the exact pieces")
+    if not equal:
+        return f"{kind}: no resolution fits as {finest_label} does ({criteria})"
+    best = min(equal, key=lambda label: sweep[label]["seconds"])
+    return (f"{kind}, best speed at equal fit ({criteria}): {best}, {sweep[best]['seconds']:.3f} s/frame, "
+            f"{sweep[best]['triangles']:,} triangles (equal fit: {', '.join(equal)})")
 
 
 if __name__ == "__main__":

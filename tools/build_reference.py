@@ -1,7 +1,7 @@
 """Build ElliMann's reference data: the Base Mannequin and the five Reference Mannequins.
 
     .venv/bin/python -m tools.build_reference [--refmodels DIR] [--out DIR] [--docs DIR] [--no-blend]
-    .venv/bin/python -m tools.build_reference --check     # rebuild in memory, compare with the shipped files
+    .venv/bin/python -m tools.build_reference --check     # rebuild in memory, compare with the shipped files and docs
 
 Reads the body meshes of ``<repo>/../shared/refmodels`` (see its README) and writes
 ``reference_blends/base_mannequin.json`` and the five ``<name>.json`` Reference Mannequins, their
@@ -631,16 +631,19 @@ def main(argv=None):
             f"{chain} " + " ".join(f"{a * 1e3:.0f}/{b * 1e3:.0f}" for a, b in zip(e["gaps"][chain], c["gaps"][chain]))
             for chain in coverage.CHAINS))
     print(f"built in {report['seconds']:.1f} s")
+    docs = {"topology.md": topology_doc(base), "reference_mannequins.md": measurements_doc(base, rms, report)}
     if args.check:
-        problems = check_shipped(base, rms, args.out)
-        print("\n".join(problems) if problems else f"identical to the files in {args.out}")
+        problems = check_shipped(base, rms, args.out) + [
+            f"docs/{name} is not what the build writes" for name, text in docs.items()
+            if not (args.docs / name).is_file() or (args.docs / name).read_text() != text]
+        print("\n".join(problems) if problems else f"identical to the files in {args.out} and {args.docs}")
         return 1 if problems else 0
 
     mannequins = {BASE_FILE: base, **rms}
     changed = save_all(mannequins, args.out)
     args.docs.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(args.docs / "topology.md", topology_doc(base))
-    atomic_write_text(args.docs / "reference_mannequins.md", measurements_doc(base, rms, report))
+    for name, text in docs.items():
+        atomic_write_text(args.docs / name, text)
     print(f"{len(changed)} of {len(mannequins)} JSON files changed in {args.out}; docs written to {args.docs}")
     if not args.no_blend:
         # .blend and .png files are not byte-reproducible: rewrite only what changed (or is missing)

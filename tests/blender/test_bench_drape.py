@@ -1,0 +1,23 @@
+"""The drape bench runs end to end on a tiny setting (its figures come from `make bench`, not from here)."""
+
+import pytest
+
+from bench import bench_drape
+from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.synthesis import REFERENCE_FOLDER
+from tools.bodies import load_obj
+
+BODY = bench_drape.REFMODELS / f"{bench_drape.BODY}.obj"  # ../shared/refmodels, beside the repository (CI too)
+
+
+@pytest.mark.slow
+def test_drape_bench_prints_its_table_and_the_resolution_verdict(capsys):
+    sweep = tuple(s for s in bench_drape.SWEEP if s[0] in ("cushions L1/L1", "cushions L2/L2", "ellipsoids L1"))
+    bench_drape.compare(Mannequin.load(REFERENCE_FOLDER / "average.json"), *load_obj(BODY), frames=3, repeat=1,
+                        sweep=sweep, kinds=("tube_dress",))
+    out = capsys.readouterr().out
+    table = [line for line in out.splitlines() if line.startswith(("dense body", "cushions L", "ellipsoids L"))]
+    assert [line.split()[0] + " " + line.split()[1] for line in table] == [
+        "dense body", "cushions L1/L1", "cushions L2/L2", "ellipsoids L1"]
+    assert "cushions" in out and ("best speed at equal fit" in out or "no resolution fits" in out)
+    assert "ellipsoids: fewer than two resolutions, no comparison" in out
