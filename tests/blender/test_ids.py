@@ -3,9 +3,14 @@
 import bpy
 import pytest
 
-from ellimann_addon.blender import ids, menus, operators, panels
+from ellimann_addon.blender import drape_panel, ids, menus, operators, panels, props, synthesize
 
 OPERATORS = operators.classes()
+# Everything whose properties show tooltips: the property groups and every operator (the Synthesize
+# module's too). test_tooltips_cover_everything_registered keeps this list complete.
+PROPERTY_GROUPS = [c for m in (props, drape_panel, synthesize) for c in m.classes
+                   if issubclass(c, bpy.types.PropertyGroup)]
+TOOLTIP_OWNERS = PROPERTY_GROUPS + OPERATORS + [c for c in synthesize.classes if issubclass(c, bpy.types.Operator)]
 ALL_IDS = [v for k, v in vars(ids).items() if k.isupper() and isinstance(v, str) and v.startswith("ellimann.")]
 READ_ONLY = {ids.VALIDATE_MANNEQUIN, ids.ADD_MEASUREMENT_PRESET}
 
@@ -39,3 +44,50 @@ def test_sub_panels_hang_under_the_main_panel_in_their_order():
     assert all(cls.bl_parent_id == ids.PANEL_MAIN for cls in subs)
     assert [cls.bl_order for cls in subs] == sorted(ids.PANEL_ORDER.values())
     assert max(ids.PANEL_ORDER.values()) < 60  # room for Synthesize and Drape
+
+
+def rna_of(cls):
+    if issubclass(cls, bpy.types.Operator):
+        return getattr(bpy.ops.ellimann, cls.bl_idname.partition(".")[2]).get_rna_type()
+    return cls.bl_rna
+
+
+def missing_tooltips(rna):
+    """Properties (and enum items) of ``rna`` without a description. Hidden properties never show one."""
+    missing = []
+    for prop in rna.properties:
+        if prop.identifier == "rna_type" or prop.is_hidden:
+            continue
+        if not prop.description.strip():
+            missing.append(prop.identifier)
+        if prop.type == "ENUM":
+            missing += [f"{prop.identifier}['{item.identifier}']" for item in prop.enum_items
+                        if not item.description.strip()]
+    return missing
+
+
+@pytest.mark.parametrize("cls", TOOLTIP_OWNERS, ids=lambda c: c.__name__)
+def test_every_property_and_enum_item_has_a_tooltip(cls):
+    assert missing_tooltips(rna_of(cls)) == []
+
+
+def test_tooltips_cover_everything_registered():
+    groups = {c.__name__ for c in bpy.types.PropertyGroup.__subclasses__()
+              if c.__name__.startswith("ELLIMANN_") and c.is_registered}
+    assert {"ELLIMANN_PG_part", "ELLIMANN_PG_mannequin", "ELLIMANN_PG_synthesis", "ELLIMANN_PG_drape"} <= groups
+    operator_classes = {ids.class_name(f"ellimann.{name}") for name in registered_operator_names()}
+    assert {c.__name__ for c in TOOLTIP_OWNERS} == groups | operator_classes
+
+
+def test_missing_tooltips_finds_properties_and_items_without_one():
+    class ELLIMANN_PG_tooltip_probe(bpy.types.PropertyGroup):
+        bare: bpy.props.IntProperty(name="Bare")
+        told: bpy.props.EnumProperty(name="Told", description="Has one",
+                                     items=(("A", "A", "Item with a tooltip"), ("B", "B", "")))
+        hidden: bpy.props.BoolProperty(options={"HIDDEN"})
+
+    bpy.utils.register_class(ELLIMANN_PG_tooltip_probe)
+    try:
+        assert missing_tooltips(ELLIMANN_PG_tooltip_probe.bl_rna) == ["bare", "told['B']"]
+    finally:
+        bpy.utils.unregister_class(ELLIMANN_PG_tooltip_probe)
