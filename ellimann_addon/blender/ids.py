@@ -19,6 +19,7 @@ FIX_FRAMES = "ellimann.fix_frames"
 SYNTHESIZE_MANNEQUIN = "ellimann.synthesize_mannequin"
 ADD_MEASUREMENT_PRESET = "ellimann.add_measurement_preset"
 DRAPE_GARMENT = "ellimann.drape_garment"
+EXPORT_MANNEQUIN = "ellimann.export_mannequin"
 
 PANEL_MAIN = "ELLIMANN_PT_main"
 PANEL_TRACE = "ELLIMANN_PT_trace"

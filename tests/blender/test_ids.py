@@ -12,7 +12,7 @@ PROPERTY_GROUPS = [c for m in (props, drape_panel, synthesize) for c in m.classe
                    if issubclass(c, bpy.types.PropertyGroup)]
 TOOLTIP_OWNERS = PROPERTY_GROUPS + OPERATORS + [c for c in synthesize.classes if issubclass(c, bpy.types.Operator)]
 ALL_IDS = [v for k, v in vars(ids).items() if k.isupper() and isinstance(v, str) and v.startswith("ellimann.")]
-READ_ONLY = {ids.VALIDATE_MANNEQUIN, ids.ADD_MEASUREMENT_PRESET}
+READ_ONLY = {ids.VALIDATE_MANNEQUIN, ids.ADD_MEASUREMENT_PRESET, ids.EXPORT_MANNEQUIN}
 
 
 def registered_operator_names():
