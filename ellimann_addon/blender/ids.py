@@ -33,9 +33,11 @@ PANEL_DRAPE = "ELLIMANN_PT_drape"
 # Sub-panels of PANEL_MAIN sort by bl_order. Room is left after Measure for the Synthesize (60)
 # and Drape (70) panels that other parts of the add-on add.
 PANEL_ORDER = {PANEL_TRACE: 10, PANEL_PART: 20, PANEL_CLEAN: 30, PANEL_CUSHIONS: 40, PANEL_MEASURE: 50}
+SYNTHESIZE_ORDER = 60
 DRAPE_ORDER = 70
 
 MENU_OBJECT = "ELLIMANN_MT_object"
+MENU_MEASUREMENT_PRESETS = "ELLIMANN_MT_measurement_presets"
 
 
 def class_name(idname):

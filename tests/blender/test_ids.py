@@ -3,7 +3,7 @@
 import bpy
 import pytest
 
-from ellimann_addon.blender import drape_panel, ids, menus, operators, panels, props, synthesize
+from ellimann_addon.blender import drape_panel, ids, menus, operators, panels, props, synthesize, synthesize_panel
 
 OPERATORS = operators.classes()
 # Everything whose properties show tooltips: the property groups and every operator (the Synthesize
@@ -43,7 +43,19 @@ def test_sub_panels_hang_under_the_main_panel_in_their_order():
     subs = [cls for cls in panels.classes if cls.bl_idname != ids.PANEL_MAIN]
     assert all(cls.bl_parent_id == ids.PANEL_MAIN for cls in subs)
     assert [cls.bl_order for cls in subs] == sorted(ids.PANEL_ORDER.values())
-    assert max(ids.PANEL_ORDER.values()) < 60  # room for Synthesize and Drape
+    assert max(ids.PANEL_ORDER.values()) < ids.SYNTHESIZE_ORDER < ids.DRAPE_ORDER  # Synthesize, Drape come last
+
+
+def test_the_other_modules_use_the_ids_of_ids_py():
+    """ids.py holds every id, including those of the Synthesize and Drape modules (whatever they spell them with)."""
+    assert synthesize.ELLIMANN_OT_synthesize_mannequin.bl_idname == ids.SYNTHESIZE_MANNEQUIN
+    assert synthesize.ELLIMANN_OT_add_measurement_preset.bl_idname == ids.ADD_MEASUREMENT_PRESET
+    assert synthesize.ELLIMANN_MT_measurement_presets.bl_idname == ids.MENU_MEASUREMENT_PRESETS
+    assert synthesize.ELLIMANN_OT_add_measurement_preset.preset_menu == ids.MENU_MEASUREMENT_PRESETS
+    for panel, order in ((synthesize_panel.ELLIMANN_PT_synthesize, ids.SYNTHESIZE_ORDER),
+                         (drape_panel.ELLIMANN_PT_drape, ids.DRAPE_ORDER)):
+        assert panel.__name__ == panel.bl_idname and panel.bl_idname in (ids.PANEL_SYNTHESIZE, ids.PANEL_DRAPE)
+        assert (panel.bl_parent_id, panel.bl_order) == (ids.PANEL_MAIN, order)
 
 
 def rna_of(cls):
