@@ -1,8 +1,11 @@
-"""Blender test helpers: select objects, look up parts, and snapshot a file's state so tests can assert
-that a refused operator changed nothing."""
+"""Blender test helpers: select objects, look up parts, make a mesh to trace, and snapshot a file's state so
+tests can assert that a refused operator changed nothing (or that undo brought everything back)."""
 
 import bpy
 import numpy as np
+from mathutils import Matrix
+
+from ellimann_addon.core.mesh import icosphere
 
 PART_FIELDS = ("is_part", "kind", "part_name", "side", "region", "girth", "partner")
 
@@ -22,7 +25,8 @@ class Matrix4:
 
 
 def state():
-    """Objects (transform, data, collections, parent, ElliMann fields), collections, meshes and curves."""
+    """Objects (transform, data, collections, parent, ElliMann fields), collections, meshes (with their vertex
+    counts) and curves, and the scene's frame range and current frame."""
     objects = {}
     for obj in bpy.data.objects:
         part = obj.ellimann
@@ -36,12 +40,14 @@ def state():
                  c.ellimann.has_measured, tuple(c.ellimann.measured))
         for c in bpy.data.collections
     }
+    scene = bpy.context.scene
     return {
         "objects": objects,
         "collections": collections,
-        "meshes": sorted(m.name for m in bpy.data.meshes),
+        "meshes": sorted((m.name, len(m.vertices)) for m in bpy.data.meshes),
         "curves": sorted(c.name for c in bpy.data.curves),
         "active_collection": bpy.context.view_layer.active_layer_collection.name,
+        "frames": (scene.frame_start, scene.frame_end, scene.frame_current),
     }
 
 
@@ -58,3 +64,29 @@ def select(*objects, active=None):
         obj.select_set(True)
     if objects or active is not None:
         bpy.context.view_layer.objects.active = active or objects[0]
+
+
+def reference_mesh(rotation, center, semi_axes, name="Reference"):
+    """An ellipsoid-shaped user mesh (not an ElliMann part) whose object transform is not the identity."""
+    unit, faces = icosphere(3)
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata((unit * semi_axes).tolist(), [], faces.tolist())
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    matrix = np.eye(4)
+    matrix[:3, :3], matrix[:3, 3] = rotation, center
+    obj.matrix_world = Matrix(matrix.tolist())
+    return obj
+
+
+def edit_with_selection(obj, selected):
+    """Make ``obj`` the only selected object and enter Edit Mode with exactly the vertices ``selected`` selected."""
+    select(obj)
+    # Edit Mode also selects the vertices of selected edges and faces: deselect everything there first.
+    bpy.ops.object.mode_set(mode="EDIT")
+    bpy.ops.mesh.select_all(action="DESELECT")
+    bpy.ops.object.mode_set(mode="OBJECT")
+    flags = np.zeros(len(obj.data.vertices), bool)
+    flags[selected] = True
+    obj.data.vertices.foreach_set("select", flags)
+    bpy.ops.object.mode_set(mode="EDIT")

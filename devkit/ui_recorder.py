@@ -1,10 +1,24 @@
 """A stand-in for ``UILayout`` that records what a panel draws and checks names against Blender.
 
 There is no GUI on the test machines, so panel ``draw`` functions are called with this recorder:
-a misspelt property or operator id, or a crash inside ``draw``, fails the test.
+a misspelt property, operator id, menu or icon name, or a crash inside ``draw``, fails the test.
 """
 
+import functools
+
 import bpy
+
+
+@functools.cache
+def icon_names():
+    """Every icon name Blender accepts for ``icon=`` (the items of UILayout.prop's icon enum)."""
+    return frozenset(bpy.types.UILayout.bl_rna.functions["prop"].parameters["icon"].enum_items.keys())
+
+
+def _check_icon(kwargs):
+    icon = kwargs.get("icon")
+    if icon is not None and icon not in icon_names():
+        raise ValueError(f"'{icon}' is not a Blender icon name")
 
 
 class Recorder:
@@ -51,24 +65,21 @@ class Recorder:
     def prop(self, data, prop, **kwargs):
         if prop not in data.bl_rna.properties:
             raise AttributeError(f"{type(data).__name__} has no property '{prop}'")
+        _check_icon(kwargs)
         self.log.append(("prop", {"data": data, "prop": prop, **kwargs}))
-
-    def prop_menu_enum(self, data, prop, **kwargs):
-        self.prop(data, prop, **kwargs)
-
-    def props_enum(self, data, prop):
-        self.prop(data, prop)
 
     def operator(self, idname, **kwargs):
         rna = _operator_rna(idname)
         if rna is None:
             raise AttributeError(f"no operator '{idname}'")
+        _check_icon(kwargs)
         props = _OperatorProps(idname, rna)
         self.log.append(("operator", {"idname": idname, "props": props.values, **kwargs}))
         return props
 
     def operator_menu_enum(self, idname, prop, **kwargs):
         self.operator(idname)._check(prop)
+        _check_icon(kwargs)
         self.log.append(("operator_menu_enum", {"idname": idname, "prop": prop, **kwargs}))
 
     def prop_search(self, data, prop, search_data, search_prop, **kwargs):
@@ -76,14 +87,17 @@ class Recorder:
             raise AttributeError(f"{type(data).__name__} has no property '{prop}'")
         if search_prop not in search_data.bl_rna.properties:
             raise AttributeError(f"{type(search_data).__name__} has no collection '{search_prop}'")
+        _check_icon(kwargs)
         self.log.append(("prop", {"data": data, "prop": prop, "search": search_prop, **kwargs}))
 
     def menu(self, menu, **kwargs):
         if not hasattr(bpy.types, menu):
             raise AttributeError(f"no menu '{menu}'")
+        _check_icon(kwargs)
         self.log.append(("menu", {"menu": menu, **kwargs}))
 
     def label(self, **kwargs):
+        _check_icon(kwargs)
         self.log.append(("label", kwargs))
 
     def separator(self, **kwargs):

@@ -221,3 +221,12 @@ def mannequin_collections(scene=None):
     """All mannequin collections in the scene's hierarchy."""
     root = (scene or bpy.context.scene).collection
     return [c for c in root.children_recursive if c.ellimann.is_mannequin]
+
+
+def objects_recursive(collection):
+    """Objects of a collection and its children, each once. Use this, not ``Collection.all_objects``: reading
+    ``all_objects`` crashed the bpy module in ElliMann's headless runs."""
+    objects = list(collection.objects)
+    for child in collection.children_recursive:
+        objects += [o for o in child.objects if o not in objects]
+    return objects

@@ -9,8 +9,11 @@
   the viewport and in renders. The cloth collides with that collection only.
 It then steps the frames one by one (``scene.frame_set``, timing each step) and turns the memory
 cache into a bake (``ptcache.bake_from_cache``), so a saved .blend replays the drape and opens on
-its last frame. The mannequin itself is not touched. Everything that can fail on bad input is
-computed before the scene changes.
+its last frame. The simulated frames are the cloth's point cache range (1..frames), which Blender
+simulates whatever the scene's frame range is: the scene's range is left as it was, and past the
+cache's end the cloth holds its last frame. The mannequin itself is not touched. Everything that
+can fail on bad input is computed before the scene changes; if Blender fails once building has
+begun, the half-built drape collection is removed and an ElliMannError raised.
 """
 
 import time
@@ -90,6 +93,11 @@ class DrapeResult:
     fit: dict = field(default_factory=dict)  # fit_statistics against the exact pieces
 
     @property
+    def frames(self):
+        """Frames baked (frame 1, the garment at rest, and the simulated ones)."""
+        return len(self.seconds) + 1
+
+    @property
     def seconds_per_frame(self):
         return float(np.mean(self.seconds)) if len(self.seconds) else 0.0
 
@@ -104,7 +112,7 @@ class DrapeResult:
 
     def summary(self):
         fit = self.fit
-        text = (f"{len(self.seconds) + 1} frames, {self.seconds_per_frame:.3f} s/frame, "
+        text = (f"{self.frames} frames, {self.seconds_per_frame:.3f} s/frame, "
                 f"{self.collider_triangles} collider triangles; {fit['penetrating']} of {fit['count']} "
                 f"vertices inside the body (deepest {fit['max_depth'] * 1e3:.1f} mm), median gap "
                 f"{fit['median'] * 1e3:.1f} mm")
@@ -175,30 +183,56 @@ def collider_objects(pieces, collection):
 
 
 def setup(garment, pieces, settings, name, parent=None):
-    """A new drape collection with the garment and its colliders; returns (collection, garment object)."""
+    """A new drape collection with the garment and its colliders; returns (collection, garment object).
+
+    If Blender raises RuntimeError on the way, what was built is removed before the error goes on.
+    """
     collection = new_collection(name, parent)
-    colliders = new_collection("Colliders", collection)
-    obj = garment_object(garment, collection, settings)
-    obj.modifiers[CLOTH_NAME].collision_settings.collection = colliders
-    collider_objects(pieces, colliders)
+    try:
+        colliders = new_collection("Colliders", collection)
+        obj = garment_object(garment, collection, settings)
+        obj.modifiers[CLOTH_NAME].collision_settings.collection = colliders
+        collider_objects(pieces, colliders)
+    except RuntimeError:
+        remove_drape(collection)
+        raise
     return collection, obj
 
 
-def bake(scene, obj, frames):
+def remove_drape(collection):
+    """Delete a drape collection: its child collections, their objects and the meshes nothing else uses."""
+    collections = [collection, *collection.children_recursive]
+    objects = {o.name: o for c in collections for o in c.objects}
+    meshes = {o.data.name: o.data for o in objects.values() if isinstance(o.data, bpy.types.Mesh)}
+    for obj in objects.values():
+        bpy.data.objects.remove(obj)
+    for mesh in meshes.values():
+        if mesh.users == 0:
+            bpy.data.meshes.remove(mesh)
+    for child in reversed(collections):
+        bpy.data.collections.remove(child)
+
+
+def bake(scene, obj, frames, progress=None):
     """Simulate frames 1..frames frame by frame; returns (wall, cpu): the seconds each of frames
     2..frames took, by the clock and in this process's CPU time (all its threads together).
 
-    Leaves the cache baked (saved with the .blend) and the scene on the last frame.
+    ``progress(frame)``, if given, is called once each frame is done. The frames are the cloth's
+    point cache range; the scene's frame range is not changed. Leaves the cache baked (saved with
+    the .blend) and the scene on the last frame.
     """
     cache = obj.modifiers[CLOTH_NAME].point_cache
     cache.frame_start, cache.frame_end = 1, frames
-    scene.frame_start, scene.frame_end = 1, frames
     scene.frame_set(1)
+    if progress is not None:
+        progress(1)
     wall, cpu = np.empty(frames - 1), np.empty(frames - 1)
     for frame in range(2, frames + 1):
         start, start_cpu = time.perf_counter(), time.process_time()
         scene.frame_set(frame)
         wall[frame - 2], cpu[frame - 2] = time.perf_counter() - start, time.process_time() - start_cpu
+        if progress is not None:
+            progress(frame)
     with bpy.context.temp_override(scene=scene, point_cache=cache):
         bpy.ops.ptcache.bake_from_cache()
     return wall, cpu
@@ -217,7 +251,7 @@ def evaluated_vertices(obj):
 # ------------------------------------------------------------------------------------------------ drape
 
 
-def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None):
+def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None, progress=None):
     """Drape ``garment`` (a ``core.garments.BUILDERS`` key or a core Garment) on ``mannequin`` (a core Mannequin).
 
     A garment named by its key is built from the mannequin's m_T and moved clear of the pieces
@@ -226,7 +260,10 @@ def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None)
     Returns a :class:`DrapeResult` whose ``fit`` compares the final garment with the exact pieces
     (ellipsoids in closed form, cushions at a fine resolution): negative distances are inside;
     distances beyond FIT_CUTOFF (20 cm, a garment hanging far off the body) are lower bounds.
-    Raises ElliMannError (MannequinError naming the parts) before anything is built.
+    Raises ElliMannError (MannequinError naming the parts) before anything is built. ``progress(frame)``
+    is called as each frame is simulated (see :func:`bake`). Should Blender raise RuntimeError once
+    building has begun, the drape collection is removed, the scene goes back to its frame and an
+    ElliMannError says what Blender reported.
     """
     settings = (settings or DrapeSettings()).checked()
     scene = scene or bpy.context.scene
@@ -239,11 +276,20 @@ def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None)
         garment = garments.clear_of(garment, lambda points: clearing.signed_distance(points, CLEARING_CUTOFF)[0])
     pieces = collision_pieces(mannequin, cushions, settings.sphere_subdivisions, settings.cushion_subdivisions)
     exact = BodyPieces(mannequin, cushions, EXACT_SUBDIVISIONS)
-    collection, obj = setup(garment, pieces, settings, name or f"Drape {garment.name} on {mannequin.name}",
-                            scene.collection)
-    collection[DRAPE_KEY] = garment.name
-    wall, cpu = bake(scene, obj, settings.frames)
-    vertices = evaluated_vertices(obj)
+    name = name or f"Drape {garment.name} on {mannequin.name}"
+    frame = scene.frame_current
+    try:
+        collection, obj = setup(garment, pieces, settings, name, scene.collection)
+    except RuntimeError as error:
+        raise ElliMannError(f"Blender failed while building the drape: {error}") from error
+    try:
+        collection[DRAPE_KEY] = garment.name
+        wall, cpu = bake(scene, obj, settings.frames, progress)
+        vertices = evaluated_vertices(obj)
+    except RuntimeError as error:
+        remove_drape(collection)
+        scene.frame_set(frame)
+        raise ElliMannError(f"Blender failed while simulating the drape: {error}") from error
     distance, _ = exact.signed_distance(vertices, FIT_CUTOFF)
     return DrapeResult(collection, obj, garment, pieces, wall, cpu, vertices, fit_statistics(distance))
 

@@ -30,7 +30,8 @@ def _subdivisions(name, default, what):
 class ELLIMANN_PG_drape(bpy.types.PropertyGroup):
     """Drape settings of a scene."""
 
-    garment: EnumProperty(name="Garment", items=GARMENT_ITEMS, default="tube_dress")
+    garment: EnumProperty(name="Garment", items=GARMENT_ITEMS, default="tube_dress",
+                          description="Garment to cut from the mannequin's measurements and drape on it")
     frames: IntProperty(name="Frames", default=DEFAULTS.frames, min=FRAME_RANGE[0], max=FRAME_RANGE[1],
                         soft_max=250, description="Frames to simulate (from frame 1, at the scene's frame rate)")
     edge: FloatProperty(name="Cloth Edge", default=DEFAULTS.edge, min=EDGE_RANGE[0], max=EDGE_RANGE[1],

@@ -19,14 +19,14 @@ What a three.js / game-engine user finds in the .glb:
 import json
 import os
 import struct
-import tempfile
 
 import bpy
 import numpy as np
 
 from ..core.constants import MEASUREMENTS
 from ..core.errors import ElliMannError
-from .convert import collection_to_mannequin
+from .atomic import atomic_output
+from .convert import collection_to_mannequin, objects_recursive
 
 EXTRAS_KEY = "ellimann"
 EXTRAS_FORMAT = "ellimann.gltf-extras"
@@ -58,7 +58,8 @@ def scene_extras(mannequin):
 
 
 def export_gltf(collection, path):
-    """Write a mannequin collection (and its child collections) to a binary glTF (.glb), atomically.
+    """Write a mannequin collection (and its child collections) to a binary glTF (.glb), atomically
+    (:func:`atomic.atomic_output`, like every file Blender writes for ElliMann).
 
     Objects hidden from renders are left out: in a mannequin shown with cushions those are the
     ellipsoids the cushions replace, so the file holds each convex piece once.
@@ -72,29 +73,23 @@ def export_gltf(collection, path):
         raise ElliMannError(f"path: a glTF export is written as binary glTF and must end in .glb, got {path!r}")
     bpy.context.view_layer.update()  # matrix_world of objects a script just moved
     mannequin = collection_to_mannequin(collection)
-    objects = [o for o in collection.all_objects if o.ellimann.is_part]
-    folder = os.path.dirname(os.path.abspath(path))
-    os.makedirs(folder, exist_ok=True)
-    handle, temp = tempfile.mkstemp(prefix=".ellimann-", suffix=".glb", dir=folder)
-    os.close(handle)
-    saved = {}
+    objects = [o for o in objects_recursive(collection) if o.ellimann.is_part]
+    saved = []
     try:
         for owner, value in [(o, part_extras(o)) for o in objects] + [(collection, scene_extras(mannequin))]:
-            saved[owner] = owner.get(EXTRAS_KEY)
+            saved.append((owner, owner.get(EXTRAS_KEY)))
             owner[EXTRAS_KEY] = value
-        result = bpy.ops.export_scene.gltf(filepath=temp, export_format="GLB", export_extras=True,
-                                           collection=collection.name, export_yup=True, use_renderable=True)
-        if result != {"FINISHED"}:
-            raise ElliMannError(f"path: Blender's glTF exporter did not finish ({result})")
-        os.replace(temp, path)
+        with atomic_output(path) as temp:
+            result = bpy.ops.export_scene.gltf(filepath=temp, export_format="GLB", export_extras=True,
+                                               collection=collection.name, export_yup=True, use_renderable=True)
+            if result != {"FINISHED"}:
+                raise ElliMannError(f"path: Blender's glTF exporter did not finish ({result})")
     finally:
-        for owner, value in saved.items():
+        for owner, value in saved:
             if value is None:
                 del owner[EXTRAS_KEY]
             else:
                 owner[EXTRAS_KEY] = value
-        if os.path.exists(temp):
-            os.unlink(temp)
     return path
 
 

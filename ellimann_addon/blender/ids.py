@@ -19,6 +19,7 @@ FIX_FRAMES = "ellimann.fix_frames"
 SYNTHESIZE_MANNEQUIN = "ellimann.synthesize_mannequin"
 ADD_MEASUREMENT_PRESET = "ellimann.add_measurement_preset"
 DRAPE_GARMENT = "ellimann.drape_garment"
+EXPORT_MANNEQUIN = "ellimann.export_mannequin"
 
 PANEL_MAIN = "ELLIMANN_PT_main"
 PANEL_TRACE = "ELLIMANN_PT_trace"
@@ -32,9 +33,11 @@ PANEL_DRAPE = "ELLIMANN_PT_drape"
 # Sub-panels of PANEL_MAIN sort by bl_order. Room is left after Measure for the Synthesize (60)
 # and Drape (70) panels that other parts of the add-on add.
 PANEL_ORDER = {PANEL_TRACE: 10, PANEL_PART: 20, PANEL_CLEAN: 30, PANEL_CUSHIONS: 40, PANEL_MEASURE: 50}
+SYNTHESIZE_ORDER = 60
 DRAPE_ORDER = 70
 
 MENU_OBJECT = "ELLIMANN_MT_object"
+MENU_MEASUREMENT_PRESETS = "ELLIMANN_MT_measurement_presets"
 
 
 def class_name(idname):

@@ -1,4 +1,5 @@
-"""ElliMann in the 3D viewport's menus: Add > ElliMann Ellipsoid, Object > ElliMann, Mesh > Fit Ellipsoid."""
+"""ElliMann in Blender's menus: Add > ElliMann Ellipsoid, Object > ElliMann, Mesh > Fit Ellipsoid (3D viewport) and
+File > Export > ElliMann Mannequin."""
 
 import bpy
 
@@ -30,6 +31,8 @@ class ELLIMANN_MT_object(bpy.types.Menu):
         layout.separator()
         layout.operator(ids.VALIDATE_MANNEQUIN)
         layout.operator(ids.FIX_FRAMES)
+        layout.separator()
+        layout.operator(ids.EXPORT_MANNEQUIN, icon="EXPORT")
 
 
 def draw_object_menu(self, context):
@@ -46,11 +49,16 @@ def draw_edit_mesh_menu(self, context):
     self.layout.operator(ids.FIT_ELLIPSOID, text="Fit ElliMann Ellipsoid")
 
 
+def draw_export_menu(self, context):
+    self.layout.operator(ids.EXPORT_MANNEQUIN, text="ElliMann Mannequin (.glb, .xml)")
+
+
 # (menu, draw function): appended on register, removed on unregister.
 MENU_ENTRIES = (
     ("VIEW3D_MT_object", draw_object_menu),
     ("VIEW3D_MT_add", draw_add_menu),
     ("VIEW3D_MT_edit_mesh", draw_edit_mesh_menu),
+    ("TOPBAR_MT_file_export", draw_export_menu),
 )
 
 

@@ -8,15 +8,14 @@ come from the core (:mod:`core.writers`) and need no scene.
 
 import contextlib
 import os
-import shutil
 import sys
-import tempfile
 
 import bpy
 
 from ..core.cushion import DEFAULT_SUBDIVISIONS
 from ..core.writers import core_format, write_core_file
-from .convert import mannequin_to_collection, write_measured
+from .atomic import atomic_output  # the CLI and render import it from here
+from .convert import mannequin_to_collection, objects_recursive, write_measured  # Synthesize imports it from here
 from .cushions import build_cushions
 from .export import export_gltf
 
@@ -47,14 +46,6 @@ def empty_scene():
     with stdout_to_stderr():
         bpy.ops.wm.read_homefile(use_empty=True)
     return bpy.context.scene
-
-
-def objects_recursive(collection):
-    """Objects of a collection and its children (``Collection.all_objects`` crashed the bpy module here)."""
-    objects = list(collection.objects)
-    for child in collection.children_recursive:
-        objects += [o for o in child.objects if o not in objects]
-    return objects
 
 
 def shown_objects(collection):
@@ -117,28 +108,6 @@ def write_mannequin(mannequin, paths, measured=None, cushions=False):
 
 def extension(path):
     return os.path.splitext(os.fspath(path))[1].lower().lstrip(".")
-
-
-@contextlib.contextmanager
-def atomic_output(path):
-    """Yield a temporary path for Blender to write; once it has, rename it onto ``path`` (same folder).
-
-    The temporary file sits in a private folder beside the target, so Blender writes a fresh file
-    (no backup of an existing one, normal permissions) and one rename on the same file system puts it
-    in place. Nothing is left behind on failure.
-    """
-    path = os.path.abspath(os.fspath(path))
-    folder = os.path.dirname(path)
-    os.makedirs(folder, exist_ok=True)
-    scratch = tempfile.mkdtemp(prefix=".ellimann-", dir=folder)
-    temp = os.path.join(scratch, os.path.basename(path))
-    try:
-        yield temp
-        if not os.path.isfile(temp) or not os.path.getsize(temp):
-            raise OSError(f"Blender wrote nothing to {path}")
-        os.replace(temp, path)
-    finally:
-        shutil.rmtree(scratch, ignore_errors=True)
 
 
 def _write_blender_file(path, collection):

@@ -34,6 +34,7 @@ class ELLIMANN_PT_main(ElliMannPanel, bpy.types.Panel):
         count = len(ellipsoid_objects(collection))
         cushions = len(built_objects(collection, "CUSHION"))
         layout.label(text=f"{count} ellipsoids, {cushions} cushions")
+        layout.operator(ids.EXPORT_MANNEQUIN, icon="EXPORT")
         if not (props.has_measured or props.has_target):
             layout.label(text="Not measured yet")
             return

@@ -33,11 +33,15 @@ class ELLIMANN_PG_part(bpy.types.PropertyGroup):
 
     is_part: BoolProperty(name="ElliMann Part", description="This object belongs to an ElliMann mannequin",
                           default=False)
-    kind: EnumProperty(name="Kind", items=KIND_ITEMS, default="ELLIPSOID")
+    kind: EnumProperty(name="Kind", items=KIND_ITEMS, default="ELLIPSOID",
+                       description="What this object is: an ellipsoid of the mannequin, or a cushion hull or "
+                                   "section curve ElliMann built from the ellipsoids (rebuilt on demand)")
     part_name: StringProperty(name="Part Name",
                               description="Topology name in the paper's style, e.g. '10.a Trapezius.L' "
                                           "(independent of the object's name, which Blender may suffix)")
-    side: EnumProperty(name="Side", items=SIDE_ITEMS, default="C")
+    side: EnumProperty(name="Side", items=SIDE_ITEMS, default="C",
+                       description="Side of the body the part is on: left and right parts mirror each other "
+                                   "across x = 0, central parts are symmetric about it")
     region: StringProperty(name="Region", description="Body region, e.g. 'legs'")
     girth: BoolProperty(name="Girth Sections", default=True,
                         description="Takes part in the breast, waist and hip sections (arms and hands do not)")
@@ -50,12 +54,19 @@ class ELLIMANN_PG_part(bpy.types.PropertyGroup):
 class ELLIMANN_PG_mannequin(bpy.types.PropertyGroup):
     """A collection that holds one mannequin's ellipsoids."""
 
-    is_mannequin: BoolProperty(name="ElliMann Mannequin", default=False)
-    role: EnumProperty(name="Role", items=ROLE_ITEMS, default="synthesized")
-    has_target: BoolProperty(name="Has Target", default=False)
+    is_mannequin: BoolProperty(name="ElliMann Mannequin", default=False,
+                               description="This collection holds an ElliMann mannequin: its ellipsoids, and in "
+                                           "child collections what ElliMann built from them")
+    role: EnumProperty(name="Role", items=ROLE_ITEMS, default="synthesized",
+                       description="What the mannequin is: the traced Base, a Reference used for synthesis, or "
+                                   "one synthesized from measurements")
+    has_target: BoolProperty(name="Has Target", default=False,
+                             description="Target holds requested measurements (those a mannequin was synthesized "
+                                         "from, or a Reference Mannequin's own)")
     target: FloatVectorProperty(name="Target (cm)", size=len(MEASUREMENTS), min=0.0,
                                 description="Requested tailor measurements He, Sh, Br, Wa, Hi in cm")
-    has_measured: BoolProperty(name="Has Measurements", default=False)
+    has_measured: BoolProperty(name="Has Measurements", default=False,
+                               description="Measured holds m_T of the mannequin (set by Measure and Synthesize)")
     measured: FloatVectorProperty(name="Measured (cm)", size=len(MEASUREMENTS), min=0.0,
                                   description="m_T of the mannequin: He, Sh, Br, Wa, Hi in cm")
 

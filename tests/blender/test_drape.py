@@ -5,6 +5,8 @@ short run can show: the cloth falls, pins hold, seams close, nothing ends inside
 replays the bake. Figures on real bodies are in bench/bench_drape.py.
 """
 
+import contextlib
+
 import bpy
 import numpy as np
 import pytest
@@ -13,8 +15,10 @@ from devkit.blender_scene import parts, select, state
 from devkit.poses import make_apose_toy
 from devkit.ui_recorder import draw_panel
 from ellimann_addon.blender import cli, drape_panel, ids
+from ellimann_addon.blender import drape as drape_module
 from ellimann_addon.blender.convert import mannequin_to_collection
 from ellimann_addon.blender.drape import CLOTH_NAME, PIN_GROUP, DrapeSettings, drape, evaluated_vertices
+from ellimann_addon.blender.operators import drape as drape_operator
 from ellimann_addon.core.errors import ElliMannError
 
 COARSE = {"edge": 0.04}
@@ -34,8 +38,12 @@ def assert_outside(fit):
 
 def test_tube_dress_falls_on_the_ellipsoids_held_by_its_pins(body):
     collection = mannequin_to_collection(body)
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 3, 7  # the user's range, shorter than the drape: left alone
     before = state()
-    result = drape(body, "tube_dress", DrapeSettings(frames=12, cushions=False, **COARSE))
+    frames_done = []
+    result = drape(body, "tube_dress", DrapeSettings(frames=12, cushions=False, **COARSE),
+                   progress=frames_done.append)
     garment, obj = result.garment, result.garment_object
     moved = result.vertices - garment.vertices
     hem = garment.vertices[:, 2] < garment.vertices[:, 2].min() + 1e-6
@@ -53,8 +61,10 @@ def test_tube_dress_falls_on_the_ellipsoids_held_by_its_pins(body):
     assert cloth.collision_settings.collection == colliders
     assert len(colliders.objects) == len(body) and result.collider_triangles == len(body) * 320
     assert all(o.modifiers[0].type == "COLLISION" and o.hide_get() and o.hide_render for o in colliders.objects)
-    assert cloth.point_cache.is_baked and bpy.context.scene.frame_current == 12
-    assert len(result.seconds) == len(result.cpu_seconds) == 11
+    assert cloth.point_cache.is_baked and (cloth.point_cache.frame_start, cloth.point_cache.frame_end) == (1, 12)
+    assert (scene.frame_start, scene.frame_end, scene.frame_current) == (3, 7, 12)
+    assert len(result.seconds) == len(result.cpu_seconds) == 11 and result.frames == 12
+    assert frames_done == list(range(1, 13))
     # The mannequin is not touched.
     after = state()
     assert {k: after["objects"][k] for k in before["objects"]} == before["objects"]
@@ -91,17 +101,96 @@ def test_bad_settings_and_garments_change_nothing(body):
     assert state() == before
 
 
+def failing_bake(scene, obj, frames, progress=None):
+    """A bake that gets a frame in and then fails as Blender's operators do, with a RuntimeError."""
+    scene.frame_set(2)
+    progress(1)
+    raise RuntimeError("Operator bpy.ops.ptcache.bake_from_cache.poll() failed, context is incorrect")
+
+
+def test_a_blender_error_while_simulating_removes_the_drape(body, monkeypatch):
+    mannequin_to_collection(body)
+    bpy.context.scene.frame_set(5)
+    before = state()
+    monkeypatch.setattr(drape_module, "bake", failing_bake)
+    with pytest.raises(ElliMannError, match="Blender failed while simulating the drape: Operator bpy.ops.ptcache"):
+        drape(body, "tube_dress", DrapeSettings(frames=4, cushions=False, **COARSE), progress=lambda _: None)
+    assert state() == before
+
+
+def test_a_blender_error_while_building_removes_the_drape(body, monkeypatch):
+    mannequin_to_collection(body)
+    before = state()
+    build = drape_module.collider_objects
+
+    def failing_colliders(pieces, collection):
+        build(pieces[:2], collection)
+        raise RuntimeError("Error: Not enough memory")
+
+    monkeypatch.setattr(drape_module, "collider_objects", failing_colliders)
+    with pytest.raises(ElliMannError, match="Blender failed while building the drape: Error: Not enough memory"):
+        drape(body, "tube_dress", DrapeSettings(frames=4, cushions=False, **COARSE))
+    assert state() == before
+
+
 # ------------------------------------------------------------------------------------------------ operator, panel
 
 
-def test_operator_drapes_the_active_mannequin_and_reports(body):
+class FakeWindowManager:
+    def __init__(self):
+        self.calls = []
+
+    def progress_begin(self, low, high):
+        self.calls.append(("begin", low, high))
+
+    def progress_update(self, value):
+        self.calls.append(value)
+
+    def progress_end(self):
+        self.calls.append("end")
+
+
+def test_progress_bar_ends_however_the_work_ends():
+    window_manager = FakeWindowManager()
+    with pytest.raises(ValueError), drape_operator.progress_bar(window_manager, 3) as update:
+        update(1)
+        raise ValueError("stopped")
+    assert window_manager.calls == [("begin", 0, 3), 1, "end"]
+
+
+@pytest.fixture
+def progress_log(monkeypatch):
+    """What the operator shows on Blender's progress indicator (which it still drives)."""
+    log = []
+    real = drape_operator.progress_bar
+
+    @contextlib.contextmanager
+    def recording(window_manager, total):
+        assert window_manager == bpy.context.window_manager
+        log.append(("begin", total))
+        try:
+            with real(window_manager, total) as update:
+                yield lambda frame: (log.append(frame), update(frame))
+        finally:
+            log.append("end")
+
+    monkeypatch.setattr(drape_operator, "progress_bar", recording)
+    return log
+
+
+def test_operator_drapes_the_active_mannequin_and_reports(body, progress_log, capfd):
     collection = mannequin_to_collection(body)
     select(parts(collection)["2.a Chest"])
-    props = bpy.context.scene.ellimann_drape
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 5, 30
+    props = scene.ellimann_drape
     props.frames, props.edge, props.cushions = 8, 0.05, True
     assert bpy.ops.ellimann.drape_garment() == {"FINISHED"}
     drapes = [c for c in bpy.data.collections if c.name.startswith("Drape Tube dress on")]
     assert len(drapes) == 1 and "8 frames" in props.status and "inside the body" in props.status
+    assert "Info: Baked 8 frames (" in capfd.readouterr().out
+    assert progress_log == [("begin", 8), *range(1, 9), "end"]
+    assert (scene.frame_start, scene.frame_end, scene.frame_current) == (5, 30, 8)
     recorder = draw_panel(drape_panel.ELLIMANN_PT_drape)
     assert recorder.operators() == [ids.DRAPE_GARMENT]
     assert {"garment", "frames", "edge", "cushions"} <= set(recorder.props())
@@ -125,6 +214,22 @@ def test_operator_refuses_a_broken_mannequin_and_needs_one(body):
     with pytest.raises(RuntimeError, match="Fix 'toy \\(A-pose\\)' first: '6.a Thigh.L'"):
         bpy.ops.ellimann.drape_garment()
     assert state() == before
+
+
+def test_operator_reports_a_blender_error_and_leaves_the_file_as_it_was(body, monkeypatch, progress_log):
+    collection = mannequin_to_collection(body)
+    select(parts(collection)["2.a Chest"])
+    props = bpy.context.scene.ellimann_drape
+    props.frames, props.edge, props.cushions = 4, 0.05, False
+    before = state()
+    monkeypatch.setattr(drape_module, "bake", failing_bake)
+    with pytest.raises(RuntimeError) as caught:
+        bpy.ops.ellimann.drape_garment()
+    message = str(caught.value)
+    assert "Cannot drape 'toy (A-pose)': Blender failed while simulating the drape" in message
+    assert "Traceback" not in message  # a report, not a Python error
+    assert progress_log == [("begin", 4), 1, "end"]
+    assert state() == before and props.status == ""
 
 
 # ------------------------------------------------------------------------------------------------ CLI

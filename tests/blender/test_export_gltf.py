@@ -1,11 +1,15 @@
 """glTF export keeps piece names and measurements in extras, exports only the mannequin, writes atomically."""
 
+import os
+import stat
+
 import bpy
 import numpy as np
 import pytest
 
 from ellimann_addon.blender import convert
 from ellimann_addon.blender.export import EXTRAS_KEY, export_gltf, read_glb_json
+from ellimann_addon.blender.output import write_mannequin
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.errors import ElliMannError, MannequinError
 from ellimann_addon.core.quaternion import quaternion_to_rotation
@@ -82,3 +86,28 @@ def test_bad_input_writes_nothing(mannequin, tmp_path):
     assert target.read_bytes() == b"previous"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["toy.glb"]
     assert all(EXTRAS_KEY not in o for o in collection.objects)
+
+
+@pytest.fixture
+def umask():
+    """A known umask (022: files 0644) for the test, the previous one restored afterwards."""
+    previous = os.umask(0o022)
+    yield 0o022
+    os.umask(previous)
+
+
+def test_every_format_gets_the_usual_permissions(mannequin, tmp_path, umask):
+    paths = [tmp_path / f"toy.{ext}" for ext in ("glb", "blend", "obj", "json", "xml")]
+    write_mannequin(mannequin, paths)
+    modes = {p.suffix: stat.S_IMODE(p.stat().st_mode) for p in paths}
+    assert modes == {p.suffix: 0o666 & ~umask for p in paths}  # mkstemp's 0600 would show here
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in paths)
+
+
+def test_export_reads_parts_in_child_collections(mannequin, tmp_path):
+    collection = convert.mannequin_to_collection(mannequin)
+    bpy.context.view_layer.objects.active = collection.objects[0]
+    bpy.ops.ellimann.build_cushions(subdivisions=1)
+    doc = read_glb_json(export_gltf(collection, tmp_path / "toy.glb"))
+    kinds = [n["extras"][EXTRAS_KEY]["kind"] for n in doc["nodes"]]
+    assert kinds.count("CUSHION") == 3 and kinds.count("ELLIPSOID") == len(mannequin)

@@ -3,11 +3,16 @@
 import bpy
 import pytest
 
-from ellimann_addon.blender import ids, menus, operators, panels
+from ellimann_addon.blender import drape_panel, ids, menus, operators, panels, props, synthesize, synthesize_panel
 
 OPERATORS = operators.classes()
+# Everything whose properties show tooltips: the property groups and every operator (the Synthesize
+# module's too). test_tooltips_cover_everything_registered keeps this list complete.
+PROPERTY_GROUPS = [c for m in (props, drape_panel, synthesize) for c in m.classes
+                   if issubclass(c, bpy.types.PropertyGroup)]
+TOOLTIP_OWNERS = PROPERTY_GROUPS + OPERATORS + [c for c in synthesize.classes if issubclass(c, bpy.types.Operator)]
 ALL_IDS = [v for k, v in vars(ids).items() if k.isupper() and isinstance(v, str) and v.startswith("ellimann.")]
-READ_ONLY = {ids.VALIDATE_MANNEQUIN, ids.ADD_MEASUREMENT_PRESET}
+READ_ONLY = {ids.VALIDATE_MANNEQUIN, ids.ADD_MEASUREMENT_PRESET, ids.EXPORT_MANNEQUIN}
 
 
 def registered_operator_names():
@@ -38,4 +43,63 @@ def test_sub_panels_hang_under_the_main_panel_in_their_order():
     subs = [cls for cls in panels.classes if cls.bl_idname != ids.PANEL_MAIN]
     assert all(cls.bl_parent_id == ids.PANEL_MAIN for cls in subs)
     assert [cls.bl_order for cls in subs] == sorted(ids.PANEL_ORDER.values())
-    assert max(ids.PANEL_ORDER.values()) < 60  # room for Synthesize and Drape
+    assert max(ids.PANEL_ORDER.values()) < ids.SYNTHESIZE_ORDER < ids.DRAPE_ORDER  # Synthesize, Drape come last
+
+
+def test_the_other_modules_use_the_ids_of_ids_py():
+    """ids.py holds every id, including those of the Synthesize and Drape modules (whatever they spell them with)."""
+    assert synthesize.ELLIMANN_OT_synthesize_mannequin.bl_idname == ids.SYNTHESIZE_MANNEQUIN
+    assert synthesize.ELLIMANN_OT_add_measurement_preset.bl_idname == ids.ADD_MEASUREMENT_PRESET
+    assert synthesize.ELLIMANN_MT_measurement_presets.bl_idname == ids.MENU_MEASUREMENT_PRESETS
+    assert synthesize.ELLIMANN_OT_add_measurement_preset.preset_menu == ids.MENU_MEASUREMENT_PRESETS
+    for panel, order in ((synthesize_panel.ELLIMANN_PT_synthesize, ids.SYNTHESIZE_ORDER),
+                         (drape_panel.ELLIMANN_PT_drape, ids.DRAPE_ORDER)):
+        assert panel.__name__ == panel.bl_idname and panel.bl_idname in (ids.PANEL_SYNTHESIZE, ids.PANEL_DRAPE)
+        assert (panel.bl_parent_id, panel.bl_order) == (ids.PANEL_MAIN, order)
+
+
+def rna_of(cls):
+    if issubclass(cls, bpy.types.Operator):
+        return getattr(bpy.ops.ellimann, cls.bl_idname.partition(".")[2]).get_rna_type()
+    return cls.bl_rna
+
+
+def missing_tooltips(rna):
+    """Properties (and enum items) of ``rna`` without a description. Hidden properties never show one."""
+    missing = []
+    for prop in rna.properties:
+        if prop.identifier == "rna_type" or prop.is_hidden:
+            continue
+        if not prop.description.strip():
+            missing.append(prop.identifier)
+        if prop.type == "ENUM":
+            missing += [f"{prop.identifier}['{item.identifier}']" for item in prop.enum_items
+                        if not item.description.strip()]
+    return missing
+
+
+@pytest.mark.parametrize("cls", TOOLTIP_OWNERS, ids=lambda c: c.__name__)
+def test_every_property_and_enum_item_has_a_tooltip(cls):
+    assert missing_tooltips(rna_of(cls)) == []
+
+
+def test_tooltips_cover_everything_registered():
+    groups = {c.__name__ for c in bpy.types.PropertyGroup.__subclasses__()
+              if c.__name__.startswith("ELLIMANN_") and c.is_registered}
+    assert {"ELLIMANN_PG_part", "ELLIMANN_PG_mannequin", "ELLIMANN_PG_synthesis", "ELLIMANN_PG_drape"} <= groups
+    operator_classes = {ids.class_name(f"ellimann.{name}") for name in registered_operator_names()}
+    assert {c.__name__ for c in TOOLTIP_OWNERS} == groups | operator_classes
+
+
+def test_missing_tooltips_finds_properties_and_items_without_one():
+    class ELLIMANN_PG_tooltip_probe(bpy.types.PropertyGroup):
+        bare: bpy.props.IntProperty(name="Bare")
+        told: bpy.props.EnumProperty(name="Told", description="Has one",
+                                     items=(("A", "A", "Item with a tooltip"), ("B", "B", "")))
+        hidden: bpy.props.BoolProperty(options={"HIDDEN"})
+
+    bpy.utils.register_class(ELLIMANN_PG_tooltip_probe)
+    try:
+        assert missing_tooltips(ELLIMANN_PG_tooltip_probe.bl_rna) == ["bare", "told['B']"]
+    finally:
+        bpy.utils.unregister_class(ELLIMANN_PG_tooltip_probe)

@@ -85,6 +85,19 @@ def test_menus_reach_every_operator():
     assert reached == everything - {ids.ADD_MEASUREMENT_PRESET}
 
 
+def test_recorder_refuses_misspelt_icons():
+    recorder = Recorder()
+    recorder.label(text="fine", icon="MOD_CLOTH")
+    recorder.operator(ids.NEW_MANNEQUIN, icon="NONE")
+    for draw in (lambda: recorder.label(text="x", icon="MOD_CLOTHES"),
+                 lambda: recorder.operator(ids.NEW_MANNEQUIN, icon="outliner_collection"),
+                 lambda: recorder.prop(bpy.context.scene.ellimann_drape, "garment", icon="CLOTH"),
+                 lambda: recorder.menu(menus.ELLIMANN_MT_object.bl_idname, icon="ELLIMANN")):
+        with pytest.raises(ValueError, match="is not a Blender icon name"):
+            draw()
+    assert [kind for kind, _ in recorder.log] == ["label", "operator"]
+
+
 def test_menu_entries_are_appended_to_blender_menus():
     for menu, draw in menus.MENU_ENTRIES:
         assert draw in getattr(bpy.types, menu)._dyn_ui_initialize()

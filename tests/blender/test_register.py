@@ -25,10 +25,10 @@ def leftovers():
 
 
 def test_disable_leaves_nothing_and_enable_works_again():
-    assert len(all_classes()) == 2 + 13 + 6 + 1 + 2
+    assert len(all_classes()) == 2 + 14 + 6 + 1 + 2
     assert not [c.__name__ for c in all_classes() if not c.is_registered]
     assert {"Object.ellimann", "Scene.ellimann_drape", "bpy.ops.ellimann.drape_garment",
-            "VIEW3D_MT_add entry"} <= set(leftovers())
+            "VIEW3D_MT_add entry", "TOPBAR_MT_file_export entry"} <= set(leftovers())
     ellimann_addon.unregister()
     try:
         assert leftovers() == []

@@ -18,3 +18,14 @@ def test_state_notices_moves_and_field_changes_but_not_reevaluation(toy_collecti
     assert state() == before
     obj.ellimann.region = "skull"
     assert state() != before
+
+
+def test_state_notices_new_mesh_data_and_frame_changes(toy_collection):
+    before = state()
+    bpy.context.scene.frame_current = 7
+    assert state() != before
+    bpy.context.scene.frame_current = before["frames"][2]
+    assert state() == before
+    mesh = bpy.data.meshes["ElliMann Unit Sphere"]
+    mesh.vertices.add(1)
+    assert state() != before

@@ -3,15 +3,13 @@
 import bpy
 import numpy as np
 import pytest
-from mathutils import Matrix
 
-from devkit.blender_scene import parts, select, state
+from devkit.blender_scene import edit_with_selection, parts, reference_mesh, state
 from devkit.toy import rotation_from_vector
 from ellimann_addon.blender.convert import collection_to_mannequin, ellipsoid_frame
 from ellimann_addon.blender.operators.trace import FIT_MODE_ITEMS, next_part_name
 from ellimann_addon.core.fit import FIT_MODES, fit_ellipsoid
 from ellimann_addon.core.frames import is_rotation
-from ellimann_addon.core.mesh import icosphere
 
 
 def test_fit_mode_items_are_the_core_modes():
@@ -62,31 +60,6 @@ def test_add_ellipsoid_without_mannequin_and_bad_name_creates_no_collection():
     with pytest.raises(RuntimeError, match="must look like"):
         bpy.ops.ellimann.add_ellipsoid(part_name="no number")
     assert state() == before and not bpy.data.collections
-
-
-def reference_mesh(rotation, center, semi_axes, name="Reference"):
-    """An ellipsoid-shaped user mesh whose object transform is not the identity."""
-    unit, faces = icosphere(3)
-    mesh = bpy.data.meshes.new(name)
-    mesh.from_pydata((unit * semi_axes).tolist(), [], faces.tolist())
-    obj = bpy.data.objects.new(name, mesh)
-    bpy.context.scene.collection.objects.link(obj)
-    matrix = np.eye(4)
-    matrix[:3, :3], matrix[:3, 3] = rotation, center
-    obj.matrix_world = Matrix(matrix.tolist())
-    return obj
-
-
-def edit_with_selection(obj, selected):
-    select(obj)
-    # Edit Mode also selects the vertices of selected edges and faces: deselect everything there first.
-    bpy.ops.object.mode_set(mode="EDIT")
-    bpy.ops.mesh.select_all(action="DESELECT")
-    bpy.ops.object.mode_set(mode="OBJECT")
-    flags = np.zeros(len(obj.data.vertices), bool)
-    flags[selected] = True
-    obj.data.vertices.foreach_set("select", flags)
-    bpy.ops.object.mode_set(mode="EDIT")
 
 
 @pytest.mark.parametrize("mode", FIT_MODES)

@@ -3,7 +3,7 @@
 import importlib
 
 # Registered in this order, unregistered in reverse.
-_MODULES = ("trace", "mirror", "clean", "cushions", "measure", "validate", "drape")
+_MODULES = ("trace", "mirror", "clean", "cushions", "measure", "validate", "drape", "export")
 
 
 def _modules():

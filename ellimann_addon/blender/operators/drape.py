@@ -1,5 +1,7 @@
 """Drape: a garment sized from the active mannequin, simulated with Blender cloth on its convex pieces."""
 
+import contextlib
+
 import bpy
 
 from ...core.errors import ElliMannError, MannequinError
@@ -10,6 +12,17 @@ from ..selection import active_mannequin
 from .common import cancel
 
 PENETRATION_WARNING = 0.01  # fraction of garment vertices inside the body worth a warning
+
+
+@contextlib.contextmanager
+def progress_bar(window_manager, total):
+    """Blender's progress indicator from 0 to ``total`` (the cursor shows the count); yields the update
+    function and ends the indicator however the block ends."""
+    window_manager.progress_begin(0, total)
+    try:
+        yield window_manager.progress_update
+    finally:
+        window_manager.progress_end()
 
 
 class ELLIMANN_OT_drape_garment(bpy.types.Operator):
@@ -31,8 +44,10 @@ class ELLIMANN_OT_drape_garment(bpy.types.Operator):
             mannequin = collection_to_mannequin(collection)
         except MannequinError as error:
             return cancel(self, f"Fix '{collection.name}' first", error.problems)
+        settings = props.settings()
         try:
-            result = drape(mannequin, props.garment, props.settings(), scene=context.scene)
+            with progress_bar(context.window_manager, settings.frames) as update:
+                result = drape(mannequin, props.garment, settings, scene=context.scene, progress=update)
         except MannequinError as error:
             return cancel(self, f"Cannot drape '{collection.name}'", error.problems)
         except ElliMannError as error:
@@ -41,8 +56,8 @@ class ELLIMANN_OT_drape_garment(bpy.types.Operator):
         if result.fit["penetrating_fraction"] > PENETRATION_WARNING:
             self.report({"WARNING"}, f"{result.fit['penetrating']} garment vertices ended inside the body: try more "
                                      "frames, a finer collider or a finer cloth")
-        self.report({"INFO"}, f"Draped a {result.garment.name} on '{collection.name}' in "
-                              f"'{result.collection.name}': {props.status}")
+        self.report({"INFO"}, f"Baked {result.frames} frames ({result.seconds.sum():.1f} s): a {result.garment.name} "
+                              f"on '{collection.name}' in '{result.collection.name}': {props.status}")
         return {"FINISHED"}
 
 

@@ -55,7 +55,9 @@ class ELLIMANN_OT_measure_mannequin(bpy.types.Operator):
     bl_label = "Measure"
     bl_options = {"REGISTER", "UNDO"}
 
-    source: EnumProperty(name="Measure On", items=SOURCE_ITEMS, default="AUTO")
+    source: EnumProperty(name="Measure On", items=SOURCE_ITEMS, default="AUTO",
+                         description="Measure the ellipsoids (exact, closed form) or the cushion mannequin (its "
+                                     "hull meshes)")
     draw_sections: BoolProperty(name="Draw Sections", default=False,
                                 description="Draw the Sh, Br, Wa and Hi section hulls as curves at their heights "
                                             "(replacing those drawn before)")

@@ -58,8 +58,10 @@ class ELLIMANN_OT_new_mannequin(bpy.types.Operator):
     bl_label = "New Mannequin"
     bl_options = {"REGISTER", "UNDO"}
 
-    name: StringProperty(name="Name", default="Mannequin")
-    role: EnumProperty(name="Role", items=ROLE_ITEMS, default="base")
+    name: StringProperty(name="Name", default="Mannequin",
+                         description="Name of the new mannequin collection (Blender adds a number if it is taken)")
+    role: EnumProperty(name="Role", items=ROLE_ITEMS, default="base",
+                       description="Role of the new mannequin: one traced over a reference body is the Base")
 
     @classmethod
     def poll(cls, context):

@@ -1,0 +1,92 @@
+"""Export Mannequin (File > Export, the sidebar): the active mannequin to .glb with extras or to MJCF, headless."""
+
+import xml.etree.ElementTree as ET
+
+import bpy
+import pytest
+
+from devkit.blender_scene import parts, select, state
+from devkit.ui_recorder import draw_menu_function, draw_operator, draw_panel
+from ellimann_addon.blender import ids, menus, panels
+from ellimann_addon.blender.convert import mannequin_to_collection
+from ellimann_addon.blender.export import EXTRAS_KEY, read_glb_json
+from ellimann_addon.blender.operators.export import (
+    ELLIMANN_OT_export_mannequin,
+    default_path,
+    reconcile,
+    with_extension,
+)
+
+
+def geoms(path):
+    return [g for g in ET.parse(path).getroot().iter("geom") if g.get("name") not in (None, "floor")]
+
+
+def test_glb_with_extras_of_the_active_mannequin(toy, toy_collection, tmp_path, capfd):
+    mannequin_to_collection(toy.copy(name="other"))
+    select(parts(toy_collection)["6.a Thigh.L"])
+    before = state()
+    path = tmp_path / "out" / "toy.glb"
+    assert bpy.ops.ellimann.export_mannequin(filepath=str(path)) == {"FINISHED"}
+    doc = read_glb_json(path)
+    assert sorted(n["name"] for n in doc["nodes"]) == sorted(toy.topology.names)  # the active one only
+    assert doc["scenes"][0]["extras"][EXTRAS_KEY]["name"] == "toy"
+    assert f"Info: Exported 'toy' (glTF) to {path}" in capfd.readouterr().out
+    assert state() == before  # writing a file changes nothing in Blender's data
+    assert [p.name for p in path.parent.iterdir()] == ["toy.glb"]
+
+
+def test_the_extension_or_the_format_chooses_mjcf(toy, toy_collection, tmp_path, capfd):
+    assert bpy.ops.ellimann.export_mannequin(filepath=str(tmp_path / "toy.xml")) == {"FINISHED"}
+    assert sorted(g.get("name") for g in geoms(tmp_path / "toy.xml")) == sorted(toy.topology.names)
+    assert all(g.get("type") == "ellipsoid" for g in geoms(tmp_path / "toy.xml"))
+    assert bpy.ops.ellimann.export_mannequin(filepath=str(tmp_path / "hulls"), format="MJCF",
+                                             cushions=True) == {"FINISHED"}
+    shapes = [g.get("type") for g in geoms(tmp_path / "hulls.xml")]
+    assert shapes.count("mesh") == len(toy.topology.cushion_pairs) == 3
+    assert shapes.count("ellipsoid") == len(toy) - 6
+    assert "(MJCF with cushion meshes)" in capfd.readouterr().out
+
+
+def test_refuses_bad_paths_and_broken_mannequins_writing_nothing(toy_collection, tmp_path):
+    for path, words in ((f"{tmp_path}/toy.obj", "'toy.obj': a mannequin is exported as .glb or .xml"),
+                        (f"{tmp_path}/", "Choose a file name")):
+        with pytest.raises(RuntimeError, match=words):
+            bpy.ops.ellimann.export_mannequin(filepath=path)
+    target = tmp_path / "toy.glb"
+    target.write_bytes(b"previous")
+    pelvis = parts(toy_collection)["3.a Pelvis"]
+    pelvis.scale.x *= -1
+    bpy.context.view_layer.update()
+    for path in (target, tmp_path / "toy.xml"):
+        with pytest.raises(RuntimeError, match="Fix 'toy' first: '3.a Pelvis'"):
+            bpy.ops.ellimann.export_mannequin(filepath=str(path))
+    assert target.read_bytes() == b"previous" and [p.name for p in tmp_path.iterdir()] == ["toy.glb"]
+
+
+def test_needs_an_active_mannequin():
+    assert not bpy.ops.ellimann.export_mannequin.poll()
+    bpy.ops.ellimann.new_mannequin()
+    assert bpy.ops.ellimann.export_mannequin.poll()
+
+
+def test_extension_and_format_follow_each_other():
+    assert with_extension("/a/toy.glb", "MJCF") == "/a/toy.xml"
+    assert with_extension("/a/ElliMann 159.5-43", "GLB") == "/a/ElliMann 159.5-43.glb"
+    assert reconcile("/a/toy.glb", "MJCF", "GLB") == ("/a/toy.xml", "MJCF")  # the format was changed
+    assert reconcile("/a/toy.xml", "GLB", "GLB") == ("/a/toy.xml", "MJCF")  # the file name was changed
+    assert reconcile("/a/toy", "GLB", "GLB") == ("/a/toy.glb", "GLB")
+    assert default_path("toy (A-pose)", "/work/scenes/traced.blend", "MJCF") == "/work/scenes/toy (A-pose).xml"
+    assert default_path("a/b", "", "GLB") == "a_slash_b.glb"  # an unsaved file: Blender's current folder
+
+
+def test_reachable_from_file_export_the_object_menu_and_the_main_panel(toy_collection):
+    export_entry = dict(menus.MENU_ENTRIES)["TOPBAR_MT_file_export"]
+    assert draw_menu_function(export_entry).operators() == [ids.EXPORT_MANNEQUIN]
+    assert ids.EXPORT_MANNEQUIN in draw_panel(menus.ELLIMANN_MT_object).operators()
+    assert ids.EXPORT_MANNEQUIN in draw_panel(panels.ELLIMANN_PT_main).operators()
+
+
+def test_options_draw():
+    recorder = draw_operator(ELLIMANN_OT_export_mannequin, format="GLB")
+    assert recorder.props() == ["format", "cushions"]
