@@ -14,8 +14,9 @@ triangles, and the final garment against the DENSE body surface (signed distance
 inside) for both, so the comparison is fair; (a) also against its own exact pieces. "Equal fit"
 for the resolution sweep (both garments, cushion and ellipsoid colliders each against the finest of
 their own kind): median and 95th-percentile gap to the dense body within FIT_TOLERANCE (p95: twice
-that) of the finest colliders', no more vertices inside it, and no vertex more than FIT_TOLERANCE
-inside the exact pieces (a coarse collider lets the cloth into them).
+that) of the finest colliders', vertices inside it within PENETRATING_TOLERANCE of the garment of
+theirs, and no vertex more than FIT_TOLERANCE inside the exact pieces (a coarse collider lets the
+cloth into them).
 """
 
 import os
@@ -39,6 +40,9 @@ FRAMES = 40
 EDGE = 0.025  # m, the garments' cloth resolution
 REPEAT = 3
 FIT_TOLERANCE = 0.001  # m
+# Vertices inside the dense body come mostly from the pieces lying inside the skin, at any collider
+# resolution; a few more than the finest collider's (this share of the garment) is still equal fit.
+PENETRATING_TOLERANCE = 0.01
 # Collider resolutions tried for (a): (label, cushions, sphere level, cushion level).
 SWEEP = (
     ("cushions L1/L1", True, 1, 1),
@@ -172,11 +176,11 @@ def best_at_equal_fit(sweep, kind):
     equal = [label for label, row in sweep.items()
              if abs(row["dense"]["median"] - finest["median"]) <= FIT_TOLERANCE
              and abs(row["dense"]["p95"] - finest["p95"]) <= 2 * FIT_TOLERANCE
-             and row["dense"]["penetrating"] <= finest["penetrating"]
+             and row["dense"]["penetrating"] <= finest["penetrating"] + PENETRATING_TOLERANCE * len(row["vertices"])
              and row["own"]["max_depth"] <= FIT_TOLERANCE]
-    criteria = (f"median within {FIT_TOLERANCE * 1e3:g} mm, p95 within {2 * FIT_TOLERANCE * 1e3:g} mm of "
-                f"{finest_label}'s, no more vertices inside the dense body, none over {FIT_TOLERANCE * 1e3:g} mm "
-                "inside the exact pieces")
+    criteria = (f"median within {FIT_TOLERANCE * 1e3:g} mm, p95 within {2 * FIT_TOLERANCE * 1e3:g} mm and vertices "
+                f"inside the dense body within {PENETRATING_TOLERANCE:.0%} of the garment of {finest_label}'s, none "
+                f"over {FIT_TOLERANCE * 1e3:g} mm inside the exact pieces")
     if not equal:
         return f"{kind}: no resolution fits as {finest_label} does ({criteria})"
     best = min(equal, key=lambda label: sweep[label]["seconds"])

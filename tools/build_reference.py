@@ -537,12 +537,12 @@ def measurements_doc(base, rms, report):
         "",
         "Smallest cosine between an ellipsoid's axis and the same axis of the same ellipsoid in the "
         f"{DISPLAY_NAMES[report['reference_rm']]} RM, over the five RMs and three axes: "
-        f"**{min(report['agreement'].values()):.4f}** (1 = identical). The five lowest parts:",
+        f"**{min(report['agreement'].values()):.4f}** (1 = identical). Every part, lowest first:",
         "",
         "| part | smallest agreement |",
         "|---|---|",
     ]
-    for name, value in sorted(report["agreement"].items(), key=lambda item: item[1])[:5]:
+    for name, value in sorted(report["agreement"].items(), key=lambda item: item[1]):
         lines.append(f"| {name} | {value:.4f} |")
     return "\n".join(lines) + "\n"
 

@@ -2,7 +2,7 @@
 
 File > Export > ElliMann Mannequin, or the button in the sidebar's ElliMann tab. The writers are the
 ones the CLI uses (:func:`..export.export_gltf`, :func:`...core.export_mjcf.write_mjcf`), so a file
-written here is the same as ``ellimann convert``'s.
+written here is the same as ``ellimann synth -o``'s.
 """
 
 import os
