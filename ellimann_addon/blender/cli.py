@@ -308,6 +308,24 @@ def read_rows(path):
     return rows
 
 
+def name_rows(rows):
+    """Give every row its output name (``row-NNNNN`` from its line when the CSV has none) and refuse a row
+    whose name an earlier row already uses (letter case ignored: the files would clash on macOS and
+    Windows). Runs over the whole CSV before sharding, so every shard refuses the same rows."""
+    seen, named = {}, []
+    for line, name, values, error, warnings in rows:
+        name = name or f"row-{line - 1:05d}"
+        key = name.casefold()
+        if error is None and key in seen:
+            first_line, first_name = seen[key]
+            same = "" if first_name == name else f" (as {first_name!r}; file names ignore case on some systems)"
+            error = f"name: {name!r} is already used on line {first_line}{same}"
+        if error is None:
+            seen[key] = (line, name)
+        named.append((line, name, values, error, warnings))
+    return named
+
+
 def run_batch(args):
     formats = parse_formats(args.format)
     shard, shards = parse_shard(args.shard)
@@ -315,14 +333,10 @@ def run_batch(args):
     if not rows:
         raise UsageError(f"{args.csv} has a header but no rows")
     reference = _references(args)
+    rows = name_rows(rows)  # over the whole CSV, so every shard agrees on which rows are bad
     mine = [row for index, row in enumerate(rows) if index % shards == shard - 1]
-    seen = {}
     jobs, report = [], []
     for line, name, values, error, warnings in mine:
-        name = name or f"row-{line - 1:05d}"
-        if error is None and name in seen:
-            error = f"name: {name!r} is already used on line {seen[name]}"
-        seen.setdefault(name, line)
         if error is not None:
             print(f"{PROG} batch: line {line}: skipped: {error}", file=sys.stderr)
             report.append(_report_row(line, name, "error", error, values))

@@ -289,6 +289,29 @@ def test_batch_shards_partition_the_rows(tmp_path, capsys, references):
     assert not (out / "report.csv").exists()
 
 
+def test_batch_shards_agree_on_duplicate_names_across_the_whole_csv(tmp_path, capsys, references):
+    """Rows 1 and 2 share a name but land in different shards: only the first may write DIR/same.json."""
+    rows = [(150, 40, 110, 95, 110, "same"), (160, 40, 110, 95, 110, "same"), (155, 40, 110, 95, 110, "SAME"),
+            (158, 40, 110, 95, 110, "other")]
+    source = write_csv(tmp_path / "in.csv", rows)
+    out = tmp_path / "out"
+    errors = {}
+    for shard in (1, 2):
+        code, _, err = run(["batch", source, "-o", str(out), "--shard", f"{shard}/2", "--mode", "idw",
+                            "--references", references], capsys)
+        assert code == 1  # each shard holds one of the duplicates
+        errors[shard] = err
+    assert "line 4: skipped: name: 'SAME' is already used on line 2 (as 'same'" in errors[1]
+    assert "line 3: skipped: name: 'same' is already used on line 2" in errors[2]
+    assert Mannequin.load(out / "same.json").measurements["He"] == 150.0  # not overwritten by line 3
+    assert sorted(p.name for p in out.iterdir()) == ["other.json", "report-1-of-2.csv", "report-2-of-2.csv",
+                                                     "same.json"]
+    statuses = {}
+    for shard in (1, 2):
+        statuses.update({r["line"]: r["status"] for r in read_report(out / f"report-{shard}-of-2.csv")})
+    assert statuses == {"2": "ok", "3": "error", "4": "error", "5": "ok"}
+
+
 @pytest.mark.parametrize("header, extra, words", [
     (("He", "Sh", "Br", "Hi"), [], ("lacks column(s) Wa",)),
     (("He", "Sh", "Br", "Wa", "Hi"), ["--shard", "4/3"], ("--shard must be I/N",)),
