@@ -63,6 +63,9 @@ def deformation(title, result, seconds):
           + ", ".join(f"{k} {m:.2f}/{x:.2f}" for k, m, x in zip(MEASUREMENTS, spread.mean(0), spread.max(0))))
 
 
+_err = synthesis.relative_error  # |a - b| / b in %
+
+
 def _stat(values):
     return f"{values.mean():5.2f} /{values.max():6.2f}"
 
@@ -100,8 +103,8 @@ def diagnose(reference, requests):
     he_only = [row for row, part in enumerate(source) if topology.dependency_mask[part].sum() == 1]
     if he_only:
         implied = weights[:, he_only[0]] @ reference.measurements
-        error = 100.0 * np.abs(implied[:, 0] - requests[:, 0]) / requests[:, 0]
-        print(f"  He: paper IDW {_stat(100.0 * np.abs(measured[:, 0] - requests[:, 0]) / requests[:, 0])}; "
+        error = _err(implied[:, 0], requests[:, 0])
+        print(f"  He: paper IDW {_stat(_err(measured[:, 0], requests[:, 0]))}; "
               f"the head (on He alone) is built for sum_j w_j He_j, off by {_stat(error)}")
     for index, key in enumerate(MEASUREMENTS[1:], start=1):
         own = topology.dependency_mask[:, index]
@@ -114,14 +117,14 @@ def diagnose(reference, requests):
         moved = _section(rotation, center, semi_axes, placed, parts, key)
         own_only = _section(rotation, center, semi_axes, z[key], parts & own, key)
         foreign = np.abs(measured[:, index] - own_only) > 1e-9
-        added = 100.0 * (measured[:, index] - own_only) / measured[:, index]
+        added = 100.0 * (measured[:, index] - own_only) / measured[:, index]  # share the foreign parts add
         target = requests[:, index]
-        print(f"  {key}: paper IDW {_stat(100.0 * np.abs(measured[:, index] - target) / target)}; its parts are "
-              f"built for an He off by {_stat(100.0 * np.abs(implied[:, 0] - requests[:, 0]) / requests[:, 0])} "
+        print(f"  {key}: paper IDW {_stat(_err(measured[:, index], target))}; its parts are "
+              f"built for an He off by {_stat(_err(implied[:, 0], requests[:, 0]))} "
               f"(section {_stat(np.abs(placed - z[key]) * 100.0)} cm off); with the section moved there "
-              f"{_stat(100.0 * np.abs(moved - target) / target)}\n"
-              f"      of which sum_j w_j {key}_j vs {key} {_stat(100.0 * np.abs(implied[:, index] - target) / target)}"
-              f" + m_T non-linearity {_stat(100.0 * np.abs(moved - implied[:, index]) / implied[:, index])}; "
+              f"{_stat(_err(moved, target))}\n"
+              f"      of which sum_j w_j {key}_j vs {key} {_stat(_err(implied[:, index], target))}"
+              f" + m_T non-linearity {_stat(_err(moved, implied[:, index]))}; "
               f"parts of other measurements change it in {foreign.sum()} mannequins, by "
               f"{_stat(added)}")
 
@@ -163,7 +166,7 @@ def run():
     start = time.perf_counter()
     old = old_exact(reference, requests)
     t_old = time.perf_counter() - start
-    old_error = 100.0 * np.abs(old.measured - requests) / requests
+    old_error = synthesis.relative_error(old.measured, requests)
     table(f"\nTable 2.4, exact mode after the paper's IDW (finite-difference start), in {t_old:.2f} s", old_error)
     print()
     deformation("exact after paper IDW       ", old, t_old)

@@ -35,6 +35,7 @@ from ..core.synthesis import (
     NORMALIZATIONS,
     PAPER_NORMALIZE,
     load_reference_set,
+    relative_error,
     synthesize,
     synthesize_batch,
     validate_request,
@@ -236,7 +237,7 @@ def run_synth(args):
     for warning in warnings:
         print(f"{PROG} synth: warning: {warning}", file=sys.stderr)
     _write(mannequin, [args.output], measured, args.cushions and kind != "json")
-    error = max(abs(measured[k] - request[k]) / request[k] * 100.0 for k in MEASUREMENTS)
+    error = relative_error(measured, request).max()
     print(f"wrote {args.output}: '{mannequin.name}' ({args.mode}), m_T {_format_me(measured.values())} cm, "
           f"max error {error:.3f}%")
     return 0
@@ -386,11 +387,11 @@ REPORT_COLUMNS = (["line", "name", "status", "message"] + list(MEASUREMENTS)
 
 def _report_row(line, name, status, message, requested=None, measured=None, paths=()):
     row = {"line": line, "name": name, "status": status, "message": message or "", "files": " ".join(paths)}
+    error = relative_error(measured, requested) if measured is not None else None
     for i, key in enumerate(MEASUREMENTS):
         row[key] = f"{requested[i]:g}" if requested is not None else ""
         row[f"{key}_measured"] = f"{measured[i]:.4f}" if measured is not None else ""
-        row[f"{key}_error_pct"] = (f"{100.0 * abs(measured[i] - requested[i]) / requested[i]:.4f}"
-                                   if measured is not None else "")
+        row[f"{key}_error_pct"] = f"{error[i]:.4f}" if error is not None else ""
     return row
 
 

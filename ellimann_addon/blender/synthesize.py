@@ -17,7 +17,14 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, PointerProperty
 
 from ..core.constants import ABSURD_LIMITS, MEASUREMENT_LABELS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS
 from ..core.errors import ElliMannError
-from ..core.synthesis import DEFAULT_NORMALIZE, DEFAULT_POWER, POWER_LIMITS, cached_reference_set, synthesize
+from ..core.synthesis import (
+    DEFAULT_NORMALIZE,
+    DEFAULT_POWER,
+    POWER_LIMITS,
+    cached_reference_set,
+    relative_error,
+    synthesize,
+)
 from .convert import ellipsoid_objects, update_collection_geometry, write_measured
 from .output import add_mannequin, objects_recursive, refresh_cushions
 
@@ -143,8 +150,7 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
         props.status = "; ".join(warnings)
         for warning in warnings:
             self.report({"WARNING"}, warning)
-        request = request_of(props)
-        worst = max(abs(measured[k] - request[k]) / request[k] * 100.0 for k in MEASUREMENTS)
+        worst = relative_error(measured, request_of(props)).max()
         values = ", ".join(f"{k} {measured[k]:.2f}" for k in MEASUREMENTS)
         self.report({"INFO"}, f"Synthesized '{collection.name}' ({len(ellipsoid_objects(collection))} ellipsoids, "
                               f"{props.mode.lower()}): m_T {values} cm, max error {worst:.2f}%")

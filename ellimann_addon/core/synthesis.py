@@ -168,6 +168,19 @@ def mannequin_name(me):
     return "ElliMann " + "-".join(f"{v:.6g}" for v in values)
 
 
+def relative_error(measured, requested, signed=False):
+    """Relative error of m_T against the request, in %: 100 |measured - requested| / requested.
+
+    Arrays (..., 5) in the order of MEASUREMENTS, or dicts keyed by them (then a (5,) array).
+    ``signed``: 100 (measured - requested) / requested instead (positive when m_T is larger).
+    The one formula every report, panel and table uses.
+    """
+    measured, requested = (np.asarray([v[k] for k in MEASUREMENTS] if isinstance(v, dict) else v, dtype=float)
+                           for v in (measured, requested))
+    error = 100.0 * (measured - requested) / requested
+    return error if signed else np.abs(error)
+
+
 def check_options(mode="idw", metric="raw", power=DEFAULT_POWER, normalize=DEFAULT_NORMALIZE):
     if mode not in MODES:
         raise ElliMannError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
@@ -697,8 +710,8 @@ class Synthesis:
                          name=name or mannequin_name(me), role="synthesized", measurements=me)
 
     def relative_error(self):
-        """(B, 5) |m_T - request| / request in %."""
-        return 100.0 * np.abs(self.measured - self.requests) / self.requests
+        """(B, 5) |m_T - request| / request in % (:func:`relative_error`)."""
+        return relative_error(self.measured, self.requests)
 
 
 def validate_requests(requests):

@@ -13,6 +13,7 @@ from devkit.ui_recorder import Recorder, draw_panel
 from ellimann_addon.blender import convert, synthesize
 from ellimann_addon.blender import synthesize_panel as panel
 from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS, TABLE_2_5
+from ellimann_addon.core.synthesis import relative_error
 from ellimann_addon.core.synthesis import synthesize as core_synthesize
 
 
@@ -37,6 +38,18 @@ def test_fields_are_in_cm_with_soft_limits_from_L_and_hard_limits_from_the_absur
         assert (field.soft_min, field.soft_max) == pytest.approx(RANGES[key])
         assert (field.hard_min, field.hard_max) == pytest.approx(ABSURD_LIMITS[key])
         assert "cm" in field.description
+
+
+def test_one_relative_error_formula_for_dicts_and_arrays():
+    """core.synthesis.relative_error is what the operator, the CLI reports and Synthesis use (in %)."""
+    request = dict(zip(MEASUREMENTS, (160.0, 40.0, 100.0, 80.0, 100.0)))
+    measured = dict(zip(MEASUREMENTS, (160.0, 42.0, 99.0, 80.4, 100.0)))
+    expected = [0.0, 5.0, 1.0, 0.5, 0.0]
+    np.testing.assert_allclose(relative_error(measured, request), expected)
+    np.testing.assert_allclose(relative_error(measured, request, signed=True), [0.0, 5.0, -1.0, 0.5, 0.0])
+    batch = relative_error(np.array([list(measured.values())] * 3), np.array([list(request.values())] * 3))
+    assert batch.shape == (3, 5)
+    np.testing.assert_allclose(batch, [expected] * 3)
 
 
 def test_synthesize_makes_a_new_collection_named_after_the_measurements(props):
