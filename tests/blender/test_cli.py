@@ -82,8 +82,20 @@ def test_python_m_bad_input_is_one_line_and_exit_code_1(tmp_path, references):
     assert not (tmp_path / "x.json").exists()
 
 
-def test_the_add_on_registers_main_as_the_blender_command():
-    assert cli._handle is not None  # bpy.utils.register_cli_command("ellimann", cli.main) ran in register()
+def test_the_add_on_registers_main_as_the_blender_command(monkeypatch):
+    from ellimann_addon import blender
+
+    assert "cli" in blender._MODULES and cli._handle is not None  # the add-on's register() ran cli.register()
+    calls = []
+    monkeypatch.setattr(cli, "_handle", None)  # the real handle is restored afterwards
+    monkeypatch.setattr(bpy.utils, "register_cli_command", lambda *args: calls.append(("register", args)) or "H")
+    monkeypatch.setattr(bpy.utils, "unregister_cli_command", lambda *args: calls.append(("unregister", args)))
+    cli.register()
+    assert calls == [("register", ("ellimann", cli.main))] and cli._handle == "H"
+    cli.unregister()
+    assert calls[1:] == [("unregister", ("H",))] and cli._handle is None
+    cli.unregister()  # twice is harmless
+    assert len(calls) == 2
 
 
 def test_a_malformed_command_line_exits_2(capsys):
