@@ -25,6 +25,7 @@ from ..core.synthesis import (
     relative_error,
     synthesize,
 )
+from . import ids
 from .convert import ellipsoid_objects, update_collection_geometry, write_measured
 from .output import add_mannequin, objects_recursive, refresh_cushions
 
@@ -58,22 +59,35 @@ class ELLIMANN_PG_synthesis(bpy.types.PropertyGroup):
     hi: _measurement("Hi")
     mode: EnumProperty(
         name="Mode", default="EXACT", update=_on_request_change,
-        items=(("EXACT", "Exact", "IDW, then a gentle refinement until m_T matches the request (beyond the paper)"),
-               ("IDW", "IDW", "Segmented inverse-distance weighting alone (m_T off by up to a few %)")))
+        description="How the mannequin is made from the Reference Mannequins: IDW alone misses the request by up "
+                    "to a few %; Exact refines it until m_T matches",
+        items=(("EXACT", "Exact", "IDW, then a gentle refinement until m_T matches the request to 0.001% "
+                                  "(beyond the paper)"),
+               ("IDW", "IDW", "Segmented inverse-distance weighting alone, as in the paper (m_T off by up to a few "
+                              "%)")))
     output: EnumProperty(
         name="Pieces", default="ELLIPSOIDS",
+        description="What Synthesize builds: ellipsoids only, or cushions (convex hulls of each cushion pair) in "
+                    "place of their two ellipsoids, which are kept but hidden",
         items=(("ELLIPSOIDS", "Ellipsoids", "One ellipsoid object per part"),
-               ("CUSHIONS", "Cushions", "Cushions (convex hulls) for the cushion pairs, ellipsoids for the rest")))
+               ("CUSHIONS", "Cushions", "Cushions (convex hulls) for the cushion pairs, ellipsoids for the rest; "
+                                        "slower to build")))
     normalize: EnumProperty(
         name="Interpolate", default=DEFAULT_NORMALIZE.upper(), update=_on_request_change,
+        description="What IDW averages over the Reference Mannequins: their proportions (ElliMann's default, "
+                    "closer to the request) or their geometry as it is (the paper's Eq. 2.1)",
         items=(("PROPORTIONAL", "Proportions", "Average each part in proportion to its RM's measurements: heights "
                 "to He, widths to the part's own measurement, then scale to the request"),
                ("HEIGHT", "Height Proportions", "Average heights in proportion to each RM's He, widths as they are"),
                ("NONE", "Geometry (Paper)", "Average the RMs' geometry as it is, as in the paper (Eq. 2.1)")))
     metric: EnumProperty(
         name="Distance", default="RAW", update=_on_request_change,
-        items=(("RAW", "cm", "IDW distances in cm, as in the paper"),
-               ("NORMALIZED", "Normalized", "Each measurement divided by its reference range L")))
+        description="How IDW measures the distance from the request to each Reference Mannequin's measurements "
+                    "(nearer ones weigh more)",
+        items=(("RAW", "cm", "IDW distances in cm, as in the paper: the wide-ranging girths weigh more than He "
+                             "and Sh"),
+               ("NORMALIZED", "Normalized", "Each measurement divided by its reference range L, so all five "
+                                            "weigh alike")))
     power: FloatProperty(name="p", default=DEFAULT_POWER, min=POWER_LIMITS[0], max=POWER_LIMITS[1],
                          update=_on_request_change, description="IDW power (the paper uses 2)")
     live: BoolProperty(name="Live", default=False, update=_on_request_change,
@@ -130,7 +144,7 @@ def live_update(scene):
 class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
     """Build a new mannequin from the five measurements (segmented IDW over the Reference Mannequins)"""
 
-    bl_idname = "ellimann.synthesize_mannequin"
+    bl_idname = ids.SYNTHESIZE_MANNEQUIN
     bl_label = "Synthesize"
     bl_options = {"REGISTER", "UNDO"}
 
@@ -174,9 +188,9 @@ class ELLIMANN_MT_measurement_presets(bpy.types.Menu):
 class ELLIMANN_OT_add_measurement_preset(AddPresetBase, bpy.types.Operator):
     """Save the five measurements as a preset (or remove the selected one of your own)"""
 
-    bl_idname = "ellimann.add_measurement_preset"
+    bl_idname = ids.ADD_MEASUREMENT_PRESET
     bl_label = "Add Measurement Preset"
-    preset_menu = "ELLIMANN_MT_measurement_presets"
+    preset_menu = ELLIMANN_MT_measurement_presets.bl_idname
     preset_subdir = PRESET_SUBDIR
     preset_defines = ["props = bpy.context.scene.ellimann_synthesis"]
     preset_values = [f"props.{attr}" for attr in FIELDS.values()]

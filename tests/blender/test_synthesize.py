@@ -40,6 +40,15 @@ def test_fields_are_in_cm_with_soft_limits_from_L_and_hard_limits_from_the_absur
         assert "cm" in field.description
 
 
+def test_every_option_and_choice_has_a_tooltip():
+    rna = synthesize.ELLIMANN_PG_synthesis.bl_rna.properties
+    for name in ("mode", "output", "normalize", "metric", "power", "live", "target", "references"):
+        assert len(rna[name].description) > 20, name
+    for name in ("mode", "output", "normalize", "metric"):
+        for item in rna[name].enum_items:
+            assert len(item.description) > 10, (name, item.identifier)
+
+
 def test_one_relative_error_formula_for_dicts_and_arrays():
     """core.synthesis.relative_error is what the operator, the CLI reports and Synthesis use (in %)."""
     request = dict(zip(MEASUREMENTS, (160.0, 40.0, 100.0, 80.0, 100.0)))
@@ -162,35 +171,7 @@ def test_users_can_save_and_remove_their_own_presets(props):
     assert not saved.exists()
 
 
-class _StandInMain(bpy.types.Panel):
-    """Only while the authoring tools' main panel is not on this branch."""
-
-    bl_idname = "ELLIMANN_PT_main"
-    bl_label = "ElliMann"
-    bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "ElliMann"
-
-    def draw(self, context):
-        pass
-
-
-@pytest.fixture
-def registered_panel():
-    stand_in = not hasattr(bpy.types, "ELLIMANN_PT_main")
-    if stand_in:
-        bpy.utils.register_class(_StandInMain)
-    own = not hasattr(bpy.types, "ELLIMANN_PT_synthesize")
-    if own:
-        panel.register()
-    yield
-    if own:
-        panel.unregister()
-    if stand_in:
-        bpy.utils.unregister_class(_StandInMain)
-
-
-def test_the_panel_draws_request_options_and_measured_values(props, registered_panel):
+def test_the_panel_draws_request_options_and_measured_values(props):
     recorder = draw_panel(panel.ELLIMANN_PT_synthesize)
     assert [p for p in recorder.props() if p in ("he", "sh", "br", "wa", "hi")] == ["he", "sh", "br", "wa", "hi"]
     for name in ("mode", "output", "normalize", "metric", "power", "live", "references"):
@@ -205,16 +186,19 @@ def test_the_panel_draws_request_options_and_measured_values(props, registered_p
     assert "m_T (cm)" in labels and "159.00" in labels and "117.00" in labels
 
 
-def test_the_panel_is_registered_with_the_add_on_once_its_parent_exists():
-    """The sub-panel needs ELLIMANN_PT_main (authoring tools); when the add-on registers that panel it must
-    register this one too (``synthesize_panel`` listed after it in blender/__init__.py's _MODULES)."""
+def test_the_panel_is_a_sub_panel_registered_with_the_add_on():
+    """Registered after its parent ELLIMANN_PT_main (``synthesize_panel`` after ``panels`` in _MODULES), with the
+    ids of ids.py, between the authoring tools' panels and Drape."""
     from ellimann_addon import blender
+    from ellimann_addon.blender import ids
 
-    if hasattr(bpy.types, "ELLIMANN_PT_main"):  # registered by the add-on (the stand-in is gone by now)
-        assert "synthesize_panel" in blender._MODULES
-        assert hasattr(bpy.types, "ELLIMANN_PT_synthesize")
-    else:
-        assert "synthesize_panel" not in blender._MODULES  # registering it would fail: no parent
+    assert blender._MODULES.index("panels") < blender._MODULES.index("synthesize_panel")
+    assert hasattr(bpy.types, ids.PANEL_SYNTHESIZE) and hasattr(bpy.types, ids.PANEL_MAIN)
+    cls = panel.ELLIMANN_PT_synthesize
+    assert (cls.bl_idname, cls.bl_parent_id) == (ids.PANEL_SYNTHESIZE, ids.PANEL_MAIN)
+    assert max(ids.PANEL_ORDER.values()) < cls.bl_order < ids.DRAPE_ORDER
+    assert synthesize.ELLIMANN_OT_synthesize_mannequin.bl_idname == ids.SYNTHESIZE_MANNEQUIN
+    assert synthesize.ELLIMANN_OT_add_measurement_preset.bl_idname == ids.ADD_MEASUREMENT_PRESET
 
 
 def test_recorder_catches_a_misspelt_property(props):
