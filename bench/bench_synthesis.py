@@ -6,8 +6,11 @@ measurement as in Table 2.4, for the paper's IDW (``normalize="none"``), ElliMan
 (the default), the height-only variant, and exact mode after each IDW, with the refinement's
 deformation factors. Latency and throughput compare the old exact mode (the paper's IDW, then a
 finite-difference Jacobian per mannequin) with the current one (proportional IDW, the RMs' mean
-Jacobian) in the same run. Uses the shipped Reference Mannequins when ``reference_blends/`` holds
-them, else the synthetic set (say which).
+Jacobian) in the same run. In Blender: building collections, m_T of mannequins in the scene
+(objects -> core arrays -> m_T, and the Measure operator), live updates with ellipsoids and with
+cushions (before: every cushion rebuilt; now: moved in place; interleaved over the same slider
+steps, so the ratio is fair under load), and file writing. Uses the shipped Reference Mannequins
+when ``reference_blends/`` holds them, else the synthetic set (say which).
 """
 
 import itertools
@@ -63,6 +66,9 @@ def deformation(title, result, seconds):
           + ", ".join(f"{k} {m:.2f}/{x:.2f}" for k, m, x in zip(MEASUREMENTS, spread.mean(0), spread.max(0))))
 
 
+_err = synthesis.relative_error  # |a - b| / b in %
+
+
 def _stat(values):
     return f"{values.mean():5.2f} /{values.max():6.2f}"
 
@@ -100,8 +106,8 @@ def diagnose(reference, requests):
     he_only = [row for row, part in enumerate(source) if topology.dependency_mask[part].sum() == 1]
     if he_only:
         implied = weights[:, he_only[0]] @ reference.measurements
-        error = 100.0 * np.abs(implied[:, 0] - requests[:, 0]) / requests[:, 0]
-        print(f"  He: paper IDW {_stat(100.0 * np.abs(measured[:, 0] - requests[:, 0]) / requests[:, 0])}; "
+        error = _err(implied[:, 0], requests[:, 0])
+        print(f"  He: paper IDW {_stat(_err(measured[:, 0], requests[:, 0]))}; "
               f"the head (on He alone) is built for sum_j w_j He_j, off by {_stat(error)}")
     for index, key in enumerate(MEASUREMENTS[1:], start=1):
         own = topology.dependency_mask[:, index]
@@ -114,14 +120,14 @@ def diagnose(reference, requests):
         moved = _section(rotation, center, semi_axes, placed, parts, key)
         own_only = _section(rotation, center, semi_axes, z[key], parts & own, key)
         foreign = np.abs(measured[:, index] - own_only) > 1e-9
-        added = 100.0 * (measured[:, index] - own_only) / measured[:, index]
+        added = 100.0 * (measured[:, index] - own_only) / measured[:, index]  # share the foreign parts add
         target = requests[:, index]
-        print(f"  {key}: paper IDW {_stat(100.0 * np.abs(measured[:, index] - target) / target)}; its parts are "
-              f"built for an He off by {_stat(100.0 * np.abs(implied[:, 0] - requests[:, 0]) / requests[:, 0])} "
+        print(f"  {key}: paper IDW {_stat(_err(measured[:, index], target))}; its parts are "
+              f"built for an He off by {_stat(_err(implied[:, 0], requests[:, 0]))} "
               f"(section {_stat(np.abs(placed - z[key]) * 100.0)} cm off); with the section moved there "
-              f"{_stat(100.0 * np.abs(moved - target) / target)}\n"
-              f"      of which sum_j w_j {key}_j vs {key} {_stat(100.0 * np.abs(implied[:, index] - target) / target)}"
-              f" + m_T non-linearity {_stat(100.0 * np.abs(moved - implied[:, index]) / implied[:, index])}; "
+              f"{_stat(_err(moved, target))}\n"
+              f"      of which sum_j w_j {key}_j vs {key} {_stat(_err(implied[:, index], target))}"
+              f" + m_T non-linearity {_stat(_err(moved, implied[:, index]))}; "
               f"parts of other measurements change it in {foreign.sum()} mannequins, by "
               f"{_stat(added)}")
 
@@ -163,7 +169,7 @@ def run():
     start = time.perf_counter()
     old = old_exact(reference, requests)
     t_old = time.perf_counter() - start
-    old_error = 100.0 * np.abs(old.measured - requests) / requests
+    old_error = synthesis.relative_error(old.measured, requests)
     table(f"\nTable 2.4, exact mode after the paper's IDW (finite-difference start), in {t_old:.2f} s", old_error)
     print()
     deformation("exact after paper IDW       ", old, t_old)
@@ -212,7 +218,7 @@ def run():
 
 
 def blender(reference, exact):
-    """Building collections, live updates and files in Blender (bpy module)."""
+    """Building, measuring and moving collections, live updates and files in Blender (bpy module)."""
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="ellimann-bench-"))
     import bpy
 
@@ -228,6 +234,7 @@ def blender(reference, exact):
         t_build = (time.perf_counter() - start) / len(mannequins)
         print(f"\nBlender ({len(reference.topology)} ellipsoids per mannequin):")
         print(f"  build a mannequin collection       {1 / t_build:10,.0f} mannequins/s  ({t_build * 1e3:7.2f} ms)")
+        measure_in_blender(bpy, convert, collections)
         target = collections[0]
         t_update = best_of(lambda: [convert.update_collection_geometry(target, m) for m in mannequins[1:11]],
                            repeat=3) / 10
@@ -253,12 +260,90 @@ def blender(reference, exact):
             times = np.array(times) * 1e3
             print(f"  live update from the panel (exact) {np.median(times):8.2f} ms median, {times.max():.2f} ms max "
                   f"over {len(times)} slider steps")
+            live_with_cushions(bpy, props)
             for kind in ("json", "blend", "glb", "obj"):
                 path = os.path.join(folder, f"m.{kind}")
                 t = best_of(lambda path=path: output.write_mannequin(mannequins[0], [path]), repeat=3)
                 print(f"  write .{kind:<5} (one mannequin)          {t * 1e3:8.2f} ms")
     finally:
         ellimann_addon.unregister()
+
+
+def measure_in_blender(bpy, convert, collections):
+    """m_T of mannequins in the scene: objects -> core arrays -> m_T, and the Measure operator."""
+    t_read = best_of(lambda: [convert.collection_to_mannequin(c) for c in collections], repeat=3) / len(collections)
+    read = [convert.collection_to_mannequin(c) for c in collections]
+    t_core = best_of(lambda: [m.measure() for m in read], repeat=3) / len(collections)
+    t_mt = best_of(lambda: [convert.collection_to_mannequin(c).measure() for c in collections],
+                   repeat=3) / len(collections)
+    print(f"  measure (read objects + m_T)       {1 / t_mt:10,.0f} mannequins/s  ({t_mt * 1e3:7.2f} ms: reading "
+          f"{t_read * 1e3:.2f} ms, m_T {t_core * 1e3:.2f} ms, best of 3 each)")
+
+    def operator():
+        for collection in collections[:10]:
+            bpy.context.view_layer.objects.active = collection.objects[0]
+            bpy.ops.ellimann.measure_mannequin(source="ELLIPSOIDS")
+
+    t_op = best_of(operator, repeat=3) / 10
+    print(f"  Measure operator (ellipsoids)      {1 / t_op:10,.0f} mannequins/s  ({t_op * 1e3:7.2f} ms)")
+
+
+def old_live_update(props, target, output, convert):
+    """A live update as it was before in-place cushions: every cushion rebuilt at 642 vertices."""
+    from ellimann_addon.blender import synthesize
+
+    mannequin, measured, _ = synthesize._synthesize(props)
+    convert.update_collection_geometry(target, mannequin)
+    convert.write_measured(target, measured)
+    output.refresh_cushions(target, output.LIVE_SUBDIVISIONS)
+    if target.name != mannequin.name:
+        target.name = mannequin.name
+
+
+def live_with_cushions(bpy, props):
+    """Live updates of a cushion mannequin: before (rebuild every cushion) and now (move them in place),
+    interleaved over the same slider steps; then the exact rebuild once the slider stops."""
+    from ellimann_addon.blender import convert, output, synthesize
+    from ellimann_addon.blender.built import built_objects
+
+    props.live = False
+    props.output = "CUSHIONS"
+    props.he = 159.0  # not a slider step: the last step leaves the cushions out of date
+    bpy.ops.ellimann.synthesize_mannequin()
+    before_target = props.target
+    bpy.ops.ellimann.synthesize_mannequin()
+    props.live = True  # the second one is the live target
+    pairs = len(built_objects(props.target, "CUSHION"))
+    now, before = [], []
+    for value in np.linspace(150.0, 170.0, 21):
+        start = time.perf_counter()
+        props.he = float(value)  # the panel's update callback
+        now.append(time.perf_counter() - start)
+        start = time.perf_counter()
+        old_live_update(props, before_target, output, convert)
+        before.append(time.perf_counter() - start)
+    now, before = np.array(now) * 1e3, np.array(before) * 1e3
+    print(f"  live update with {pairs} cushions, {len(now)} slider steps (interleaved, same requests):")
+    print(f"    before: rebuild every cushion     {np.median(before):8.2f} ms median, {before.max():.2f} ms max")
+    print(f"    now: move them in place          {np.median(now):8.2f} ms median, {now.max():.2f} ms max")
+    print(f"    {np.median(before) / np.median(now):.1f}x faster (median), {before.max() / now.max():.1f}x (max)")
+    start = time.perf_counter()
+    rebuilt = synthesize.settle_live(bpy.context.scene)
+    print(f"    exact rebuild once the slider stops ({rebuilt} cushions, "
+          f"{synthesize.LIVE_SETTLE_SECONDS:g} s later): {(time.perf_counter() - start) * 1e3:.0f} ms")
+    calls = []
+    real = synthesize.live_update
+    synthesize.live_update = lambda scene: calls.append(time.perf_counter()) or real(scene)
+    try:
+        preset = synthesize.SHIPPED_PRESETS / "Table 2.5 (1).py"
+        start = time.perf_counter()
+        bpy.ops.script.execute_preset(filepath=str(preset), menu_idname="ELLIMANN_MT_measurement_presets")
+        seconds = time.perf_counter() - start
+    finally:
+        synthesize.live_update = real
+    print(f"    a preset (five fields): {len(calls)} live update, {seconds * 1e3:.0f} ms")
+    props.live = False
+    props.output = "ELLIPSOIDS"
 
 
 if __name__ == "__main__":

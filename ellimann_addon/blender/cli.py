@@ -12,15 +12,18 @@ non-zero exit code: 1 for bad input or a failed row, 2 for a malformed command l
 """
 
 import argparse
+import contextlib
 import csv
+import dataclasses
 import io
 import json
 import os
 import re
 import sys
+import tempfile
 import time
 
-from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS, RANGES, TABLE_2_5
+from ..core.constants import CM_PER_M, MEASUREMENT_LABELS, MEASUREMENTS, RANGES, TABLE_2_5
 from ..core.ellipsoid import bounds
 from ..core.errors import ElliMannError, MeasurementError, ReferenceSetError
 from ..core.files import atomic_write_text
@@ -35,6 +38,7 @@ from ..core.synthesis import (
     NORMALIZATIONS,
     PAPER_NORMALIZE,
     load_reference_set,
+    relative_error,
     synthesize,
     synthesize_batch,
     validate_request,
@@ -135,21 +139,43 @@ def build_parser():
                                 description="Build a garment sized from the mannequin's m_T, drape it with "
                                             "Blender cloth (the mannequin's convex pieces as colliders), bake the "
                                             "frames and save the scene as a .blend; prints the fit (garment-to-"
-                                            "body distances, vertices inside the body).")
+                                            "body distances, vertices inside the body). Defaults are the Drape "
+                                            "panel's (DrapeSettings).",
+                                formatter_class=_DrapeHelp)
     drape.add_argument("mannequin", metavar="MANNEQUIN", help="a .json or .blend mannequin")
     drape.add_argument("--garment", choices=tuple(GARMENTS), default="tube_dress",
                        help="tube_dress (strapless, pinned at the top edge; default) or t_shirt (sewn at the "
                             "shoulders and armholes)")
-    drape.add_argument("--frames", type=int, default=60, help="frames to simulate (default 60, at 24 fps)")
-    drape.add_argument("--cushions", action="store_true",
-                       help="collide with the cushions and the ellipsoids not in one (default: ellipsoids only)")
-    drape.add_argument("--edge", type=_number, default=2.5, metavar="CM",
-                       help="edge length of the cloth mesh in cm (default 2.5; smaller is finer and slower)")
-    drape.add_argument("--collection", help="the mannequin collection in a .blend holding several")
+    drape.add_argument("--frames", type=int, help="frames to simulate (default {frames}, at 24 fps)")
+    drape.add_argument("--cushions", action=argparse.BooleanOptionalAction,
+                       help="collide with the cushions and the ellipsoids not in one; --no-cushions: with every "
+                            "ellipsoid (default: {cushions})")
+    drape.add_argument("--edge", type=_number, metavar="CM",
+                       help="edge length of the cloth mesh in cm (default {edge_cm:g}; smaller is finer and slower)")
+    drape.add_argument("--collection", help="the mannequin collection in a .blend holding several (.blend only)")
     drape.add_argument("-o", "--output", required=True, metavar="OUT.blend")
     drape.add_argument("--render", metavar="OUT.png", help="also a Workbench picture of the last frame")
     drape.set_defaults(run=run_drape)
     return parser
+
+
+class _DrapeHelp(argparse.HelpFormatter):
+    """Fills the drape defaults into ``drape --help`` from DrapeSettings, the one place they are set.
+
+    DrapeSettings lives in the bpy layer, so only ``drape --help`` loads Blender, not ``--help``.
+    """
+
+    def _get_help_string(self, action):
+        text = super()._get_help_string(action)
+        return text.format(**_drape_defaults()) if text and "{" in text else text
+
+
+def _drape_defaults():
+    from .drape import DrapeSettings
+
+    defaults = DrapeSettings()
+    return {"frames": defaults.frames, "edge_cm": defaults.edge * CM_PER_M,
+            "cushions": "cushions" if defaults.cushions else "every ellipsoid"}
 
 
 def main(argv=None):
@@ -213,15 +239,68 @@ def _format_me(values):
 
 
 def _write(mannequin, paths, measured, cushions):
-    """Write every path (format from the extension); Blender is loaded only for .blend/.glb/.obj."""
-    if any(core_format(p) is None for p in paths):
+    """Write every path (format from the extension); Blender is loaded only for .blend/.glb/.obj.
+
+    A path that cannot be written raises UsageError naming it (not the temporary file behind it).
+    """
+    for path in paths:
+        if core_format(path):
+            with _writing(path):
+                write_core_file(mannequin, path, cushions)
+    blender = [p for p in paths if core_format(p) is None]
+    if blender:
         _ensure_registered()
         from .output import write_mannequin
 
-        return write_mannequin(mannequin, paths, measured, cushions)
-    for path in paths:
-        write_core_file(mannequin, path, cushions)
+        try:
+            write_mannequin(mannequin, blender, measured, cushions)
+        except OSError as error:  # the temporary's name holds the target's, where there is one
+            failed = next((p for p in blender if os.path.basename(p) in str(error.filename or "")), blender[0])
+            raise _cannot_write(failed, error) from None
     return paths
+
+
+@contextlib.contextmanager
+def _writing(target, folder=False):
+    """Turn an OSError while writing ``target`` (a file, or a folder with ``folder``) into one line naming it."""
+    try:
+        yield
+    except OSError as error:
+        raise _cannot_write(target, error, folder) from None
+
+
+def _cannot_write(target, error, folder=False):
+    where = os.path.abspath(target if folder else os.path.dirname(os.path.abspath(target)))
+    blocker = _file_in_the_way(where)
+    what = f"the folder {target}" if folder else target
+    if not folder and os.path.isdir(target):
+        reason = "it is a folder"
+    elif blocker is not None:
+        reason = "it is a file" if blocker == where and folder else f"{blocker} is a file, not a folder"
+    else:
+        reason = error.strerror or _one_line(error)
+        if error.filename and os.path.abspath(error.filename) not in (os.path.abspath(target), where):
+            reason += f" (creating a file in {where})"  # the temporary file it is written through
+    return UsageError(f"cannot write {what}: {reason}")
+
+
+def _file_in_the_way(folder):
+    """The nearest existing path at or above ``folder`` if it is not a folder (nothing can be made under it)."""
+    path = folder
+    while not os.path.lexists(path):
+        parent = os.path.dirname(path)
+        if parent == path:
+            return None
+        path = parent
+    return None if os.path.isdir(path) else path
+
+
+def _output_folder(folder):
+    """Make the output folder and check that files can be created in it, before any work is done."""
+    with _writing(folder, folder=True):
+        os.makedirs(folder, exist_ok=True)
+        with tempfile.TemporaryFile(prefix=".ellimann-", dir=folder):
+            pass
 
 
 # ------------------------------------------------------------------------------------------------ synth
@@ -236,7 +315,7 @@ def run_synth(args):
     for warning in warnings:
         print(f"{PROG} synth: warning: {warning}", file=sys.stderr)
     _write(mannequin, [args.output], measured, args.cushions and kind != "json")
-    error = max(abs(measured[k] - request[k]) / request[k] * 100.0 for k in MEASUREMENTS)
+    error = relative_error(measured, request).max()
     print(f"wrote {args.output}: '{mannequin.name}' ({args.mode}), m_T {_format_me(measured.values())} cm, "
           f"max error {error:.3f}%")
     return 0
@@ -308,6 +387,24 @@ def read_rows(path):
     return rows
 
 
+def name_rows(rows):
+    """Give every row its output name (``row-NNNNN`` from its line when the CSV has none) and refuse a row
+    whose name an earlier row already uses (letter case ignored: the files would clash on macOS and
+    Windows). Runs over the whole CSV before sharding, so every shard refuses the same rows."""
+    seen, named = {}, []
+    for line, name, values, error, warnings in rows:
+        name = name or f"row-{line - 1:05d}"
+        key = name.casefold()
+        if error is None and key in seen:
+            first_line, first_name = seen[key]
+            same = "" if first_name == name else f" (as {first_name!r}; file names ignore case on some systems)"
+            error = f"name: {name!r} is already used on line {first_line}{same}"
+        if error is None:
+            seen[key] = (line, name)
+        named.append((line, name, values, error, warnings))
+    return named
+
+
 def run_batch(args):
     formats = parse_formats(args.format)
     shard, shards = parse_shard(args.shard)
@@ -315,14 +412,10 @@ def run_batch(args):
     if not rows:
         raise UsageError(f"{args.csv} has a header but no rows")
     reference = _references(args)
+    rows = name_rows(rows)  # over the whole CSV, so every shard agrees on which rows are bad
     mine = [row for index, row in enumerate(rows) if index % shards == shard - 1]
-    seen = {}
     jobs, report = [], []
     for line, name, values, error, warnings in mine:
-        name = name or f"row-{line - 1:05d}"
-        if error is None and name in seen:
-            error = f"name: {name!r} is already used on line {seen[name]}"
-        seen.setdefault(name, line)
         if error is not None:
             print(f"{PROG} batch: line {line}: skipped: {error}", file=sys.stderr)
             report.append(_report_row(line, name, "error", error, values))
@@ -330,8 +423,8 @@ def run_batch(args):
         for warning in warnings:
             print(f"{PROG} batch: line {line}: warning: {warning}", file=sys.stderr)
         jobs.append((line, name, values, warnings))
-    os.makedirs(args.output, exist_ok=True)
-    progress = _Progress(len(jobs))
+    _output_folder(args.output)
+    progress = _Progress(len(jobs), "batch")
     failed = sum(1 for r in report if r["status"] == "error")
     for start in range(0, len(jobs), CHUNK):
         chunk = jobs[start:start + CHUNK]
@@ -356,7 +449,8 @@ def run_batch(args):
     report.sort(key=lambda r: r["line"])
     report_name = "report.csv" if shards == 1 else f"report-{shard}-of-{shards}.csv"
     report_path = os.path.join(args.output, report_name)
-    atomic_write_text(report_path, _report_csv(report))
+    with _writing(report_path):
+        atomic_write_text(report_path, _report_csv(report))
     done = len(report) - failed
     print(f"{PROG} batch: {done} of {len(report)} mannequins written to {args.output}"
           + (f" (shard {shard}/{shards} of {len(rows)} rows)" if shards > 1 else "") + f"; report {report_path}")
@@ -372,11 +466,11 @@ REPORT_COLUMNS = (["line", "name", "status", "message"] + list(MEASUREMENTS)
 
 def _report_row(line, name, status, message, requested=None, measured=None, paths=()):
     row = {"line": line, "name": name, "status": status, "message": message or "", "files": " ".join(paths)}
+    error = relative_error(measured, requested) if measured is not None else None
     for i, key in enumerate(MEASUREMENTS):
         row[key] = f"{requested[i]:g}" if requested is not None else ""
         row[f"{key}_measured"] = f"{measured[i]:.4f}" if measured is not None else ""
-        row[f"{key}_error_pct"] = (f"{100.0 * abs(measured[i] - requested[i]) / requested[i]:.4f}"
-                                   if measured is not None else "")
+        row[f"{key}_error_pct"] = f"{error[i]:.4f}" if error is not None else ""
     return row
 
 
@@ -391,16 +485,20 @@ def _report_csv(rows):
 class _Progress:
     """One progress line on stderr: rewritten in place on a terminal, every ~5% in a log."""
 
-    def __init__(self, total):
+    def __init__(self, total, command, every=None):
         self.total, self.count, self.start = total, 0, time.perf_counter()
+        self.command = command
         self.tty = sys.stderr.isatty()
-        self.every = max(1, total // 20)
+        self.every = every or max(1, total // 20)
 
-    def step(self, name):
-        self.count += 1
+    def step(self, name, count=None):
+        """One more done (``name``: what), or ``count`` done so far; repeated counts are ignored."""
+        if count is not None and count <= self.count:
+            return
+        self.count = self.count + 1 if count is None else count
         if self.tty or self.count % self.every == 0 or self.count == self.total:
             rate = self.count / max(time.perf_counter() - self.start, 1e-9)
-            text = f"{PROG} batch: {self.count}/{self.total} ({rate:.1f}/s) {name}"
+            text = f"{PROG} {self.command}: {self.count}/{self.total} ({rate:.1f}/s) {name}"
             print(f"\r{text[:100]:<100}" if self.tty else text, end="" if self.tty else "\n", file=sys.stderr,
                   flush=True)
 
@@ -462,28 +560,27 @@ def _load_blend_mannequin(path, collection_name=None):
 def run_demo(args):
     reference = _references(args)
     out = args.output
-    os.makedirs(out, exist_ok=True)
+    _output_folder(out)
     result = synthesize_batch(reference, [list(row) for row in TABLE_2_5], args.mode, args.metric, args.power,
                               normalize=args.normalize)
-    _ensure_registered()
-    from .output import write_mannequin
-
     rows, mannequins = [], []
     for i in range(len(result)):
         name = f"table_2_5_{i + 1:02d}"
         mannequin = result.mannequin(i)
         paths = [os.path.join(out, f"{name}.{kind}") for kind in ("blend", "json")]
-        write_mannequin(mannequin, paths, as_dict(result.measured[i]), args.cushions)
+        _write(mannequin, paths, as_dict(result.measured[i]), args.cushions)
         rows.append(_report_row(i + 1, name, "ok", mannequin.name, result.requests[i], result.measured[i], paths))
         mannequins.append(mannequin)
         print(f"{PROG} demo: wrote {name} ({mannequin.name})", file=sys.stderr)
-    atomic_write_text(os.path.join(out, "report.csv"), _report_csv(rows))
-    atomic_write_text(os.path.join(out, "report.md"), _report_markdown(result, reference, args))
+    for name, text in (("report.csv", _report_csv(rows)), ("report.md", _report_markdown(result, reference, args))):
+        with _writing(os.path.join(out, name)):
+            atomic_write_text(os.path.join(out, name), text)
     if args.picture:
         from .render import render_lineup
 
-        render_lineup(mannequins, os.path.join(out, "lineup.png"), labels=[f"({i + 1})" for i in range(len(rows))],
-                      cushions=args.cushions)
+        with _writing(os.path.join(out, "lineup.png")):
+            render_lineup(mannequins, os.path.join(out, "lineup.png"),
+                          labels=[f"({i + 1})" for i in range(len(rows))], cushions=args.cushions)
     error = result.relative_error()
     print(f"{PROG} demo: {len(rows)} mannequins in {out} ({args.mode}); m_T error mean {error.mean():.3f}%, "
           f"max {error.max():.3f}%; see {os.path.join(out, 'report.md')}")
@@ -534,32 +631,66 @@ def run_drape(args):
     kind = os.path.splitext(args.mannequin)[1].lower()
     if kind not in (".json", ".blend"):
         raise UsageError(f"MANNEQUIN must be a .json or .blend mannequin, got {args.mannequin!r}")
+    if kind == ".json" and args.collection is not None:
+        raise UsageError(f"--collection picks one of the mannequins in a .blend; {args.mannequin} is a .json file "
+                         "holding one mannequin (leave --collection out)")
     if not os.path.isfile(args.mannequin):
         raise UsageError(f"{args.mannequin}: no such file")
     if kind == ".json":
         mannequin = Mannequin.load(args.mannequin)
     bpy = _ensure_registered()
-    from .drape import DrapeSettings, drape
+    from .drape import drape
     from .output import add_mannequin, atomic_output, empty_scene, stdout_to_stderr
 
-    settings = DrapeSettings(frames=args.frames, edge=args.edge / 100.0, cushions=args.cushions).checked()
+    settings = drape_settings(args)
     if kind == ".json":
         empty_scene()
-        add_mannequin(mannequin, cushions=args.cushions and bool(mannequin.topology.cushion_pairs))
+        add_mannequin(mannequin, cushions=settings.cushions and bool(mannequin.topology.cushion_pairs))
     else:
         mannequin = _load_blend_mannequin(args.mannequin, args.collection)
+    print(f"{PROG} drape: {args.garment} on '{mannequin.name}', {settings.frames} frames, cloth edge "
+          f"{settings.edge * CM_PER_M:g} cm, colliding with {'cushions' if settings.cushions else 'ellipsoids'}",
+          file=sys.stderr, flush=True)
     with stdout_to_stderr():
-        result = drape(mannequin, args.garment, settings)
-        with atomic_output(args.output) as temp:
+        with _frame_progress(bpy, settings.frames):
+            result = drape(mannequin, args.garment, settings)
+        with _writing(args.output), atomic_output(args.output) as temp:
             bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)
     print(f"wrote {args.output}: {result.garment.name} on '{mannequin.name}', {result.summary()}")
     if args.render:
         from .render import render_view
 
         low, high = bounds(mannequin.rotation, mannequin.center, mannequin.semi_axes)
-        render_view(args.render, low.min(axis=0), high.max(axis=0))
+        with _writing(args.render):
+            render_view(args.render, low.min(axis=0), high.max(axis=0))
         print(f"wrote {args.render}")
     return 0
+
+
+def drape_settings(args):
+    """DrapeSettings from the command line: what is not given keeps DrapeSettings' default (the panel's too)."""
+    from .drape import DrapeSettings
+
+    given = {"frames": args.frames, "edge": None if args.edge is None else args.edge / CM_PER_M,
+             "cushions": args.cushions}
+    return dataclasses.replace(DrapeSettings(), **{k: v for k, v in given.items() if v is not None}).checked()
+
+
+@contextlib.contextmanager
+def _frame_progress(bpy, frames):
+    """Progress lines on stderr while the cloth steps through the frames (a frame-change handler)."""
+    progress = _Progress(frames, "drape", every=max(10, frames // 20))
+
+    def report(scene, *_):
+        frame = scene.frame_current
+        progress.step("frames simulated" + ("; baking and measuring the fit" if frame == frames else ""), frame)
+
+    bpy.app.handlers.frame_change_post.append(report)
+    try:
+        yield
+    finally:
+        bpy.app.handlers.frame_change_post.remove(report)
+        progress.done()
 
 
 # ------------------------------------------------------------------------------------------------ Blender

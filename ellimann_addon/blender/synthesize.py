@@ -4,31 +4,77 @@
 named after the measurements; with "Live" on, every change of a field moves the last synthesized
 mannequin in place (``live_update``). Presets (the five RMs, the ten mannequins of the paper's
 Table 2.5, and the user's own) use Blender's preset system; the shipped ones are read from this
-add-on's ``presets/`` folder, the user's are saved in Blender's user preset folder.
+add-on's ``presets/`` folder, the user's are saved in Blender's user preset folder. A preset sets
+five fields but makes one live update (the preset menu's ``reset_cb`` / ``post_cb`` hold it back).
+
+Live updates with cushions keep up with a dragged slider by moving the existing cushion meshes:
+their vertices are rewritten in place (``core.synthesis.cushion_vertices``, every pair in one
+vectorised call; same vertex order at the same resolution) and their faces kept. Those faces were
+made convex for the previous ellipsoids, so the cushions count as out of date until the fields
+have been still for ``LIVE_SETTLE_SECONDS``; a timer then rebuilds them exactly (``settle_live``).
 """
 
 import os
 import pathlib
+import re
 import time
 
 import bpy
+import numpy as np
 from bl_operators.presets import AddPresetBase
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, PointerProperty, StringProperty
 
 from ..core.constants import ABSURD_LIMITS, MEASUREMENT_LABELS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS
+from ..core.cushion import DEFAULT_SUBDIVISIONS
 from ..core.errors import ElliMannError
-from ..core.synthesis import DEFAULT_NORMALIZE, DEFAULT_POWER, POWER_LIMITS, cached_reference_set, synthesize
+from ..core.synthesis import (
+    DEFAULT_NORMALIZE,
+    DEFAULT_POWER,
+    POWER_LIMITS,
+    cached_reference_set,
+    cushion_vertices,
+    relative_error,
+    synthesize,
+)
+from . import ids
+from .built import built_objects, is_stale
 from .convert import ellipsoid_objects, update_collection_geometry, write_measured
-from .output import add_mannequin, objects_recursive, refresh_cushions
+from .cushions import rigid_frame
+from .output import LIVE_SUBDIVISIONS, add_mannequin, refresh_cushions
+from .selection import part_lookup
 
 PRESET_SUBDIR = "ellimann/synthesis"
 SHIPPED_PRESETS = pathlib.Path(__file__).resolve().parent / "presets" / "synthesis"
 FIELDS = {key: key.lower() for key in MEASUREMENTS}  # He -> props.he
+LIVE_SETTLE_SECONDS = 0.5  # fields still this long: the live target's cushions are rebuilt exactly
+LIVE_NAME_KEY = "ellimann_live_name"  # on a live target: the name live updates last gave it
+
+_held = {"depth": 0, "changed": False}  # live updates held back while a preset sets its fields
+_settling = {"scene": None}  # the scene whose live target waits for exact cushions
 
 
 def _on_request_change(self, context):
-    if self.live and self.target is not None:
-        live_update(context.scene)
+    if not (self.live and self.target is not None):
+        return
+    if _held["depth"]:
+        _held["changed"] = True
+        return
+    live_update(context.scene)
+
+
+def hold_live_updates():
+    """Until :func:`release_live_updates`, field changes make no live update (a preset sets five at once)."""
+    _held["depth"] += 1
+
+
+def release_live_updates(scene):
+    """End a hold; one live update if a field changed meanwhile. Returns live_update's result or None."""
+    _held["depth"] = max(0, _held["depth"] - 1)
+    if _held["depth"] or not _held["changed"]:
+        return None
+    _held["changed"] = False
+    props = scene.ellimann_synthesis
+    return live_update(scene) if props.live and props.target is not None else None
 
 
 def _measurement(key):
@@ -51,22 +97,35 @@ class ELLIMANN_PG_synthesis(bpy.types.PropertyGroup):
     hi: _measurement("Hi")
     mode: EnumProperty(
         name="Mode", default="EXACT", update=_on_request_change,
-        items=(("EXACT", "Exact", "IDW, then a gentle refinement until m_T matches the request (beyond the paper)"),
-               ("IDW", "IDW", "Segmented inverse-distance weighting alone (m_T off by up to a few %)")))
+        description="How the mannequin is made from the Reference Mannequins: IDW alone misses the request by up "
+                    "to a few %; Exact refines it until m_T matches",
+        items=(("EXACT", "Exact", "IDW, then a gentle refinement until m_T matches the request to 0.001% "
+                                  "(beyond the paper)"),
+               ("IDW", "IDW", "Segmented inverse-distance weighting alone, as in the paper (m_T off by up to a few "
+                              "%)")))
     output: EnumProperty(
         name="Pieces", default="ELLIPSOIDS",
+        description="What Synthesize builds: ellipsoids only, or cushions (convex hulls of each cushion pair) in "
+                    "place of their two ellipsoids, which are kept but hidden",
         items=(("ELLIPSOIDS", "Ellipsoids", "One ellipsoid object per part"),
-               ("CUSHIONS", "Cushions", "Cushions (convex hulls) for the cushion pairs, ellipsoids for the rest")))
+               ("CUSHIONS", "Cushions", "Cushions (convex hulls) for the cushion pairs, ellipsoids for the rest; "
+                                        "slower to build")))
     normalize: EnumProperty(
         name="Interpolate", default=DEFAULT_NORMALIZE.upper(), update=_on_request_change,
+        description="What IDW averages over the Reference Mannequins: their proportions (ElliMann's default, "
+                    "closer to the request) or their geometry as it is (the paper's Eq. 2.1)",
         items=(("PROPORTIONAL", "Proportions", "Average each part in proportion to its RM's measurements: heights "
                 "to He, widths to the part's own measurement, then scale to the request"),
                ("HEIGHT", "Height Proportions", "Average heights in proportion to each RM's He, widths as they are"),
                ("NONE", "Geometry (Paper)", "Average the RMs' geometry as it is, as in the paper (Eq. 2.1)")))
     metric: EnumProperty(
         name="Distance", default="RAW", update=_on_request_change,
-        items=(("RAW", "cm", "IDW distances in cm, as in the paper"),
-               ("NORMALIZED", "Normalized", "Each measurement divided by its reference range L")))
+        description="How IDW measures the distance from the request to each Reference Mannequin's measurements "
+                    "(nearer ones weigh more)",
+        items=(("RAW", "cm", "IDW distances in cm, as in the paper: the wide-ranging girths weigh more than He "
+                             "and Sh"),
+               ("NORMALIZED", "Normalized", "Each measurement divided by its reference range L, so all five "
+                                            "weigh alike")))
     power: FloatProperty(name="p", default=DEFAULT_POWER, min=POWER_LIMITS[0], max=POWER_LIMITS[1],
                          update=_on_request_change, description="IDW power (the paper uses 2)")
     live: BoolProperty(name="Live", default=False, update=_on_request_change,
@@ -92,10 +151,6 @@ def _synthesize(props):
                       normalize=props.normalize.lower())
 
 
-def _has_cushions(collection):
-    return any(o.ellimann.kind == "CUSHION" for o in objects_recursive(collection))
-
-
 def live_update(scene):
     """Move the last synthesized mannequin to the current request. Returns seconds taken, or None."""
     props = scene.ellimann_synthesis
@@ -107,10 +162,12 @@ def live_update(scene):
         mannequin, measured, warnings = _synthesize(props)
         update_collection_geometry(target, mannequin)
         write_measured(target, measured)
-        if _has_cushions(target):
-            refresh_cushions(target)
-        if target.name != mannequin.name:
-            target.name = mannequin.name
+        cushions = built_objects(target, "CUSHION")
+        if cushions:
+            if not move_cushions(target, mannequin, cushions):  # rebuilt once; afterwards they move in place
+                refresh_cushions(target, min(_level(cushions), LIVE_SUBDIVISIONS))
+            _settle_later(scene)
+        rename_live_target(target, mannequin.name)
     except ElliMannError as error:
         props.status = f"Live update failed: {error}"
         return None
@@ -120,10 +177,107 @@ def live_update(scene):
     return seconds
 
 
+def _icosphere_level(vertex_count):
+    """s with 10 * 4^s + 2 == vertex_count (a cushion mesh's resolution), or None."""
+    return next((s for s in range(8) if 10 * 4 ** s + 2 == vertex_count), None)
+
+
+def _level(cushions):
+    """The resolution most of the cushions have (DEFAULT_SUBDIVISIONS if none is an icosphere's)."""
+    levels = [_icosphere_level(len(o.data.vertices)) for o in cushions if o.type == "MESH"]
+    levels = [level for level in levels if level is not None]
+    return max(set(levels), key=levels.count) if levels else DEFAULT_SUBDIVISIONS
+
+
+def move_cushions(collection, mannequin, cushions):
+    """Move the built cushions onto ``mannequin``'s ellipsoids by rewriting their vertices in place.
+
+    Needs one cushion per pair, each with a mesh of its own at an icosphere resolution (as
+    build_cushions makes them); returns False, changing nothing, otherwise. The faces are kept, so
+    the cushions stay out of date (``built.is_stale``) until :func:`settle_live` rebuilds them.
+    """
+    topology = mannequin.topology
+    pairs = np.asarray(topology.cushion_pairs, dtype=int).reshape(-1, 2)
+    by_pair = {(o.ellimann.part_name, o.ellimann.partner): o for o in cushions}
+    objects = [by_pair.get((topology.names[i], topology.names[j])) for i, j in pairs]
+    if len(cushions) != len(pairs) or any(o is None or o.type != "MESH" or o.data.users != 1 for o in objects):
+        return False
+    levels = [_icosphere_level(len(o.data.vertices)) for o in objects]
+    if None in levels:
+        return False
+    for level in set(levels):
+        rows = [k for k, found in enumerate(levels) if found == level]
+        local = cushion_vertices(mannequin.rotation, mannequin.center, mannequin.semi_axes, pairs[rows], level)
+        for k, vertices in zip(rows, local.astype(np.float32)):
+            obj, first = objects[k], pairs[k, 0]
+            obj.data.vertices.foreach_set("co", vertices.ravel())
+            obj.data.update()
+            obj.matrix_world = rigid_frame(mannequin.rotation[first], mannequin.center[first])
+    return True
+
+
+def _settle_later(scene):
+    """(Re)start the timer that rebuilds the cushions once the fields are still (restarted by every update)."""
+    _settling["scene"] = scene.name
+    if bpy.app.timers.is_registered(_settle_timer):
+        bpy.app.timers.unregister(_settle_timer)
+    bpy.app.timers.register(_settle_timer, first_interval=LIVE_SETTLE_SECONDS)
+
+
+def _settle_timer():
+    name, _settling["scene"] = _settling["scene"], None
+    scene = bpy.data.scenes.get(name) if name else None
+    if scene is not None:
+        settle_live(scene)
+    return None  # once
+
+
+def settle_live(scene):
+    """Rebuild the live target's out-of-date cushions exactly (closed convex hulls).
+
+    Live updates call this through a timer once the fields have been still for LIVE_SETTLE_SECONDS.
+    The hulls are rebuilt at output.LIVE_SUBDIVISIONS (642 vertices; or their own resolution if
+    coarser): at Synthesize's 2,562 the rebuild takes seconds on a 40-part mannequin, at 642 about
+    half a second. Synthesize again for full-resolution cushions. Returns the number rebuilt (0 if
+    none was out of date).
+    """
+    props = scene.ellimann_synthesis
+    target = props.target
+    if target is None or not target.ellimann.is_mannequin:
+        return 0
+    cushions = built_objects(target, "CUSHION")
+    parts = part_lookup(target)
+    if not any(is_stale(c, parts) for c in cushions):
+        return 0
+    try:
+        refresh_cushions(target, min(_level(cushions), LIVE_SUBDIVISIONS))
+    except ElliMannError as error:
+        props.status = f"Cushions not rebuilt: {error}"
+        return 0
+    return len(built_objects(target, "CUSHION"))
+
+
+def rename_live_target(target, name):
+    """Give the live target the name of its request, without renaming it on every update.
+
+    When another collection holds that name, Blender appends a suffix ("... .001"); the target keeps
+    the suffixed name (remembered on it) instead of being renamed again at each update.
+    Returns True if it was renamed.
+    """
+    if target.name == name:
+        return False
+    suffixed = re.fullmatch(re.escape(name) + r"\.\d{3,}", target.name) is not None
+    if suffixed and target.get(LIVE_NAME_KEY) == name and bpy.data.collections.get(name) not in (None, target):
+        return False
+    target.name = name
+    target[LIVE_NAME_KEY] = name
+    return True
+
+
 class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
     """Build a new mannequin from the five measurements (segmented IDW over the Reference Mannequins)"""
 
-    bl_idname = "ellimann.synthesize_mannequin"
+    bl_idname = ids.SYNTHESIZE_MANNEQUIN
     bl_label = "Synthesize"
     bl_options = {"REGISTER", "UNDO"}
 
@@ -143,8 +297,7 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
         props.status = "; ".join(warnings)
         for warning in warnings:
             self.report({"WARNING"}, warning)
-        request = request_of(props)
-        worst = max(abs(measured[k] - request[k]) / request[k] * 100.0 for k in MEASUREMENTS)
+        worst = relative_error(measured, request_of(props)).max()
         values = ", ".join(f"{k} {measured[k]:.2f}" for k in MEASUREMENTS)
         self.report({"INFO"}, f"Synthesized '{collection.name}' ({len(ellipsoid_objects(collection))} ellipsoids, "
                               f"{props.mode.lower()}): m_T {values} cm, max error {worst:.2f}%")
@@ -159,6 +312,16 @@ class ELLIMANN_MT_measurement_presets(bpy.types.Menu):
     preset_subdir = PRESET_SUBDIR
     preset_operator = "script.execute_preset"
 
+    # script.execute_preset calls these before and after running the preset file (which sets the five
+    # fields one by one): one live update instead of five.
+    @staticmethod
+    def reset_cb(_context, _filepath):
+        hold_live_updates()
+
+    @staticmethod
+    def post_cb(context, _filepath):
+        release_live_updates(context.scene)
+
     def draw(self, _context):
         folders = [str(SHIPPED_PRESETS)] + bpy.utils.preset_paths(PRESET_SUBDIR)
         self.path_menu(folders, self.preset_operator, filter_ext=lambda ext: ext.lower() == ".py",
@@ -168,9 +331,9 @@ class ELLIMANN_MT_measurement_presets(bpy.types.Menu):
 class ELLIMANN_OT_add_measurement_preset(AddPresetBase, bpy.types.Operator):
     """Save the five measurements as a preset (or remove the selected one of your own)"""
 
-    bl_idname = "ellimann.add_measurement_preset"
+    bl_idname = ids.ADD_MEASUREMENT_PRESET
     bl_label = "Add Measurement Preset"
-    preset_menu = "ELLIMANN_MT_measurement_presets"
+    preset_menu = ELLIMANN_MT_measurement_presets.bl_idname
     preset_subdir = PRESET_SUBDIR
     preset_defines = ["props = bpy.context.scene.ellimann_synthesis"]
     preset_values = [f"props.{attr}" for attr in FIELDS.values()]
@@ -191,5 +354,7 @@ def register():
 
 
 def unregister():
+    if bpy.app.timers.is_registered(_settle_timer):
+        bpy.app.timers.unregister(_settle_timer)
     del bpy.types.Scene.ellimann_synthesis
     _unregister_classes()

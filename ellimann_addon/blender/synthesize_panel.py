@@ -6,6 +6,7 @@ Registered after the main panel ``ELLIMANN_PT_main`` (its parent), hence a modul
 import bpy
 
 from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS
+from . import ids
 from .panel_base import ElliMannPanel
 from .synthesize import FIELDS, ELLIMANN_MT_measurement_presets
 
@@ -13,10 +14,10 @@ from .synthesize import FIELDS, ELLIMANN_MT_measurement_presets
 class ELLIMANN_PT_synthesize(ElliMannPanel, bpy.types.Panel):
     """Type five measurements, get a mannequin"""
 
-    bl_idname = "ELLIMANN_PT_synthesize"
+    bl_idname = ids.PANEL_SYNTHESIZE
     bl_label = "Synthesize"
-    bl_parent_id = "ELLIMANN_PT_main"
-    bl_order = 60  # after the authoring tools' panels (Trace ... Measure: 10-50)
+    bl_parent_id = ids.PANEL_MAIN
+    bl_order = max(ids.PANEL_ORDER.values()) + 10  # right after the authoring tools' panels, before Drape
 
     @classmethod
     def poll(cls, context):
@@ -29,9 +30,9 @@ class ELLIMANN_PT_synthesize(ElliMannPanel, bpy.types.Panel):
         measured = tuple(target.ellimann.measured) if target is not None and target.ellimann.has_measured else None
 
         row = layout.row(align=True)
-        row.menu("ELLIMANN_MT_measurement_presets", text=ELLIMANN_MT_measurement_presets.bl_label)
-        row.operator("ellimann.add_measurement_preset", text="", icon="ADD")
-        row.operator("ellimann.add_measurement_preset", text="", icon="REMOVE").remove_active = True
+        row.menu(ELLIMANN_MT_measurement_presets.bl_idname, text=ELLIMANN_MT_measurement_presets.bl_label)
+        row.operator(ids.ADD_MEASUREMENT_PRESET, text="", icon="ADD")
+        row.operator(ids.ADD_MEASUREMENT_PRESET, text="", icon="REMOVE").remove_active = True
 
         header = layout.row()
         header.label(text="Request (cm)")
@@ -50,7 +51,7 @@ class ELLIMANN_PT_synthesize(ElliMannPanel, bpy.types.Panel):
         options.prop(props, "power")
         options.prop(props, "references")
 
-        layout.operator("ellimann.synthesize_mannequin", icon="OUTLINER_OB_ARMATURE")
+        layout.operator(ids.SYNTHESIZE_MANNEQUIN, icon="OUTLINER_OB_ARMATURE")
         row = layout.row()
         row.prop(props, "live")
         if target is not None:

@@ -16,9 +16,11 @@ import pytest
 
 from devkit import synthetic
 from ellimann_addon.blender import cli
+from ellimann_addon.blender.drape import DrapeSettings
 from ellimann_addon.blender.export import EXTRAS_KEY, read_glb_json
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.synthesis import relative_error
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]
@@ -80,8 +82,20 @@ def test_python_m_bad_input_is_one_line_and_exit_code_1(tmp_path, references):
     assert not (tmp_path / "x.json").exists()
 
 
-def test_the_add_on_registers_main_as_the_blender_command():
-    assert cli._handle is not None  # bpy.utils.register_cli_command("ellimann", cli.main) ran in register()
+def test_the_add_on_registers_main_as_the_blender_command(monkeypatch):
+    from ellimann_addon import blender
+
+    assert "cli" in blender._MODULES and cli._handle is not None  # the add-on's register() ran cli.register()
+    calls = []
+    monkeypatch.setattr(cli, "_handle", None)  # the real handle is restored afterwards
+    monkeypatch.setattr(bpy.utils, "register_cli_command", lambda *args: calls.append(("register", args)) or "H")
+    monkeypatch.setattr(bpy.utils, "unregister_cli_command", lambda *args: calls.append(("unregister", args)))
+    cli.register()
+    assert calls == [("register", ("ellimann", cli.main))] and cli._handle == "H"
+    cli.unregister()
+    assert calls[1:] == [("unregister", ("H",))] and cli._handle is None
+    cli.unregister()  # twice is harmless
+    assert len(calls) == 2
 
 
 def test_a_malformed_command_line_exits_2(capsys):
@@ -111,7 +125,7 @@ def test_synth_idw_reports_its_error(tmp_path, capsys, references):
     assert code == 0
     error = float(stdout.rsplit("max error ", 1)[1].rstrip("%\n"))
     measured = Mannequin.load(out).measure()
-    assert error == pytest.approx(max(abs(measured[k] - VALUES[k]) / VALUES[k] * 100 for k in MEASUREMENTS), abs=1e-3)
+    assert error == pytest.approx(relative_error(measured, VALUES).max(), abs=1e-3)
     assert error > 0.1  # the paper's IDW misses: the point of exact mode
 
 
@@ -193,6 +207,79 @@ def test_synth_mjcf_loads_in_mujoco_without_blender(tmp_path, references):
                                    + [int(mujoco.mjtGeom.mjGEOM_ELLIPSOID)] * singles)
     measured = {key: float(model.numeric(f"measured_{key}").data[0]) for key in MEASUREMENTS}
     assert measured == pytest.approx(VALUES, rel=1e-4)
+
+
+def test_an_unwritable_target_is_named_in_one_line(tmp_path, capsys, references):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("mine")
+    for out in (blocker / "m.json", blocker / "deeper" / "m.blend"):
+        code, _, err = run(["synth", *REQUEST, "-o", str(out), "--references", references], capsys)
+        assert_one_line_error(code, err, f"cannot write {out}: {blocker} is a file, not a folder")
+    (tmp_path / "folder.json").mkdir()
+    code, _, err = run(["synth", *REQUEST, "-o", str(tmp_path / "folder.json"), "--references", references], capsys)
+    assert_one_line_error(code, err, f"cannot write {tmp_path / 'folder.json'}: it is a folder")
+    source = write_csv(tmp_path / "in.csv", GOOD_ROWS[:1])
+    code, _, err = run(["batch", source, "-o", str(blocker), "--references", references], capsys)
+    assert_one_line_error(code, err, f"cannot write the folder {blocker}: it is a file")
+    assert blocker.read_text() == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file", "folder.json", "in.csv"]
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux's /proc, where no file can be created")
+@pytest.mark.parametrize("kind", ["json", "xml", "blend"])
+def test_a_folder_that_takes_no_files_names_the_target_not_the_temporary(capsys, references, kind):
+    code, _, err = run(["synth", *REQUEST, "-o", f"/proc/m.{kind}", "--references", references], capsys)
+    assert_one_line_error(code, err, f"cannot write /proc/m.{kind}: ")
+    assert ".tmp" not in err and ".ellimann-" not in err
+
+
+# ------------------------------------------------------------------------------------------------ drape
+
+
+def parse(argv):
+    return cli.build_parser().parse_args(argv)
+
+
+def test_drape_defaults_are_the_drape_settings_defaults():
+    """The CLI, the Drape panel and drape() from Python start from DrapeSettings()."""
+    args = parse(["drape", "m.json", "-o", "m.blend"])
+    assert cli.drape_settings(args) == DrapeSettings()
+    args = parse(["drape", "m.json", "-o", "m.blend", "--frames", "12", "--edge", "4", "--no-cushions"])
+    assert cli.drape_settings(args) == DrapeSettings(frames=12, edge=0.04, cushions=False)
+    assert cli.drape_settings(parse(["drape", "m.json", "-o", "m.blend", "--cushions"])).cushions
+
+
+def test_drape_help_shows_those_defaults(capsys):
+    code, out, _ = run(["drape", "--help"], capsys)
+    defaults = DrapeSettings()
+    assert code == 0
+    help_text = " ".join(out.split())
+    assert f"(default {defaults.frames}, at 24 fps)" in help_text
+    assert f"(default {defaults.edge * 100:g};" in help_text
+    assert f"(default: {'cushions' if defaults.cushions else 'every ellipsoid'})" in help_text
+
+
+def test_drape_refuses_collection_for_a_json_mannequin(tmp_path, capsys, toy):
+    toy.save(tmp_path / "toy.json")
+    out = tmp_path / "x.blend"
+    code, _, err = run(["drape", str(tmp_path / "toy.json"), "--collection", "Body", "-o", str(out)], capsys)
+    assert_one_line_error(code, err, "--collection", "toy.json is a .json file")
+    assert not out.exists()
+
+
+def test_drape_prints_progress_while_it_simulates(tmp_path, capsys, toy):
+    toy.save(tmp_path / "toy.json")
+    out = tmp_path / "x.blend"
+    code, stdout, err = run(["drape", str(tmp_path / "toy.json"), "--frames", "12", "--edge", "6", "--no-cushions",
+                             "-o", str(out)], capsys)
+    assert code == 0, err
+    assert stdout.startswith(f"wrote {out}: ")
+    lines = [line for line in err.splitlines() if line.startswith("ellimann drape: ")]
+    assert lines[0] == "ellimann drape: tube_dress on 'toy', 12 frames, cloth edge 6 cm, colliding with ellipsoids"
+    progress = [line.split()[2] for line in lines[1:]]
+    assert progress == ["10/12", "12/12"]  # every 10 frames, and the last
+    assert lines[-1].endswith("frames simulated; baking and measuring the fit")
+    assert not [h for h in bpy.app.handlers.frame_change_post if h.__module__ == cli.__name__]  # removed again
 
 
 # ------------------------------------------------------------------------------------------------ measure
@@ -287,6 +374,29 @@ def test_batch_shards_partition_the_rows(tmp_path, capsys, references):
     assert set().union(*seen) == {r[-1] for r in rows}
     assert sum(len(s) for s in seen) == 10
     assert not (out / "report.csv").exists()
+
+
+def test_batch_shards_agree_on_duplicate_names_across_the_whole_csv(tmp_path, capsys, references):
+    """Rows 1 and 2 share a name but land in different shards: only the first may write DIR/same.json."""
+    rows = [(150, 40, 110, 95, 110, "same"), (160, 40, 110, 95, 110, "same"), (155, 40, 110, 95, 110, "SAME"),
+            (158, 40, 110, 95, 110, "other")]
+    source = write_csv(tmp_path / "in.csv", rows)
+    out = tmp_path / "out"
+    errors = {}
+    for shard in (1, 2):
+        code, _, err = run(["batch", source, "-o", str(out), "--shard", f"{shard}/2", "--mode", "idw",
+                            "--references", references], capsys)
+        assert code == 1  # each shard holds one of the duplicates
+        errors[shard] = err
+    assert "line 4: skipped: name: 'SAME' is already used on line 2 (as 'same'" in errors[1]
+    assert "line 3: skipped: name: 'same' is already used on line 2" in errors[2]
+    assert Mannequin.load(out / "same.json").measurements["He"] == 150.0  # not overwritten by line 3
+    assert sorted(p.name for p in out.iterdir()) == ["other.json", "report-1-of-2.csv", "report-2-of-2.csv",
+                                                     "same.json"]
+    statuses = {}
+    for shard in (1, 2):
+        statuses.update({r["line"]: r["status"] for r in read_report(out / f"report-{shard}-of-2.csv")})
+    assert statuses == {"2": "ok", "3": "error", "4": "error", "5": "ok"}
 
 
 @pytest.mark.parametrize("header, extra, words", [

@@ -12,7 +12,12 @@ from devkit import synthetic
 from devkit.ui_recorder import Recorder, draw_panel
 from ellimann_addon.blender import convert, synthesize
 from ellimann_addon.blender import synthesize_panel as panel
+from ellimann_addon.blender.built import is_stale
+from ellimann_addon.blender.selection import part_lookup
 from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS, TABLE_2_5
+from ellimann_addon.core.cushion import DEFAULT_SUBDIVISIONS, cushion_mesh, to_frame
+from ellimann_addon.core.mesh import convexity_defect, is_closed_manifold
+from ellimann_addon.core.synthesis import cushion_vertices, relative_error
 from ellimann_addon.core.synthesis import synthesize as core_synthesize
 
 
@@ -37,6 +42,27 @@ def test_fields_are_in_cm_with_soft_limits_from_L_and_hard_limits_from_the_absur
         assert (field.soft_min, field.soft_max) == pytest.approx(RANGES[key])
         assert (field.hard_min, field.hard_max) == pytest.approx(ABSURD_LIMITS[key])
         assert "cm" in field.description
+
+
+def test_every_option_and_choice_has_a_tooltip():
+    rna = synthesize.ELLIMANN_PG_synthesis.bl_rna.properties
+    for name in ("mode", "output", "normalize", "metric", "power", "live", "target", "references"):
+        assert len(rna[name].description) > 20, name
+    for name in ("mode", "output", "normalize", "metric"):
+        for item in rna[name].enum_items:
+            assert len(item.description) > 10, (name, item.identifier)
+
+
+def test_one_relative_error_formula_for_dicts_and_arrays():
+    """core.synthesis.relative_error is what the operator, the CLI reports and Synthesis use (in %)."""
+    request = dict(zip(MEASUREMENTS, (160.0, 40.0, 100.0, 80.0, 100.0)))
+    measured = dict(zip(MEASUREMENTS, (160.0, 42.0, 99.0, 80.4, 100.0)))
+    expected = [0.0, 5.0, 1.0, 0.5, 0.0]
+    np.testing.assert_allclose(relative_error(measured, request), expected)
+    np.testing.assert_allclose(relative_error(measured, request, signed=True), [0.0, 5.0, -1.0, 0.5, 0.0])
+    batch = relative_error(np.array([list(measured.values())] * 3), np.array([list(request.values())] * 3))
+    assert batch.shape == (3, 5)
+    np.testing.assert_allclose(batch, [expected] * 3)
 
 
 def test_synthesize_makes_a_new_collection_named_after_the_measurements(props):
@@ -103,19 +129,116 @@ def test_live_updates_the_last_mannequin_in_place(props):
     assert len(convert.mannequin_collections()) == 1
 
 
-def test_live_rebuilds_cushions_and_survives_a_deleted_target(props):
+def cushion_objects():
+    return sorted((o for o in bpy.data.objects if o.ellimann.kind == "CUSHION"), key=lambda o: o.name)
+
+
+def local_vertices(obj):
+    return convert.mesh_vertices(obj.data)
+
+
+@pytest.mark.parametrize("subdivisions", [2, 4])
+def test_cushion_vertices_are_the_hull_builders_support_points_for_every_pair_at_once(subdivisions):
+    reference = synthetic.make_reference_set()
+    mannequin, _, _ = core_synthesize(reference, REFERENCE_MEASUREMENTS["small_chubby"], "exact")
+    pairs = mannequin.topology.cushion_pairs
+    batch = cushion_vertices(mannequin.rotation, mannequin.center, mannequin.semi_axes, pairs, subdivisions)
+    assert batch.shape == (len(pairs), 10 * 4 ** subdivisions + 2, 3)
+    for vertices, (i, j) in zip(batch, pairs):
+        first = (mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i])
+        second = (mannequin.rotation[j], mannequin.center[j], mannequin.semi_axes[j])
+        world, _ = cushion_mesh(first, second, subdivisions)
+        np.testing.assert_allclose(vertices, to_frame(world, first[0], first[1]), atol=1e-12)
+
+
+def test_live_moves_the_cushions_in_place_then_rebuilds_them_exactly(props):
     props.output = "CUSHIONS"
     bpy.ops.ellimann.synthesize_mannequin()
+    collection = props.target
+    before = {o.name: (o.data.as_pointer(), local_vertices(o)) for o in cushion_objects()}
+    faces = {o.name: [tuple(p.vertices) for p in o.data.polygons] for o in cushion_objects()}
     props.live = True
-    pairs = len([o for o in bpy.data.objects if o.ellimann.kind == "CUSHION"])
-    first = {tuple(o.data.vertices[0].co) for o in bpy.data.objects if o.ellimann.kind == "CUSHION"}
-    props.hi = 130.0
-    cushions = [o for o in bpy.data.objects if o.ellimann.kind == "CUSHION"]
-    assert len(cushions) == pairs and {tuple(o.data.vertices[0].co) for o in cushions} != first
-    print(f"\nlive update with {pairs} cushions: {props.live_ms:.1f} ms")
+    props.he = 165.0  # every part depends on He
+    cushions = cushion_objects()
+    assert [o.name for o in cushions] == sorted(before)  # the same objects and meshes, moved
+    assert all(o.data.as_pointer() == before[o.name][0] for o in cushions)
+    assert all([tuple(p.vertices) for p in o.data.polygons] == faces[o.name] for o in cushions)
+    mannequin = convert.collection_to_mannequin(collection)
+    names = mannequin.topology.names
+    for obj in cushions:  # vertices: the support points of the moved ellipsoids, in the first one's frame
+        first, second = names.index(obj.ellimann.part_name), names.index(obj.ellimann.partner)
+        expected = cushion_vertices(mannequin.rotation, mannequin.center, mannequin.semi_axes, [(first, second)],
+                                    DEFAULT_SUBDIVISIONS)[0]
+        np.testing.assert_allclose(local_vertices(obj), expected, atol=1e-6)
+        assert np.abs(local_vertices(obj) - before[obj.name][1]).max() > 1e-4
+        np.testing.assert_allclose(np.array(obj.matrix_world)[:3, 3], mannequin.center[first], atol=1e-6)
+    print(f"\nlive update with {len(cushions)} cushions: {props.live_ms:.1f} ms")
+    # The kept faces were convex for the old ellipsoids: out of date until the fields are still.
+    parts = part_lookup(collection)
+    assert all(is_stale(o, parts) for o in cushions)
+    assert bpy.app.timers.is_registered(synthesize._settle_timer)
+    bpy.app.timers.unregister(synthesize._settle_timer)
+    assert synthesize._settle_timer() is None  # what the timer runs, once
+    settled = cushion_objects()
+    assert len(settled) == len(cushions) and not any(is_stale(o, parts) for o in settled)
+    for obj in settled:
+        vertices, triangles = convert.mesh_vertices(obj.data), np.array([tuple(p.vertices) for p in obj.data.polygons])
+        assert is_closed_manifold(triangles) and convexity_defect(vertices, triangles) < 1e-6
+    assert synthesize.settle_live(bpy.context.scene) == 0  # nothing left to do
     bpy.data.collections.remove(props.target)
     props.hi = 120.0  # no target left: nothing to update, no error
     assert props.target is None
+
+
+def test_live_rebuilds_the_cushions_once_if_one_is_missing(props):
+    props.output = "CUSHIONS"
+    bpy.ops.ellimann.synthesize_mannequin()
+    count = len(cushion_objects())
+    bpy.data.objects.remove(cushion_objects()[0])
+    props.live = True  # turning Live on updates once: all cushions rebuilt, exact
+    cushions = cushion_objects()
+    assert len(cushions) == count and not any(is_stale(o, part_lookup(props.target)) for o in cushions)
+    moved = {o.name: (o.data.as_pointer(), local_vertices(o)) for o in cushions}
+    props.he = 162.0  # complete again: moved in place
+    assert {o.name: o.data.as_pointer() for o in cushion_objects()} == {k: v[0] for k, v in moved.items()}
+    assert all(np.abs(local_vertices(o) - moved[o.name][1]).max() > 1e-5 for o in cushion_objects())
+
+
+def test_a_preset_makes_one_live_update(props, monkeypatch):
+    bpy.ops.ellimann.synthesize_mannequin()
+    props.live = True
+    calls = []
+    real = synthesize.live_update
+    monkeypatch.setattr(synthesize, "live_update", lambda scene: calls.append(scene) or real(scene))
+    preset = synthesize.SHIPPED_PRESETS / "Table 2.5 (3).py"
+    bpy.ops.script.execute_preset(filepath=str(preset), menu_idname="ELLIMANN_MT_measurement_presets")
+    assert len(calls) == 1
+    assert tuple(props.target.ellimann.measured) == pytest.approx(TABLE_2_5[2], rel=1e-4)
+    props.live = False
+    bpy.ops.script.execute_preset(filepath=str(preset), menu_idname="ELLIMANN_MT_measurement_presets")
+    assert len(calls) == 1  # live off: none
+    props.he = 150.0
+    props.live = True
+    props.he = 151.0  # held no longer: every change updates again
+    assert len(calls) == 3
+
+
+def test_a_live_target_whose_name_is_taken_keeps_its_suffix(props):
+    taken = "ElliMann 160-43-117-104-117"
+    mine = convert.new_collection(taken)
+    bpy.ops.ellimann.synthesize_mannequin()
+    target = props.target
+    props.live = True
+    props.he = 160.0
+    assert target.name == taken + ".001" and mine.name == taken
+    assert not synthesize.rename_live_target(target, taken)  # next updates leave the name alone
+    props.mode = "IDW"
+    assert target.name == taken + ".001" and mine.name == taken
+    props.he = 161.0
+    assert target.name == "ElliMann 161-43-117-104-117"
+    bpy.data.collections.remove(mine)
+    props.he = 160.0
+    assert target.name == taken  # the name is free again
 
 
 def shipped_presets():
@@ -149,35 +272,7 @@ def test_users_can_save_and_remove_their_own_presets(props):
     assert not saved.exists()
 
 
-class _StandInMain(bpy.types.Panel):
-    """Only while the authoring tools' main panel is not on this branch."""
-
-    bl_idname = "ELLIMANN_PT_main"
-    bl_label = "ElliMann"
-    bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "ElliMann"
-
-    def draw(self, context):
-        pass
-
-
-@pytest.fixture
-def registered_panel():
-    stand_in = not hasattr(bpy.types, "ELLIMANN_PT_main")
-    if stand_in:
-        bpy.utils.register_class(_StandInMain)
-    own = not hasattr(bpy.types, "ELLIMANN_PT_synthesize")
-    if own:
-        panel.register()
-    yield
-    if own:
-        panel.unregister()
-    if stand_in:
-        bpy.utils.unregister_class(_StandInMain)
-
-
-def test_the_panel_draws_request_options_and_measured_values(props, registered_panel):
+def test_the_panel_draws_request_options_and_measured_values(props):
     recorder = draw_panel(panel.ELLIMANN_PT_synthesize)
     assert [p for p in recorder.props() if p in ("he", "sh", "br", "wa", "hi")] == ["he", "sh", "br", "wa", "hi"]
     for name in ("mode", "output", "normalize", "metric", "power", "live", "references"):
@@ -192,16 +287,19 @@ def test_the_panel_draws_request_options_and_measured_values(props, registered_p
     assert "m_T (cm)" in labels and "159.00" in labels and "117.00" in labels
 
 
-def test_the_panel_is_registered_with_the_add_on_once_its_parent_exists():
-    """The sub-panel needs ELLIMANN_PT_main (authoring tools); when the add-on registers that panel it must
-    register this one too (``synthesize_panel`` listed after it in blender/__init__.py's _MODULES)."""
+def test_the_panel_is_a_sub_panel_registered_with_the_add_on():
+    """Registered after its parent ELLIMANN_PT_main (``synthesize_panel`` after ``panels`` in _MODULES), with the
+    ids of ids.py, between the authoring tools' panels and Drape."""
     from ellimann_addon import blender
+    from ellimann_addon.blender import ids
 
-    if hasattr(bpy.types, "ELLIMANN_PT_main"):  # registered by the add-on (the stand-in is gone by now)
-        assert "synthesize_panel" in blender._MODULES
-        assert hasattr(bpy.types, "ELLIMANN_PT_synthesize")
-    else:
-        assert "synthesize_panel" not in blender._MODULES  # registering it would fail: no parent
+    assert blender._MODULES.index("panels") < blender._MODULES.index("synthesize_panel")
+    assert hasattr(bpy.types, ids.PANEL_SYNTHESIZE) and hasattr(bpy.types, ids.PANEL_MAIN)
+    cls = panel.ELLIMANN_PT_synthesize
+    assert (cls.bl_idname, cls.bl_parent_id) == (ids.PANEL_SYNTHESIZE, ids.PANEL_MAIN)
+    assert max(ids.PANEL_ORDER.values()) < cls.bl_order < ids.DRAPE_ORDER
+    assert synthesize.ELLIMANN_OT_synthesize_mannequin.bl_idname == ids.SYNTHESIZE_MANNEQUIN
+    assert synthesize.ELLIMANN_OT_add_measurement_preset.bl_idname == ids.ADD_MEASUREMENT_PRESET
 
 
 def test_recorder_catches_a_misspelt_property(props):
