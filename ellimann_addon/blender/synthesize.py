@@ -307,7 +307,7 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
 class ELLIMANN_MT_measurement_presets(bpy.types.Menu):
     """Measurements of the Reference Mannequins, the paper's Table 2.5 and your own presets"""
 
-    bl_idname = "ELLIMANN_MT_measurement_presets"
+    bl_idname = ids.MENU_MEASUREMENT_PRESETS
     bl_label = "Measurement Presets"  # Blender shows the last preset chosen here
     preset_subdir = PRESET_SUBDIR
     preset_operator = "script.execute_preset"
@@ -333,7 +333,7 @@ class ELLIMANN_OT_add_measurement_preset(AddPresetBase, bpy.types.Operator):
 
     bl_idname = ids.ADD_MEASUREMENT_PRESET
     bl_label = "Add Measurement Preset"
-    preset_menu = ELLIMANN_MT_measurement_presets.bl_idname
+    preset_menu = ids.MENU_MEASUREMENT_PRESETS
     preset_subdir = PRESET_SUBDIR
     preset_defines = ["props = bpy.context.scene.ellimann_synthesis"]
     preset_values = [f"props.{attr}" for attr in FIELDS.values()]

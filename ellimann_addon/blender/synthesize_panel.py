@@ -17,7 +17,7 @@ class ELLIMANN_PT_synthesize(ElliMannPanel, bpy.types.Panel):
     bl_idname = ids.PANEL_SYNTHESIZE
     bl_label = "Synthesize"
     bl_parent_id = ids.PANEL_MAIN
-    bl_order = max(ids.PANEL_ORDER.values()) + 10  # right after the authoring tools' panels, before Drape
+    bl_order = ids.SYNTHESIZE_ORDER
 
     @classmethod
     def poll(cls, context):
@@ -30,7 +30,7 @@ class ELLIMANN_PT_synthesize(ElliMannPanel, bpy.types.Panel):
         measured = tuple(target.ellimann.measured) if target is not None and target.ellimann.has_measured else None
 
         row = layout.row(align=True)
-        row.menu(ELLIMANN_MT_measurement_presets.bl_idname, text=ELLIMANN_MT_measurement_presets.bl_label)
+        row.menu(ids.MENU_MEASUREMENT_PRESETS, text=ELLIMANN_MT_measurement_presets.bl_label)
         row.operator(ids.ADD_MEASUREMENT_PRESET, text="", icon="ADD")
         row.operator(ids.ADD_MEASUREMENT_PRESET, text="", icon="REMOVE").remove_active = True
 
