@@ -15,7 +15,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .constants import MEASUREMENTS
-from .ellipsoid import Ellipsoid
 from .errors import MannequinError, Problem
 from .files import atomic_write_text
 
@@ -168,9 +167,6 @@ class Topology:
                     pairs.append((i, j))
         return pairs
 
-    def to_list(self):
-        return [p.to_dict() for p in self.parts]
-
     @classmethod
     def from_list(cls, items):
         parts, problems = [], []
@@ -228,10 +224,6 @@ class Mannequin:
                       measurements=dict(self.measurements) if self.measurements else None)
         values.update(changes)
         return Mannequin(**values)
-
-    def ellipsoid(self, name):
-        i = self.topology.index[name]
-        return Ellipsoid(self.center[i], self.rotation[i], self.semi_axes[i])
 
     def problems(self):
         """Geometry problems, each naming the ellipsoid and field (the topology validated itself)."""
