@@ -17,7 +17,7 @@ fail the check and are rebuilt by an exact incremental hull of the same points i
 import numpy as np
 
 from .ellipsoid import shape_matrix
-from .mesh import icosphere
+from .mesh import directed_edges, face_normals, icosphere
 
 DEFAULT_SUBDIVISIONS = 4  # 2,562 vertices; capsule volume within 0.5% (see tests)
 _MAX_FLIP_ROUNDS = 200
@@ -50,9 +50,8 @@ def cushion_mesh(first, second, subdivisions=DEFAULT_SUBDIVISIONS):
 
 
 def _faces_point_away(vertices, faces, interior):
-    v = vertices[faces]
-    normal = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
-    return bool(np.all(np.einsum("ij,ij->i", normal, v[:, 0] - interior) > 0.0))
+    normal = face_normals(vertices, faces)
+    return bool(np.all(np.einsum("ij,ij->i", normal, vertices[faces[:, 0]] - interior) > 0.0))
 
 
 def to_frame(vertices, rotation, center):
@@ -83,14 +82,14 @@ def make_locally_convex(vertices, faces):
 
 
 def _edge_set(faces):
-    e = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    e = np.sort(directed_edges(faces), axis=1)
     return set(map(tuple, e.tolist()))
 
 
 def _reflex_edges(vertices, faces, tol):
     """Edges (a, b) whose far vertex d lies above the plane of the face (a, b, c), worst first."""
     m = len(faces)
-    directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    directed = directed_edges(faces)
     opposite = np.concatenate([faces[:, 2], faces[:, 0], faces[:, 1]])
     owner = np.tile(np.arange(m), 3)
     key = directed[:, 0].astype(np.int64) * (len(vertices) + 1) + directed[:, 1]
@@ -101,7 +100,8 @@ def _reflex_edges(vertices, faces, tol):
     idx = np.nonzero(first)[0]
     a, b, c = directed[idx, 0], directed[idx, 1], opposite[idx]
     d = opposite[twin[idx]]
-    normal = np.cross(vertices[b] - vertices[a], vertices[c] - vertices[a])
+    # Seen from the edge's own corner a: rounded alike for every edge (ties between excesses stay ties).
+    normal = face_normals(vertices, np.column_stack([a, b, c]))
     normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-300)
     excess = np.einsum("ij,ij->i", normal, vertices[d] - vertices[a])
     bad = np.nonzero(excess > tol)[0]
@@ -145,8 +145,7 @@ def convex_hull_3d(points):
         visible = np.nonzero(alive & (normals @ points[apex] - offsets > eps))[0]
         if not len(visible):
             visible = np.array([face])
-        vis_faces = faces[visible]
-        edges = np.concatenate([vis_faces[:, [0, 1]], vis_faces[:, [1, 2]], vis_faces[:, [2, 0]]])
+        edges = directed_edges(faces[visible])
         keys = edges[:, 0].astype(np.int64) * len(points) + edges[:, 1]
         rkeys = edges[:, 1].astype(np.int64) * len(points) + edges[:, 0]
         horizon = edges[~np.isin(rkeys, keys)]
@@ -170,10 +169,9 @@ def convex_hull_3d(points):
 
 
 def _planes(points, faces):
-    v = points[faces]
-    normal = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+    normal = face_normals(points, faces)
     normal /= np.linalg.norm(normal, axis=1, keepdims=True)
-    return normal, np.einsum("ij,ij->i", normal, v[:, 0])
+    return normal, np.einsum("ij,ij->i", normal, points[faces[:, 0]])
 
 
 def _assign(points, which, normals, offsets, candidates, eps):

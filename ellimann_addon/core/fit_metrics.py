@@ -21,6 +21,7 @@ import numpy as np
 
 from .cushion import cushion_mesh
 from .errors import ElliMannError
+from .mesh import face_normals
 
 NEWTON_LIMIT = 60  # iterations at most; typical convergence is under 10
 _PAIRS_PER_CHUNK = 200_000  # point-triangle pairs per vectorised block (temporaries stay near 100 MB)
@@ -188,7 +189,7 @@ def mesh_distance(points, vertices, faces, signed=True, pairs_per_chunk=_PAIRS_P
 def _pseudo_normals(vertices, faces):
     """Angle-weighted pseudo-normals: per face (F, 3), per face edge k -> k+1 (F, 3, 3), per vertex (V, 3)."""
     tri = vertices[faces]
-    face = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    face = face_normals(vertices, faces)
     face /= np.linalg.norm(face, axis=1, keepdims=True)
     vertex = np.zeros_like(vertices)
     for k in range(3):
@@ -294,8 +295,9 @@ def convex_mesh_signed_distance(points, vertices, faces, cutoff=np.inf):
     vertices = np.asarray(vertices, dtype=float)
     centre = vertices.mean(axis=0)
     bound = np.linalg.norm(points - centre, axis=1) - np.linalg.norm(vertices - centre, axis=1).max()
-    tri = np.asarray(vertices, dtype=float)[np.asarray(faces)]
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    faces = np.asarray(faces)
+    tri = vertices[faces]
+    normal = face_normals(vertices, faces)
     normal /= np.linalg.norm(normal, axis=1, keepdims=True)
     height = points @ normal.T - np.einsum("ij,ij->i", normal, tri[:, 0])  # (P, F)
     best = np.argmax(height, axis=1)

@@ -35,6 +35,7 @@ from .ellipsoid import section_at_height
 from .errors import ElliMannError, MeasurementError
 from .fit_metrics import ellipsoid_signed_distance
 from .measure import hull_perimeter, section_heights
+from .mesh import face_normals
 
 DEFAULT_EDGE = 0.02  # m, target edge length of the cloth mesh
 MIN_CLEARANCE = 0.005  # m, least initial gap between garment and body
@@ -549,7 +550,7 @@ def _sleeve(mannequin, arm, loop, vertices, sizes, sleeve_ease, length, edge, cl
 def _orient_away_from_body(vertices, faces, panel, mannequin):
     """Flip faces whose normal points towards the nearest body part (each panel is consistently wound)."""
     tri = vertices[faces]
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    normal = face_normals(vertices, faces)
     centroid = tri.mean(axis=1)
     distance, closest = ellipsoid_signed_distance(centroid, mannequin.rotation, mannequin.center,
                                                   mannequin.semi_axes, return_closest=True)
