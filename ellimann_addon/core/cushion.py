@@ -16,7 +16,7 @@ fail the check and are rebuilt by an exact incremental hull of the same points i
 
 import numpy as np
 
-from .ellipsoid import shape_matrix
+from .ellipsoid import support_and_point
 from .mesh import directed_edges, face_normals, icosphere
 
 DEFAULT_SUBDIVISIONS = 4  # 2,562 vertices; capsule volume within 0.5% (see tests)
@@ -30,14 +30,7 @@ def cushion_mesh(first, second, subdivisions=DEFAULT_SUBDIVISIONS):
     outside. Use :func:`to_frame` for vertices in the first ellipsoid's frame (the paper's S_o).
     """
     directions, faces = icosphere(subdivisions)
-    points = []
-    reach = []
-    for rotation, center, semi_axes in (first, second):
-        m = shape_matrix(np.asarray(rotation, float), np.asarray(semi_axes, float))
-        mn = directions @ m  # m is symmetric
-        root = np.sqrt(np.einsum("ij,ij->i", directions, mn))
-        points.append(np.asarray(center, float) + mn / root[:, None])
-        reach.append(directions @ np.asarray(center, float) + root)
+    reach, points = zip(*(support_and_point(*ellipsoid, directions) for ellipsoid in (first, second)))
     vertices = np.where((reach[0] >= reach[1])[:, None], points[0], points[1])
     interior = 0.5 * (np.asarray(first[1], float) + np.asarray(second[1], float))
     try:
