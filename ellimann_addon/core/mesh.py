@@ -39,8 +39,9 @@ def icosphere(subdivisions=3):
 
 
 def directed_edges(faces):
-    """Every face's edges (3F, 2): row k * F + f runs from corner k of face f to corner k + 1."""
-    return np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    """Every face's edges (..., 3F, 2) of faces (..., F, 3): row k * F + f runs from corner k of face f
+    to corner k + 1."""
+    return np.concatenate([faces[..., [0, 1]], faces[..., [1, 2]], faces[..., [2, 0]]], axis=-2)
 
 
 def face_normals(vertices, faces):

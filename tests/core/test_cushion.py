@@ -65,6 +65,26 @@ def test_identical_and_nested_ellipsoids():
     assert np.all(contains(e[0], e[1], e[2], v, tol=1e-9))
 
 
+def test_a_batch_builds_every_pair_as_if_alone(monkeypatch):
+    """cushion_meshes runs all pairs through shared arrays; each mesh must be exactly the one built alone,
+    also next to a flat pair whose folded triangulation is rebuilt by the exact hull."""
+    flat = ((rotation_from_vector((0.3, 0.5, 0.1)), (0, 0, 0), (0.2, 0.02, 0.15)),
+            (np.eye(3), (0.05, 0.02, 0.25), (0.08, 0.1, 0.12)))
+    capsule = ((np.eye(3), (0, 0, 0), (0.1, 0.1, 0.1)), (np.eye(3), (0, 0, 0.3), (0.1, 0.1, 0.1)))
+    rng = np.random.default_rng(3)
+    pairs = [random_pair(rng), flat, capsule, (capsule[0], capsule[0]), random_pair(rng)]
+    exact_hulls = []
+    real_hull = cushion.convex_hull_3d
+    monkeypatch.setattr(cushion, "convex_hull_3d", lambda points: exact_hulls.append(len(points)) or real_hull(points))
+    batch = cushion.cushion_meshes(pairs, 3)
+    assert len(exact_hulls) == 1  # the flat pair, and only it
+    for pair, (v, f) in zip(pairs, batch):
+        check_convex_closed(v, f)
+        alone_v, alone_f = cushion.cushion_mesh(*pair, 3)
+        assert np.array_equal(v, alone_v) and np.array_equal(f, alone_f)
+    assert len(exact_hulls) == 2 and cushion.cushion_meshes([], 3) == []
+
+
 def test_to_frame_expresses_vertices_in_the_first_frame():
     r = rotation_from_vector((0.4, -0.2, 1.0))
     e1 = (r, (1.0, 2.0, 3.0), (0.1, 0.2, 0.3))
