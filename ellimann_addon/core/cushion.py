@@ -26,6 +26,11 @@ DEFAULT_SUBDIVISIONS = 4  # 2,562 vertices; capsule volume within 0.5% (see test
 _MAX_FLIP_ROUNDS = 200
 
 
+def cushion_name(first, second):
+    """Name of the cushion of the parts named ``first`` and ``second``: ``"2.a Chest + 2.b Belly"``."""
+    return f"{first} + {second}"
+
+
 def cushion_mesh(first, second, subdivisions=DEFAULT_SUBDIVISIONS):
     """Hull of two ellipsoids, each given as (rotation, center, semi_axes).
 
@@ -56,6 +61,33 @@ def cushion_meshes(pairs, subdivisions=DEFAULT_SUBDIVISIONS):
             faces = convex_hull_3d(v)
         meshes.append((v, faces))
     return meshes
+
+
+class CushionMesh(NamedTuple):
+    """The hull of a mannequin's cushion pair: part indices, :func:`cushion_name`, vertices (V, 3), faces (F, 3)."""
+
+    first: int
+    second: int
+    name: str
+    vertices: np.ndarray
+    faces: np.ndarray
+
+
+def mannequin_cushions(mannequin, subdivisions=DEFAULT_SUBDIVISIONS, local=False):
+    """The hull of every cushion pair of ``mannequin``, in topology order, built in one batch: a list
+    of :class:`CushionMesh`. Vertices are in world coordinates, or with ``local`` in the first
+    ellipsoid's frame (the paper's S_o, as :func:`to_frame`).
+    """
+    topology = mannequin.topology
+    pairs = topology.cushion_pairs
+    frames = [tuple((mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i]) for i in pair)
+              for pair in pairs]
+    out = []
+    for (i, j), (vertices, faces) in zip(pairs, cushion_meshes(frames, subdivisions)):
+        if local:
+            vertices = to_frame(vertices, mannequin.rotation[i], mannequin.center[i])
+        out.append(CushionMesh(i, j, cushion_name(topology.names[i], topology.names[j]), vertices, faces))
+    return out
 
 
 # Edge slots: slot k * F + f is the edge of face f from its corner k to corner k + 1 (the rows of

@@ -19,7 +19,7 @@ is then off that plane) and the closed form at t = -a_min^2 is used.
 
 import numpy as np
 
-from .cushion import cushion_mesh
+from .cushion import mannequin_cushions
 from .errors import ElliMannError
 from .mesh import face_normals
 
@@ -240,20 +240,17 @@ class BodyPieces:
 
     The pieces are its ellipsoids or, with ``cushions``, one convex hull mesh per cushion pair
     (built at ``subdivisions``) plus the remaining single ellipsoids. ``names`` holds a part name
-    per piece, or ``"first + second"`` for a cushion.
+    per piece, or :func:`cushion.cushion_name` for a cushion.
     """
 
     def __init__(self, mannequin, cushions=False, subdivisions=3):
         topology = mannequin.topology
-        pairs = topology.cushion_pairs if cushions else []
-        paired = {i for pair in pairs for i in pair}
-        self.singles = np.array([i for i in range(len(topology)) if i not in paired], dtype=int)
+        self.singles = np.array(topology.single_parts(cushions), dtype=int)
         self.frames = (mannequin.rotation[self.singles], mannequin.center[self.singles],
                        mannequin.semi_axes[self.singles])
-        self.meshes = [cushion_mesh(*((mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i])
-                                      for i in pair), subdivisions=subdivisions) for pair in pairs]
-        self.names = [topology.names[i] for i in self.singles] + [
-            f"{topology.names[a]} + {topology.names[b]}" for a, b in pairs]
+        hulls = mannequin_cushions(mannequin, subdivisions) if cushions else []
+        self.meshes = [(hull.vertices, hull.faces) for hull in hulls]
+        self.names = [topology.names[i] for i in self.singles] + [hull.name for hull in hulls]
 
     def signed_distance(self, points, cutoff=np.inf):
         """(distance (P,), index into ``names`` of the nearest piece (P,)).

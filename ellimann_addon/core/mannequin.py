@@ -167,6 +167,12 @@ class Topology:
                     pairs.append((i, j))
         return pairs
 
+    def single_parts(self, cushions=True):
+        """Indices of the parts that are pieces of the body on their own: with ``cushions`` those in
+        no cushion pair (the pairs become cushions), else all of them."""
+        paired = {i for pair in self.cushion_pairs for i in pair} if cushions else set()
+        return [i for i in range(len(self.parts)) if i not in paired]
+
     @classmethod
     def from_list(cls, items):
         parts, problems = [], []

@@ -85,6 +85,19 @@ def test_a_batch_builds_every_pair_as_if_alone(monkeypatch):
     assert len(exact_hulls) == 2 and cushion.cushion_meshes([], 3) == []
 
 
+def test_mannequin_cushions_are_the_hulls_of_its_pairs(toy):
+    world, local = cushion.mannequin_cushions(toy, 2), cushion.mannequin_cushions(toy, 2, local=True)
+    assert [(h.first, h.second) for h in world] == toy.topology.cushion_pairs == [(1, 2), (8, 9), (10, 11)]
+    assert [h.name for h in world] == ["2.a Chest + 2.b Belly", "6.a Thigh.L + 6.b Shin.L", "6.a Thigh.R + 6.b Shin.R"]
+    for hull, in_frame in zip(world, local):
+        pair = [(toy.rotation[i], toy.center[i], toy.semi_axes[i]) for i in (hull.first, hull.second)]
+        alone = cushion.cushion_mesh(*pair, 2)
+        assert np.array_equal(hull.vertices, alone[0]) and np.array_equal(hull.faces, alone[1])
+        r, c = toy.rotation[hull.first], toy.center[hull.first]
+        assert np.allclose(in_frame.vertices @ r.T + c, hull.vertices, rtol=0, atol=1e-15)
+        assert np.array_equal(in_frame.faces, hull.faces) and in_frame.name == hull.name
+
+
 def test_to_frame_expresses_vertices_in_the_first_frame():
     r = rotation_from_vector((0.4, -0.2, 1.0))
     e1 = (r, (1.0, 2.0, 3.0), (0.1, 0.2, 0.3))

@@ -25,6 +25,9 @@ def test_toy_topology_is_valid_and_indexed(toy):
     assert topo.twin_indices[topo.index["1.a Head"]] == topo.index["1.a Head"]
     pairs = {(topo.names[a], topo.names[b]) for a, b in topo.cushion_pairs}
     assert pairs == {("2.a Chest", "2.b Belly"), ("6.a Thigh.L", "6.b Shin.L"), ("6.a Thigh.R", "6.b Shin.R")}
+    names = [topo.names[i] for i in topo.single_parts()]
+    assert names == ["1.a Head", "3.a Pelvis", "4.a Trapezius.L", "4.a Trapezius.R", "5.a Arm.L", "5.a Arm.R"]
+    assert topo.single_parts(cushions=False) == list(range(12))
     assert topo.girth_mask.sum() == 9
     assert topo.dependency_mask.shape == (12, 5)
     assert twin_name("4.a Trapezius.L") == "4.a Trapezius.R"
