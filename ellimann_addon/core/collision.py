@@ -13,10 +13,11 @@ import numpy as np
 
 from .cushion import mannequin_cushions
 from .ellipsoid import matrix_world
-from .errors import ElliMannError
-from .mesh import icosphere
+from .mesh import check_subdivision_level, icosphere
 
-SUBDIVISION_RANGE = (0, 5)  # icosphere levels: 20 to 20,480 triangles per piece
+# Icosphere levels of cloth colliders: 20 to 20,480 triangles per piece; the solver's cost grows
+# with the triangles, 4x a level (MJCF's cushion levels differ: export_mjcf.SUBDIVISION_RANGE).
+SUBDIVISION_RANGE = (0, 5)
 
 
 @dataclass
@@ -34,10 +35,8 @@ class CollisionPiece:
 
 
 def check_subdivisions(name, value):
-    low, high = SUBDIVISION_RANGE
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not low <= value <= high:
-        raise ElliMannError(f"{name}: must be an integer from {low} to {high}, got {value!r}")
-    return int(value)
+    """A collision mesh level (SUBDIVISION_RANGE) as an int, else ElliMannError naming ``name``."""
+    return check_subdivision_level(name, value, SUBDIVISION_RANGE)
 
 
 def collision_pieces(mannequin, cushions=False, sphere_subdivisions=2, cushion_subdivisions=2):

@@ -25,6 +25,7 @@ from .constants import MEASUREMENTS
 from .cushion import mannequin_cushions
 from .errors import ElliMannError
 from .files import atomic_write_text
+from .mesh import check_subdivision_level
 from .quaternion import rotation_to_quaternion
 
 # Contact and integration defaults for a static mannequin that objects fall onto. MuJoCo's own
@@ -38,7 +39,7 @@ FRICTION = (1.0, 0.005, 0.0001)  # sliding, torsional, rolling
 # Cushion hull resolution: level 3 = 642 vertices, volume within about 1% (inscribed) of the exact
 # hull and about 38 kB of XML per cushion; level 4 (2,562 vertices) gets 0.25% at four times the size.
 MJCF_SUBDIVISIONS = 3
-SUBDIVISION_RANGE = (1, 6)  # cushion resolution: 42 to 40,962 hull vertices
+SUBDIVISION_RANGE = (1, 6)  # cushion resolution: 42 to 40,962 hull vertices (about 2.4 MB of XML each)
 SIDE_RGBA = {"L": (0.85, 0.55, 0.45, 1.0), "R": (0.45, 0.6, 0.85, 1.0), "C": (0.8, 0.78, 0.72, 1.0)}
 CUSHION_RGBA = (0.72, 0.7, 0.82, 1.0)
 MANNEQUIN_CLASS = "ellimann"
@@ -46,14 +47,6 @@ MANNEQUIN_CLASS = "ellimann"
 
 def _fmt(values, digits=9):
     return " ".join(f"{float(v):.{digits}g}" for v in np.ravel(values))
-
-
-def _check_subdivisions(subdivisions):
-    low, high = SUBDIVISION_RANGE
-    if isinstance(subdivisions, bool) or not isinstance(subdivisions, (int, np.integer)) or not (
-            low <= subdivisions <= high):
-        raise ElliMannError(f"subdivisions: must be an integer from {low} to {high}, got {subdivisions!r}")
-    return int(subdivisions)
 
 
 def mannequin_to_mjcf(mannequin, cushions=False, subdivisions=MJCF_SUBDIVISIONS, floor=True,
@@ -64,7 +57,7 @@ def mannequin_to_mjcf(mannequin, cushions=False, subdivisions=MJCF_SUBDIVISIONS,
     (icosphere level of the support directions, 1..6); ``floor`` adds a plane at z = 0.
     """
     mannequin.check()
-    subdivisions = _check_subdivisions(subdivisions)
+    subdivisions = check_subdivision_level("subdivisions", subdivisions, SUBDIVISION_RANGE)
     if isinstance(timestep, bool) or not (isinstance(timestep, (int, float)) and 0.0 < timestep <= 0.05):
         raise ElliMannError(f"timestep: must be a number in (0, 0.05] seconds, got {timestep!r}")
     topology = mannequin.topology

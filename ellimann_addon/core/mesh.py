@@ -2,6 +2,8 @@
 
 import numpy as np
 
+from .errors import ElliMannError
+
 
 def icosphere(subdivisions=3):
     """Unit icosphere: (vertices (V, 3), faces (F, 3) int, counter-clockwise seen from outside).
@@ -36,6 +38,15 @@ def icosphere(subdivisions=3):
         ])
         verts = np.concatenate([verts, mids])
     return verts, faces
+
+
+def check_subdivision_level(name, value, allowed):
+    """``value`` as an int if it is an integer icosphere level in ``allowed`` (low, high), else an
+    ElliMannError naming ``name`` and the range."""
+    low, high = allowed
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not low <= value <= high:
+        raise ElliMannError(f"{name}: must be an integer from {low} to {high}, got {value!r}")
+    return int(value)
 
 
 def directed_edges(faces):

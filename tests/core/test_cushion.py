@@ -5,6 +5,7 @@ from scipy.spatial import ConvexHull
 from devkit.toy import rotation_from_vector
 from ellimann_addon.core import cushion, mesh
 from ellimann_addon.core.ellipsoid import contains, support
+from ellimann_addon.core.errors import ElliMannError
 
 
 def check_convex_closed(v, f):
@@ -119,3 +120,11 @@ def test_icosphere_sizes_and_orientation():
         v, f = mesh.icosphere(s)
         assert len(v) == 10 * 4**s + 2 and len(f) == 20 * 4**s
         check_convex_closed(v, f)
+
+
+def test_subdivision_levels_are_integers_in_the_allowed_range():
+    assert mesh.check_subdivision_level("level", 3, (1, 6)) == 3
+    assert type(mesh.check_subdivision_level("level", np.int64(1), (1, 6))) is int
+    for bad in (0, 7, 3.0, True, "3", None):
+        with pytest.raises(ElliMannError, match=r"level: must be an integer from 1 to 6, got "):
+            mesh.check_subdivision_level("level", bad, (1, 6))

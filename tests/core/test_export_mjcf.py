@@ -131,8 +131,9 @@ def test_write_is_atomic_and_bad_input_writes_nothing(toy, tmp_path):
     bad.semi_axes[3, 1] = -0.1
     with pytest.raises(MannequinError, match="3.a Pelvis"):
         write_mjcf(bad, tmp_path / "bad.xml")
-    with pytest.raises(ElliMannError, match="subdivisions"):
-        write_mjcf(toy, tmp_path / "bad.xml", cushions=True, subdivisions=0)
+    for level in (0, 7, 2.0, True):
+        with pytest.raises(ElliMannError, match=f"subdivisions: must be an integer from 1 to 6, got {level!r}"):
+            write_mjcf(toy, tmp_path / "bad.xml", cushions=True, subdivisions=level)
     with pytest.raises(ElliMannError, match="timestep"):
         write_mjcf(toy, tmp_path / "bad.xml", timestep=-1)
     assert not (tmp_path / "bad.xml").exists()
