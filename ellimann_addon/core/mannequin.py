@@ -242,9 +242,10 @@ class Mannequin:
             return out
         if self.role not in ROLES:
             out.append(Problem("", "role", f"is '{self.role}'; expected one of {', '.join(ROLES)}"))
-        det = np.linalg.det(self.rotation)
-        gram = np.swapaxes(self.rotation, -1, -2) @ self.rotation
-        ortho_error = np.abs(gram - np.eye(3)).max(axis=(1, 2))
+        with np.errstate(invalid="ignore"):  # a non-finite frame is reported below, not warned about
+            det = np.linalg.det(self.rotation)
+            gram = np.swapaxes(self.rotation, -1, -2) @ self.rotation
+            ortho_error = np.abs(gram - np.eye(3)).max(axis=(1, 2))
         for i, part in enumerate(self.topology):
             for attr in ("rotation", "center", "semi_axes"):
                 if not np.all(np.isfinite(getattr(self, attr)[i])):
