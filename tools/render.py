@@ -5,13 +5,11 @@ so the file being rendered is left as it was. Each *slot* is one group of solid 
 collections or objects) with optional semi-transparent *ghosts* (e.g. the reference body it was
 traced over); several slots stand side by side along X for a line-up.
 
-    python -m tools.render trace-example --mesh BODY.obj --regions BODY_regions.json --out PNG
     python -m tools.render mannequins A.json [B.json ...] [--ghost A.obj ...] --out PNG [--view SIDE]
         [--ghost-shift X Y Z] [--side-too]
 """
 
 import argparse
-import json
 import math
 import sys
 from dataclasses import dataclass, field
@@ -23,8 +21,7 @@ from mathutils import Matrix
 
 import ellimann_addon
 from ellimann_addon.blender.convert import mannequin_to_collection
-from ellimann_addon.core.fit import fit_ellipsoid
-from ellimann_addon.core.mannequin import Mannequin, Part, Topology
+from ellimann_addon.core.mannequin import Mannequin
 
 GHOST_COLOR = (0.55, 0.55, 0.58, 0.22)
 BACKGROUND = (1.0, 1.0, 1.0)
@@ -147,47 +144,6 @@ def import_obj(path):
     return [o for o in bpy.data.objects if o not in before]
 
 
-def obj_vertices(path):
-    """Vertex positions of an OBJ file in file order (n, 3)."""
-    with open(path, encoding="utf-8") as stream:
-        rows = [line.split()[1:4] for line in stream if line.startswith("v ")]
-    return np.array(rows, dtype=float)
-
-
-# Reference body regions -> a traced part each (number, label, side suffix), paper-style names.
-REGION_PARTS = {
-    "head": (1, "Head", ""), "neck": (2, "Neck", ""), "chest": (3, "Chest", ""), "abdomen": (4, "Abdomen", ""),
-    "pelvis": (5, "Pelvis", ""), "upper_arm": (6, "UpperArm", ""), "forearm": (7, "Forearm", ""),
-    "hand": (8, "Hand", ""), "thigh": (9, "Thigh", ""), "shin": (10, "Shin", ""), "foot": (11, "Foot", ""),
-}
-
-
-def traced_mannequin(vertices, regions, mode="moments"):
-    """One ellipsoid per body region, fitted to that region's vertices as the Fit operator does."""
-    labels = np.asarray(regions["labels"])
-    parts, frames = [], []
-    for index, region in enumerate(regions["region_names"]):
-        base, _, side = region.rpartition("_") if region.endswith(("_L", "_R")) else (region, "", "")
-        number, label, _ = REGION_PARTS[base]
-        name = f"{number}.a {label}" + (f".{side}" if side else "")
-        girth = region not in regions["arm_regions"]
-        parts.append(Part(name, side or "C", base, girth, ("He",)))
-        frames.append(fit_ellipsoid(vertices[labels == index], mode))
-    rotation, center, semi_axes = (np.array(a) for a in zip(*frames))
-    return Mannequin(Topology(parts), rotation, center, semi_axes, name="Traced", role="base")
-
-
-def trace_example(mesh_path, regions_path, out, mode="moments", view="FRONT"):
-    """The README picture: ellipsoids fitted to the reference body's regions over the body, front and side."""
-    bpy.ops.wm.read_homefile(use_empty=True)
-    regions = json.loads(Path(regions_path).read_text())
-    mannequin = traced_mannequin(obj_vertices(mesh_path), regions, mode)
-    collection = mannequin_to_collection(mannequin)
-    body = import_obj(mesh_path)
-    front, side = Slot([collection], body), Slot([collection], body, turn=90.0)
-    return render(out, [front, side], resolution=(1000, 900), view=view)
-
-
 def mannequins(files, ghosts, out, view="FRONT", ghost_shift=(0.0, 0.0, 0.0), side_too=False):
     """Mannequin JSON files side by side, each over its ghost mesh (OBJ) if given, moved by
     ``ghost_shift`` (m: e.g. the registration that moved the mannequin off its body); with
@@ -210,26 +166,18 @@ def mannequins(files, ghosts, out, view="FRONT", ghost_shift=(0.0, 0.0, 0.0), si
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m tools.render", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
-    trace = sub.add_parser("trace-example", help="ellipsoids fitted to a body's regions, over the body")
-    trace.add_argument("--mesh", required=True, type=Path)
-    trace.add_argument("--regions", required=True, type=Path)
-    trace.add_argument("--mode", default="moments", choices=("inscribed", "moments", "enclosing"))
     lineup = sub.add_parser("mannequins", help="mannequin JSON files side by side")
     lineup.add_argument("files", nargs="+", type=Path)
     lineup.add_argument("--ghost", action="append", default=[], type=Path)
     lineup.add_argument("--ghost-shift", nargs=3, type=float, default=(0.0, 0.0, 0.0), metavar=("X", "Y", "Z"),
                         help="move the ghost meshes by this much (m), e.g. by the mannequin's registration")
     lineup.add_argument("--side-too", action="store_true", help="each mannequin also seen from the side")
-    for p in (trace, lineup):
-        p.add_argument("--out", required=True, type=Path)
-        p.add_argument("--view", default="FRONT", choices=sorted(VIEWS))
+    lineup.add_argument("--out", required=True, type=Path)
+    lineup.add_argument("--view", default="FRONT", choices=sorted(VIEWS))
     args = parser.parse_args(argv)
     ellimann_addon.register()  # the mannequin collections need ElliMann's properties
     try:
-        if args.command == "trace-example":
-            trace_example(args.mesh, args.regions, args.out, args.mode, args.view)
-        else:
-            mannequins(args.files, args.ghost, args.out, args.view, args.ghost_shift, args.side_too)
+        mannequins(args.files, args.ghost, args.out, args.view, args.ghost_shift, args.side_too)
     finally:
         ellimann_addon.unregister()
     print(f"wrote {args.out}")

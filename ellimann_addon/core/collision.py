@@ -11,12 +11,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .cushion import cushion_mesh, to_frame
+from .cushion import mannequin_cushions
 from .ellipsoid import matrix_world
-from .errors import ElliMannError
-from .mesh import icosphere
+from .mesh import check_subdivision_level, icosphere
 
-SUBDIVISION_RANGE = (0, 5)  # icosphere levels: 20 to 20,480 triangles per piece
+# Icosphere levels of cloth colliders: 20 to 20,480 triangles per piece; the solver's cost grows
+# with the triangles, 4x a level (MJCF's cushion levels differ: export_mjcf.SUBDIVISION_RANGE).
+SUBDIVISION_RANGE = (0, 5)
 
 
 @dataclass
@@ -34,10 +35,8 @@ class CollisionPiece:
 
 
 def check_subdivisions(name, value):
-    low, high = SUBDIVISION_RANGE
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not low <= value <= high:
-        raise ElliMannError(f"{name}: must be an integer from {low} to {high}, got {value!r}")
-    return int(value)
+    """A collision mesh level (SUBDIVISION_RANGE) as an int, else ElliMannError naming ``name``."""
+    return check_subdivision_level(name, value, SUBDIVISION_RANGE)
 
 
 def collision_pieces(mannequin, cushions=False, sphere_subdivisions=2, cushion_subdivisions=2):
@@ -47,22 +46,14 @@ def collision_pieces(mannequin, cushions=False, sphere_subdivisions=2, cushion_s
     sphere_subdivisions = check_subdivisions("sphere_subdivisions", sphere_subdivisions)
     cushion_subdivisions = check_subdivisions("cushion_subdivisions", cushion_subdivisions)
     topology = mannequin.topology
-    pairs = topology.cushion_pairs if cushions else []
-    paired = {i for pair in pairs for i in pair}
     sphere_vertices, sphere_faces = icosphere(sphere_subdivisions)
-    pieces = []
     frames = matrix_world(mannequin.rotation, mannequin.center, mannequin.semi_axes)
-    for i, name in enumerate(topology.names):
-        if i not in paired:
-            pieces.append(CollisionPiece(name, "ELLIPSOID", frames[i], sphere_vertices, sphere_faces))
-    for i, j in pairs:
-        first = (mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i])
-        second = (mannequin.rotation[j], mannequin.center[j], mannequin.semi_axes[j])
-        vertices, faces = cushion_mesh(first, second, cushion_subdivisions)
+    pieces = [CollisionPiece(topology.names[i], "ELLIPSOID", frames[i], sphere_vertices, sphere_faces)
+              for i in topology.single_parts(cushions)]
+    for hull in mannequin_cushions(mannequin, cushion_subdivisions, local=True) if cushions else []:
         rigid = np.eye(4)
-        rigid[:3, :3], rigid[:3, 3] = first[0], first[1]
-        pieces.append(CollisionPiece(f"{topology.names[i]} + {topology.names[j]}", "CUSHION", rigid,
-                                     to_frame(vertices, first[0], first[1]), faces))
+        rigid[:3, :3], rigid[:3, 3] = mannequin.rotation[hull.first], mannequin.center[hull.first]
+        pieces.append(CollisionPiece(hull.name, "CUSHION", rigid, hull.vertices, hull.faces))
     return pieces
 
 

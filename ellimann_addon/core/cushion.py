@@ -14,13 +14,21 @@ flat ellipsoids (axis ratios beyond about 6:1) can fold the direction triangulat
 fail the check and are rebuilt by an exact incremental hull of the same points instead.
 """
 
+import functools
+from typing import NamedTuple
+
 import numpy as np
 
-from .ellipsoid import shape_matrix
-from .mesh import icosphere
+from .ellipsoid import support_and_point
+from .mesh import directed_edges, face_normals, icosphere
 
 DEFAULT_SUBDIVISIONS = 4  # 2,562 vertices; capsule volume within 0.5% (see tests)
 _MAX_FLIP_ROUNDS = 200
+
+
+def cushion_name(first, second):
+    """Name of the cushion of the parts named ``first`` and ``second``: ``"2.a Chest + 2.b Belly"``."""
+    return f"{first} + {second}"
 
 
 def cushion_mesh(first, second, subdivisions=DEFAULT_SUBDIVISIONS):
@@ -29,30 +37,88 @@ def cushion_mesh(first, second, subdivisions=DEFAULT_SUBDIVISIONS):
     Returns (vertices (V, 3) in world coordinates, faces (F, 3)), counter-clockwise seen from
     outside. Use :func:`to_frame` for vertices in the first ellipsoid's frame (the paper's S_o).
     """
+    return cushion_meshes([(first, second)], subdivisions)[0]
+
+
+def cushion_meshes(pairs, subdivisions=DEFAULT_SUBDIVISIONS):
+    """:func:`cushion_mesh` of every (first, second) in ``pairs``: a list of (vertices, faces).
+
+    The meshes are those of one call per pair, built faster: the pairs share one direction sphere
+    and go through the support points and the edge flips together.
+    """
+    if not len(pairs):
+        return []
+    sphere = _direction_sphere(subdivisions)
+    # (2, K, ...): the first and the second ellipsoid of every pair.
+    rotation, center, semi_axes = (np.array([[pair[side][field] for pair in pairs] for side in (0, 1)], dtype=float)
+                                   for field in range(3))
+    reach, points = support_and_point(rotation, center, semi_axes, sphere.directions)
+    vertices = np.where((reach[0] >= reach[1])[..., None], points[0], points[1])
+    interiors = 0.5 * (center[0] + center[1])
+    meshes = []
+    for v, faces, interior in zip(vertices, _flip_to_locally_convex(vertices, sphere), interiors):
+        if faces is None or not _faces_point_away(v, faces, interior):
+            faces = convex_hull_3d(v)
+        meshes.append((v, faces))
+    return meshes
+
+
+class CushionMesh(NamedTuple):
+    """The hull of a mannequin's cushion pair: part indices, :func:`cushion_name`, vertices (V, 3), faces (F, 3)."""
+
+    first: int
+    second: int
+    name: str
+    vertices: np.ndarray
+    faces: np.ndarray
+
+
+def mannequin_cushions(mannequin, subdivisions=DEFAULT_SUBDIVISIONS, local=False):
+    """The hull of every cushion pair of ``mannequin``, in topology order, built in one batch: a list
+    of :class:`CushionMesh`. Vertices are in world coordinates, or with ``local`` in the first
+    ellipsoid's frame (the paper's S_o, as :func:`to_frame`).
+    """
+    topology = mannequin.topology
+    pairs = topology.cushion_pairs
+    frames = [tuple((mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i]) for i in pair)
+              for pair in pairs]
+    out = []
+    for (i, j), (vertices, faces) in zip(pairs, cushion_meshes(frames, subdivisions)):
+        if local:
+            vertices = to_frame(vertices, mannequin.rotation[i], mannequin.center[i])
+        out.append(CushionMesh(i, j, cushion_name(topology.names[i], topology.names[j]), vertices, faces))
+    return out
+
+
+# Edge slots: slot k * F + f is the edge of face f from its corner k to corner k + 1 (the rows of
+# mesh.directed_edges); its far vertex is corner k + 2 of f, its twin the slot of the reverse edge.
+
+
+class _DirectionSphere(NamedTuple):
+    """The icosphere of support directions and its edge structure, shared by every cushion of a level."""
+
+    directions: np.ndarray  # (V, 3)
+    faces: np.ndarray  # (F, 3)
+    twin: np.ndarray  # (3F,): each edge slot's twin
+    edge_keys: frozenset  # undirected edges as min * (V + 1) + max
+
+
+@functools.lru_cache(maxsize=8)
+def _direction_sphere(subdivisions):
     directions, faces = icosphere(subdivisions)
-    points = []
-    reach = []
-    for rotation, center, semi_axes in (first, second):
-        m = shape_matrix(np.asarray(rotation, float), np.asarray(semi_axes, float))
-        mn = directions @ m  # m is symmetric
-        root = np.sqrt(np.einsum("ij,ij->i", directions, mn))
-        points.append(np.asarray(center, float) + mn / root[:, None])
-        reach.append(directions @ np.asarray(center, float) + root)
-    vertices = np.where((reach[0] >= reach[1])[:, None], points[0], points[1])
-    interior = 0.5 * (np.asarray(first[1], float) + np.asarray(second[1], float))
-    try:
-        faces = make_locally_convex(vertices, faces)
-    except RuntimeError:
-        faces = None
-    if faces is None or not _faces_point_away(vertices, faces, interior):
-        faces = convex_hull_3d(vertices)
-    return vertices, faces
+    edges = directed_edges(faces)
+    undirected = np.sort(edges, axis=1) @ np.array([len(directions) + 1, 1])
+    order = np.argsort(undirected, kind="stable")  # each undirected edge twice, side by side
+    twin = np.empty(len(edges), dtype=np.int64)
+    twin[order[0::2]], twin[order[1::2]] = order[1::2], order[0::2]
+    for array in (directions, faces, twin):
+        array.flags.writeable = False  # shared by every call
+    return _DirectionSphere(directions, faces, twin, frozenset(undirected.tolist()))
 
 
 def _faces_point_away(vertices, faces, interior):
-    v = vertices[faces]
-    normal = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
-    return bool(np.all(np.einsum("ij,ij->i", normal, v[:, 0] - interior) > 0.0))
+    normal = face_normals(vertices, faces)
+    return bool(np.all(np.einsum("ij,ij->i", normal, vertices[faces[:, 0]] - interior) > 0.0))
 
 
 def to_frame(vertices, rotation, center):
@@ -60,53 +126,106 @@ def to_frame(vertices, rotation, center):
     return (np.asarray(vertices) - center) @ np.asarray(rotation)
 
 
-def make_locally_convex(vertices, faces):
-    """Flip reflex edges of a closed, outward-wound triangulation until every edge is convex."""
-    faces = np.array(faces)
-    scale = float(np.ptp(vertices, axis=0).max()) or 1.0
-    tol = 1e-12 * scale
+def _flip_to_locally_convex(vertices, sphere):
+    """Flip reflex edges of K closed, outward-wound triangulations until every edge is convex.
+
+    ``vertices`` (K, V, 3) start triangulated as ``sphere.faces``. Each round flips, worst first, the
+    edges that are reflex at its start, skipping an edge whose face was flipped already in that round
+    or whose flip would duplicate an edge. Returns K face arrays, None for a mesh still reflex after
+    _MAX_FLIP_ROUNDS rounds. Flips change few faces, so the twins, the edge set and the excesses are
+    kept up to date rather than recomputed, and only the excesses near a flip are computed again.
+    """
+    count, size = vertices.shape[:2]
+    m = len(sphere.faces)
+    faces = np.repeat(sphere.faces[None], count, axis=0)
+    twin = np.repeat(sphere.twin[None], count, axis=0)
+    edges = [set(sphere.edge_keys) for _ in range(count)]
+    scale = np.ptp(vertices, axis=1).max(axis=1)
+    tol = 1e-12 * np.where(scale > 0.0, scale, 1.0)
+    excess = np.empty((count, 3 * m))
+    _update_excess(excess, vertices, faces, twin, np.repeat(np.arange(count), 3 * m), np.tile(np.arange(3 * m), count))
+    done = np.zeros(count, dtype=bool)
+    active = np.arange(count)
     for _ in range(_MAX_FLIP_ROUNDS):
-        reflex = _reflex_edges(vertices, faces, tol)
-        if not reflex:
-            return faces
-        edge_set = _edge_set(faces)
-        touched = set()
-        for f1, f2, a, b, c, d in reflex:
-            if f1 in touched or f2 in touched or (min(c, d), max(c, d)) in edge_set:
-                continue
-            faces[f1] = (a, d, c)
-            faces[f2] = (d, b, c)
-            edge_set.discard((min(a, b), max(a, b)))
-            edge_set.add((min(c, d), max(c, d)))
-            touched.update((f1, f2))
-    raise RuntimeError("triangulation did not become locally convex")
+        mesh, slot = np.nonzero(excess[active] > tol[active, None])
+        mesh = active[mesh]
+        done[np.setdiff1d(active, mesh)] = True
+        if not len(mesh):
+            break
+        a, b, c, t, d = _slot_corners(faces, twin, mesh, slot)
+        starts = np.flatnonzero(np.r_[True, mesh[1:] != mesh[:-1]])  # ``mesh`` runs in ascending order
+        changed_mesh, changed_slot = [], []
+        for k, start, stop in zip(mesh[starts].tolist(), starts.tolist(), [*starts[1:].tolist(), len(mesh)]):
+            rows = np.arange(start, stop)
+            rows = rows[np.argsort(-excess[k, slot[rows]])]  # the order sorting this mesh alone would give
+            changed = _flip(faces[k], twin[k], edges[k], size + 1, m, zip(
+                *(array[rows].tolist() for array in (slot, t, a, b, c, d))))
+            changed_mesh += [k] * len(changed)
+            changed_slot += changed
+        _update_excess(excess, vertices, faces, twin, np.array(changed_mesh, dtype=int),
+                       np.array(changed_slot, dtype=int))
+        active = np.unique(mesh)
+    return [f if ok else None for f, ok in zip(faces, done)]
 
 
-def _edge_set(faces):
-    e = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
-    return set(map(tuple, e.tolist()))
+def _slot_corners(faces, twin, mesh, slot):
+    """For edge slots of the meshes ``mesh``: the edge (a, b), its far vertex c, twin slot t, and d,
+    the far vertex of the twin."""
+    m = faces.shape[1]
+    corner, face = np.divmod(slot, m)
+    t = twin[mesh, slot]
+    twin_corner, twin_face = np.divmod(t, m)
+    a, b, c = (faces[mesh, face, (corner + k) % 3] for k in range(3))
+    return a, b, c, t, faces[mesh, twin_face, (twin_corner + 2) % 3]
 
 
-def _reflex_edges(vertices, faces, tol):
-    """Edges (a, b) whose far vertex d lies above the plane of the face (a, b, c), worst first."""
-    m = len(faces)
-    directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    opposite = np.concatenate([faces[:, 2], faces[:, 0], faces[:, 1]])
-    owner = np.tile(np.arange(m), 3)
-    key = directed[:, 0].astype(np.int64) * (len(vertices) + 1) + directed[:, 1]
-    rkey = directed[:, 1].astype(np.int64) * (len(vertices) + 1) + directed[:, 0]
-    order = np.argsort(key)
-    twin = order[np.searchsorted(key[order], rkey)]
-    first = directed[:, 0] < directed[:, 1]  # visit each undirected edge once
-    idx = np.nonzero(first)[0]
-    a, b, c = directed[idx, 0], directed[idx, 1], opposite[idx]
-    d = opposite[twin[idx]]
-    normal = np.cross(vertices[b] - vertices[a], vertices[c] - vertices[a])
+def _update_excess(excess, vertices, faces, twin, mesh, slot):
+    """Store how far each edge slot's far vertex d lies above the plane of its face (a, b, c), for
+    slots with a < b (each undirected edge once); -inf for the others."""
+    a, b, c, _, d = _slot_corners(faces, twin, mesh, slot)
+    excess[mesh, slot] = -np.inf
+    once = a < b
+    mesh, a, b, c, d = mesh[once], a[once], b[once], c[once], d[once]
+    flat = vertices.reshape(-1, 3)
+    at = mesh * vertices.shape[1]  # where each mesh's vertices start in ``flat``
+    # Seen from the edge's own corner a: rounded alike for every edge (ties between excesses stay ties).
+    normal = face_normals(flat, np.column_stack([a + at, b + at, c + at]))
     normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-300)
-    excess = np.einsum("ij,ij->i", normal, vertices[d] - vertices[a])
-    bad = np.nonzero(excess > tol)[0]
-    bad = bad[np.argsort(-excess[bad])]
-    return [(owner[idx[i]], owner[twin[idx[i]]], a[i], b[i], c[i], d[i]) for i in bad.tolist()]
+    excess[mesh, slot[once]] = np.einsum("ij,ij->i", normal, flat[d + at] - flat[a + at])
+
+
+def _flip(faces, twin, edges, key_base, m, reflex):
+    """Flip one mesh's reflex edges (slot s of edge (a, b) in face f1 = (a, b, c), twin slot t in
+    f2 = (b, a, d)) into (c, d), in the given order; returns the slots whose excess changed."""
+    touched, changed, rows, corners = set(), [], [], []
+    links = twin.tolist()  # read and written flip by flip: a list is much faster than the array
+    for s, t, a, b, c, d in reflex:
+        f1, f2 = s % m, t % m
+        cd = c * key_base + d if c < d else d * key_base + c
+        if f1 in touched or f2 in touched or cd in edges:
+            continue
+        s_corner, t_corner = s // m, t // m
+        # Twins outside the two faces, of (b, c), (c, a), (a, d) and (d, b).
+        bc, ca = links[(s_corner + 1) % 3 * m + f1], links[(s_corner + 2) % 3 * m + f1]
+        ad, db = links[(t_corner + 1) % 3 * m + f2], links[(t_corner + 2) % 3 * m + f2]
+        rows.append(f1)
+        rows.append(f2)
+        corners.append((a, d, c))  # slots f1: (a, d), m + f1: (d, c), 2m + f1: (c, a)
+        corners.append((d, b, c))  # slots f2: (d, b), m + f2: (b, c), 2m + f2: (c, d)
+        links[f1], links[ad] = ad, f1
+        links[m + f1], links[2 * m + f2] = 2 * m + f2, m + f1
+        links[2 * m + f1], links[ca] = ca, 2 * m + f1
+        links[f2], links[db] = db, f2
+        links[m + f2], links[bc] = bc, m + f2
+        edges.discard(a * key_base + b)
+        edges.add(cd)
+        touched.add(f1)
+        touched.add(f2)
+        changed += (f1, m + f1, 2 * m + f1, f2, m + f2, 2 * m + f2, ad, bc, ca, db)
+    if rows:  # no flip reads faces, so they are written once, at the end
+        faces[rows] = corners
+        twin[:] = links
+    return changed
 
 
 def convex_hull_3d(points):
@@ -145,8 +264,7 @@ def convex_hull_3d(points):
         visible = np.nonzero(alive & (normals @ points[apex] - offsets > eps))[0]
         if not len(visible):
             visible = np.array([face])
-        vis_faces = faces[visible]
-        edges = np.concatenate([vis_faces[:, [0, 1]], vis_faces[:, [1, 2]], vis_faces[:, [2, 0]]])
+        edges = directed_edges(faces[visible])
         keys = edges[:, 0].astype(np.int64) * len(points) + edges[:, 1]
         rkeys = edges[:, 1].astype(np.int64) * len(points) + edges[:, 0]
         horizon = edges[~np.isin(rkeys, keys)]
@@ -170,10 +288,9 @@ def convex_hull_3d(points):
 
 
 def _planes(points, faces):
-    v = points[faces]
-    normal = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+    normal = face_normals(points, faces)
     normal /= np.linalg.norm(normal, axis=1, keepdims=True)
-    return normal, np.einsum("ij,ij->i", normal, v[:, 0])
+    return normal, np.einsum("ij,ij->i", normal, points[faces[:, 0]])
 
 
 def _assign(points, which, normals, offsets, candidates, eps):

@@ -22,21 +22,30 @@ def shape_matrix(rotation, semi_axes):
     return scaled @ np.swapaxes(rotation, -1, -2)
 
 
+def support_and_point(rotation, center, semi_axes, directions):
+    """Support function h(n) = c.n + sqrt(n^T M n) and support point c + M n / sqrt(n^T M n), the
+    boundary point where the plane with outward normal n touches the ellipsoid.
+
+    ``directions`` (..., V, 3), unit or not, broadcast against the ellipsoids' leading dimensions;
+    returns (h (..., V), points (..., V, 3)).
+    """
+    directions = np.asarray(directions, dtype=float)
+    center = np.asarray(center, dtype=float)
+    mn = directions @ shape_matrix(np.asarray(rotation, dtype=float), np.asarray(semi_axes, dtype=float))
+    root = np.sqrt(np.einsum("...i,...i->...", directions, mn))  # M is symmetric: rows of mn are M n
+    return (directions @ center[..., :, None])[..., 0] + root, center[..., None, :] + mn / root[..., None]
+
+
 def support(rotation, center, semi_axes, direction):
-    """Support function h(n) = c.n + sqrt(n^T M n) for unit or non-unit directions n."""
-    direction = np.asarray(direction, dtype=float)
-    m = shape_matrix(rotation, semi_axes)
-    quad = np.einsum("...i,...ij,...j->...", direction, m, direction)
-    return np.einsum("...i,...i->...", center, direction) + np.sqrt(quad)
+    """Support function h(n) for directions (..., 3) broadcast against the ellipsoids: (...)."""
+    one_each = np.asarray(direction, dtype=float)[..., None, :]
+    return support_and_point(rotation, center, semi_axes, one_each)[0][..., 0]
 
 
 def support_point(rotation, center, semi_axes, direction):
-    """The boundary point where the plane with outward normal n touches the ellipsoid."""
-    direction = np.asarray(direction, dtype=float)
-    m = shape_matrix(rotation, semi_axes)
-    mn = np.einsum("...ij,...j->...i", m, direction)
-    quad = np.einsum("...i,...i->...", direction, mn)
-    return center + mn / np.sqrt(quad)[..., None]
+    """Support point for directions (..., 3) broadcast against the ellipsoids: (..., 3)."""
+    one_each = np.asarray(direction, dtype=float)[..., None, :]
+    return support_and_point(rotation, center, semi_axes, one_each)[1][..., 0, :]
 
 
 def axis_extent(rotation, semi_axes, axis):
@@ -47,7 +56,7 @@ def axis_extent(rotation, semi_axes, axis):
 
 def bounds(rotation, center, semi_axes):
     """Axis-aligned bounding box (lo, hi), each (..., 3)."""
-    half = np.sqrt(np.sum((np.asarray(rotation) * np.asarray(semi_axes)[..., None, :]) ** 2, axis=-1))
+    half = np.stack([axis_extent(rotation, semi_axes, axis) for axis in range(3)], axis=-1)
     return center - half, center + half
 
 

@@ -8,7 +8,7 @@ they are welded to the world: a static, collision-only mannequin that loads and 
 (floor plane, timestep and contact defaults included).
 
 Names: bodies and geoms carry the part names verbatim (``"7.a Thigh.L"``); a cushion is named
-``"2.a Chest + 2.b Belly"`` (see :func:`cushion_label`). MuJoCo accepts any string as a name and
+``"2.a Chest + 2.b Belly"`` (:func:`cushion.cushion_name`). MuJoCo accepts any string as a name and
 ``xml.etree`` escapes what XML needs, so no sanitising is done; part names are already validated
 by the topology (unique, ``number.letter label[.L|.R]``).
 
@@ -22,9 +22,10 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from .constants import MEASUREMENTS
-from .cushion import cushion_mesh, to_frame
+from .cushion import mannequin_cushions
 from .errors import ElliMannError
 from .files import atomic_write_text
+from .mesh import check_subdivision_level
 from .quaternion import rotation_to_quaternion
 
 # Contact and integration defaults for a static mannequin that objects fall onto. MuJoCo's own
@@ -38,27 +39,14 @@ FRICTION = (1.0, 0.005, 0.0001)  # sliding, torsional, rolling
 # Cushion hull resolution: level 3 = 642 vertices, volume within about 1% (inscribed) of the exact
 # hull and about 38 kB of XML per cushion; level 4 (2,562 vertices) gets 0.25% at four times the size.
 MJCF_SUBDIVISIONS = 3
-SUBDIVISION_RANGE = (1, 6)  # cushion resolution: 42 to 40,962 hull vertices
+SUBDIVISION_RANGE = (1, 6)  # cushion resolution: 42 to 40,962 hull vertices (about 2.4 MB of XML each)
 SIDE_RGBA = {"L": (0.85, 0.55, 0.45, 1.0), "R": (0.45, 0.6, 0.85, 1.0), "C": (0.8, 0.78, 0.72, 1.0)}
 CUSHION_RGBA = (0.72, 0.7, 0.82, 1.0)
 MANNEQUIN_CLASS = "ellimann"
 
 
-def cushion_label(first, second):
-    """Name of the geom, body and mesh asset of a cushion built from parts ``first`` and ``second``."""
-    return f"{first} + {second}"
-
-
 def _fmt(values, digits=9):
     return " ".join(f"{float(v):.{digits}g}" for v in np.ravel(values))
-
-
-def _check_subdivisions(subdivisions):
-    low, high = SUBDIVISION_RANGE
-    if isinstance(subdivisions, bool) or not isinstance(subdivisions, (int, np.integer)) or not (
-            low <= subdivisions <= high):
-        raise ElliMannError(f"subdivisions: must be an integer from {low} to {high}, got {subdivisions!r}")
-    return int(subdivisions)
 
 
 def mannequin_to_mjcf(mannequin, cushions=False, subdivisions=MJCF_SUBDIVISIONS, floor=True,
@@ -69,7 +57,7 @@ def mannequin_to_mjcf(mannequin, cushions=False, subdivisions=MJCF_SUBDIVISIONS,
     (icosphere level of the support directions, 1..6); ``floor`` adds a plane at z = 0.
     """
     mannequin.check()
-    subdivisions = _check_subdivisions(subdivisions)
+    subdivisions = check_subdivision_level("subdivisions", subdivisions, SUBDIVISION_RANGE)
     if isinstance(timestep, bool) or not (isinstance(timestep, (int, float)) and 0.0 < timestep <= 0.05):
         raise ElliMannError(f"timestep: must be a number in (0, 0.05] seconds, got {timestep!r}")
     topology = mannequin.topology
@@ -113,25 +101,17 @@ def mannequin_to_mjcf(mannequin, cushions=False, subdivisions=MJCF_SUBDIVISIONS,
                            childclass=MANNEQUIN_CLASS)
 
     quats = rotation_to_quaternion(mannequin.rotation)
-    in_cushion = set()
-    if cushions:
-        for first, second in topology.cushion_pairs:
-            in_cushion.update((first, second))
-    for i, part in enumerate(topology):
-        if i in in_cushion:
-            continue
+    for i in topology.single_parts(cushions):
+        part = topology.parts[i]
         body = ET.SubElement(holder, "body", name=part.name, pos=_fmt(mannequin.center[i]), quat=_fmt(quats[i]))
         ET.SubElement(body, "geom", name=part.name, type="ellipsoid", size=_fmt(mannequin.semi_axes[i]),
                       material=f"ellimann_{part.side}")
-    if cushions:
-        for first, second in topology.cushion_pairs:
-            label = cushion_label(topology.names[first], topology.names[second])
-            vertices, faces = cushion_mesh(_frame(mannequin, first), _frame(mannequin, second), subdivisions)
-            local = to_frame(vertices, mannequin.rotation[first], mannequin.center[first])
-            ET.SubElement(asset, "mesh", name=label, vertex=_fmt(local, 8), face=" ".join(map(str, faces.ravel())))
-            body = ET.SubElement(holder, "body", name=label, pos=_fmt(mannequin.center[first]),
-                                 quat=_fmt(quats[first]))
-            ET.SubElement(body, "geom", name=label, type="mesh", mesh=label, material="ellimann_cushion")
+    for hull in mannequin_cushions(mannequin, subdivisions, local=True) if cushions else []:
+        ET.SubElement(asset, "mesh", name=hull.name, vertex=_fmt(hull.vertices, 8),
+                      face=" ".join(map(str, hull.faces.ravel())))
+        body = ET.SubElement(holder, "body", name=hull.name, pos=_fmt(mannequin.center[hull.first]),
+                             quat=_fmt(quats[hull.first]))
+        ET.SubElement(body, "geom", name=hull.name, type="mesh", mesh=hull.name, material="ellimann_cushion")
 
     ET.indent(root, space="  ")
     return ET.tostring(root, encoding="unicode") + "\n"
@@ -144,10 +124,6 @@ def write_mjcf(mannequin, path, cushions=False, subdivisions=MJCF_SUBDIVISIONS, 
                              timestep=timestep)
     atomic_write_text(path, text)
     return path
-
-
-def _frame(mannequin, i):
-    return mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i]
 
 
 def _summary(mannequin, measured, cushions):

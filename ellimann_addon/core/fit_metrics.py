@@ -19,8 +19,9 @@ is then off that plane) and the closed form at t = -a_min^2 is used.
 
 import numpy as np
 
-from .cushion import cushion_mesh
+from .cushion import mannequin_cushions
 from .errors import ElliMannError
+from .mesh import face_normals
 
 NEWTON_LIMIT = 60  # iterations at most; typical convergence is under 10
 _PAIRS_PER_CHUNK = 200_000  # point-triangle pairs per vectorised block (temporaries stay near 100 MB)
@@ -188,7 +189,7 @@ def mesh_distance(points, vertices, faces, signed=True, pairs_per_chunk=_PAIRS_P
 def _pseudo_normals(vertices, faces):
     """Angle-weighted pseudo-normals: per face (F, 3), per face edge k -> k+1 (F, 3, 3), per vertex (V, 3)."""
     tri = vertices[faces]
-    face = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    face = face_normals(vertices, faces)
     face /= np.linalg.norm(face, axis=1, keepdims=True)
     vertex = np.zeros_like(vertices)
     for k in range(3):
@@ -239,20 +240,17 @@ class BodyPieces:
 
     The pieces are its ellipsoids or, with ``cushions``, one convex hull mesh per cushion pair
     (built at ``subdivisions``) plus the remaining single ellipsoids. ``names`` holds a part name
-    per piece, or ``"first + second"`` for a cushion.
+    per piece, or :func:`cushion.cushion_name` for a cushion.
     """
 
     def __init__(self, mannequin, cushions=False, subdivisions=3):
         topology = mannequin.topology
-        pairs = topology.cushion_pairs if cushions else []
-        paired = {i for pair in pairs for i in pair}
-        self.singles = np.array([i for i in range(len(topology)) if i not in paired], dtype=int)
+        self.singles = np.array(topology.single_parts(cushions), dtype=int)
         self.frames = (mannequin.rotation[self.singles], mannequin.center[self.singles],
                        mannequin.semi_axes[self.singles])
-        self.meshes = [cushion_mesh(*((mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i])
-                                      for i in pair), subdivisions=subdivisions) for pair in pairs]
-        self.names = [topology.names[i] for i in self.singles] + [
-            f"{topology.names[a]} + {topology.names[b]}" for a, b in pairs]
+        hulls = mannequin_cushions(mannequin, subdivisions) if cushions else []
+        self.meshes = [(hull.vertices, hull.faces) for hull in hulls]
+        self.names = [topology.names[i] for i in self.singles] + [hull.name for hull in hulls]
 
     def signed_distance(self, points, cutoff=np.inf):
         """(distance (P,), index into ``names`` of the nearest piece (P,)).
@@ -294,8 +292,9 @@ def convex_mesh_signed_distance(points, vertices, faces, cutoff=np.inf):
     vertices = np.asarray(vertices, dtype=float)
     centre = vertices.mean(axis=0)
     bound = np.linalg.norm(points - centre, axis=1) - np.linalg.norm(vertices - centre, axis=1).max()
-    tri = np.asarray(vertices, dtype=float)[np.asarray(faces)]
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    faces = np.asarray(faces)
+    tri = vertices[faces]
+    normal = face_normals(vertices, faces)
     normal /= np.linalg.norm(normal, axis=1, keepdims=True)
     height = points @ normal.T - np.einsum("ij,ij->i", normal, tri[:, 0])  # (P, F)
     best = np.argmax(height, axis=1)

@@ -31,10 +31,11 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .constants import CM_PER_M, MEASUREMENTS, SECTION_FRACTIONS
-from .ellipsoid import section_at_height
+from .ellipsoid import axis_extent, section_at_height
 from .errors import ElliMannError, MeasurementError
 from .fit_metrics import ellipsoid_signed_distance
 from .measure import hull_perimeter, section_heights
+from .mesh import face_normals
 
 DEFAULT_EDGE = 0.02  # m, target edge length of the cloth mesh
 MIN_CLEARANCE = 0.005  # m, least initial gap between garment and body
@@ -380,9 +381,9 @@ def t_shirt(mannequin, ease=0.08, sleeve_ease=0.3, edge=DEFAULT_EDGE, measuremen
     #    starts at armpit ring node j and slants to x * spread at the top, where the top edge follows
     #    the shoulder silhouette (boat neck across the neck opening). Each node sits on the front or
     #    back of an offset ring through every part at its own height.
-    neck_parts = [i for i, p in enumerate(topology) if p.side == "C" and
-                  mannequin.center[i, 2] - np.sqrt(_shape_zz(mannequin, i)) > z_sh]
-    neck = max((np.sqrt(_shape_xx(mannequin, i)) for i in neck_parts), default=0.05 * height) + clearance
+    half_x, half_z = (axis_extent(mannequin.rotation, mannequin.semi_axes, axis) for axis in (0, 2))
+    neck_parts = [i for i, p in enumerate(topology) if p.side == "C" and mannequin.center[i, 2] - half_z[i] > z_sh]
+    neck = max((float(half_x[i]) for i in neck_parts), default=0.05 * height) + clearance
     # The shoulder point: half the shoulder width, but not beyond the top of the upper arm (where
     # the sleeve starts) for bodies whose arms are not hung from the shoulders' outer edge.
     arm_top = max(_arm_top_x(mannequin, arms[side]) for side in ("L", "R"))
@@ -484,16 +485,6 @@ def _arm_top_x(mannequin, i):
     return float(abs(c[0] + d[long] * up[0]) + np.sort(d)[1])
 
 
-def _shape_xx(mannequin, i):
-    r, d = mannequin.rotation[i], mannequin.semi_axes[i]
-    return float(np.sum((r[0] * d) ** 2))
-
-
-def _shape_zz(mannequin, i):
-    r, d = mannequin.rotation[i], mannequin.semi_axes[i]
-    return float(np.sum((r[2] * d) ** 2))
-
-
 def _sleeve(mannequin, arm, loop, vertices, sizes, sleeve_ease, length, edge, clearance):
     """Rings perpendicular to the upper arm's long axis, from near the armhole down ``length``.
 
@@ -549,7 +540,7 @@ def _sleeve(mannequin, arm, loop, vertices, sizes, sleeve_ease, length, edge, cl
 def _orient_away_from_body(vertices, faces, panel, mannequin):
     """Flip faces whose normal points towards the nearest body part (each panel is consistently wound)."""
     tri = vertices[faces]
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    normal = face_normals(vertices, faces)
     centroid = tri.mean(axis=1)
     distance, closest = ellipsoid_signed_distance(centroid, mannequin.rotation, mannequin.center,
                                                   mannequin.semi_axes, return_closest=True)

@@ -15,7 +15,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .constants import MEASUREMENTS
-from .ellipsoid import Ellipsoid
 from .errors import MannequinError, Problem
 from .files import atomic_write_text
 
@@ -168,8 +167,11 @@ class Topology:
                     pairs.append((i, j))
         return pairs
 
-    def to_list(self):
-        return [p.to_dict() for p in self.parts]
+    def single_parts(self, cushions=True):
+        """Indices of the parts that are pieces of the body on their own: with ``cushions`` those in
+        no cushion pair (the pairs become cushions), else all of them."""
+        paired = {i for pair in self.cushion_pairs for i in pair} if cushions else set()
+        return [i for i in range(len(self.parts)) if i not in paired]
 
     @classmethod
     def from_list(cls, items):
@@ -229,10 +231,6 @@ class Mannequin:
         values.update(changes)
         return Mannequin(**values)
 
-    def ellipsoid(self, name):
-        i = self.topology.index[name]
-        return Ellipsoid(self.center[i], self.rotation[i], self.semi_axes[i])
-
     def problems(self):
         """Geometry problems, each naming the ellipsoid and field (the topology validated itself)."""
         n = len(self.topology)
@@ -244,9 +242,10 @@ class Mannequin:
             return out
         if self.role not in ROLES:
             out.append(Problem("", "role", f"is '{self.role}'; expected one of {', '.join(ROLES)}"))
-        det = np.linalg.det(self.rotation)
-        gram = np.swapaxes(self.rotation, -1, -2) @ self.rotation
-        ortho_error = np.abs(gram - np.eye(3)).max(axis=(1, 2))
+        with np.errstate(invalid="ignore"):  # a non-finite frame is reported below, not warned about
+            det = np.linalg.det(self.rotation)
+            gram = np.swapaxes(self.rotation, -1, -2) @ self.rotation
+            ortho_error = np.abs(gram - np.eye(3)).max(axis=(1, 2))
         for i, part in enumerate(self.topology):
             for attr in ("rotation", "center", "semi_axes"):
                 if not np.all(np.isfinite(getattr(self, attr)[i])):

@@ -28,18 +28,21 @@ _GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(GAUSS_ORDER)
 _CHUNK = 256  # mannequins per batch chunk (bounds the temporary arrays to tens of MB)
 
 
+def _quadratic_form(k, c, s):
+    """n^T k n for the directions n = (cos, sin) = (c, s)."""
+    return k[..., 0, 0] * c * c + 2.0 * k[..., 0, 1] * c * s + k[..., 1, 1] * s * s
+
+
 def _support_2d(centre, k, theta):
     """Support function of section ellipses: centre (..., 2), k (..., 2, 2), theta broadcastable."""
     c, s = np.cos(theta), np.sin(theta)
-    quad = k[..., 0, 0] * c * c + 2.0 * k[..., 0, 1] * c * s + k[..., 1, 1] * s * s
-    return centre[..., 0] * c + centre[..., 1] * s + np.sqrt(np.maximum(quad, 0.0))
+    return centre[..., 0] * c + centre[..., 1] * s + np.sqrt(np.maximum(_quadratic_form(k, c, s), 0.0))
 
 
 def _support_2d_with_derivative(centre, k, theta):
     """(h, dh/dtheta) of section ellipses, sharing the trigonometry."""
     c, s = np.cos(theta), np.sin(theta)
-    quad = k[..., 0, 0] * c * c + 2.0 * k[..., 0, 1] * c * s + k[..., 1, 1] * s * s
-    root = np.sqrt(np.maximum(quad, 1e-30))
+    root = np.sqrt(np.maximum(_quadratic_form(k, c, s), 1e-30))
     dquad = (k[..., 1, 1] - k[..., 0, 0]) * c * s + k[..., 0, 1] * (c * c - s * s)
     value = centre[..., 0] * c + centre[..., 1] * s + root
     slope = centre[..., 1] * c - centre[..., 0] * s + dquad / root
@@ -163,11 +166,10 @@ def hull_boundary(centre, k, active, samples=256):
     theta = np.linspace(0.0, 2.0 * np.pi, samples, endpoint=False)
     h = np.where(active[:, None], _support_2d(centre[:, None, :], k[:, None, :, :], theta), -np.inf)
     winner = np.argmax(h, axis=0)
-    d = np.stack([np.cos(theta), np.sin(theta)], axis=-1)
-    kw = k[winner]
-    kd = np.einsum("sij,sj->si", kw, d)
-    norm = np.sqrt(np.clip(np.einsum("si,si->s", d, kd), 1e-30, None))
-    return centre[winner] + kd / norm[:, None]
+    # The support point in direction n = (cos, sin) is h n + h' n_perp (h' = dh/dtheta).
+    value, slope = _support_2d_with_derivative(centre[winner], k[winner], theta)
+    c, s = np.cos(theta), np.sin(theta)
+    return np.stack([value * c - slope * s, value * s + slope * c], axis=-1)
 
 
 def section_heights(rotation, center, semi_axes):

@@ -2,6 +2,8 @@
 
 import numpy as np
 
+from .errors import ElliMannError
+
 
 def icosphere(subdivisions=3):
     """Unit icosphere: (vertices (V, 3), faces (F, 3) int, counter-clockwise seen from outside).
@@ -22,7 +24,7 @@ def icosphere(subdivisions=3):
     ])
     verts /= np.linalg.norm(verts, axis=1, keepdims=True)
     for _ in range(int(subdivisions)):
-        edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+        edges = np.sort(directed_edges(faces), axis=1)
         unique, inverse = np.unique(edges, axis=0, return_inverse=True)
         inverse = inverse.reshape(-1)
         mids = verts[unique[:, 0]] + verts[unique[:, 1]]
@@ -38,6 +40,21 @@ def icosphere(subdivisions=3):
     return verts, faces
 
 
+def check_subdivision_level(name, value, allowed):
+    """``value`` as an int if it is an integer icosphere level in ``allowed`` (low, high), else an
+    ElliMannError naming ``name`` and the range."""
+    low, high = allowed
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not low <= value <= high:
+        raise ElliMannError(f"{name}: must be an integer from {low} to {high}, got {value!r}")
+    return int(value)
+
+
+def directed_edges(faces):
+    """Every face's edges (..., 3F, 2) of faces (..., F, 3): row k * F + f runs from corner k of face f
+    to corner k + 1."""
+    return np.concatenate([faces[..., [0, 1]], faces[..., [1, 2]], faces[..., [2, 0]]], axis=-2)
+
+
 def face_normals(vertices, faces):
     """Unnormalised face normals (cross products); their length is twice the face area."""
     v = vertices[faces]
@@ -51,14 +68,13 @@ def volume(vertices, faces):
 
 
 def euler_characteristic(vertices, faces):
-    edges = np.unique(np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1),
-                      axis=0)
+    edges = np.unique(np.sort(directed_edges(faces), axis=1), axis=0)
     return len(vertices) - len(edges) + len(faces)
 
 
 def is_closed_manifold(faces):
     """Every directed edge appears once and its reverse once: closed, 2-manifold, consistently wound."""
-    directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    directed = directed_edges(faces)
     unique, counts = np.unique(directed, axis=0, return_counts=True)
     if np.any(counts != 1):
         return False
@@ -81,7 +97,7 @@ def convexity_defect(vertices, faces):
 def plane_section_points(vertices, faces, height):
     """Points where the mesh's edges cross the plane z = height: (k, 2) x-y coordinates."""
     faces = np.asarray(faces)
-    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    edges = directed_edges(faces)
     above = vertices[:, 2] > height
     below = vertices[:, 2] < height
     crossing = (above[edges[:, 0]] & below[edges[:, 1]]) | (below[edges[:, 0]] & above[edges[:, 1]])

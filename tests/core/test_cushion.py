@@ -5,6 +5,7 @@ from scipy.spatial import ConvexHull
 from devkit.toy import rotation_from_vector
 from ellimann_addon.core import cushion, mesh
 from ellimann_addon.core.ellipsoid import contains, support
+from ellimann_addon.core.errors import ElliMannError
 
 
 def check_convex_closed(v, f):
@@ -65,6 +66,39 @@ def test_identical_and_nested_ellipsoids():
     assert np.all(contains(e[0], e[1], e[2], v, tol=1e-9))
 
 
+def test_a_batch_builds_every_pair_as_if_alone(monkeypatch):
+    """cushion_meshes runs all pairs through shared arrays; each mesh must be exactly the one built alone,
+    also next to a flat pair whose folded triangulation is rebuilt by the exact hull."""
+    flat = ((rotation_from_vector((0.3, 0.5, 0.1)), (0, 0, 0), (0.2, 0.02, 0.15)),
+            (np.eye(3), (0.05, 0.02, 0.25), (0.08, 0.1, 0.12)))
+    capsule = ((np.eye(3), (0, 0, 0), (0.1, 0.1, 0.1)), (np.eye(3), (0, 0, 0.3), (0.1, 0.1, 0.1)))
+    rng = np.random.default_rng(3)
+    pairs = [random_pair(rng), flat, capsule, (capsule[0], capsule[0]), random_pair(rng)]
+    exact_hulls = []
+    real_hull = cushion.convex_hull_3d
+    monkeypatch.setattr(cushion, "convex_hull_3d", lambda points: exact_hulls.append(len(points)) or real_hull(points))
+    batch = cushion.cushion_meshes(pairs, 3)
+    assert len(exact_hulls) == 1  # the flat pair, and only it
+    for pair, (v, f) in zip(pairs, batch):
+        check_convex_closed(v, f)
+        alone_v, alone_f = cushion.cushion_mesh(*pair, 3)
+        assert np.array_equal(v, alone_v) and np.array_equal(f, alone_f)
+    assert len(exact_hulls) == 2 and cushion.cushion_meshes([], 3) == []
+
+
+def test_mannequin_cushions_are_the_hulls_of_its_pairs(toy):
+    world, local = cushion.mannequin_cushions(toy, 2), cushion.mannequin_cushions(toy, 2, local=True)
+    assert [(h.first, h.second) for h in world] == toy.topology.cushion_pairs == [(1, 2), (8, 9), (10, 11)]
+    assert [h.name for h in world] == ["2.a Chest + 2.b Belly", "6.a Thigh.L + 6.b Shin.L", "6.a Thigh.R + 6.b Shin.R"]
+    for hull, in_frame in zip(world, local):
+        pair = [(toy.rotation[i], toy.center[i], toy.semi_axes[i]) for i in (hull.first, hull.second)]
+        alone = cushion.cushion_mesh(*pair, 2)
+        assert np.array_equal(hull.vertices, alone[0]) and np.array_equal(hull.faces, alone[1])
+        r, c = toy.rotation[hull.first], toy.center[hull.first]
+        assert np.allclose(in_frame.vertices @ r.T + c, hull.vertices, rtol=0, atol=1e-15)
+        assert np.array_equal(in_frame.faces, hull.faces) and in_frame.name == hull.name
+
+
 def test_to_frame_expresses_vertices_in_the_first_frame():
     r = rotation_from_vector((0.4, -0.2, 1.0))
     e1 = (r, (1.0, 2.0, 3.0), (0.1, 0.2, 0.3))
@@ -86,3 +120,11 @@ def test_icosphere_sizes_and_orientation():
         v, f = mesh.icosphere(s)
         assert len(v) == 10 * 4**s + 2 and len(f) == 20 * 4**s
         check_convex_closed(v, f)
+
+
+def test_subdivision_levels_are_integers_in_the_allowed_range():
+    assert mesh.check_subdivision_level("level", 3, (1, 6)) == 3
+    assert type(mesh.check_subdivision_level("level", np.int64(1), (1, 6))) is int
+    for bad in (0, 7, 3.0, True, "3", None):
+        with pytest.raises(ElliMannError, match=r"level: must be an integer from 1 to 6, got "):
+            mesh.check_subdivision_level("level", bad, (1, 6))

@@ -29,6 +29,20 @@ def test_support_is_the_max_over_surface_points(rv, c, d, n):
     assert e.contains(p[None], tol=1e-9)[0]
 
 
+def test_support_and_point_in_shared_directions_of_axis_aligned_ellipsoids():
+    """Closed form for R = I: h(n) = c.n + |D n| and p = c + D^2 n / |D n|, each ellipsoid in every direction."""
+    center = np.array([(0.1, -0.2, 0.3), (-1.0, 0.5, 2.0)])
+    semi = np.array([(0.1, 0.2, 0.3), (0.5, 0.05, 0.25)])
+    directions = np.random.default_rng(4).normal(size=(7, 3))  # not unit: h is positively homogeneous
+    h, points = el.support_and_point(np.stack([np.eye(3)] * 2), center, semi, directions)
+    assert h.shape == (2, 7) and points.shape == (2, 7, 3)
+    for i in range(2):
+        scaled = np.linalg.norm(directions * semi[i], axis=1)
+        assert np.allclose(h[i], directions @ center[i] + scaled, rtol=1e-14)
+        assert np.allclose(points[i], center[i] + directions * semi[i] ** 2 / scaled[:, None], rtol=1e-14)
+        assert np.allclose(el.support(np.eye(3), center[i], semi[i], directions), h[i], rtol=1e-14)
+
+
 @settings(max_examples=60, deadline=None)
 @given(vectors, points3, sizes, st.floats(-0.99, 0.99))
 def test_section_ellipse_lies_on_the_surface(rv, c, d, frac):

@@ -9,10 +9,10 @@ import pytest
 from devkit.toy import make_toy_mannequin
 from ellimann_addon.core import mesh
 from ellimann_addon.core.constants import MEASUREMENTS
-from ellimann_addon.core.cushion import cushion_mesh
+from ellimann_addon.core.cushion import cushion_mesh, cushion_name
 from ellimann_addon.core.ellipsoid import bounds, contains
 from ellimann_addon.core.errors import ElliMannError, MannequinError
-from ellimann_addon.core.export_mjcf import MJCF_SUBDIVISIONS, cushion_label, mannequin_to_mjcf, write_mjcf
+from ellimann_addon.core.export_mjcf import MJCF_SUBDIVISIONS, mannequin_to_mjcf, write_mjcf
 from ellimann_addon.core.fit_metrics import BodyPieces
 from ellimann_addon.core.mannequin import Mannequin
 
@@ -71,7 +71,7 @@ def test_cushions_become_convex_mesh_geoms_of_the_right_volume(make):
     directions = rng.normal(size=(200, 3))
     directions /= np.linalg.norm(directions, axis=1, keepdims=True)
     for first, second in pairs:
-        label = cushion_label(topology.names[first], topology.names[second])
+        label = cushion_name(topology.names[first], topology.names[second])
         g = model.geom(label)
         assert g.type[0] == geom_type("mesh")
         body = model.body(label)
@@ -131,8 +131,9 @@ def test_write_is_atomic_and_bad_input_writes_nothing(toy, tmp_path):
     bad.semi_axes[3, 1] = -0.1
     with pytest.raises(MannequinError, match="3.a Pelvis"):
         write_mjcf(bad, tmp_path / "bad.xml")
-    with pytest.raises(ElliMannError, match="subdivisions"):
-        write_mjcf(toy, tmp_path / "bad.xml", cushions=True, subdivisions=0)
+    for level in (0, 7, 2.0, True):
+        with pytest.raises(ElliMannError, match=f"subdivisions: must be an integer from 1 to 6, got {level!r}"):
+            write_mjcf(toy, tmp_path / "bad.xml", cushions=True, subdivisions=level)
     with pytest.raises(ElliMannError, match="timestep"):
         write_mjcf(toy, tmp_path / "bad.xml", timestep=-1)
     assert not (tmp_path / "bad.xml").exists()

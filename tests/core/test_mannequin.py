@@ -25,6 +25,9 @@ def test_toy_topology_is_valid_and_indexed(toy):
     assert topo.twin_indices[topo.index["1.a Head"]] == topo.index["1.a Head"]
     pairs = {(topo.names[a], topo.names[b]) for a, b in topo.cushion_pairs}
     assert pairs == {("2.a Chest", "2.b Belly"), ("6.a Thigh.L", "6.b Shin.L"), ("6.a Thigh.R", "6.b Shin.R")}
+    names = [topo.names[i] for i in topo.single_parts()]
+    assert names == ["1.a Head", "3.a Pelvis", "4.a Trapezius.L", "4.a Trapezius.R", "5.a Arm.L", "5.a Arm.R"]
+    assert topo.single_parts(cushions=False) == list(range(12))
     assert topo.girth_mask.sum() == 9
     assert topo.dependency_mask.shape == (12, 5)
     assert twin_name("4.a Trapezius.L") == "4.a Trapezius.R"
@@ -65,6 +68,49 @@ def test_geometry_problems_name_the_ellipsoid_and_field(toy):
     assert any("'4.a Trapezius.R' rotation: is not orthonormal" in t for t in text)
     with pytest.raises(MannequinError):
         bad.check()
+
+
+@pytest.mark.parametrize("attr,index", [("center", (1, 2)), ("semi_axes", (3, 0)), ("rotation", (6, 1, 1))])
+@pytest.mark.parametrize("value", [np.inf, -np.inf])
+def test_infinite_geometry_names_the_ellipsoid_and_field(toy, attr, index, value):
+    bad = toy.copy()
+    getattr(bad, attr)[index] = value
+    name = toy.topology.names[index[0]]
+    text = [str(p) for p in bad.problems()]
+    assert f"'{name}' {attr}: contains NaN or infinity" in text
+    assert all(t.startswith(f"'{name}' ") for t in text)  # no other part is blamed
+    with pytest.raises(MannequinError, match=f"'{name}' {attr}: contains NaN or infinity"):
+        bad.check()
+
+
+def test_infinity_in_a_file_and_in_the_measurements_is_refused(toy):
+    data = json.loads(json.dumps(toy.to_dict()))
+    data["ellipsoids"][2]["center"][0] = float("inf")  # written as JSON's Infinity
+    with pytest.raises(MannequinError, match="'2.b Belly' center: contains NaN or infinity"):
+        Mannequin.from_dict(json.loads(json.dumps(data)))
+    bad = toy.copy(measurements={"He": float("inf"), "Sh": 40.0})
+    assert [str(p) for p in bad.problems()] == ["measurements: He=inf is not a positive measurement"]
+
+
+@pytest.mark.parametrize("name", ["", None, 7])
+def test_an_ellipsoid_without_a_name_is_refused(toy, name):
+    data = toy.to_dict()
+    if name is None:
+        del data["ellipsoids"][4]["name"]
+    else:
+        data["ellipsoids"][4]["name"] = name
+    data["ellipsoids"][7]["side"] = 3
+    with pytest.raises(MannequinError) as info:
+        Mannequin.from_dict(data)
+    # A nameless entry cannot be named, so the problem names the field; the others are still reported.
+    assert [str(p) for p in info.value.problems] == ["name: every ellipsoid needs a non-empty name",
+                                                     "'5.a Arm.R' side: missing or not a str"]
+    assert info.value.problems[0].field == "name" and info.value.problems[0].ellipsoid == ""
+
+
+def test_an_empty_part_name_is_refused_by_the_topology():
+    assert problems_of(replace(TOY_PARTS, "1.a Head", name="")) == [
+        "name: must look like '10.a Trapezius.L' (number.letter label[.L|.R])"]
 
 
 def test_json_round_trip_is_exact(toy, tmp_path):

@@ -82,9 +82,11 @@ def test_known_two_sphere_body():
     z_sh = 4 * r * SECTION_FRACTIONS["Sh"]  # 0.632 -> upper sphere
     assert sh == pytest.approx(200 * np.sqrt(r * r - (z_sh - 3 * r) ** 2))
     assert hi == pytest.approx(0.0, abs=1e-9)  # z = 2r: the spheres touch at a point
-    z_br = 4 * r * SECTION_FRACTIONS["Br"]
-    assert br == pytest.approx(200 * np.pi * np.sqrt(r * r - (z_br - 3 * r) ** 2))
-    del wa
+    # Br and Wa cut only the upper sphere (above z = 2r): circles of radius sqrt(r^2 - (z - 3r)^2).
+    for value, key in ((br, "Br"), (wa, "Wa")):
+        z = 4 * r * SECTION_FRACTIONS[key]
+        assert 2 * r < z < 4 * r
+        assert value == pytest.approx(200 * np.pi * np.sqrt(r * r - (z - 3 * r) ** 2), rel=1e-12)
 
 
 @settings(max_examples=30, deadline=None)
