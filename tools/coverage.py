@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ellimann_addon.core.cushion import cushion_mesh
+from ellimann_addon.core.cushion import cushion_mesh, cushion_name
 from ellimann_addon.core.ellipsoid import bounds, fibonacci_sphere, sample_surface, support
 from ellimann_addon.core.fit_metrics import closest_points_on_triangles
 from ellimann_addon.core.mannequin import NAME_PATTERN
@@ -165,7 +165,7 @@ def pieces(mannequin, cushions=False):
         if cushions and part.partner:
             j = topology.index[part.partner]
             done.add(j)
-            out.append((f"{part.name} + {part.partner}", (i, j)))
+            out.append((cushion_name(part.name, part.partner), (i, j)))
         else:
             out.append((part.name, (i,)))
     return out

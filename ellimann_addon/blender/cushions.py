@@ -6,15 +6,11 @@ Shared by the Build Cushions operator, the Synthesize panel (live updates) and t
 import numpy as np
 from mathutils import Matrix
 
-from ..core.cushion import DEFAULT_SUBDIVISIONS, cushion_mesh, to_frame
+from ..core.cushion import DEFAULT_SUBDIVISIONS, mannequin_cushions
 from ..core.errors import MannequinError, Problem
 from .built import built_collection, new_cushion_object, remove_built
 from .convert import collection_to_mannequin
 from .selection import part_lookup
-
-
-def cushion_name(first, second):
-    return f"{first} + {second}"
 
 
 def rigid_frame(rotation, center):
@@ -35,18 +31,14 @@ def build_cushions(collection, subdivisions=DEFAULT_SUBDIVISIONS):
     if not pairs:
         raise MannequinError([Problem("", "cushions", f"'{collection.name}' has no cushion pairs: "
                                                       "set Cushion Partner on two ellipsoids")])
-    hulls = []
-    for i, j in pairs:
-        first = (mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i])
-        second = (mannequin.rotation[j], mannequin.center[j], mannequin.semi_axes[j])
-        vertices, faces = cushion_mesh(first, second, subdivisions)
-        hulls.append((i, j, to_frame(vertices, first[0], first[1]), faces))
+    hulls = mannequin_cushions(mannequin, subdivisions, local=True)
     removed = remove_built(collection, "CUSHION")
     target = built_collection(collection, "CUSHION")
     parts = part_lookup(collection)
     objects = []
-    for i, j, local, faces in hulls:
-        first, second = topology.names[i], topology.names[j]
-        objects.append(new_cushion_object(cushion_name(first, second), parts[first], parts[second], local, faces,
-                                          rigid_frame(mannequin.rotation[i], mannequin.center[i]), target))
+    for hull in hulls:
+        first, second = topology.names[hull.first], topology.names[hull.second]
+        objects.append(new_cushion_object(hull.name, parts[first], parts[second], hull.vertices, hull.faces,
+                                          rigid_frame(mannequin.rotation[hull.first], mannequin.center[hull.first]),
+                                          target))
     return objects, removed

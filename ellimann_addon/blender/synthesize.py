@@ -8,7 +8,7 @@ add-on's ``presets/`` folder, the user's are saved in Blender's user preset fold
 five fields but makes one live update (the preset menu's ``reset_cb`` / ``post_cb`` hold it back).
 
 Live updates with cushions keep up with a dragged slider by moving the existing cushion meshes:
-their vertices are rewritten in place (``core.synthesis.cushion_vertices``, every pair in one
+their vertices are rewritten in place (``core.cushion.cushion_vertices``, every pair in one
 vectorised call; same vertex order at the same resolution) and their faces kept. Those faces were
 made convex for the previous ellipsoids, so the cushions count as out of date until the fields
 have been still for ``LIVE_SETTLE_SECONDS``; a timer then rebuilds them exactly (``settle_live``).
@@ -25,14 +25,13 @@ from bl_operators.presets import AddPresetBase
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, PointerProperty, StringProperty
 
 from ..core.constants import ABSURD_LIMITS, MEASUREMENT_LABELS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS
-from ..core.cushion import DEFAULT_SUBDIVISIONS
+from ..core.cushion import DEFAULT_SUBDIVISIONS, cushion_vertices
 from ..core.errors import ElliMannError
 from ..core.synthesis import (
     DEFAULT_NORMALIZE,
     DEFAULT_POWER,
     POWER_LIMITS,
     cached_reference_set,
-    cushion_vertices,
     relative_error,
     synthesize,
 )

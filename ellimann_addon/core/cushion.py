@@ -52,8 +52,7 @@ def cushion_meshes(pairs, subdivisions=DEFAULT_SUBDIVISIONS):
     # (2, K, ...): the first and the second ellipsoid of every pair.
     rotation, center, semi_axes = (np.array([[pair[side][field] for pair in pairs] for side in (0, 1)], dtype=float)
                                    for field in range(3))
-    reach, points = support_and_point(rotation, center, semi_axes, sphere.directions)
-    vertices = np.where((reach[0] >= reach[1])[..., None], points[0], points[1])
+    vertices = _hull_support_points(rotation, center, semi_axes, sphere.directions)
     interiors = 0.5 * (center[0] + center[1])
     meshes = []
     for v, faces, interior in zip(vertices, _flip_to_locally_convex(vertices, sphere), interiors):
@@ -61,6 +60,30 @@ def cushion_meshes(pairs, subdivisions=DEFAULT_SUBDIVISIONS):
             faces = convex_hull_3d(v)
         meshes.append((v, faces))
     return meshes
+
+
+def cushion_vertices(rotation, center, semi_axes, pairs, subdivisions=DEFAULT_SUBDIVISIONS):
+    """The vertices :func:`cushion_meshes` builds the hulls of a mannequin's ``pairs`` on, each in its
+    first ellipsoid's frame (as :func:`to_frame`), without the faces: (P, V, 3).
+
+    rotation (n, 3, 3), center (n, 3), semi_axes (n, 3): one mannequin; pairs (P, 2) part indices
+    (``Topology.cushion_pairs``). Vertex k lies along direction k of the level's sphere whatever
+    the ellipsoids, so a cushion mesh built at that level follows new ellipsoids by rewriting its
+    vertices (the Blender panel's live update); its faces may then be no longer convex.
+    """
+    pairs = np.asarray(pairs, dtype=int).reshape(-1, 2)
+    # (2, P, ...): the first and the second ellipsoid of every pair.
+    rotation, center, semi_axes = (np.asarray(a, dtype=float)[pairs].swapaxes(0, 1)
+                                   for a in (rotation, center, semi_axes))
+    vertices = _hull_support_points(rotation, center, semi_axes, _direction_sphere(subdivisions).directions)
+    return to_frame(vertices, rotation[0], center[0][:, None, :])
+
+
+def _hull_support_points(rotation, center, semi_axes, directions):
+    """(K, V, 3): along each direction, the support point of whichever of a pair's two ellipsoids
+    (arrays (2, K, ...)) reaches further: the hull's own support point."""
+    reach, points = support_and_point(rotation, center, semi_axes, directions)
+    return np.where((reach[0] >= reach[1])[..., None], points[0], points[1])
 
 
 class CushionMesh(NamedTuple):

@@ -45,7 +45,6 @@ from the RMs' mean Jacobian, Broyden updates):
 Rotations are never changed by the refinement; every operation is symmetric about x = 0.
 """
 
-import functools
 import math
 import os
 import pathlib
@@ -55,13 +54,11 @@ import numpy as np
 
 from .clean import asymmetry
 from .constants import ABSURD_LIMITS, CM_PER_M, GIRTHS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
-from .cushion import DEFAULT_SUBDIVISIONS
-from .ellipsoid import axis_extent, section_at_height, shape_matrix
+from .ellipsoid import axis_extent, section_at_height
 from .errors import ElliMannError, MannequinError, MeasurementError, ReferenceSetError
 from .frames import SAGITTAL_REFLECTION, rotation_mean, symmetrize_central
 from .mannequin import Mannequin
 from .measure import as_dict, section_heights, tailor_measurements
-from .mesh import icosphere
 
 REFERENCE_NAMES = tuple(REFERENCE_MEASUREMENTS)  # small_slim, tall_slim, small_chubby, tall_chubby, average
 REFERENCE_FOLDER = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"
@@ -763,37 +760,3 @@ def synthesize(reference, request, mode="idw", metric="raw", power=DEFAULT_POWER
         worst = MEASUREMENTS[int(np.argmax(batch.relative_error()[0]))]
         warnings.append(f"exact mode did not fully converge: {worst} is off by {batch.relative_error()[0].max():.2f}%")
     return batch.mannequin(0, name), as_dict(batch.measured[0]), warnings
-
-
-# --------------------------------------------------------------------------------------------
-# Live updates
-
-
-@functools.lru_cache(maxsize=8)
-def _directions(subdivisions):
-    directions = icosphere(subdivisions)[0]
-    directions.setflags(write=False)
-    return directions
-
-
-def cushion_vertices(rotation, center, semi_axes, pairs, subdivisions=DEFAULT_SUBDIVISIONS):
-    """Vertices of every cushion pair's hull in one vectorised call, each in its first ellipsoid's frame.
-
-    rotation (n, 3, 3), center (n, 3), semi_axes (n, 3): one mannequin; pairs (P, 2) part indices
-    (``Topology.cushion_pairs``). Returns (P, V, 3), V = 10 * 4**subdivisions + 2: the support
-    points :func:`cushion.cushion_mesh` builds its hull on (vertex k along icosphere direction k,
-    from whichever ellipsoid reaches further), expressed as :func:`cushion.to_frame` does. The
-    vertex order never changes, so a cushion mesh built at that level can be moved to new
-    ellipsoids by rewriting its vertices (live updates); its faces are not recomputed here.
-    """
-    pairs = np.asarray(pairs, dtype=int).reshape(-1, 2)
-    directions = _directions(int(subdivisions))
-    r, c = np.asarray(rotation, float)[pairs], np.asarray(center, float)[pairs]  # (P, 2, 3, 3), (P, 2, 3)
-    m = shape_matrix(r, np.asarray(semi_axes, float)[pairs])  # symmetric (P, 2, 3, 3)
-    mn = directions @ m  # (P, 2, V, 3): M n for every direction n
-    root = np.sqrt(np.einsum("pkvi,vi->pkv", mn, directions))
-    reach = c @ directions.T + root  # support function of each ellipsoid
-    second = reach[:, 1] > reach[:, 0]  # (P, V): the second ellipsoid's support point is the hull's
-    mn, root = np.where(second[..., None], mn[:, 1], mn[:, 0]), np.where(second, root[:, 1], root[:, 0])
-    offset = np.where(second[..., None], (c[:, 1] - c[:, 0])[:, None, :], 0.0)
-    return (offset + mn / root[..., None]) @ r[:, 0]  # support point - first centre, in the first frame

@@ -15,9 +15,9 @@ from ellimann_addon.blender import synthesize_panel as panel
 from ellimann_addon.blender.built import is_stale
 from ellimann_addon.blender.selection import part_lookup
 from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS, TABLE_2_5
-from ellimann_addon.core.cushion import DEFAULT_SUBDIVISIONS, cushion_mesh, to_frame
+from ellimann_addon.core.cushion import DEFAULT_SUBDIVISIONS, cushion_mesh, cushion_vertices, to_frame
 from ellimann_addon.core.mesh import convexity_defect, is_closed_manifold
-from ellimann_addon.core.synthesis import cushion_vertices, relative_error
+from ellimann_addon.core.synthesis import relative_error
 from ellimann_addon.core.synthesis import synthesize as core_synthesize
 
 

@@ -4,6 +4,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty
 
 from ...core.constants import MEASUREMENTS
+from ...core.cushion import cushion_name
 from ...core.errors import MannequinError
 from ...core.measure import as_dict, measure_meshes, section_hulls, tailor_measurements
 from .. import ids
@@ -32,7 +33,7 @@ def cushion_mannequin_meshes(collection, mannequin, cushions):
         first, second = topology.parts[i], topology.parts[j]
         obj = hull_of.get((first.name, second.name))
         if obj is None or is_stale(obj, parts):
-            missing.append(f"{first.name} + {second.name}")
+            missing.append(cushion_name(first.name, second.name))
             continue
         meshes.append(world_triangles(obj))
         girth.append(first.girth or second.girth)
