@@ -29,8 +29,8 @@ from .mesh import check_subdivision_level
 from .quaternion import rotation_to_quaternion
 
 # Contact and integration defaults for a static mannequin that objects fall onto. MuJoCo's own
-# defaults (2 ms steps, 20 ms contact time constant) let a 2 cm ball dropped 0.5 m onto an arm sink
-# 16 mm into it; 1 ms steps with the stiffest safe time constant (2 timesteps) keep it near 2 mm.
+# defaults (2 ms steps, 20 ms contact time constant) let a 1 cm ball dropped 0.5 m onto an arm sink
+# about 2 cm into it; 1 ms steps with the stiffest safe time constant (2 timesteps) keep it near 1 mm.
 # The solref sits in the top-level default so objects a user adds inherit it (MuJoCo mixes the
 # solref of the two geoms in contact and clamps it to 2 timesteps if the timestep grows).
 TIMESTEP = 0.001  # s
