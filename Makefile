@@ -1,5 +1,5 @@
 # Every target sets itself up: the first run creates .venv with Blender's bpy module and the dev tools.
-PYTHON ?= python3
+PYTHON ?= python3.11
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed-$(shell cksum < requirements-dev.txt | cut -d' ' -f1)
