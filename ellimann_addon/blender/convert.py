@@ -10,7 +10,7 @@ import numpy as np
 from mathutils import Matrix
 
 from ..core.constants import MEASUREMENTS
-from ..core.ellipsoid import decompose_matrix_world, matrix_world
+from ..core.ellipsoid import decompose_matrices_world, decompose_matrix_world, matrix_world
 from ..core.errors import FrameError, MannequinError, Problem
 from ..core.mannequin import NAME_PATTERN, Mannequin, Part, Topology
 from ..core.mesh import icosphere
@@ -96,7 +96,16 @@ def ellipsoid_frame(obj, checked=None):
 
 def read_frames(objects):
     """Stacked (rotation, center, semi_axes) of ellipsoid objects; MannequinError names every bad one."""
-    problems, frames, checked = [], [], {}
+    objects = list(objects)
+    checked = {}
+    if objects and all(obj.type == "MESH" for obj in objects):
+        for mesh in {obj.data.as_pointer(): obj.data for obj in objects}.values():
+            checked[mesh.as_pointer()] = is_unit_sphere(mesh)
+        if all(checked.values()):
+            frames = decompose_matrices_world([np.array(obj.matrix_world) for obj in objects])
+            if frames is not None:  # all valid: one vectorised pass (a panel's live update reads every frame)
+                return frames
+    problems, frames = [], []
     for obj in objects:
         try:
             frames.append(ellipsoid_frame(obj, checked))

@@ -140,6 +140,25 @@ def decompose_matrix_world(matrix, tol=ORTHONORMAL_TOL):
     return rotation, matrix[:3, 3].copy(), semi_axes
 
 
+def decompose_matrices_world(matrices, tol=ORTHONORMAL_TOL):
+    """:func:`decompose_matrix_world` of a stack (n, 4, 4) in one vectorised pass: stacked
+    (rotation, center, semi_axes), the same numbers as one call per matrix, or None when any matrix
+    is not an ellipsoid frame (decompose them one by one to learn which and why).
+    """
+    matrices = np.asarray(matrices, dtype=float).reshape(-1, 4, 4)
+    if not np.all(np.isfinite(matrices)) or not np.allclose(matrices[:, 3], (0.0, 0.0, 0.0, 1.0), atol=tol):
+        return None
+    linear = matrices[:, :3, :3]
+    semi_axes = np.linalg.norm(linear, axis=1)
+    if np.any(semi_axes <= 1e-12):
+        return None
+    rotation = linear / semi_axes[:, None, :]
+    gram = np.swapaxes(rotation, 1, 2) @ rotation
+    if not np.allclose(gram, np.eye(3), atol=1e-4) or np.any(np.linalg.det(rotation) < 0.0):
+        return None
+    return rotation, matrices[:, :3, 3].copy(), semi_axes
+
+
 def repair_matrix_world(matrix, flip_axis=None, tol=ORTHONORMAL_TOL):
     """A valid ellipsoid frame for an object matrix that is not one (negative scale or shear).
 

@@ -105,6 +105,33 @@ def test_decompose_refuses_negative_scale_shear_and_zero_scale():
         el.decompose_matrix_world(np.full((4, 4), np.nan))
 
 
+def test_decomposing_a_stack_is_one_decomposition_per_matrix_or_none_if_any_is_not_a_frame():
+    rng = np.random.default_rng(7)
+    good = np.array([el.matrix_world(rotation_from_vector(rng.normal(size=3)), rng.normal(size=3),
+                                     rng.uniform(0.02, 0.3, 3)) for _ in range(12)])
+    stacked = el.decompose_matrices_world(good)
+    for i, matrix in enumerate(good):
+        for got, one in zip(stacked, el.decompose_matrix_world(matrix)):
+            assert np.array_equal(got[i], one)
+    bad = {"negative": (slice(None), 0, -1.0), "sheared": (0, 1, 0.1), "zero": (slice(None), 2, 0.0)}
+    for kind, (row, column, value) in bad.items():
+        broken = good.copy()
+        if kind == "sheared":
+            broken[5, row, column] += value
+        else:
+            broken[5, :3, column] *= value
+        with pytest.raises(FrameError):
+            el.decompose_matrix_world(broken[5])
+        assert el.decompose_matrices_world(broken) is None, kind
+    for value in (np.nan, np.inf):
+        broken = good.copy()
+        broken[3, 0, 0] = value
+        assert el.decompose_matrices_world(broken) is None
+    projective = good.copy()
+    projective[0, 3, 0] = 0.5
+    assert el.decompose_matrices_world(projective) is None
+
+
 def same_set(matrix, repaired):
     """Two descriptions of one ellipsoid: same centre and same shape matrix L L^T."""
     rotation, center, semi = repaired
