@@ -27,6 +27,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, PointerProperty
 from ..core.constants import ABSURD_LIMITS, MEASUREMENT_LABELS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS
 from ..core.cushion import DEFAULT_SUBDIVISIONS, cushion_vertices
 from ..core.errors import ElliMannError
+from ..core.mesh import icosphere_level
 from ..core.synthesis import (
     DEFAULT_NORMALIZE,
     DEFAULT_POWER,
@@ -176,14 +177,9 @@ def live_update(scene):
     return seconds
 
 
-def _icosphere_level(vertex_count):
-    """s with 10 * 4^s + 2 == vertex_count (a cushion mesh's resolution), or None."""
-    return next((s for s in range(8) if 10 * 4 ** s + 2 == vertex_count), None)
-
-
 def _level(cushions):
     """The resolution most of the cushions have (DEFAULT_SUBDIVISIONS if none is an icosphere's)."""
-    levels = [_icosphere_level(len(o.data.vertices)) for o in cushions if o.type == "MESH"]
+    levels = [icosphere_level(len(o.data.vertices)) for o in cushions if o.type == "MESH"]
     levels = [level for level in levels if level is not None]
     return max(set(levels), key=levels.count) if levels else DEFAULT_SUBDIVISIONS
 
@@ -201,7 +197,7 @@ def move_cushions(collection, mannequin, cushions):
     objects = [by_pair.get((topology.names[i], topology.names[j])) for i, j in pairs]
     if len(cushions) != len(pairs) or any(o is None or o.type != "MESH" or o.data.users != 1 for o in objects):
         return False
-    levels = [_icosphere_level(len(o.data.vertices)) for o in objects]
+    levels = [icosphere_level(len(o.data.vertices)) for o in objects]
     if None in levels:
         return False
     for level in set(levels):

@@ -122,6 +122,15 @@ def test_icosphere_sizes_and_orientation():
         check_convex_closed(v, f)
 
 
+def test_icosphere_level_is_read_back_from_the_vertex_count():
+    for s in range(8):
+        assert mesh.icosphere_vertex_count(s) == 10 * 4**s + 2
+        assert mesh.icosphere_level(mesh.icosphere_vertex_count(s)) == s
+    assert mesh.icosphere_level(len(mesh.icosphere(3)[0])) == 3
+    for count in (0, 1, 11, 13, 41, 43, 641, 2561, 10 * 4**8 + 1):
+        assert mesh.icosphere_level(count) is None
+
+
 def test_subdivision_levels_are_integers_in_the_allowed_range():
     assert mesh.check_subdivision_level("level", 3, (1, 6)) == 3
     assert type(mesh.check_subdivision_level("level", np.int64(1), (1, 6))) is int
