@@ -639,8 +639,9 @@ def run_drape(args):
     if kind == ".json":
         mannequin = Mannequin.load(args.mannequin)
     bpy = _ensure_registered()
+    from .atomic import atomic_output
     from .drape import drape
-    from .output import add_mannequin, atomic_output, empty_scene, stdout_to_stderr
+    from .output import add_mannequin, empty_scene, stdout_to_stderr
 
     settings = drape_settings(args)
     if kind == ".json":

@@ -14,8 +14,8 @@ import bpy
 
 from ..core.cushion import DEFAULT_SUBDIVISIONS
 from ..core.writers import core_format, write_core_file
-from .atomic import atomic_output  # the CLI and render import it from here
-from .convert import mannequin_to_collection, objects_recursive, write_measured  # Synthesize imports it from here
+from .atomic import atomic_output
+from .convert import mannequin_to_collection, objects_recursive, write_measured
 from .cushions import build_cushions
 from .export import export_gltf
 
@@ -81,8 +81,11 @@ def _add_cushions(collection, subdivisions=DEFAULT_SUBDIVISIONS):
 def refresh_cushions(collection, subdivisions=LIVE_SUBDIVISIONS):
     """Rebuild a mannequin's cushions after its ellipsoids moved (replaces only the cushions ElliMann built).
 
-    Live updates use a coarser mesh (642 vertices instead of 2,562) to keep up with a dragged
-    slider; Synthesize builds them at full resolution.
+    Live updates call it rarely: while a slider is dragged they move the cushions in place
+    (``synthesize.move_cushions``), and rebuild them here only once the fields are still
+    (``synthesize.settle_live``) or when the cushions cannot be moved (one is missing). They rebuild at
+    ``subdivisions`` = LIVE_SUBDIVISIONS (642 vertices), or the cushions' own level if coarser, since
+    a rebuild at Synthesize's 2,562 takes seconds; Synthesize builds them at full resolution.
     """
     _add_cushions(collection, subdivisions)
 

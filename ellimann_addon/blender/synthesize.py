@@ -164,9 +164,10 @@ def live_update(scene):
         write_measured(target, measured)
         cushions = built_objects(target, "CUSHION")
         if cushions:
-            if not move_cushions(target, mannequin, cushions):  # rebuilt once; afterwards they move in place
+            if move_cushions(mannequin, cushions):  # out of date until the fields are still
+                _settle_later(scene)
+            else:  # rebuilt exactly once; afterwards they move in place
                 refresh_cushions(target, min(_level(cushions), LIVE_SUBDIVISIONS))
-            _settle_later(scene)
         rename_live_target(target, mannequin.name)
     except ElliMannError as error:
         props.status = f"Live update failed: {error}"
@@ -184,7 +185,7 @@ def _level(cushions):
     return max(set(levels), key=levels.count) if levels else DEFAULT_SUBDIVISIONS
 
 
-def move_cushions(collection, mannequin, cushions):
+def move_cushions(mannequin, cushions):
     """Move the built cushions onto ``mannequin``'s ellipsoids by rewriting their vertices in place.
 
     Needs one cushion per pair, each with a mesh of its own at an icosphere resolution (as

@@ -198,10 +198,12 @@ def test_live_rebuilds_the_cushions_once_if_one_is_missing(props):
     props.live = True  # turning Live on updates once: all cushions rebuilt, exact
     cushions = cushion_objects()
     assert len(cushions) == count and not any(is_stale(o, part_lookup(props.target)) for o in cushions)
+    assert not bpy.app.timers.is_registered(synthesize._settle_timer)  # exact already: nothing to settle
     moved = {o.name: (o.data.as_pointer(), local_vertices(o)) for o in cushions}
     props.he = 162.0  # complete again: moved in place
     assert {o.name: o.data.as_pointer() for o in cushion_objects()} == {k: v[0] for k, v in moved.items()}
     assert all(np.abs(local_vertices(o) - moved[o.name][1]).max() > 1e-5 for o in cushion_objects())
+    assert bpy.app.timers.is_registered(synthesize._settle_timer)  # moved: out of date until settled
 
 
 def test_a_preset_makes_one_live_update(props, monkeypatch):
