@@ -13,6 +13,7 @@ import sys
 import bpy
 
 from ..core.cushion import DEFAULT_SUBDIVISIONS
+from ..core.errors import ElliMannError
 from ..core.writers import core_format, write_core_file
 from .atomic import atomic_output
 from .convert import mannequin_to_collection, objects_recursive, write_measured
@@ -66,19 +67,29 @@ def add_mannequin(mannequin, measured=None, cushions=False):
     return collection
 
 
-def _add_cushions(collection, subdivisions=DEFAULT_SUBDIVISIONS):
-    build_cushions(collection, subdivisions)
-    shown = set(shown_objects(collection))
+def _add_cushions(collection, subdivisions=DEFAULT_SUBDIVISIONS, view_layer=None):
+    """Build the cushions and hide the ellipsoids they replace in ``view_layer`` (default: the context's).
+
+    Checked before anything changes: every ellipsoid to hide is in ``view_layer`` (ElliMannError otherwise),
+    so a failure leaves neither new cushions with their ellipsoids shown nor half the ellipsoids hidden.
+    """
+    view_layer = view_layer or bpy.context.view_layer
     # Hidden in the view layer, not disabled (hide_viewport): Blender does not evaluate disabled
     # objects, so after reopening the file their matrix_world would be the identity.
-    bpy.context.view_layer.update()  # new objects get their view-layer bases (hide_set needs them)
-    for obj in objects_recursive(collection):
-        if obj.ellimann.kind == "ELLIPSOID" and obj not in shown:
-            obj.hide_set(True)
-            obj.hide_render = True
+    view_layer.update()  # new objects get their view-layer bases (hide_set needs them)
+    replaced = [o for o in objects_recursive(collection)
+                if o.ellimann.is_part and o.ellimann.kind == "ELLIPSOID" and o.ellimann.partner]
+    missing = [o.name for o in replaced if view_layer.objects.get(o.name) != o]
+    if missing:
+        raise ElliMannError(f"cannot hide '{missing[0]}' of '{collection.name}': it is not in view layer "
+                            f"'{view_layer.name}' (include the mannequin there to build its cushions)")
+    build_cushions(collection, subdivisions)
+    for obj in replaced:
+        obj.hide_set(True, view_layer=view_layer)
+        obj.hide_render = True
 
 
-def refresh_cushions(collection, subdivisions=LIVE_SUBDIVISIONS):
+def refresh_cushions(collection, subdivisions=LIVE_SUBDIVISIONS, view_layer=None):
     """Rebuild a mannequin's cushions after its ellipsoids moved (replaces only the cushions ElliMann built).
 
     Live updates call it rarely: while a slider is dragged they move the cushions in place
@@ -86,8 +97,11 @@ def refresh_cushions(collection, subdivisions=LIVE_SUBDIVISIONS):
     (``synthesize.settle_live``) or when the cushions cannot be moved (one is missing). They rebuild at
     ``subdivisions`` = LIVE_SUBDIVISIONS (642 vertices), or the cushions' own level if coarser, since
     a rebuild at Synthesize's 2,562 takes seconds; Synthesize builds them at full resolution.
+
+    The ellipsoids they replace are hidden in ``view_layer`` (default: the context's; a timer passes the
+    view layer of the scene it works on). Raises ElliMannError, changing nothing, if they are not in it.
     """
-    _add_cushions(collection, subdivisions)
+    _add_cushions(collection, subdivisions, view_layer)
 
 
 def write_mannequin(mannequin, paths, measured=None, cushions=False):

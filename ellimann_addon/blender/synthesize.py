@@ -17,6 +17,7 @@ have been still for ``LIVE_SETTLE_SECONDS``; a timer then rebuilds them exactly 
 import os
 import pathlib
 import re
+import sys
 import time
 
 import bpy
@@ -167,7 +168,7 @@ def live_update(scene):
             if move_cushions(mannequin, cushions):  # out of date until the fields are still
                 _settle_later(scene)
             else:  # rebuilt exactly once; afterwards they move in place
-                refresh_cushions(target, min(_level(cushions), LIVE_SUBDIVISIONS))
+                refresh_cushions(target, min(_level(cushions), LIVE_SUBDIVISIONS), scene_view_layer(scene))
         rename_live_target(target, mannequin.name)
     except ElliMannError as error:
         props.status = f"Live update failed: {error}"
@@ -231,26 +232,46 @@ def _settle_timer():
 def settle_live(scene):
     """Rebuild the live target's out-of-date cushions exactly (closed convex hulls).
 
-    Live updates call this through a timer once the fields have been still for LIVE_SETTLE_SECONDS.
+    Live updates call this through a timer once the fields have been still for LIVE_SETTLE_SECONDS
     The hulls are rebuilt at output.LIVE_SUBDIVISIONS (642 vertices; or their own resolution if
     coarser): at Synthesize's 2,562 the rebuild takes seconds on a 40-part mannequin, at 642 about
-    half a second. Synthesize again for full-resolution cushions. Returns the number rebuilt (0 if
-    none was out of date).
+    half a second. Synthesize again for full-resolution cushions. The ellipsoids the cushions replace
+    are hidden in ``scene``'s view layer (:func:`scene_view_layer`), whatever the context's is. Returns
+    the number rebuilt (0 if none was out of date, or if they could not be rebuilt: then nothing
+    changed, the panel's status says why and so does one line on the console).
     """
     props = scene.ellimann_synthesis
     target = props.target
     if target is None or not target.ellimann.is_mannequin:
         return 0
     cushions = built_objects(target, "CUSHION")
-    parts = part_lookup(target)
-    if not any(is_stale(c, parts) for c in cushions):
+    if not _has_stale(target, cushions):
         return 0
     try:
-        refresh_cushions(target, min(_level(cushions), LIVE_SUBDIVISIONS))
-    except ElliMannError as error:
-        props.status = f"Cushions not rebuilt: {error}"
+        refresh_cushions(target, min(_level(cushions), LIVE_SUBDIVISIONS), scene_view_layer(scene))
+    except (ElliMannError, RuntimeError) as error:
+        message = " ".join(str(error).split())
+        props.status = f"Cushions not rebuilt: {message}"
+        print(f"ElliMann: cushions of '{target.name}' not rebuilt: {message}", file=sys.stderr)
         return 0
     return len(built_objects(target, "CUSHION"))
+
+
+def _has_stale(target, cushions):
+    parts = part_lookup(target)
+    return any(is_stale(c, parts) for c in cushions)
+
+
+def scene_view_layer(scene):
+    """The view layer ``scene`` is shown in: the context's if it is one of ``scene``'s, else that of a
+    window showing ``scene``, else its first. (A timer runs in whatever context the window manager has.)"""
+    context = bpy.context
+    if context.view_layer is not None and context.view_layer.id_data == scene:
+        return context.view_layer
+    for window in context.window_manager.windows if context.window_manager else ():
+        if window.scene == scene:
+            return window.view_layer
+    return scene.view_layers[0]
 
 
 def rename_live_target(target, name):

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from devkit import synthetic
+from devkit.blender_scene import state
 from devkit.ui_recorder import Recorder, draw_panel
 from ellimann_addon.blender import convert, synthesize
 from ellimann_addon.blender import synthesize_panel as panel
@@ -188,6 +189,43 @@ def test_live_moves_the_cushions_in_place_then_rebuilds_them_exactly(props):
     bpy.data.collections.remove(props.target)
     props.hi = 120.0  # no target left: nothing to update, no error
     assert props.target is None
+
+
+def moved_live_cushions(props):
+    """Synthesize with cushions, then one live update: the cushions are moved in place, out of date."""
+    props.output = "CUSHIONS"
+    bpy.ops.ellimann.synthesize_mannequin()
+    props.live = True
+    props.he = 165.0
+    assert all(is_stale(o, part_lookup(props.target)) for o in cushion_objects())
+    return props.target
+
+
+def test_the_settle_timer_works_in_the_live_scene_whatever_scene_the_context_shows(props):
+    scene = bpy.context.scene
+    target = moved_live_cushions(props)
+    other = bpy.data.scenes.new("Other")
+    bpy.app.timers.unregister(synthesize._settle_timer)
+    with bpy.context.temp_override(scene=other, view_layer=other.view_layers[0]):  # another window's context
+        assert synthesize._settle_timer() is None
+    assert cushion_objects() and not any(is_stale(o, part_lookup(target)) for o in cushion_objects())
+    layer = scene.view_layers[0]
+    paired = [o for o in target.objects if o.ellimann.partner]
+    assert paired and all(o.hide_get(view_layer=layer) and o.hide_render for o in paired)
+    assert not any(o.hide_get(view_layer=layer) for o in target.objects if not o.ellimann.partner)
+
+
+def test_cushions_that_cannot_be_settled_are_left_as_they_were_with_one_line_on_the_console(props, capsys):
+    target = moved_live_cushions(props)
+    bpy.context.view_layer.layer_collection.children[target.name].exclude = True  # not in the view layer
+    before = state()
+    capsys.readouterr()
+    assert synthesize.settle_live(bpy.context.scene) == 0
+    assert state() == before and all(is_stale(o, part_lookup(target)) for o in cushion_objects())
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"ElliMann: cushions of '{target.name}' not rebuilt: cannot hide ") and "\n" not in err
+    assert props.status.startswith("Cushions not rebuilt: cannot hide ")
+    assert "is not in view layer 'ViewLayer'" in props.status
 
 
 def test_live_rebuilds_the_cushions_once_if_one_is_missing(props):
