@@ -12,6 +12,9 @@ their vertices are rewritten in place (``core.cushion.cushion_vertices``, every 
 vectorised call; same vertex order at the same resolution) and their faces kept. Those faces were
 made convex for the previous ellipsoids, so the cushions count as out of date until the fields
 have been still for ``LIVE_SETTLE_SECONDS``; a timer then rebuilds them exactly (``settle_live``).
+Blender records a slider's undo step when it is released, before that timer, and a file may be
+saved before it too: undo, redo and opening a file can bring moved cushions back, so handlers
+(``settle_restored``) start the timer again whenever a live target's cushions are out of date.
 """
 
 import os
@@ -51,7 +54,7 @@ LIVE_SETTLE_SECONDS = 0.5  # fields still this long: the live target's cushions 
 LIVE_NAME_KEY = "ellimann_live_name"  # on a live target: the name live updates last gave it
 
 _held = {"depth": 0, "changed": False}  # live updates held back while a preset sets its fields
-_settling = {"scene": None}  # the scene whose live target waits for exact cushions
+_settling = {"scenes": set()}  # names of the scenes whose live targets wait for exact cushions
 
 
 def _on_request_change(self, context):
@@ -215,18 +218,37 @@ def move_cushions(mannequin, cushions):
 
 def _settle_later(scene):
     """(Re)start the timer that rebuilds the cushions once the fields are still (restarted by every update)."""
-    _settling["scene"] = scene.name
     if bpy.app.timers.is_registered(_settle_timer):
         bpy.app.timers.unregister(_settle_timer)
+    else:  # a file load removes the timer: forget what it was to do in the old file
+        _settling["scenes"].clear()
+    _settling["scenes"].add(scene.name)
     bpy.app.timers.register(_settle_timer, first_interval=LIVE_SETTLE_SECONDS)
 
 
 def _settle_timer():
-    name, _settling["scene"] = _settling["scene"], None
-    scene = bpy.data.scenes.get(name) if name else None
-    if scene is not None:
-        settle_live(scene)
+    names, _settling["scenes"] = _settling["scenes"], set()
+    for name in sorted(names):
+        scene = bpy.data.scenes.get(name)
+        if scene is not None:
+            settle_live(scene)
     return None  # once
+
+
+@bpy.app.handlers.persistent
+def settle_restored(*_args):
+    """undo_post, redo_post and load_post handler: start the settle timer for every scene whose live
+    target has out-of-date cushions (moved in place, then recorded in an undo step or saved before the
+    timer rebuilt them)."""
+    for scene in bpy.data.scenes:
+        props = getattr(scene, "ellimann_synthesis", None)
+        target = props.target if props is not None and props.live else None
+        if target is not None and target.ellimann.is_mannequin and _has_stale(
+                target, built_objects(target, "CUSHION")):
+            _settle_later(scene)
+
+
+HANDLERS = ("undo_post", "redo_post", "load_post")
 
 
 def settle_live(scene):
@@ -368,10 +390,19 @@ _register_classes, _unregister_classes = bpy.utils.register_classes_factory(clas
 def register():
     _register_classes()
     bpy.types.Scene.ellimann_synthesis = PointerProperty(type=ELLIMANN_PG_synthesis)
+    for name in HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        if settle_restored not in handlers:
+            handlers.append(settle_restored)
 
 
 def unregister():
+    for name in HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        if settle_restored in handlers:
+            handlers.remove(settle_restored)
     if bpy.app.timers.is_registered(_settle_timer):
         bpy.app.timers.unregister(_settle_timer)
+    _settling["scenes"].clear()
     del bpy.types.Scene.ellimann_synthesis
     _unregister_classes()

@@ -27,6 +27,14 @@ def folder(tmp_path_factory):
     return str(synthetic.write_reference_folder(tmp_path_factory.mktemp("rm")))
 
 
+@pytest.fixture(autouse=True)
+def no_settle_timer_left():
+    """Live updates leave the settle timer registered; it must not fire in a later test."""
+    yield
+    if bpy.app.timers.is_registered(synthesize._settle_timer):
+        bpy.app.timers.unregister(synthesize._settle_timer)
+
+
 @pytest.fixture
 def props(folder):
     props = bpy.context.scene.ellimann_synthesis
@@ -226,6 +234,55 @@ def test_cushions_that_cannot_be_settled_are_left_as_they_were_with_one_line_on_
     assert err.startswith(f"ElliMann: cushions of '{target.name}' not rebuilt: cannot hide ") and "\n" not in err
     assert props.status.startswith("Cushions not rebuilt: cannot hide ")
     assert "is not in view layer 'ViewLayer'" in props.status
+
+
+def live_stale():
+    """Out of date or not, each cushion of the current scene's live target (looked up again: undo and file
+    loads replace Blender's data, so references held from before are invalid)."""
+    target = bpy.context.scene.ellimann_synthesis.target
+    return [is_stale(o, part_lookup(target)) for o in cushion_objects()]
+
+
+def fire_settle_timer():
+    """What Blender does once the timer is due: it is registered, and runs once."""
+    assert bpy.app.timers.is_registered(synthesize._settle_timer)
+    bpy.app.timers.unregister(synthesize._settle_timer)
+    assert synthesize._settle_timer() is None
+    assert live_stale() and not any(live_stale())
+
+
+def test_undo_and_redo_to_moved_cushions_settle_them_again(props):
+    props.output = "CUSHIONS"
+    bpy.ops.ellimann.synthesize_mannequin()
+    props.live = True
+    bpy.ops.ed.undo_push(message="Synthesize")
+    for attr, value in (("he", 165.0), ("hi", 125.0)):
+        setattr(bpy.context.scene.ellimann_synthesis, attr, value)
+        bpy.ops.ed.undo_push(message=attr)  # what releasing the slider records: moved, out-of-date cushions
+        fire_settle_timer()  # afterwards, recorded by no step
+    assert bpy.ops.ed.undo() == {"FINISHED"}  # back to He 165 as recorded: moved cushions
+    assert all(live_stale())
+    fire_settle_timer()
+    assert bpy.ops.ed.redo() == {"FINISHED"}  # Hi 125 as recorded: the cushions Hi moved are out of date
+    assert any(live_stale())
+    fire_settle_timer()
+    props = bpy.context.scene.ellimann_synthesis
+    props.live = False  # with Live off the handler leaves out-of-date cushions alone
+    next(o for o in props.target.objects if o.ellimann.partner).location.x += 0.01
+    bpy.context.view_layer.update()
+    synthesize.settle_restored(bpy.context.scene, None)
+    assert any(live_stale()) and not bpy.app.timers.is_registered(synthesize._settle_timer)
+
+
+def test_a_file_saved_before_the_cushions_settled_settles_them_when_opened(props, tmp_path):
+    moved_live_cushions(props)
+    path = tmp_path / "live.blend"
+    assert bpy.ops.wm.save_as_mainfile(filepath=str(path)) == {"FINISHED"}
+    bpy.ops.wm.read_homefile(use_empty=True)  # a file load removes the timer
+    assert not bpy.app.timers.is_registered(synthesize._settle_timer)
+    assert bpy.ops.wm.open_mainfile(filepath=str(path)) == {"FINISHED"}
+    assert all(live_stale())
+    fire_settle_timer()
 
 
 def test_live_rebuilds_the_cushions_once_if_one_is_missing(props):
