@@ -64,6 +64,23 @@ def test_refuses_bad_paths_and_broken_mannequins_writing_nothing(toy_collection,
     assert target.read_bytes() == b"previous" and [p.name for p in tmp_path.iterdir()] == ["toy.glb"]
 
 
+def test_refuses_a_glb_of_out_of_date_cushions_until_they_are_built_again(toy_collection, tmp_path):
+    assert bpy.ops.ellimann.build_cushions() == {"FINISHED"}
+    parts(toy_collection)["6.b Shin.L"].location.z += 0.02  # what a live update, an undo or a reload can leave
+    bpy.context.view_layer.update()
+    before = state()
+    path = tmp_path / "toy.glb"
+    with pytest.raises(RuntimeError, match=r"Cannot export 'toy': the cushions of 'toy' are out of date "
+                                           r"\('6.a Thigh.L \+ 6.b Shin.L': .*\): Build Cushions first"):
+        bpy.ops.ellimann.export_mannequin(filepath=str(path))
+    assert state() == before and not path.exists()
+    # MJCF takes its cushion meshes from the ellipsoids, not from the built objects: nothing out of date.
+    assert bpy.ops.ellimann.export_mannequin(filepath=str(tmp_path / "toy.xml"), cushions=True) == {"FINISHED"}
+    assert bpy.ops.ellimann.build_cushions() == {"FINISHED"}
+    assert bpy.ops.ellimann.export_mannequin(filepath=str(path)) == {"FINISHED"}
+    assert "6.a Thigh.L + 6.b Shin.L" in {n["name"] for n in read_glb_json(path)["nodes"]}
+
+
 def test_needs_an_active_mannequin():
     assert not bpy.ops.ellimann.export_mannequin.poll()
     bpy.ops.ellimann.new_mannequin()
