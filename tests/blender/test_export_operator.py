@@ -1,6 +1,7 @@
 """Export Mannequin (File > Export, the sidebar): the active mannequin to .glb with extras or to MJCF, headless."""
 
 import xml.etree.ElementTree as ET
+from types import SimpleNamespace
 
 import bpy
 import pytest
@@ -85,6 +86,50 @@ def test_needs_an_active_mannequin():
     assert not bpy.ops.ellimann.export_mannequin.poll()
     bpy.ops.ellimann.new_mannequin()
     assert bpy.ops.ellimann.export_mannequin.poll()
+
+
+class RestoredProperties:
+    """An operator's properties as Blender hands them to invoke after an earlier run: the last-used values,
+    which count as set unless ``ghost=False`` asks for what the caller set."""
+
+    def __init__(self, restored=(), given=()):
+        self.restored, self.given = set(restored), set(given)
+
+    def is_property_set(self, name, ghost=True):
+        return name in self.given or (ghost and name in self.restored)
+
+
+class FileBrowser:
+    def fileselect_add(self, operator):
+        self.operator = operator
+
+
+def invoke_export(context, properties, **values):
+    """Run the operator's invoke on a stand-in (headless Blender executes instead of invoking)."""
+    operator = SimpleNamespace(properties=properties, filepath="", format="GLB", cushions=False, last_format="")
+    vars(operator).update(values)
+    browser = FileBrowser()
+    fake = SimpleNamespace(active_object=context.active_object, collection=context.collection, window_manager=browser)
+    assert ELLIMANN_OT_export_mannequin.invoke(operator, fake, None) == {"RUNNING_MODAL"}
+    assert browser.operator is operator
+    return operator
+
+
+def test_each_export_suggests_the_active_mannequin_not_the_last_run(toy, toy_collection):
+    rna = bpy.ops.ellimann.export_mannequin.get_rna_type().properties
+    assert rna["filepath"].is_skip_save  # Blender restores the last-used filepath otherwise (A's file for B)
+    assert rna["filepath"].subtype == "FILE_PATH" and rna["filepath"].description
+    other = mannequin_to_collection(toy.copy(name="Other"))
+    select(parts(other)["1.a Head"])
+    # The last export (of toy, with cushion meshes) is what Blender restores: Other has no cushions.
+    operator = invoke_export(bpy.context, RestoredProperties(restored={"cushions"}), cushions=True)
+    assert (operator.filepath, operator.cushions) == ("Other.glb", False)
+    operator = invoke_export(bpy.context, RestoredProperties(given={"cushions"}), cushions=True, format="MJCF")
+    assert (operator.filepath, operator.cushions, operator.last_format) == ("Other.xml", True, "MJCF")  # as given
+    select(parts(toy_collection)["1.a Head"])
+    assert bpy.ops.ellimann.build_cushions() == {"FINISHED"}
+    operator = invoke_export(bpy.context, RestoredProperties())
+    assert (operator.filepath, operator.cushions) == ("toy.glb", True)
 
 
 def test_extension_and_format_follow_each_other():
