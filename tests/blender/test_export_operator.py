@@ -49,11 +49,23 @@ def test_the_extension_or_the_format_chooses_mjcf(toy, toy_collection, tmp_path,
     assert "(MJCF with cushion meshes)" in capfd.readouterr().out
 
 
+def test_a_name_without_glb_or_xml_gets_the_formats_extension_as_in_the_file_browser(toy_collection, tmp_path):
+    """A dot in a mannequin's name ("ElliMann 159.5-43") is no extension; execute() and check() agree."""
+    cases = (("ElliMann 159.5-43", "GLB", "ElliMann 159.5-43.glb"),
+             ("ElliMann 159.5-43", "MJCF", "ElliMann 159.5-43.xml"), ("toy.obj", "GLB", "toy.obj.glb"))
+    for i, (name, kind, written) in enumerate(cases):
+        assert with_extension(name, kind) == written  # what check() makes of the name
+        path = tmp_path / str(i) / name
+        assert bpy.ops.ellimann.export_mannequin(filepath=str(path), format=kind) == {"FINISHED"}
+        assert [p.name for p in path.parent.iterdir()] == [written]
+    # .glb or .xml (in any case) decides the format, whatever the format option says.
+    assert bpy.ops.ellimann.export_mannequin(filepath=str(tmp_path / "toy.GLB"), format="MJCF") == {"FINISHED"}
+    assert read_glb_json(tmp_path / "toy.GLB")["scenes"][0]["extras"][EXTRAS_KEY]["name"] == "toy"
+
+
 def test_refuses_bad_paths_and_broken_mannequins_writing_nothing(toy_collection, tmp_path):
-    for path, words in ((f"{tmp_path}/toy.obj", "'toy.obj': a mannequin is exported as .glb or .xml"),
-                        (f"{tmp_path}/", "Choose a file name")):
-        with pytest.raises(RuntimeError, match=words):
-            bpy.ops.ellimann.export_mannequin(filepath=path)
+    with pytest.raises(RuntimeError, match="Choose a file name"):
+        bpy.ops.ellimann.export_mannequin(filepath=f"{tmp_path}/")
     target = tmp_path / "toy.glb"
     target.write_bytes(b"previous")
     pelvis = parts(toy_collection)["3.a Pelvis"]

@@ -119,11 +119,9 @@ class ELLIMANN_OT_export_mannequin(bpy.types.Operator, ExportHelper):
         path = bpy.path.abspath(self.filepath)
         if not os.path.basename(path):
             return cancel(self, "Choose a file name to export to")
-        kind = format_of(path)
-        if kind is None:
-            if os.path.splitext(path)[1]:
-                return cancel(self, f"'{os.path.basename(path)}': a mannequin is exported as .glb or .xml")
-            kind, path = self.format, path + EXTENSIONS[self.format]
+        kind = format_of(path)  # .glb or .xml decides the format; any other name gets the format's extension
+        if kind is None:  # as check() does in the file browser: "ElliMann 159.5-43" -> "ElliMann 159.5-43.glb"
+            kind, path = self.format, with_extension(path, self.format)
         try:
             if kind == "GLB":
                 export_gltf(collection, path)
