@@ -254,9 +254,10 @@ def _write(mannequin, paths, measured, cushions):
 
         try:
             write_mannequin(mannequin, blender, measured, cushions)
-        except OSError as error:  # the temporary's name holds the target's, where there is one
-            failed = next((p for p in blender if os.path.basename(p) in str(error.filename or "")), blender[0])
-            raise _cannot_write(failed, error) from None
+        except OSError as error:  # atomic_output names the file that failed
+            if error.filename is None:
+                raise
+            raise _cannot_write(error.filename, error) from None
     return paths
 
 

@@ -1,9 +1,10 @@
-"""Write mannequins to .blend, .glb, .obj, .json and .xml (MJCF), atomically (headless CLI and scripts).
+"""Write mannequins to .blend, .glb and .obj, atomically (headless CLI and scripts).
 
 Blender files are written from an empty scene holding only that mannequin (and its cushions when
-asked), to a temporary file in the target folder that is renamed into place once complete. A .glb
-goes through :func:`export.export_gltf`, so it always carries ElliMann's extras. JSON and MJCF
-come from the core (:mod:`core.writers`) and need no scene.
+asked), to a temporary file in the target folder that is renamed into place once complete
+(:func:`atomic.atomic_output`). A .glb goes through :func:`export.export_gltf`, so it always
+carries ElliMann's extras. JSON and MJCF come from the core (:func:`core.writers.write_core_file`)
+and need no scene.
 """
 
 import contextlib
@@ -14,7 +15,6 @@ import bpy
 
 from ..core.cushion import DEFAULT_SUBDIVISIONS
 from ..core.errors import ElliMannError
-from ..core.writers import core_format, write_core_file
 from .atomic import atomic_output
 from .convert import mannequin_to_collection, objects_recursive, write_measured
 from .cushions import build_cushions
@@ -105,20 +105,21 @@ def refresh_cushions(collection, subdivisions=LIVE_SUBDIVISIONS, view_layer=None
 
 
 def write_mannequin(mannequin, paths, measured=None, cushions=False):
-    """Write one mannequin to every path in ``paths`` (format from the extension). Returns the paths.
+    """Write one mannequin to every .blend, .glb and .obj in ``paths`` (format from the extension), all
+    from one empty scene. Returns the paths. (.json and MJCF need no Blender: ``core.writers``.)
 
-    ``cushions``: .blend/.glb/.obj show the cushions instead of the ellipsoids they replace; MJCF
-    gets one convex mesh geom per cushion pair.
+    ``cushions``: the files show the cushions instead of the ellipsoids they replace. A path of another
+    kind raises ElliMannError before anything is written; an OSError names the file that failed
+    (``filename``, as given in ``paths``).
     """
     paths = [os.fspath(p) for p in paths]
-    blender_paths = [p for p in paths if extension(p) in BLENDER_FORMATS]
-    for path in paths:
-        if core_format(path):
-            write_core_file(mannequin, path, cushions)
-    if blender_paths:
+    other = [p for p in paths if extension(p) not in BLENDER_FORMATS]
+    if other:
+        raise ElliMannError(f"path: {other[0]!r} is not a .blend, .glb or .obj file")
+    if paths:
         empty_scene()
         collection = add_mannequin(mannequin, measured, cushions)
-        for path in blender_paths:
+        for path in paths:
             _write_blender_file(path, collection)
     return paths
 
