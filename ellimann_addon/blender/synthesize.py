@@ -5,7 +5,9 @@ named after the measurements; with "Live" on, every change of a field moves the 
 mannequin in place (``live_update``). Presets (the five RMs, the ten mannequins of the paper's
 Table 2.5, and the user's own) use Blender's preset system; the shipped ones are read from this
 add-on's ``presets/`` folder, the user's are saved in Blender's user preset folder. A preset sets
-five fields but makes one live update (the preset menu's ``reset_cb`` / ``post_cb`` hold it back).
+five fields but makes one live update (the preset menu's ``reset_cb`` / ``post_cb`` hold it back),
+and the menu runs it through ``ELLIMANN_OT_apply_measurement_preset``, so that fields and mannequin
+change in one undo step (Blender's ``script.execute_preset`` makes none).
 
 Live updates with cushions keep up with a dragged slider by moving the existing cushion meshes:
 their vertices are rewritten in place (``core.cushion.cushion_vertices``, every pair in one
@@ -349,7 +351,7 @@ class ELLIMANN_MT_measurement_presets(bpy.types.Menu):
     bl_idname = ids.MENU_MEASUREMENT_PRESETS
     bl_label = "Measurement Presets"  # Blender shows the last preset chosen here
     preset_subdir = PRESET_SUBDIR
-    preset_operator = "script.execute_preset"
+    preset_operator = ids.APPLY_MEASUREMENT_PRESET  # script.execute_preset in one undo step
 
     # script.execute_preset calls these before and after running the preset file (which sets the five
     # fields one by one): one live update instead of five.
@@ -365,6 +367,31 @@ class ELLIMANN_MT_measurement_presets(bpy.types.Menu):
         folders = [str(SHIPPED_PRESETS)] + bpy.utils.preset_paths(PRESET_SUBDIR)
         self.path_menu(folders, self.preset_operator, filter_ext=lambda ext: ext.lower() == ".py",
                        display_name=lambda path: bpy.path.display_name(os.path.basename(path), title_case=False))
+
+
+class ELLIMANN_OT_apply_measurement_preset(bpy.types.Operator):
+    """Set the five measurements from a preset; with Live on the mannequin follows, in the same undo step"""
+
+    bl_idname = ids.APPLY_MEASUREMENT_PRESET
+    bl_label = "Apply Measurement Preset"
+    bl_options = {"REGISTER", "UNDO", "INTERNAL"}  # script.execute_preset has no undo step of its own
+
+    filepath: StringProperty(name="Preset", subtype="FILE_PATH", options={"HIDDEN", "SKIP_SAVE"},
+                             description="The preset file (.py) to run")
+
+    @classmethod
+    def poll(cls, context):
+        return hasattr(context.scene, "ellimann_synthesis")
+
+    def execute(self, context):
+        if not (self.filepath.lower().endswith(".py") and os.path.isfile(self.filepath)):
+            self.report({"ERROR"}, f"No measurement preset at '{self.filepath}'")
+            return {"CANCELLED"}
+        try:
+            bpy.ops.script.execute_preset(filepath=self.filepath, menu_idname=ids.MENU_MEASUREMENT_PRESETS)
+        except RuntimeError as error:  # the preset ran part-way: FINISHED, so that one undo takes it back
+            self.report({"ERROR"}, f"Preset '{os.path.basename(self.filepath)}' failed: {error}")
+        return {"FINISHED"}
 
 
 class ELLIMANN_OT_add_measurement_preset(AddPresetBase, bpy.types.Operator):
@@ -383,7 +410,7 @@ class ELLIMANN_OT_add_measurement_preset(AddPresetBase, bpy.types.Operator):
 
 
 classes = (ELLIMANN_PG_synthesis, ELLIMANN_OT_synthesize_mannequin, ELLIMANN_MT_measurement_presets,
-           ELLIMANN_OT_add_measurement_preset)
+           ELLIMANN_OT_apply_measurement_preset, ELLIMANN_OT_add_measurement_preset)
 _register_classes, _unregister_classes = bpy.utils.register_classes_factory(classes)
 
 

@@ -11,7 +11,7 @@ import pytest
 from devkit import synthetic
 from devkit.blender_scene import state
 from devkit.ui_recorder import Recorder, draw_panel
-from ellimann_addon.blender import convert, synthesize
+from ellimann_addon.blender import convert, ids, synthesize
 from ellimann_addon.blender import synthesize_panel as panel
 from ellimann_addon.blender.built import is_stale
 from ellimann_addon.blender.selection import part_lookup
@@ -293,6 +293,39 @@ def test_a_preset_makes_one_live_update(props, monkeypatch):
     assert len(calls) == 3
 
 
+def test_a_preset_is_one_undo_step_with_its_live_update(props):
+    props.output = "CUSHIONS"
+    bpy.ops.ellimann.synthesize_mannequin()
+    props.live = True
+    bpy.ops.ed.undo_push(message="Before")
+    before = state()
+    preset = synthesize.SHIPPED_PRESETS / "Table 2.5 (3).py"
+    # As the preset menu runs it (a click: undo=True); script.execute_preset alone pushes no step.
+    assert bpy.ops.ellimann.apply_measurement_preset("EXEC_DEFAULT", True, filepath=str(preset)) == {"FINISHED"}
+    after = state()
+    measured = tuple(bpy.context.scene.ellimann_synthesis.target.ellimann.measured)
+    assert after != before and measured == pytest.approx(TABLE_2_5[2], rel=1e-4)
+    assert synthesize.ELLIMANN_MT_measurement_presets.bl_label == "Table 2.5 (3)"  # the menu shows it
+    assert bpy.ops.ed.undo() == {"FINISHED"}
+    assert state() == before
+    assert [getattr(bpy.context.scene.ellimann_synthesis, m.lower()) for m in MEASUREMENTS] == [
+        159.0, 43.0, 117.0, 104.0, 117.0]
+    assert bpy.ops.ed.redo() == {"FINISHED"}
+    assert state() == after
+
+
+def test_a_missing_preset_is_refused_and_a_broken_one_can_be_undone(props, tmp_path):
+    before = state()
+    with pytest.raises(RuntimeError, match="No measurement preset at"):
+        bpy.ops.ellimann.apply_measurement_preset(filepath=str(tmp_path / "gone.py"))
+    assert state() == before and props.he == 159.0
+    broken = tmp_path / "broken.py"
+    broken.write_text("import bpy\nprops = bpy.context.scene.ellimann_synthesis\nprops.he = 150.0\nprops.sh = 'wide'\n")
+    with pytest.raises(RuntimeError, match="Preset 'broken.py' failed: .*Failed to execute the preset"):
+        bpy.ops.ellimann.apply_measurement_preset(filepath=str(broken))
+    assert props.he == 150.0  # what it set before failing stays: the operator finished, one undo takes it back
+
+
 def test_a_live_target_whose_name_is_taken_keeps_its_suffix(props):
     taken = "ElliMann 160-43-117-104-117"
     mine = convert.new_collection(taken)
@@ -335,6 +368,8 @@ def test_users_can_save_and_remove_their_own_presets(props):
     bpy.ops.script.execute_preset(filepath=str(saved), menu_idname="ELLIMANN_MT_measurement_presets")
     assert (props.he, props.hi) == pytest.approx((161.5, 121.0))
     menu = draw_panel(synthesize.ELLIMANN_MT_measurement_presets)
+    assert set(menu.operators()) == {ids.APPLY_MEASUREMENT_PRESET}  # an undo step per preset
+    assert str(saved) in [kw["props"].get("filepath") for kind, kw in menu.log if kind == "operator"]
     names = [kw.get("text") for kind, kw in menu.log if kind == "operator"]
     assert "My Client" in names and "RM Small Slim" in names and "Table 2.5 (10)" in names
     assert names.index("RM Average") < names.index("Table 2.5 (1)") < names.index("Table 2.5 (10)")
