@@ -256,7 +256,8 @@ HANDLERS = ("undo_post", "redo_post", "load_post")
 def settle_live(scene):
     """Rebuild the live target's out-of-date cushions exactly (closed convex hulls).
 
-    Live updates call this through a timer once the fields have been still for LIVE_SETTLE_SECONDS
+    Live updates call this through a timer once the fields have been still for LIVE_SETTLE_SECONDS,
+    and so does an undo, a redo or opening a file that brings moved cushions back (:func:`settle_restored`).
     The hulls are rebuilt at output.LIVE_SUBDIVISIONS (642 vertices; or their own resolution if
     coarser): at Synthesize's 2,562 the rebuild takes seconds on a 40-part mannequin, at 642 about
     half a second. Synthesize again for full-resolution cushions. The ellipsoids the cushions replace
