@@ -254,9 +254,10 @@ def _write(mannequin, paths, measured, cushions):
 
         try:
             write_mannequin(mannequin, blender, measured, cushions)
-        except OSError as error:  # the temporary's name holds the target's, where there is one
-            failed = next((p for p in blender if os.path.basename(p) in str(error.filename or "")), blender[0])
-            raise _cannot_write(failed, error) from None
+        except OSError as error:  # atomic_output names the file that failed
+            if error.filename is None:
+                raise
+            raise _cannot_write(error.filename, error) from None
     return paths
 
 
@@ -639,8 +640,9 @@ def run_drape(args):
     if kind == ".json":
         mannequin = Mannequin.load(args.mannequin)
     bpy = _ensure_registered()
+    from .atomic import atomic_output
     from .drape import drape
-    from .output import add_mannequin, atomic_output, empty_scene, stdout_to_stderr
+    from .output import add_mannequin, empty_scene, stdout_to_stderr
 
     settings = drape_settings(args)
     if kind == ".json":
@@ -651,9 +653,17 @@ def run_drape(args):
     print(f"{PROG} drape: {args.garment} on '{mannequin.name}', {settings.frames} frames, cloth edge "
           f"{settings.edge * CM_PER_M:g} cm, colliding with {'cushions' if settings.cushions else 'ellipsoids'}",
           file=sys.stderr, flush=True)
+    progress = _Progress(settings.frames, "drape", every=max(10, settings.frames // 20))  # 10 frames, 5% past 200
+
+    def frame_done(frame):
+        progress.step("frames simulated" + ("; baking and measuring the fit" if frame == settings.frames else ""),
+                      frame)
+
     with stdout_to_stderr():
-        with _frame_progress(bpy, settings.frames):
-            result = drape(mannequin, args.garment, settings)
+        try:
+            result = drape(mannequin, args.garment, settings, progress=frame_done)
+        finally:
+            progress.done()
         with _writing(args.output), atomic_output(args.output) as temp:
             bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)
     print(f"wrote {args.output}: {result.garment.name} on '{mannequin.name}', {result.summary()}")
@@ -674,23 +684,6 @@ def drape_settings(args):
     given = {"frames": args.frames, "edge": None if args.edge is None else args.edge / CM_PER_M,
              "cushions": args.cushions}
     return dataclasses.replace(DrapeSettings(), **{k: v for k, v in given.items() if v is not None}).checked()
-
-
-@contextlib.contextmanager
-def _frame_progress(bpy, frames):
-    """Progress lines on stderr while the cloth steps through the frames (a frame-change handler)."""
-    progress = _Progress(frames, "drape", every=max(10, frames // 20))
-
-    def report(scene, *_):
-        frame = scene.frame_current
-        progress.step("frames simulated" + ("; baking and measuring the fit" if frame == frames else ""), frame)
-
-    bpy.app.handlers.frame_change_post.append(report)
-    try:
-        yield
-    finally:
-        bpy.app.handlers.frame_change_post.remove(report)
-        progress.done()
 
 
 # ------------------------------------------------------------------------------------------------ Blender

@@ -3,20 +3,19 @@
 Shared by the Build Cushions operator, the Synthesize panel (live updates) and the CLI writers.
 """
 
-import numpy as np
 from mathutils import Matrix
 
 from ..core.cushion import DEFAULT_SUBDIVISIONS, mannequin_cushions
 from ..core.errors import MannequinError, Problem
+from ..core.frames import rigid_matrix
 from .built import built_collection, new_cushion_object, remove_built
 from .convert import collection_to_mannequin
 from .selection import part_lookup
 
 
 def rigid_frame(rotation, center):
-    matrix = np.eye(4)
-    matrix[:3, :3], matrix[:3, 3] = rotation, center
-    return Matrix(matrix.tolist())
+    """:func:`core.frames.rigid_matrix` as a mathutils Matrix (a cushion object's matrix_world)."""
+    return Matrix(rigid_matrix(rotation, center).tolist())
 
 
 def build_cushions(collection, subdivisions=DEFAULT_SUBDIVISIONS):

@@ -12,10 +12,12 @@ cache into a bake (``ptcache.bake_from_cache``), so a saved .blend replays the d
 its last frame. The simulated frames are the cloth's point cache range (1..frames), which Blender
 simulates whatever the scene's frame range is: the scene's range is left as it was, and past the
 cache's end the cloth holds its last frame. The mannequin itself is not touched. Everything that
-can fail on bad input is computed before the scene changes; if Blender fails once building has
-begun, the half-built drape collection is removed and an ElliMannError raised.
+can fail on bad input is computed before the scene changes; if anything fails once building has
+begun, everything the drape made is removed and the scene goes back to its frame (a RuntimeError
+of Blender's becomes an ElliMannError; other errors go on as they are).
 """
 
+import contextlib
 import time
 from dataclasses import dataclass, field
 
@@ -185,32 +187,35 @@ def collider_objects(pieces, collection):
 def setup(garment, pieces, settings, name, parent=None):
     """A new drape collection with the garment and its colliders; returns (collection, garment object).
 
-    If Blender raises RuntimeError on the way, what was built is removed before the error goes on.
+    If anything fails on the way, what was built is removed (:func:`removed_on_failure`) before the
+    error goes on.
     """
-    collection = new_collection(name, parent)
-    try:
+    with removed_on_failure():
+        collection = new_collection(name, parent)
         colliders = new_collection("Colliders", collection)
         obj = garment_object(garment, collection, settings)
         obj.modifiers[CLOTH_NAME].collision_settings.collection = colliders
         collider_objects(pieces, colliders)
-    except RuntimeError:
-        remove_drape(collection)
-        raise
     return collection, obj
 
 
-def remove_drape(collection):
-    """Delete a drape collection: its child collections, their objects and the meshes nothing else uses."""
-    collections = [collection, *collection.children_recursive]
-    objects = {o.name: o for c in collections for o in c.objects}
-    meshes = {o.data.name: o.data for o in objects.values() if isinstance(o.data, bpy.types.Mesh)}
-    for obj in objects.values():
-        bpy.data.objects.remove(obj)
-    for mesh in meshes.values():
-        if mesh.users == 0:
-            bpy.data.meshes.remove(mesh)
-    for child in reversed(collections):
-        bpy.data.collections.remove(child)
+@contextlib.contextmanager
+def removed_on_failure():
+    """Remove every object, mesh and collection made inside the block if it raises, then re-raise.
+
+    What is made is told from what existed before, so a mesh made before an object used it, or an
+    object not yet linked anywhere, goes too (removing the drape collection's contents would miss them).
+    """
+    kinds = ("objects", "meshes", "collections")  # in removal order: users before what they use
+    before = {kind: {block.as_pointer() for block in getattr(bpy.data, kind)} for kind in kinds}
+    try:
+        yield
+    except Exception:
+        for kind in kinds:
+            data = getattr(bpy.data, kind)
+            for block in [b for b in data if b.as_pointer() not in before[kind]]:
+                data.remove(block)
+        raise
 
 
 def bake(scene, obj, frames, progress=None):
@@ -261,9 +266,10 @@ def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None,
     (ellipsoids in closed form, cushions at a fine resolution): negative distances are inside;
     distances beyond FIT_CUTOFF (20 cm, a garment hanging far off the body) are lower bounds.
     Raises ElliMannError (MannequinError naming the parts) before anything is built. ``progress(frame)``
-    is called as each frame is simulated (see :func:`bake`). Should Blender raise RuntimeError once
-    building has begun, the drape collection is removed, the scene goes back to its frame and an
-    ElliMannError says what Blender reported.
+    is called as each frame is simulated (see :func:`bake`). Should anything fail once building has
+    begun (simulating, or measuring the fit), everything the drape made is removed, the scene goes
+    back to its frame and the error goes on; a RuntimeError of Blender's becomes an ElliMannError
+    saying what Blender reported.
     """
     settings = (settings or DrapeSettings()).checked()
     scene = scene or bpy.context.scene
@@ -278,20 +284,23 @@ def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None,
     exact = BodyPieces(mannequin, cushions, EXACT_SUBDIVISIONS)
     name = name or f"Drape {garment.name} on {mannequin.name}"
     frame = scene.frame_current
+    stage = "building"
     try:
-        collection, obj = setup(garment, pieces, settings, name, scene.collection)
-    except RuntimeError as error:
-        raise ElliMannError(f"Blender failed while building the drape: {error}") from error
-    try:
-        collection[DRAPE_KEY] = garment.name
-        wall, cpu = bake(scene, obj, settings.frames, progress)
-        vertices = evaluated_vertices(obj)
-    except RuntimeError as error:
-        remove_drape(collection)
-        scene.frame_set(frame)
-        raise ElliMannError(f"Blender failed while simulating the drape: {error}") from error
-    distance, _ = exact.signed_distance(vertices, FIT_CUTOFF)
-    return DrapeResult(collection, obj, garment, pieces, wall, cpu, vertices, fit_statistics(distance))
+        with removed_on_failure():
+            collection, obj = setup(garment, pieces, settings, name, scene.collection)
+            stage = "simulating"
+            collection[DRAPE_KEY] = garment.name
+            wall, cpu = bake(scene, obj, settings.frames, progress)
+            vertices = evaluated_vertices(obj)
+            distance, _ = exact.signed_distance(vertices, FIT_CUTOFF)
+            fit = fit_statistics(distance)
+    except Exception as error:
+        if stage == "simulating":
+            scene.frame_set(frame)
+        if isinstance(error, RuntimeError):
+            raise ElliMannError(f"Blender failed while {stage} the drape: {error}") from error
+        raise
+    return DrapeResult(collection, obj, garment, pieces, wall, cpu, vertices, fit)
 
 
 def mesh_piece(name, vertices, faces):

@@ -26,7 +26,9 @@ import numpy as np
 from ..core.constants import MEASUREMENTS
 from ..core.errors import ElliMannError
 from .atomic import atomic_output
+from .built import built_objects, is_stale
 from .convert import collection_to_mannequin, objects_recursive
+from .selection import part_lookup
 
 EXTRAS_KEY = "ellimann"
 EXTRAS_FORMAT = "ellimann.gltf-extras"
@@ -64,15 +66,22 @@ def export_gltf(collection, path):
     Objects hidden from renders are left out: in a mannequin shown with cushions those are the
     ellipsoids the cushions replace, so the file holds each convex piece once.
 
-    Raises ElliMannError for a path not ending in .glb and MannequinError (naming the parts) for
-    a collection that is not a valid mannequin; nothing is written then, and the file is
-    unchanged. Returns the path.
+    Raises ElliMannError for a path not ending in .glb or for built cushions that are out of date
+    (their ellipsoids moved since they were built: a live update, an undo or a reload can leave them
+    so), and MannequinError (naming the parts) for a collection that is not a valid mannequin;
+    nothing is written then, and the file is unchanged. Returns the path.
     """
     path = os.fspath(path)
     if not path.lower().endswith(".glb"):
         raise ElliMannError(f"path: a glTF export is written as binary glTF and must end in .glb, got {path!r}")
     bpy.context.view_layer.update()  # matrix_world of objects a script just moved
     mannequin = collection_to_mannequin(collection)
+    parts = part_lookup(collection)
+    stale = [c.name for c in built_objects(collection, "CUSHION") if is_stale(c, parts)]
+    if stale:
+        more = f" and {len(stale) - 1} more" if len(stale) > 1 else ""
+        raise ElliMannError(f"the cushions of '{collection.name}' are out of date ('{stale[0]}'{more}: their "
+                            "ellipsoids moved since they were built): Build Cushions first")
     objects = [o for o in objects_recursive(collection) if o.ellimann.is_part]
     saved = []
     try:

@@ -18,6 +18,7 @@ VALIDATE_MANNEQUIN = "ellimann.validate_mannequin"
 FIX_FRAMES = "ellimann.fix_frames"
 SYNTHESIZE_MANNEQUIN = "ellimann.synthesize_mannequin"
 ADD_MEASUREMENT_PRESET = "ellimann.add_measurement_preset"
+APPLY_MEASUREMENT_PRESET = "ellimann.apply_measurement_preset"
 DRAPE_GARMENT = "ellimann.drape_garment"
 EXPORT_MANNEQUIN = "ellimann.export_mannequin"
 

@@ -1,9 +1,10 @@
-"""Write mannequins to .blend, .glb, .obj, .json and .xml (MJCF), atomically (headless CLI and scripts).
+"""Write mannequins to .blend, .glb and .obj, atomically (headless CLI and scripts).
 
 Blender files are written from an empty scene holding only that mannequin (and its cushions when
-asked), to a temporary file in the target folder that is renamed into place once complete. A .glb
-goes through :func:`export.export_gltf`, so it always carries ElliMann's extras. JSON and MJCF
-come from the core (:mod:`core.writers`) and need no scene.
+asked), to a temporary file in the target folder that is renamed into place once complete
+(:func:`atomic.atomic_output`). A .glb goes through :func:`export.export_gltf`, so it always
+carries ElliMann's extras. JSON and MJCF come from the core (:func:`core.writers.write_core_file`)
+and need no scene.
 """
 
 import contextlib
@@ -13,9 +14,9 @@ import sys
 import bpy
 
 from ..core.cushion import DEFAULT_SUBDIVISIONS
-from ..core.writers import core_format, write_core_file
-from .atomic import atomic_output  # the CLI and render import it from here
-from .convert import mannequin_to_collection, objects_recursive, write_measured  # Synthesize imports it from here
+from ..core.errors import ElliMannError
+from .atomic import atomic_output
+from .convert import mannequin_to_collection, objects_recursive, write_measured
 from .cushions import build_cushions
 from .export import export_gltf
 
@@ -66,42 +67,59 @@ def add_mannequin(mannequin, measured=None, cushions=False):
     return collection
 
 
-def _add_cushions(collection, subdivisions=DEFAULT_SUBDIVISIONS):
-    build_cushions(collection, subdivisions)
-    shown = set(shown_objects(collection))
+def _add_cushions(collection, subdivisions=DEFAULT_SUBDIVISIONS, view_layer=None):
+    """Build the cushions and hide the ellipsoids they replace in ``view_layer`` (default: the context's).
+
+    Checked before anything changes: every ellipsoid to hide is in ``view_layer`` (ElliMannError otherwise),
+    so a failure leaves neither new cushions with their ellipsoids shown nor half the ellipsoids hidden.
+    """
+    view_layer = view_layer or bpy.context.view_layer
     # Hidden in the view layer, not disabled (hide_viewport): Blender does not evaluate disabled
     # objects, so after reopening the file their matrix_world would be the identity.
-    bpy.context.view_layer.update()  # new objects get their view-layer bases (hide_set needs them)
-    for obj in objects_recursive(collection):
-        if obj.ellimann.kind == "ELLIPSOID" and obj not in shown:
-            obj.hide_set(True)
-            obj.hide_render = True
+    view_layer.update()  # new objects get their view-layer bases (hide_set needs them)
+    replaced = [o for o in objects_recursive(collection)
+                if o.ellimann.is_part and o.ellimann.kind == "ELLIPSOID" and o.ellimann.partner]
+    missing = [o.name for o in replaced if view_layer.objects.get(o.name) != o]
+    if missing:
+        raise ElliMannError(f"cannot hide '{missing[0]}' of '{collection.name}': it is not in view layer "
+                            f"'{view_layer.name}' (include the mannequin there to build its cushions)")
+    build_cushions(collection, subdivisions)
+    for obj in replaced:
+        obj.hide_set(True, view_layer=view_layer)
+        obj.hide_render = True
 
 
-def refresh_cushions(collection, subdivisions=LIVE_SUBDIVISIONS):
+def refresh_cushions(collection, subdivisions=LIVE_SUBDIVISIONS, view_layer=None):
     """Rebuild a mannequin's cushions after its ellipsoids moved (replaces only the cushions ElliMann built).
 
-    Live updates use a coarser mesh (642 vertices instead of 2,562) to keep up with a dragged
-    slider; Synthesize builds them at full resolution.
+    Live updates call it rarely: while a slider is dragged they move the cushions in place
+    (``synthesize.move_cushions``), and rebuild them here only once the fields are still
+    (``synthesize.settle_live``) or when the cushions cannot be moved (one is missing). They rebuild at
+    ``subdivisions`` = LIVE_SUBDIVISIONS (642 vertices), or the cushions' own level if coarser, since
+    a rebuild at Synthesize's 2,562 takes seconds; Synthesize builds them at full resolution.
+
+    The ellipsoids they replace are hidden in ``view_layer`` (default: the context's; a timer passes the
+    view layer of the scene it works on). Raises ElliMannError, changing nothing, if they are not in it.
     """
-    _add_cushions(collection, subdivisions)
+    _add_cushions(collection, subdivisions, view_layer)
 
 
 def write_mannequin(mannequin, paths, measured=None, cushions=False):
-    """Write one mannequin to every path in ``paths`` (format from the extension). Returns the paths.
+    """Write one mannequin to every .blend, .glb and .obj in ``paths`` (format from the extension), all
+    from one empty scene. Returns the paths. (.json and MJCF need no Blender: ``core.writers``.)
 
-    ``cushions``: .blend/.glb/.obj show the cushions instead of the ellipsoids they replace; MJCF
-    gets one convex mesh geom per cushion pair.
+    ``cushions``: the files show the cushions instead of the ellipsoids they replace. A path of another
+    kind raises ElliMannError before anything is written; an OSError names the file that failed
+    (``filename``, as given in ``paths``).
     """
     paths = [os.fspath(p) for p in paths]
-    blender_paths = [p for p in paths if extension(p) in BLENDER_FORMATS]
-    for path in paths:
-        if core_format(path):
-            write_core_file(mannequin, path, cushions)
-    if blender_paths:
+    other = [p for p in paths if extension(p) not in BLENDER_FORMATS]
+    if other:
+        raise ElliMannError(f"path: {other[0]!r} is not a .blend, .glb or .obj file")
+    if paths:
         empty_scene()
         collection = add_mannequin(mannequin, measured, cushions)
-        for path in blender_paths:
+        for path in paths:
             _write_blender_file(path, collection)
     return paths
 

@@ -7,7 +7,8 @@ import bpy
 import numpy as np
 
 from ..core.ellipsoid import bounds
-from .output import add_mannequin, atomic_output, empty_scene, stdout_to_stderr
+from .atomic import atomic_output
+from .output import add_mannequin, empty_scene, stdout_to_stderr
 
 BACKGROUND = (1.0, 1.0, 1.0)
 LABEL_COLOR = (0.15, 0.15, 0.15, 1.0)

@@ -5,18 +5,24 @@ named after the measurements; with "Live" on, every change of a field moves the 
 mannequin in place (``live_update``). Presets (the five RMs, the ten mannequins of the paper's
 Table 2.5, and the user's own) use Blender's preset system; the shipped ones are read from this
 add-on's ``presets/`` folder, the user's are saved in Blender's user preset folder. A preset sets
-five fields but makes one live update (the preset menu's ``reset_cb`` / ``post_cb`` hold it back).
+five fields but makes one live update (the preset menu's ``reset_cb`` / ``post_cb`` hold it back),
+and the menu runs it through ``ELLIMANN_OT_apply_measurement_preset``, so that fields and mannequin
+change in one undo step (Blender's ``script.execute_preset`` makes none).
 
 Live updates with cushions keep up with a dragged slider by moving the existing cushion meshes:
 their vertices are rewritten in place (``core.cushion.cushion_vertices``, every pair in one
 vectorised call; same vertex order at the same resolution) and their faces kept. Those faces were
 made convex for the previous ellipsoids, so the cushions count as out of date until the fields
 have been still for ``LIVE_SETTLE_SECONDS``; a timer then rebuilds them exactly (``settle_live``).
+Blender records a slider's undo step when it is released, before that timer, and a file may be
+saved before it too: undo, redo and opening a file can bring moved cushions back, so handlers
+(``settle_restored``) start the timer again whenever a live target's cushions are out of date.
 """
 
 import os
 import pathlib
 import re
+import sys
 import time
 
 import bpy
@@ -27,6 +33,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, PointerProperty
 from ..core.constants import ABSURD_LIMITS, MEASUREMENT_LABELS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS
 from ..core.cushion import DEFAULT_SUBDIVISIONS, cushion_vertices
 from ..core.errors import ElliMannError
+from ..core.mesh import icosphere_level
 from ..core.synthesis import (
     DEFAULT_NORMALIZE,
     DEFAULT_POWER,
@@ -49,7 +56,7 @@ LIVE_SETTLE_SECONDS = 0.5  # fields still this long: the live target's cushions 
 LIVE_NAME_KEY = "ellimann_live_name"  # on a live target: the name live updates last gave it
 
 _held = {"depth": 0, "changed": False}  # live updates held back while a preset sets its fields
-_settling = {"scene": None}  # the scene whose live target waits for exact cushions
+_settling = {"scenes": set()}  # names of the scenes whose live targets wait for exact cushions
 
 
 def _on_request_change(self, context):
@@ -163,9 +170,10 @@ def live_update(scene):
         write_measured(target, measured)
         cushions = built_objects(target, "CUSHION")
         if cushions:
-            if not move_cushions(target, mannequin, cushions):  # rebuilt once; afterwards they move in place
-                refresh_cushions(target, min(_level(cushions), LIVE_SUBDIVISIONS))
-            _settle_later(scene)
+            if move_cushions(mannequin, cushions):  # out of date until the fields are still
+                _settle_later(scene)
+            else:  # rebuilt exactly once; afterwards they move in place
+                refresh_cushions(target, min(_level(cushions), LIVE_SUBDIVISIONS), scene_view_layer(scene))
         rename_live_target(target, mannequin.name)
     except ElliMannError as error:
         props.status = f"Live update failed: {error}"
@@ -176,19 +184,14 @@ def live_update(scene):
     return seconds
 
 
-def _icosphere_level(vertex_count):
-    """s with 10 * 4^s + 2 == vertex_count (a cushion mesh's resolution), or None."""
-    return next((s for s in range(8) if 10 * 4 ** s + 2 == vertex_count), None)
-
-
 def _level(cushions):
     """The resolution most of the cushions have (DEFAULT_SUBDIVISIONS if none is an icosphere's)."""
-    levels = [_icosphere_level(len(o.data.vertices)) for o in cushions if o.type == "MESH"]
+    levels = [icosphere_level(len(o.data.vertices)) for o in cushions if o.type == "MESH"]
     levels = [level for level in levels if level is not None]
     return max(set(levels), key=levels.count) if levels else DEFAULT_SUBDIVISIONS
 
 
-def move_cushions(collection, mannequin, cushions):
+def move_cushions(mannequin, cushions):
     """Move the built cushions onto ``mannequin``'s ellipsoids by rewriting their vertices in place.
 
     Needs one cushion per pair, each with a mesh of its own at an icosphere resolution (as
@@ -201,7 +204,7 @@ def move_cushions(collection, mannequin, cushions):
     objects = [by_pair.get((topology.names[i], topology.names[j])) for i, j in pairs]
     if len(cushions) != len(pairs) or any(o is None or o.type != "MESH" or o.data.users != 1 for o in objects):
         return False
-    levels = [_icosphere_level(len(o.data.vertices)) for o in objects]
+    levels = [icosphere_level(len(o.data.vertices)) for o in objects]
     if None in levels:
         return False
     for level in set(levels):
@@ -217,43 +220,83 @@ def move_cushions(collection, mannequin, cushions):
 
 def _settle_later(scene):
     """(Re)start the timer that rebuilds the cushions once the fields are still (restarted by every update)."""
-    _settling["scene"] = scene.name
     if bpy.app.timers.is_registered(_settle_timer):
         bpy.app.timers.unregister(_settle_timer)
+    else:  # a file load removes the timer: forget what it was to do in the old file
+        _settling["scenes"].clear()
+    _settling["scenes"].add(scene.name)
     bpy.app.timers.register(_settle_timer, first_interval=LIVE_SETTLE_SECONDS)
 
 
 def _settle_timer():
-    name, _settling["scene"] = _settling["scene"], None
-    scene = bpy.data.scenes.get(name) if name else None
-    if scene is not None:
-        settle_live(scene)
+    names, _settling["scenes"] = _settling["scenes"], set()
+    for name in sorted(names):
+        scene = bpy.data.scenes.get(name)
+        if scene is not None:
+            settle_live(scene)
     return None  # once
+
+
+@bpy.app.handlers.persistent
+def settle_restored(*_args):
+    """undo_post, redo_post and load_post handler: start the settle timer for every scene whose live
+    target has out-of-date cushions (moved in place, then recorded in an undo step or saved before the
+    timer rebuilt them)."""
+    for scene in bpy.data.scenes:
+        props = getattr(scene, "ellimann_synthesis", None)
+        target = props.target if props is not None and props.live else None
+        if target is not None and target.ellimann.is_mannequin and _has_stale(
+                target, built_objects(target, "CUSHION")):
+            _settle_later(scene)
+
+
+HANDLERS = ("undo_post", "redo_post", "load_post")
 
 
 def settle_live(scene):
     """Rebuild the live target's out-of-date cushions exactly (closed convex hulls).
 
-    Live updates call this through a timer once the fields have been still for LIVE_SETTLE_SECONDS.
+    Live updates call this through a timer once the fields have been still for LIVE_SETTLE_SECONDS,
+    and so does an undo, a redo or opening a file that brings moved cushions back (:func:`settle_restored`).
     The hulls are rebuilt at output.LIVE_SUBDIVISIONS (642 vertices; or their own resolution if
     coarser): at Synthesize's 2,562 the rebuild takes seconds on a 40-part mannequin, at 642 about
-    half a second. Synthesize again for full-resolution cushions. Returns the number rebuilt (0 if
-    none was out of date).
+    half a second. Synthesize again for full-resolution cushions. The ellipsoids the cushions replace
+    are hidden in ``scene``'s view layer (:func:`scene_view_layer`), whatever the context's is. Returns
+    the number rebuilt (0 if none was out of date, or if they could not be rebuilt: then nothing
+    changed, the panel's status says why and so does one line on the console).
     """
     props = scene.ellimann_synthesis
     target = props.target
     if target is None or not target.ellimann.is_mannequin:
         return 0
     cushions = built_objects(target, "CUSHION")
-    parts = part_lookup(target)
-    if not any(is_stale(c, parts) for c in cushions):
+    if not _has_stale(target, cushions):
         return 0
     try:
-        refresh_cushions(target, min(_level(cushions), LIVE_SUBDIVISIONS))
-    except ElliMannError as error:
-        props.status = f"Cushions not rebuilt: {error}"
+        refresh_cushions(target, min(_level(cushions), LIVE_SUBDIVISIONS), scene_view_layer(scene))
+    except (ElliMannError, RuntimeError) as error:
+        message = " ".join(str(error).split())
+        props.status = f"Cushions not rebuilt: {message}"
+        print(f"ElliMann: cushions of '{target.name}' not rebuilt: {message}", file=sys.stderr)
         return 0
     return len(built_objects(target, "CUSHION"))
+
+
+def _has_stale(target, cushions):
+    parts = part_lookup(target)
+    return any(is_stale(c, parts) for c in cushions)
+
+
+def scene_view_layer(scene):
+    """The view layer ``scene`` is shown in: the context's if it is one of ``scene``'s, else that of a
+    window showing ``scene``, else its first. (A timer runs in whatever context the window manager has.)"""
+    context = bpy.context
+    if context.view_layer is not None and context.view_layer.id_data == scene:
+        return context.view_layer
+    for window in context.window_manager.windows if context.window_manager else ():
+        if window.scene == scene:
+            return window.view_layer
+    return scene.view_layers[0]
 
 
 def rename_live_target(target, name):
@@ -309,7 +352,7 @@ class ELLIMANN_MT_measurement_presets(bpy.types.Menu):
     bl_idname = ids.MENU_MEASUREMENT_PRESETS
     bl_label = "Measurement Presets"  # Blender shows the last preset chosen here
     preset_subdir = PRESET_SUBDIR
-    preset_operator = "script.execute_preset"
+    preset_operator = ids.APPLY_MEASUREMENT_PRESET  # script.execute_preset in one undo step
 
     # script.execute_preset calls these before and after running the preset file (which sets the five
     # fields one by one): one live update instead of five.
@@ -325,6 +368,31 @@ class ELLIMANN_MT_measurement_presets(bpy.types.Menu):
         folders = [str(SHIPPED_PRESETS)] + bpy.utils.preset_paths(PRESET_SUBDIR)
         self.path_menu(folders, self.preset_operator, filter_ext=lambda ext: ext.lower() == ".py",
                        display_name=lambda path: bpy.path.display_name(os.path.basename(path), title_case=False))
+
+
+class ELLIMANN_OT_apply_measurement_preset(bpy.types.Operator):
+    """Set the five measurements from a preset; with Live on the mannequin follows, in the same undo step"""
+
+    bl_idname = ids.APPLY_MEASUREMENT_PRESET
+    bl_label = "Apply Measurement Preset"
+    bl_options = {"REGISTER", "UNDO", "INTERNAL"}  # script.execute_preset has no undo step of its own
+
+    filepath: StringProperty(name="Preset", subtype="FILE_PATH", options={"HIDDEN", "SKIP_SAVE"},
+                             description="The preset file (.py) to run")
+
+    @classmethod
+    def poll(cls, context):
+        return hasattr(context.scene, "ellimann_synthesis")
+
+    def execute(self, context):
+        if not (self.filepath.lower().endswith(".py") and os.path.isfile(self.filepath)):
+            self.report({"ERROR"}, f"No measurement preset at '{self.filepath}'")
+            return {"CANCELLED"}
+        try:
+            bpy.ops.script.execute_preset(filepath=self.filepath, menu_idname=ids.MENU_MEASUREMENT_PRESETS)
+        except RuntimeError as error:  # the preset ran part-way: FINISHED, so that one undo takes it back
+            self.report({"ERROR"}, f"Preset '{os.path.basename(self.filepath)}' failed: {error}")
+        return {"FINISHED"}
 
 
 class ELLIMANN_OT_add_measurement_preset(AddPresetBase, bpy.types.Operator):
@@ -343,17 +411,26 @@ class ELLIMANN_OT_add_measurement_preset(AddPresetBase, bpy.types.Operator):
 
 
 classes = (ELLIMANN_PG_synthesis, ELLIMANN_OT_synthesize_mannequin, ELLIMANN_MT_measurement_presets,
-           ELLIMANN_OT_add_measurement_preset)
+           ELLIMANN_OT_apply_measurement_preset, ELLIMANN_OT_add_measurement_preset)
 _register_classes, _unregister_classes = bpy.utils.register_classes_factory(classes)
 
 
 def register():
     _register_classes()
     bpy.types.Scene.ellimann_synthesis = PointerProperty(type=ELLIMANN_PG_synthesis)
+    for name in HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        if settle_restored not in handlers:
+            handlers.append(settle_restored)
 
 
 def unregister():
+    for name in HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        if settle_restored in handlers:
+            handlers.remove(settle_restored)
     if bpy.app.timers.is_registered(_settle_timer):
         bpy.app.timers.unregister(_settle_timer)
+    _settling["scenes"].clear()
     del bpy.types.Scene.ellimann_synthesis
     _unregister_classes()

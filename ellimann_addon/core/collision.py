@@ -13,6 +13,7 @@ import numpy as np
 
 from .cushion import mannequin_cushions
 from .ellipsoid import matrix_world
+from .frames import rigid_matrix
 from .mesh import check_subdivision_level, icosphere
 
 # Icosphere levels of cloth colliders: 20 to 20,480 triangles per piece; the solver's cost grows
@@ -51,8 +52,7 @@ def collision_pieces(mannequin, cushions=False, sphere_subdivisions=2, cushion_s
     pieces = [CollisionPiece(topology.names[i], "ELLIPSOID", frames[i], sphere_vertices, sphere_faces)
               for i in topology.single_parts(cushions)]
     for hull in mannequin_cushions(mannequin, cushion_subdivisions, local=True) if cushions else []:
-        rigid = np.eye(4)
-        rigid[:3, :3], rigid[:3, 3] = mannequin.rotation[hull.first], mannequin.center[hull.first]
+        rigid = rigid_matrix(mannequin.rotation[hull.first], mannequin.center[hull.first])
         pieces.append(CollisionPiece(hull.name, "CUSHION", rigid, hull.vertices, hull.faces))
     return pieces
 

@@ -23,6 +23,19 @@ def is_right_handed(rotation):
     return np.linalg.det(np.asarray(rotation, dtype=float)) > 0.0
 
 
+def rigid_matrix(rotation, center):
+    """The 4x4 matrix [[R, c], [0, 1]] of frames (rotation (..., 3, 3), center (..., 3)): (..., 4, 4).
+
+    A cushion's object matrix is its first ellipsoid's rigid frame (no scale), its vertices local to it.
+    """
+    rotation = np.asarray(rotation, dtype=float)
+    out = np.zeros(rotation.shape[:-2] + (4, 4))
+    out[..., :3, :3] = rotation
+    out[..., :3, 3] = center
+    out[..., 3, 3] = 1.0
+    return out
+
+
 def mirror_axis(rotation):
     """Index of the local axis that a sagittal mirror flips back: the one most aligned with world X.
 

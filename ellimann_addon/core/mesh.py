@@ -8,7 +8,7 @@ from .errors import ElliMannError
 def icosphere(subdivisions=3):
     """Unit icosphere: (vertices (V, 3), faces (F, 3) int, counter-clockwise seen from outside).
 
-    V = 10 * 4**s + 2. Built by repeated 4-to-1 subdivision of an icosahedron.
+    V = :func:`icosphere_vertex_count` (10 * 4**s + 2). Built by repeated 4-to-1 subdivision of an icosahedron.
     """
     phi = (1.0 + 5.0 ** 0.5) / 2.0
     verts = np.array([
@@ -38,6 +38,22 @@ def icosphere(subdivisions=3):
         ])
         verts = np.concatenate([verts, mids])
     return verts, faces
+
+
+def icosphere_vertex_count(subdivisions):
+    """Vertices of :func:`icosphere` at ``subdivisions``: 10 * 4**s + 2."""
+    return 10 * 4 ** int(subdivisions) + 2
+
+
+def icosphere_level(vertex_count):
+    """The subdivision level s whose icosphere has ``vertex_count`` vertices (10 * 4**s + 2), or None.
+
+    Meshes built on an icosphere's directions (cushions) keep its vertex count, so it tells their level.
+    """
+    level = 0
+    while icosphere_vertex_count(level) < vertex_count:
+        level += 1
+    return level if icosphere_vertex_count(level) == vertex_count else None
 
 
 def check_subdivision_level(name, value, allowed):

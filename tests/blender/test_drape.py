@@ -133,6 +133,40 @@ def test_a_blender_error_while_building_removes_the_drape(body, monkeypatch):
     assert state() == before
 
 
+def test_any_error_while_building_removes_what_was_made_even_a_mesh_no_object_uses_yet(body, monkeypatch):
+    mannequin_to_collection(body)
+    before = state()
+    made = []
+    real = drape_module.mesh_from_arrays
+
+    def failing_mesh(name, vertices, faces):
+        mesh = real(name, vertices, faces)
+        made.append(name)
+        if name.startswith("Collider"):  # the garment is linked; this mesh exists but no object uses it
+            raise ValueError("not a Blender error")
+        return mesh
+
+    monkeypatch.setattr(drape_module, "mesh_from_arrays", failing_mesh)
+    with pytest.raises(ValueError, match="not a Blender error"):  # not a RuntimeError: it goes on as it is
+        drape(body, "tube_dress", DrapeSettings(frames=4, cushions=False, **COARSE))
+    assert len(made) == 2 and made[1].startswith("Collider")
+    assert state() == before
+
+
+def test_an_error_while_measuring_the_fit_removes_the_drape(body, monkeypatch):
+    mannequin_to_collection(body)
+    bpy.context.scene.frame_set(5)
+    before = state()
+
+    def failing_fit(distance):
+        raise FloatingPointError("fit failed")
+
+    monkeypatch.setattr(drape_module, "fit_statistics", failing_fit)
+    with pytest.raises(FloatingPointError, match="fit failed"):
+        drape(body, "tube_dress", DrapeSettings(frames=3, cushions=False, **COARSE))
+    assert state() == before  # the drape's objects, meshes and collections gone; back on frame 5
+
+
 # ------------------------------------------------------------------------------------------------ operator, panel
 
 

@@ -8,11 +8,13 @@ import numpy as np
 import pytest
 
 from ellimann_addon.blender import convert
+from ellimann_addon.blender.atomic import atomic_output
 from ellimann_addon.blender.export import EXTRAS_KEY, export_gltf, read_glb_json
 from ellimann_addon.blender.output import write_mannequin
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.errors import ElliMannError, MannequinError
 from ellimann_addon.core.quaternion import quaternion_to_rotation
+from ellimann_addon.core.writers import write_core_file
 
 # glTF is Y-up: Blender's exporter maps (x, y, z) -> (x, z, -y).
 Z_UP_FROM_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
@@ -98,7 +100,9 @@ def umask():
 
 def test_every_format_gets_the_usual_permissions(mannequin, tmp_path, umask):
     paths = [tmp_path / f"toy.{ext}" for ext in ("glb", "blend", "obj", "json", "xml")]
-    write_mannequin(mannequin, paths)
+    write_mannequin(mannequin, paths[:3])
+    for path in paths[3:]:
+        write_core_file(mannequin, path)
     modes = {p.suffix: stat.S_IMODE(p.stat().st_mode) for p in paths}
     assert modes == {p.suffix: 0o666 & ~umask for p in paths}  # mkstemp's 0600 would show here
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in paths)
@@ -111,3 +115,26 @@ def test_export_reads_parts_in_child_collections(mannequin, tmp_path):
     doc = read_glb_json(export_gltf(collection, tmp_path / "toy.glb"))
     kinds = [n["extras"][EXTRAS_KEY]["kind"] for n in doc["nodes"]]
     assert kinds.count("CUSHION") == 3 and kinds.count("ELLIPSOID") == len(mannequin)
+
+
+def test_a_failed_write_names_its_target_not_the_temporary_file(mannequin, tmp_path):
+    """atomic_output raises OSErrors with filename = the path as given, whichever step failed."""
+    blocked = tmp_path / "blocked.glb"
+    (blocked / "inside").mkdir(parents=True)  # a folder in the way: the final rename fails
+    paths = [str(tmp_path / "ok.blend"), str(blocked)]
+    with pytest.raises(OSError) as raised:
+        write_mannequin(mannequin, paths)
+    assert raised.value.filename == str(blocked) and ".ellimann-" not in str(raised.value)
+    for target, error in ((str(tmp_path / "a_file" / "m.blend"), "File exists"),  # a file where its folder should be
+                          (str(tmp_path / "empty.png"), "Blender wrote nothing")):
+        (tmp_path / "a_file").touch()
+        with pytest.raises(OSError, match=error) as raised, atomic_output(target):
+            pass
+        assert raised.value.filename == target
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file", "blocked.glb", "ok.blend"]
+
+
+def test_write_mannequin_writes_blender_files_only(mannequin, tmp_path):
+    with pytest.raises(ElliMannError, match=r"'.*toy.json' is not a .blend, .glb or .obj file"):
+        write_mannequin(mannequin, [tmp_path / "toy.blend", tmp_path / "toy.json"])
+    assert list(tmp_path.iterdir()) == []

@@ -1,6 +1,7 @@
 """Export Mannequin (File > Export, the sidebar): the active mannequin to .glb with extras or to MJCF, headless."""
 
 import xml.etree.ElementTree as ET
+from types import SimpleNamespace
 
 import bpy
 import pytest
@@ -48,11 +49,23 @@ def test_the_extension_or_the_format_chooses_mjcf(toy, toy_collection, tmp_path,
     assert "(MJCF with cushion meshes)" in capfd.readouterr().out
 
 
+def test_a_name_without_glb_or_xml_gets_the_formats_extension_as_in_the_file_browser(toy_collection, tmp_path):
+    """A dot in a mannequin's name ("ElliMann 159.5-43") is no extension; execute() and check() agree."""
+    cases = (("ElliMann 159.5-43", "GLB", "ElliMann 159.5-43.glb"),
+             ("ElliMann 159.5-43", "MJCF", "ElliMann 159.5-43.xml"), ("toy.obj", "GLB", "toy.obj.glb"))
+    for i, (name, kind, written) in enumerate(cases):
+        assert with_extension(name, kind) == written  # what check() makes of the name
+        path = tmp_path / str(i) / name
+        assert bpy.ops.ellimann.export_mannequin(filepath=str(path), format=kind) == {"FINISHED"}
+        assert [p.name for p in path.parent.iterdir()] == [written]
+    # .glb or .xml (in any case) decides the format, whatever the format option says.
+    assert bpy.ops.ellimann.export_mannequin(filepath=str(tmp_path / "toy.GLB"), format="MJCF") == {"FINISHED"}
+    assert read_glb_json(tmp_path / "toy.GLB")["scenes"][0]["extras"][EXTRAS_KEY]["name"] == "toy"
+
+
 def test_refuses_bad_paths_and_broken_mannequins_writing_nothing(toy_collection, tmp_path):
-    for path, words in ((f"{tmp_path}/toy.obj", "'toy.obj': a mannequin is exported as .glb or .xml"),
-                        (f"{tmp_path}/", "Choose a file name")):
-        with pytest.raises(RuntimeError, match=words):
-            bpy.ops.ellimann.export_mannequin(filepath=path)
+    with pytest.raises(RuntimeError, match="Choose a file name"):
+        bpy.ops.ellimann.export_mannequin(filepath=f"{tmp_path}/")
     target = tmp_path / "toy.glb"
     target.write_bytes(b"previous")
     pelvis = parts(toy_collection)["3.a Pelvis"]
@@ -64,10 +77,71 @@ def test_refuses_bad_paths_and_broken_mannequins_writing_nothing(toy_collection,
     assert target.read_bytes() == b"previous" and [p.name for p in tmp_path.iterdir()] == ["toy.glb"]
 
 
+def test_refuses_a_glb_of_out_of_date_cushions_until_they_are_built_again(toy_collection, tmp_path):
+    assert bpy.ops.ellimann.build_cushions() == {"FINISHED"}
+    parts(toy_collection)["6.b Shin.L"].location.z += 0.02  # what a live update, an undo or a reload can leave
+    bpy.context.view_layer.update()
+    before = state()
+    path = tmp_path / "toy.glb"
+    with pytest.raises(RuntimeError, match=r"Cannot export 'toy': the cushions of 'toy' are out of date "
+                                           r"\('6.a Thigh.L \+ 6.b Shin.L': .*\): Build Cushions first"):
+        bpy.ops.ellimann.export_mannequin(filepath=str(path))
+    assert state() == before and not path.exists()
+    # MJCF takes its cushion meshes from the ellipsoids, not from the built objects: nothing out of date.
+    assert bpy.ops.ellimann.export_mannequin(filepath=str(tmp_path / "toy.xml"), cushions=True) == {"FINISHED"}
+    assert bpy.ops.ellimann.build_cushions() == {"FINISHED"}
+    assert bpy.ops.ellimann.export_mannequin(filepath=str(path)) == {"FINISHED"}
+    assert "6.a Thigh.L + 6.b Shin.L" in {n["name"] for n in read_glb_json(path)["nodes"]}
+
+
 def test_needs_an_active_mannequin():
     assert not bpy.ops.ellimann.export_mannequin.poll()
     bpy.ops.ellimann.new_mannequin()
     assert bpy.ops.ellimann.export_mannequin.poll()
+
+
+class RestoredProperties:
+    """An operator's properties as Blender hands them to invoke after an earlier run: the last-used values,
+    which count as set unless ``ghost=False`` asks for what the caller set."""
+
+    def __init__(self, restored=(), given=()):
+        self.restored, self.given = set(restored), set(given)
+
+    def is_property_set(self, name, ghost=True):
+        return name in self.given or (ghost and name in self.restored)
+
+
+class FileBrowser:
+    def fileselect_add(self, operator):
+        self.operator = operator
+
+
+def invoke_export(context, properties, **values):
+    """Run the operator's invoke on a stand-in (headless Blender executes instead of invoking)."""
+    operator = SimpleNamespace(properties=properties, filepath="", format="GLB", cushions=False, last_format="")
+    vars(operator).update(values)
+    browser = FileBrowser()
+    fake = SimpleNamespace(active_object=context.active_object, collection=context.collection, window_manager=browser)
+    assert ELLIMANN_OT_export_mannequin.invoke(operator, fake, None) == {"RUNNING_MODAL"}
+    assert browser.operator is operator
+    return operator
+
+
+def test_each_export_suggests_the_active_mannequin_not_the_last_run(toy, toy_collection):
+    rna = bpy.ops.ellimann.export_mannequin.get_rna_type().properties
+    assert rna["filepath"].is_skip_save  # Blender restores the last-used filepath otherwise (A's file for B)
+    assert rna["filepath"].subtype == "FILE_PATH" and rna["filepath"].description
+    other = mannequin_to_collection(toy.copy(name="Other"))
+    select(parts(other)["1.a Head"])
+    # The last export (of toy, with cushion meshes) is what Blender restores: Other has no cushions.
+    operator = invoke_export(bpy.context, RestoredProperties(restored={"cushions"}), cushions=True)
+    assert (operator.filepath, operator.cushions) == ("Other.glb", False)
+    operator = invoke_export(bpy.context, RestoredProperties(given={"cushions"}), cushions=True, format="MJCF")
+    assert (operator.filepath, operator.cushions, operator.last_format) == ("Other.xml", True, "MJCF")  # as given
+    select(parts(toy_collection)["1.a Head"])
+    assert bpy.ops.ellimann.build_cushions() == {"FINISHED"}
+    operator = invoke_export(bpy.context, RestoredProperties())
+    assert (operator.filepath, operator.cushions) == ("toy.glb", True)
 
 
 def test_extension_and_format_follow_each_other():

@@ -5,7 +5,7 @@ import pytest
 
 from devkit.blender_scene import parts, select
 from devkit.ui_recorder import Recorder, draw_menu_function, draw_panel
-from ellimann_addon.blender import ids, menus, panels, synthesize_panel
+from ellimann_addon.blender import ids, menus, panels, synthesize, synthesize_panel
 from ellimann_addon.blender.convert import write_measured
 
 
@@ -80,9 +80,10 @@ def test_menus_reach_every_operator():
         reached.update(layout.operators())
         assert isinstance(layout, Recorder)
     everything = {v for k, v in vars(ids).items() if isinstance(v, str) and v.startswith("ellimann.")}
-    # Saving a measurement preset belongs beside the preset menu, in the Synthesize panel.
+    # Saving a measurement preset belongs beside the preset menu, in the Synthesize panel; applying one, in it.
     assert ids.ADD_MEASUREMENT_PRESET in draw_panel(synthesize_panel.ELLIMANN_PT_synthesize).operators()
-    assert reached == everything - {ids.ADD_MEASUREMENT_PRESET}
+    assert set(draw_panel(synthesize.ELLIMANN_MT_measurement_presets).operators()) == {ids.APPLY_MEASUREMENT_PRESET}
+    assert reached == everything - {ids.ADD_MEASUREMENT_PRESET, ids.APPLY_MEASUREMENT_PRESET}
 
 
 def test_recorder_refuses_misspelt_icons():

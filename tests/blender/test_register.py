@@ -3,7 +3,7 @@
 import bpy
 
 import ellimann_addon
-from ellimann_addon.blender import drape_panel, menus, operators, panels, props
+from ellimann_addon.blender import drape_panel, menus, operators, panels, props, synthesize
 
 
 def all_classes():
@@ -21,20 +21,28 @@ def leftovers():
     found += [f"bpy.ops.ellimann.{name}" for name in dir(bpy.ops.ellimann) if not name.startswith("_")]
     found += [f"{menu} entry" for menu, draw in menus.MENU_ENTRIES
               if draw in getattr(bpy.types, menu)._dyn_ui_initialize()]
+    found += [f"bpy.app.handlers.{name}: {handler.__name__}" for name in dir(bpy.app.handlers)
+              if isinstance(getattr(bpy.app.handlers, name), list) for handler in getattr(bpy.app.handlers, name)
+              if getattr(handler, "__module__", "").startswith(ellimann_addon.__name__)]
+    found += ["bpy.app.timers: settle"] if bpy.app.timers.is_registered(synthesize._settle_timer) else []
     return found
 
 
 def test_disable_leaves_nothing_and_enable_works_again():
     assert len(all_classes()) == 2 + 14 + 6 + 1 + 2
     assert not [c.__name__ for c in all_classes() if not c.is_registered]
+    synthesize._settle_later(bpy.context.scene)  # a live update's timer, still waiting
     assert {"Object.ellimann", "Scene.ellimann_drape", "bpy.ops.ellimann.drape_garment",
-            "VIEW3D_MT_add entry", "TOPBAR_MT_file_export entry"} <= set(leftovers())
+            "VIEW3D_MT_add entry", "TOPBAR_MT_file_export entry", "bpy.app.timers: settle",
+            "bpy.app.handlers.undo_post: settle_restored", "bpy.app.handlers.redo_post: settle_restored",
+            "bpy.app.handlers.load_post: settle_restored"} <= set(leftovers())
     ellimann_addon.unregister()
     try:
         assert leftovers() == []
     finally:
         ellimann_addon.register()
     assert not [c.__name__ for c in all_classes() if not c.is_registered]
+    assert [h for h in bpy.app.handlers.undo_post if h is synthesize.settle_restored] == [synthesize.settle_restored]
     bpy.ops.ellimann.new_mannequin(name="Again")
     assert bpy.ops.ellimann.add_ellipsoid() == {"FINISHED"}
     assert bpy.data.collections["Again"].ellimann.is_mannequin

@@ -2,10 +2,13 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull
 
+from devkit import synthetic
 from devkit.toy import rotation_from_vector
 from ellimann_addon.core import cushion, mesh
+from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS
 from ellimann_addon.core.ellipsoid import contains, support
 from ellimann_addon.core.errors import ElliMannError
+from ellimann_addon.core.synthesis import synthesize
 
 
 def check_convex_closed(v, f):
@@ -54,6 +57,20 @@ def test_random_pairs_are_the_convex_hull(seed):
     union = np.maximum(support(*e1, n), support(*e2, n))
     assert np.all((v @ n.T).max(axis=0) <= union + 1e-12)
     assert np.all((v @ n.T).max(axis=0) >= union - 0.01 * 0.2)
+
+
+@pytest.mark.parametrize("subdivisions", [1, 2, 3, 4])
+def test_batched_hulls_agree_with_scipys_convex_hull_of_the_same_vertices(subdivisions):
+    rng = np.random.default_rng(100 + subdivisions)
+    pairs = [random_pair(rng, lo=0.01) for _ in range(6)]
+    for v, f in cushion.cushion_meshes(pairs, subdivisions):
+        check_convex_closed(v, f)
+        reference = ConvexHull(v)
+        assert mesh.volume(v, f) == pytest.approx(reference.volume, rel=1e-9)
+        # Signed distance of every vertex to each of scipy's facet planes (unit normals, <= 0 inside): the
+        # largest is the vertex's distance to the hull's surface, so 0 means on it, never inside it.
+        heights = reference.equations[:, :3] @ v.T + reference.equations[:, 3:]
+        assert np.all(heights.max(axis=0) >= -1e-12) and heights.max() <= 1e-12
 
 
 def test_identical_and_nested_ellipsoids():
@@ -122,9 +139,32 @@ def test_icosphere_sizes_and_orientation():
         check_convex_closed(v, f)
 
 
+def test_icosphere_level_is_read_back_from_the_vertex_count():
+    for s in range(8):
+        assert mesh.icosphere_vertex_count(s) == 10 * 4**s + 2
+        assert mesh.icosphere_level(mesh.icosphere_vertex_count(s)) == s
+    assert mesh.icosphere_level(len(mesh.icosphere(3)[0])) == 3
+    for count in (0, 1, 11, 13, 41, 43, 641, 2561, 10 * 4**8 + 1):
+        assert mesh.icosphere_level(count) is None
+
+
 def test_subdivision_levels_are_integers_in_the_allowed_range():
     assert mesh.check_subdivision_level("level", 3, (1, 6)) == 3
     assert type(mesh.check_subdivision_level("level", np.int64(1), (1, 6))) is int
     for bad in (0, 7, 3.0, True, "3", None):
         with pytest.raises(ElliMannError, match=r"level: must be an integer from 1 to 6, got "):
             mesh.check_subdivision_level("level", bad, (1, 6))
+
+
+@pytest.mark.parametrize("subdivisions", [2, 4])
+def test_cushion_vertices_are_the_hull_builders_support_points_for_every_pair_at_once(subdivisions):
+    reference = synthetic.make_reference_set()
+    mannequin, _, _ = synthesize(reference, REFERENCE_MEASUREMENTS["small_chubby"], "exact")
+    pairs = mannequin.topology.cushion_pairs
+    batch = cushion.cushion_vertices(mannequin.rotation, mannequin.center, mannequin.semi_axes, pairs, subdivisions)
+    assert batch.shape == (len(pairs), 10 * 4 ** subdivisions + 2, 3)
+    for vertices, (i, j) in zip(batch, pairs):
+        first = (mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i])
+        second = (mannequin.rotation[j], mannequin.center[j], mannequin.semi_axes[j])
+        world, _ = cushion.cushion_mesh(first, second, subdivisions)
+        np.testing.assert_allclose(vertices, cushion.to_frame(world, first[0], first[1]), atol=1e-12)

@@ -103,3 +103,14 @@ def test_is_rotation_flags_left_handed_and_sheared():
     assert not frames.is_rotation(F)
     assert not frames.is_right_handed(F)
     assert not frames.is_rotation(np.eye(3) * 1.01)
+
+
+def test_rigid_matrix_is_the_frame_without_scale_for_one_frame_or_a_stack():
+    r, c = rotation_from_vector((0.4, -0.2, 1.0)), np.array([1.0, 2.0, 3.0])
+    m = frames.rigid_matrix(r, c)
+    assert m.shape == (4, 4) and np.array_equal(m[:3, :3], r) and np.array_equal(m[:3, 3], c)
+    assert np.array_equal(m[3], [0.0, 0.0, 0.0, 1.0])
+    point = np.array([0.1, -0.2, 0.3])
+    assert np.allclose((m @ np.append(point, 1.0))[:3], r @ point + c)
+    stack = frames.rigid_matrix(np.stack([r, np.eye(3)]), np.stack([c, -c]))
+    assert stack.shape == (2, 4, 4) and np.array_equal(stack[0], m) and np.array_equal(stack[1, :3, 3], -c)

@@ -419,3 +419,15 @@ def test_cached_reference_set_reloads_when_a_file_changes(folder):
 def test_mannequin_name_formats_the_request():
     name = synthesis.mannequin_name([153.75, 35.75, 101.25, 102.5, 134.75])
     assert name == "ElliMann 153.75-35.75-101.25-102.5-134.75"
+
+
+def test_one_relative_error_formula_for_dicts_and_arrays():
+    """core.synthesis.relative_error is what the operator, the CLI reports and Synthesis use (in %)."""
+    request = dict(zip(MEASUREMENTS, (160.0, 40.0, 100.0, 80.0, 100.0)))
+    measured = dict(zip(MEASUREMENTS, (160.0, 42.0, 99.0, 80.4, 100.0)))
+    expected = [0.0, 5.0, 1.0, 0.5, 0.0]
+    np.testing.assert_allclose(synthesis.relative_error(measured, request), expected)
+    np.testing.assert_allclose(synthesis.relative_error(measured, request, signed=True), [0.0, 5.0, -1.0, 0.5, 0.0])
+    batch = synthesis.relative_error(np.array([list(measured.values())] * 3), np.array([list(request.values())] * 3))
+    assert batch.shape == (3, 5)
+    np.testing.assert_allclose(batch, [expected] * 3)

@@ -67,6 +67,10 @@ class ELLIMANN_OT_export_mannequin(bpy.types.Operator, ExportHelper):
     bl_options = {"REGISTER"}  # writes a file; nothing in the Blender file changes
 
     filename_ext = EXTENSIONS["GLB"]  # ExportHelper's default; check() follows the format
+    # ExportHelper's filepath, but not remembered: Blender restores an operator's last-used properties, so
+    # the next export (of another mannequin, perhaps) would suggest this one's file.
+    filepath: StringProperty(name="File Path", description="File to export to", maxlen=1024, subtype="FILE_PATH",
+                             options={"SKIP_SAVE"})
     filter_glob: StringProperty(default="*.glb;*.xml", options={"HIDDEN"})
     format: EnumProperty(name="Format", items=FORMAT_ITEMS, default="GLB",
                          description="File format (a file name ending in .glb or .xml chooses it)")
@@ -80,8 +84,10 @@ class ELLIMANN_OT_export_mannequin(bpy.types.Operator, ExportHelper):
         return active_mannequin(context) is not None
 
     def invoke(self, context, event):
+        """Suggest the active mannequin's name as the file, and cushions if it has built ones (unless the
+        caller set them: a last-used value Blender restores is only a "ghost", not set)."""
         collection = active_mannequin(context)
-        if not self.properties.is_property_set("cushions"):
+        if not self.properties.is_property_set("cushions", ghost=False):
             self.cushions = bool(built_objects(collection, "CUSHION"))
         if not self.filepath:
             self.filepath = default_path(collection.name, bpy.data.filepath, self.format)
@@ -113,11 +119,9 @@ class ELLIMANN_OT_export_mannequin(bpy.types.Operator, ExportHelper):
         path = bpy.path.abspath(self.filepath)
         if not os.path.basename(path):
             return cancel(self, "Choose a file name to export to")
-        kind = format_of(path)
-        if kind is None:
-            if os.path.splitext(path)[1]:
-                return cancel(self, f"'{os.path.basename(path)}': a mannequin is exported as .glb or .xml")
-            kind, path = self.format, path + EXTENSIONS[self.format]
+        kind = format_of(path)  # .glb or .xml decides the format; any other name gets the format's extension
+        if kind is None:  # as check() does in the file browser: "ElliMann 159.5-43" -> "ElliMann 159.5-43.glb"
+            kind, path = self.format, with_extension(path, self.format)
         try:
             if kind == "GLB":
                 export_gltf(collection, path)
