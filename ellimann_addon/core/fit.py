@@ -7,14 +7,16 @@ from .frames import relabel_to_reference
 FIT_MODES = ("inscribed", "moments", "enclosing")
 
 
-def fit_ellipsoid(points, mode="inscribed"):
+def fit_ellipsoid(points, mode="inscribed", surface=None):
     """Principal-axes ellipsoid of surface points: (rotation, center, semi_axes), right-handed.
 
     The axes are the principal directions of the points, labelled to agree best with the world
     axes. Sizes: ``moments`` matches the second moments of points spread over an ellipsoid's
     surface (D_i = sqrt(3 lambda_i)); ``inscribed`` scales that shape down until no point lies
-    inside it, so it stays within the traced surface; ``enclosing`` scales it up until every point
-    is inside.
+    inside it, nor any of ``surface`` (m, 3), the rest of the traced surface, if given: an
+    ellipsoid inside a closed surface contains none of its vertices, while one fitted to part of
+    it (a patch on one side of a body) would otherwise reach through the unselected rest;
+    ``enclosing`` scales it up until every point is inside.
     """
     points = np.asarray(points, dtype=float)
     if points.ndim != 2 or points.shape[1] != 3 or len(points) < 4:
@@ -23,6 +25,9 @@ def fit_ellipsoid(points, mode="inscribed"):
         raise ValueError("points contain NaN or infinity")
     if mode not in FIT_MODES:
         raise ValueError(f"mode is '{mode}'; expected one of {', '.join(FIT_MODES)}")
+    surface = np.zeros((0, 3)) if surface is None else np.asarray(surface, dtype=float).reshape(-1, 3)
+    if not np.all(np.isfinite(surface)):
+        raise ValueError("surface points contain NaN or infinity")
     center = points.mean(axis=0)
     offsets = points - center
     eigenvalues, rotation = np.linalg.eigh(offsets.T @ offsets / len(points))
@@ -32,10 +37,11 @@ def fit_ellipsoid(points, mode="inscribed"):
         rotation[:, 0] = -rotation[:, 0]
     semi_axes = np.sqrt(3.0 * eigenvalues)
     rotation, semi_axes, _ = relabel_to_reference(rotation, semi_axes, np.eye(3))
-    if mode != "moments":
-        local = offsets @ rotation / semi_axes
-        radius = np.linalg.norm(local, axis=1)
-        semi_axes = semi_axes * (radius.min() if mode == "inscribed" else radius.max())
+    if mode == "inscribed":
+        radius = np.linalg.norm(np.concatenate([offsets, surface - center]) @ rotation / semi_axes, axis=1)
+        semi_axes = semi_axes * radius.min()
+    elif mode == "enclosing":
+        semi_axes = semi_axes * np.linalg.norm(offsets @ rotation / semi_axes, axis=1).max()
     return rotation, center, semi_axes
 
 

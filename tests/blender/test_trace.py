@@ -90,6 +90,21 @@ def test_fit_uses_only_the_selected_vertices_and_agrees_with_the_core():
         assert np.allclose(a, b, atol=1e-5)
 
 
+def test_inscribed_fit_keeps_every_vertex_of_the_traced_mesh_outside():
+    obj = reference_mesh(np.eye(3), (0.0, 0.0, 1.0), np.array((0.2, 0.2, 0.2)))
+    local = np.array([v.co for v in obj.data.vertices])
+    groove = (np.abs(local[:, 2]) < 0.05) & (local[:, 0] < -0.1)  # pressed in, and left unselected
+    local[groove] *= 0.5
+    obj.data.vertices.foreach_set("co", local.astype(np.float32).ravel())
+    edit_with_selection(obj, np.nonzero(~groove)[0])
+    assert bpy.ops.ellimann.fit_ellipsoid(mode="inscribed", part_name="1.a Body") == {"FINISHED"}
+    collection = bpy.context.view_layer.active_layer_collection.collection
+    rotation, center, semi = ellipsoid_frame(parts(collection)["1.a Body"])
+    world = local + (0.0, 0.0, 1.0)
+    assert np.sum(((world - center) @ rotation / semi) ** 2, axis=1).min() >= 1 - 1e-5
+    assert np.sum(((world[groove] - center) @ rotation / semi) ** 2, axis=1).min() == pytest.approx(1, abs=1e-5)
+
+
 def test_fit_goes_into_the_active_mannequin(toy_collection):
     obj = reference_mesh(np.eye(3), (0.0, 0.0, 1.0), np.array((0.1, 0.1, 0.1)))
     obj.select_set(True)

@@ -58,3 +58,27 @@ def test_fit_affine_recovers_an_applied_transform():
     assert fit.fit_affine(unit, edited)[1] > 0.05
     with pytest.raises(ValueError, match="corresponding points"):
         fit.fit_affine(unit, unit[:-1])
+
+
+def test_inscribed_fit_keeps_the_unselected_rest_of_the_surface_outside():
+    # A sphere with a groove pressed into one side; the selection is everything but the groove, so
+    # its ellipsoid, sized on the selection alone, reaches through the groove out of the body.
+    body = surface(np.eye(3), np.zeros(3), (0.2, 0.2, 0.2), subdivisions=4)
+    groove = (np.abs(body[:, 2]) < 0.05) & (body[:, 0] < -0.1)
+    body[groove] *= 0.5
+
+    def inside(fitted, points):
+        rotation, center, semi = fitted
+        return np.sum(((points - center) @ rotation / semi) ** 2, axis=1) < 1 - 1e-9
+
+    alone = fit.fit_ellipsoid(body[~groove], "inscribed")
+    assert inside(alone, body[groove]).any()
+    fitted = fit.fit_ellipsoid(body[~groove], "inscribed", surface=body[groove])
+    assert not inside(fitted, body).any()
+    assert np.allclose(fitted[0], alone[0]) and np.allclose(fitted[1], alone[1])  # same axes, only smaller
+    assert np.all(fitted[2] < alone[2])
+    for mode in ("moments", "enclosing"):  # the surface only bounds the inscribed size
+        assert np.array_equal(fit.fit_ellipsoid(body[~groove], mode, surface=body[groove])[2],
+                              fit.fit_ellipsoid(body[~groove], mode)[2])
+    with pytest.raises(ValueError, match="surface"):
+        fit.fit_ellipsoid(body[~groove], "inscribed", surface=np.full((2, 3), np.nan))

@@ -15,7 +15,8 @@ from .common import cancel
 
 DEFAULT_LABEL = "Ellipsoid"
 FIT_MODE_ITEMS = (
-    ("inscribed", "Inscribed", "Principal axes of the selection, sized to stay inside the traced surface"),
+    ("inscribed", "Inscribed", "Principal axes of the selection, sized so that no vertex of the mesh, selected or "
+                               "not, lies inside it: it stays inside the traced surface"),
     ("moments", "Moments", "Principal axes and sizes from the second moments of the selected vertices"),
     ("enclosing", "Enclosing", "Principal axes of the selection, sized to enclose every selected vertex"),
 )
@@ -102,9 +103,9 @@ class ELLIMANN_OT_add_ellipsoid(bpy.types.Operator):
         return {"FINISHED"}
 
 
-def selected_world_vertices(context):
-    """World coordinates (n, 3) of the selected vertices of every mesh in Edit Mode."""
-    chunks = []
+def edit_mesh_world_vertices(context):
+    """World coordinates of the vertices of every mesh in Edit Mode: (selected (n, 3), the others (m, 3))."""
+    selected_chunks, other_chunks = [], []
     for obj in context.objects_in_mode:
         if obj.type != "MESH":
             continue
@@ -113,8 +114,10 @@ def selected_world_vertices(context):
         selected = np.zeros(len(mesh.vertices), dtype=bool)
         mesh.vertices.foreach_get("select", selected)
         matrix = np.array(obj.matrix_world)
-        chunks.append(mesh_vertices(mesh)[selected] @ matrix[:3, :3].T + matrix[:3, 3])
-    return np.concatenate(chunks) if chunks else np.zeros((0, 3))
+        world = mesh_vertices(mesh) @ matrix[:3, :3].T + matrix[:3, 3]
+        selected_chunks.append(world[selected])
+        other_chunks.append(world[~selected])
+    return tuple(np.concatenate(chunks) if chunks else np.zeros((0, 3)) for chunks in (selected_chunks, other_chunks))
 
 
 class ELLIMANN_OT_fit_ellipsoid(bpy.types.Operator):
@@ -133,11 +136,11 @@ class ELLIMANN_OT_fit_ellipsoid(bpy.types.Operator):
         return context.mode == "EDIT_MESH"
 
     def execute(self, context):
-        points = selected_world_vertices(context)
+        points, rest = edit_mesh_world_vertices(context)
         if len(points) < 4:
             return cancel(self, f"Select at least 4 vertices that enclose a volume ({len(points)} selected)")
         try:
-            rotation, center, semi_axes = fit_ellipsoid(points, self.mode)
+            rotation, center, semi_axes = fit_ellipsoid(points, self.mode, surface=rest)
         except ValueError as error:
             return cancel(self, f"Cannot fit an ellipsoid: {error}")
         obj, collection, error = add_part(self, context, rotation, center, semi_axes)
