@@ -5,6 +5,7 @@ import bpy
 import numpy as np
 from mathutils import Matrix
 
+from ellimann_addon.core.frames import rigid_matrix
 from ellimann_addon.core.mesh import icosphere
 
 PART_FIELDS = ("is_part", "kind", "part_name", "side", "region", "girth", "partner")
@@ -73,9 +74,7 @@ def reference_mesh(rotation, center, semi_axes, name="Reference"):
     mesh.from_pydata((unit * semi_axes).tolist(), [], faces.tolist())
     obj = bpy.data.objects.new(name, mesh)
     bpy.context.scene.collection.objects.link(obj)
-    matrix = np.eye(4)
-    matrix[:3, :3], matrix[:3, 3] = rotation, center
-    obj.matrix_world = Matrix(matrix.tolist())
+    obj.matrix_world = Matrix(rigid_matrix(rotation, center).tolist())
     return obj
 
 

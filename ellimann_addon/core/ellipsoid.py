@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import FrameError
-from .frames import mirror_axis, project_to_rotation, relabel_to_reference
+from .frames import mirror_axis, project_to_rotation, relabel_to_reference, rigid_matrix
 
 ORTHONORMAL_TOL = 1e-6
 
@@ -108,12 +108,7 @@ def volume(semi_axes):
 
 def matrix_world(rotation, center, semi_axes):
     """Blender's object matrix for an ellipsoid on a unit-sphere mesh: S @ diag(D, 1)."""
-    rotation = np.asarray(rotation, dtype=float)
-    out = np.zeros(rotation.shape[:-2] + (4, 4))
-    out[..., :3, :3] = rotation * np.asarray(semi_axes)[..., None, :]
-    out[..., :3, 3] = center
-    out[..., 3, 3] = 1.0
-    return out
+    return rigid_matrix(np.asarray(rotation, dtype=float) * np.asarray(semi_axes)[..., None, :], center)
 
 
 def decompose_matrix_world(matrix, tol=ORTHONORMAL_TOL):

@@ -26,7 +26,8 @@ def is_right_handed(rotation):
 def rigid_matrix(rotation, center):
     """The 4x4 matrix [[R, c], [0, 1]] of frames (rotation (..., 3, 3), center (..., 3)): (..., 4, 4).
 
-    A cushion's object matrix is its first ellipsoid's rigid frame (no scale), its vertices local to it.
+    A cushion's object matrix is its first ellipsoid's rigid frame (no scale), its vertices local to it;
+    the linear part may also carry a scale (``ellipsoid.matrix_world``).
     """
     rotation = np.asarray(rotation, dtype=float)
     out = np.zeros(rotation.shape[:-2] + (4, 4))
