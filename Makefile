@@ -1,38 +1,41 @@
-# Every target sets itself up: the first run creates .venv with Blender's bpy module and the dev tools.
+# Every target sets itself up. The working venv .venv is the matrix's Blender 5.0 lane (bpy 5.0.1,
+# Python 3.11); `make test` also makes the other lanes' venvs (.venv-bpy4.2, .venv-bpy4.5,
+# .venv-bpy5.3) on first use. tools/matrix.py says which Blender, Python and numpy each one holds.
 PYTHON ?= python3.11
 VENV := .venv
 PY := $(VENV)/bin/python
-STAMP := $(VENV)/.installed-$(shell cksum < requirements-dev.txt | cut -d' ' -f1)
 VERSION := $(shell sed -n 's/^version = "\(.*\)"/\1/p' blender_manifest.toml)
 ZIP := dist/ellimann-$(VERSION).zip
 EXT_TOOL = $(VENV)/lib/python3.11/site-packages/bpy/5.0/scripts/addons_core/bl_pkg/cli/blender_ext.py
 DEMO_OUT ?= out/demo
+# make test LANES=4.2,5.3 runs some lanes only
+LANES ?=
 
-.PHONY: setup test demo build bench lint clean
+.PHONY: setup test check demo build bench lint clean
 
-setup: $(STAMP)
+setup:
+	@$(PYTHON) -m tools.matrix --setup-only --lanes 5.0
 
-$(STAMP): requirements-dev.txt
-	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet -r requirements-dev.txt
-	rm -f $(VENV)/.installed-*
-	touch $@
+# The whole matrix: Blender 4.2, 4.5, 5.0 and 5.3 (what CI runs).
+test:
+	$(PYTHON) -m tools.matrix --lanes "$(LANES)"
 
-test: $(STAMP)
-	$(PY) -m pytest
+# The fast lane for working: core and Blender tests not marked slow, on the working venv.
+check: setup
+	$(PY) -m pytest -p no:cacheprovider -q -m "not slow" tests/core tests/blender
 
-demo: $(STAMP)
+demo: setup
 	$(PY) -m ellimann_addon demo -o $(DEMO_OUT)
 
-build: $(STAMP)
+build: setup
 	mkdir -p dist
 	$(PY) $(EXT_TOOL) build --source-dir . --output-filepath $(ZIP)
 	$(PY) $(EXT_TOOL) validate $(ZIP)
 
-bench: $(STAMP)
+bench: setup
 	$(PY) -m bench
 
-lint: $(STAMP)
+lint: setup
 	$(VENV)/bin/ruff check .
 
 clean:

@@ -4,4 +4,9 @@ import sys
 
 from .blender.cli import main
 
-sys.exit(main())
+code = main()
+from .blender import teardown  # noqa: E402  (after main: it looks at whether main imported bpy)
+
+if teardown.needs_workaround():
+    teardown.exit_without_teardown(code)
+sys.exit(code)

@@ -2,9 +2,11 @@
 
 Blender's glTF exporter, asked for one collection (``collection=``, Blender 4.2+) with
 ``export_extras=True``, writes each object's custom properties as its node's ``extras`` and the
-collection's as the glTF scene's ``extras``. ElliMann's own data lives in registered property
-groups, which the exporter does not see, so for the export it copies them into plain custom
-properties named ``ellimann`` and removes them again afterwards (prior values are restored).
+collection's as the glTF scene's ``extras``. ElliMann's own data lives in a registered property
+group named ``ellimann``, which Blender 5.0+ keeps apart from custom properties but 4.x stores as the
+custom property of that name (and refuses to have replaced by a dict). So the export leaves the
+objects alone and writes ``extras.ellimann`` into the written file's JSON chunk afterwards, the same
+on every Blender; the user's own custom properties still travel as the exporter writes them.
 
 What a three.js / game-engine user finds in the .glb:
 - one node per piece, named after the part (``"7.a Thigh.L"``); ellipsoids share one unit-sphere
@@ -83,31 +85,47 @@ def export_gltf(collection, path):
         raise ElliMannError(f"the cushions of '{collection.name}' are out of date ('{stale[0]}'{more}: their "
                             "ellipsoids moved since they were built): Build Cushions first")
     objects = [o for o in objects_recursive(collection) if o.ellimann.is_part]
-    saved = []
-    try:
-        for owner, value in [(o, part_extras(o)) for o in objects] + [(collection, scene_extras(mannequin))]:
-            saved.append((owner, owner.get(EXTRAS_KEY)))
-            owner[EXTRAS_KEY] = value
-        with atomic_output(path) as temp:
-            result = bpy.ops.export_scene.gltf(filepath=temp, export_format="GLB", export_extras=True,
-                                               collection=collection.name, export_yup=True, use_renderable=True)
-            if result != {"FINISHED"}:
-                raise ElliMannError(f"path: Blender's glTF exporter did not finish ({result})")
-    finally:
-        for owner, value in saved:
-            if value is None:
-                del owner[EXTRAS_KEY]
-            else:
-                owner[EXTRAS_KEY] = value
+    node_extras = {o.name: part_extras(o) for o in objects}
+    with atomic_output(path) as temp:
+        result = bpy.ops.export_scene.gltf(filepath=temp, export_format="GLB", export_extras=True,
+                                           collection=collection.name, export_yup=True, use_renderable=True)
+        if result != {"FINISHED"}:
+            raise ElliMannError(f"path: Blender's glTF exporter did not finish ({result})")
+        _set_extras(temp, node_extras, scene_extras(mannequin))
     return path
+
+
+def _set_extras(path, node_extras, scene_extras_):
+    """Put ``extras.ellimann`` on the scene of a .glb file and on each of its nodes named in ``node_extras``
+    (the exporter leaves out what is hidden from renders: those objects have no node to carry it)."""
+    with open(path, "rb") as stream:
+        data = stream.read()
+    doc, rest = _split_glb(data, path)
+    for node in doc.get("nodes", []):
+        if node.get("name") in node_extras:
+            node.setdefault("extras", {})[EXTRAS_KEY] = node_extras[node["name"]]
+    for scene in doc.get("scenes", []):
+        scene.setdefault("extras", {})[EXTRAS_KEY] = scene_extras_
+    chunk = json.dumps(doc, separators=(",", ":"), allow_nan=False).encode()
+    chunk += b" " * (-len(chunk) % 4)  # chunks are 4-byte aligned; glTF pads JSON with spaces
+    header = struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(chunk) + len(rest))
+    with open(path, "wb") as stream:
+        stream.write(header + struct.pack("<I4s", len(chunk), b"JSON") + chunk + rest)
+
+
+def _split_glb(data, path):
+    """(the JSON chunk as a dict, every chunk after it as bytes) of a .glb file's bytes."""
+    if len(data) < 20:
+        raise ElliMannError(f"path: {path} is not a binary glTF file")
+    magic, _, total = struct.unpack_from("<4sII", data)
+    length, kind = struct.unpack_from("<I4s", data, 12)
+    if magic != b"glTF" or kind != b"JSON" or total != len(data) or 20 + length > len(data):
+        raise ElliMannError(f"path: {path} is not a whole binary glTF file")
+    return json.loads(data[20:20 + length]), data[20 + length:]
 
 
 def read_glb_json(path):
     """The JSON chunk of a .glb file as a dict (for tests and tools that check the extras)."""
     with open(path, "rb") as stream:
-        header = stream.read(20)
-        magic, _, _, length, kind = struct.unpack("<4sIII4s", header)
-        if magic != b"glTF" or kind != b"JSON":
-            raise ElliMannError(f"path: {path} is not a binary glTF file")
-        return json.loads(stream.read(length))
+        return _split_glb(stream.read(), path)[0]
 

@@ -649,7 +649,9 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
         normal = rt @ reduced
         scale = np.diagonal(normal, axis1=-2, axis2=-1) + _TIKHONOV  # Marquardt: each factor by its own scale
         system = normal + (damping[todo, None] * scale + ~mask)[..., None] * eye
-        step = -np.linalg.solve(system, np.einsum("tfm,tm->tf", rt, residual[todo] * mask))
+        # A stacked right-hand side as explicit column vectors: numpy 2 no longer broadcasts (t, f) against (t, f, f).
+        rhs = np.einsum("tfm,tm->tf", rt, residual[todo] * mask)
+        step = -np.linalg.solve(system, rhs[..., None])[..., 0]
         wanted = x[todo] + np.clip(step, -_MAX_STEP, _MAX_STEP)
         new_x = np.clip(wanted, lo, hi)
         c, d = deform(basis.take(todo), center[todo], semi_axes[todo], np.exp(new_x))

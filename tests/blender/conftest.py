@@ -34,3 +34,20 @@ def toy_collection(toy):
     bpy.context.view_layer.objects.active = parts(collection)["1.a Head"]
     return collection
 
+
+
+_exit_status = {}
+
+
+def pytest_sessionfinish(session, exitstatus):
+    _exit_status["code"] = int(exitstatus)
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_unconfigure(config):
+    # Blender 4.x as a module segfaults in its own teardown after the tests have run and reported
+    # (ellimann_addon/blender/teardown.py): leave with pytest's own exit status instead.
+    from ellimann_addon.blender import teardown
+
+    if teardown.needs_workaround() and "code" in _exit_status:
+        teardown.exit_without_teardown(_exit_status["code"])

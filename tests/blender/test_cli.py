@@ -434,6 +434,7 @@ def test_batch_header_is_case_insensitive_and_extra_columns_are_ignored(tmp_path
 # ------------------------------------------------------------------------------------------------ demo
 
 
+@pytest.mark.slow
 def test_demo_writes_files_report_and_lineup(tmp_path, capsys, references):
     out = tmp_path / "demo"
     code, stdout, err = run(["demo", "-o", str(out), "--references", references], capsys)

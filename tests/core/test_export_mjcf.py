@@ -198,6 +198,7 @@ def drop_balls(mannequin, cushions):
 SOFT_CONTACT_DEPTH = 0.005
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("cushions", [False, True], ids=["ellipsoids", "cushions"])
 @pytest.mark.parametrize("make", mannequins(only="average"))  # a few seconds each: the toy and one RM
 def test_falling_balls_never_pass_through_the_mannequin(make, cushions):

@@ -239,6 +239,7 @@ def test_gaps_between_parts_are_bridged_by_straight_tubes(body):
     assert d.min() >= 0.5 * garments.MIN_CLEARANCE
 
 
+@pytest.mark.slow
 def test_both_garments_build_clear_of_every_shipped_reference_mannequin():
     try:
         reference = load_reference_set()

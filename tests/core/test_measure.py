@@ -50,6 +50,7 @@ def test_empty_section_has_zero_perimeter():
     assert measure.hull_perimeter(np.zeros((1, 1, 2)), k, np.zeros((1, 1), bool))[0] == 0.0
 
 
+@pytest.mark.slow
 def test_agrees_with_brute_force_hull_on_random_mannequins():
     rng = np.random.default_rng(7)
     worst = 0.0

@@ -1,0 +1,91 @@
+"""The test matrix covers what the manifest promises, and the shipped .blend files open on all of it."""
+
+import pathlib
+import re
+import tomllib
+
+import pytest
+
+from tools import matrix
+from tools.reference_blends import FOLDER, STEMS
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+ZSTD_MAGIC = b"\x28\xb5\x2f\xfd"
+
+
+def manifest_minimum():
+    with open(REPO / "blender_manifest.toml", "rb") as stream:
+        return tuple(int(p) for p in tomllib.load(stream)["blender_version_min"].split("."))
+
+
+def lane_version(lane):
+    pin = next(p for p in lane.pins if p.startswith("bpy=="))
+    return tuple(int(p) for p in pin.removeprefix("bpy==").split("."))
+
+
+def test_the_oldest_lane_is_the_manifests_minimum_and_the_lanes_run_oldest_first():
+    versions = [lane_version(lane) for lane in matrix.LANES]
+    assert versions == sorted(versions)
+    assert versions[0][:2] == manifest_minimum()[:2]
+    assert all(lane.blender == f"{v[0]}.{v[1]}" for lane, v in zip(matrix.LANES, versions))
+
+
+def test_every_suite_runs_on_each_numpy_major_and_blender_on_every_lane():
+    majors = {}
+    for lane in matrix.LANES:
+        numpy = next(p for p in lane.pins if p.startswith("numpy=="))
+        majors.setdefault(numpy.removeprefix("numpy==").split(".")[0], set()).update(lane.suites)
+        assert "blender" in lane.suites
+    assert set(majors) == {"1", "2"}
+    assert all(suites == set(matrix.SUITES) for suites in majors.values())
+
+
+def blend_header_version(path):
+    """Blender's version in a .blend file's header ('BLENDER-v402' in 4.x files, 'BLENDER17-01v0500' in
+    the format Blender 5.0 introduced), through zstd when the file is compressed."""
+    data = path.read_bytes()
+    if data.startswith(ZSTD_MAGIC):
+        zstandard = pytest.importorskip("zstandard", reason="bpy's wheels bring zstandard")
+        data = zstandard.ZstdDecompressor().stream_reader(data).read(32)
+    found = re.match(rb"BLENDER(?:[-_][vV]|\d\d-\d\d[vV])(\d{3,4})", data)
+    assert found, f"{path.name} has no .blend header"
+    return int(found.group(1))
+
+
+@pytest.mark.parametrize("stem", STEMS)
+def test_shipped_blends_are_saved_by_the_oldest_supported_blender(stem):
+    # A file saved by a newer Blender does not open in an older one (5.0 files not at all in 4.x):
+    # tools/reference_blends.py writes them on the oldest lane.
+    major, minor = manifest_minimum()[:2]
+    assert blend_header_version(FOLDER / f"{stem}.blend") == major * 100 + minor
+
+
+def test_a_5_0_header_is_read_as_such(tmp_path):
+    path = tmp_path / "new.blend"
+    path.write_bytes(b"BLENDER17-01v0500REND" + bytes(12))
+    assert blend_header_version(path) == 500
+
+
+JUNIT = """<?xml version="1.0" encoding="utf-8"?><testsuites name="pytest tests">
+<testsuite name="pytest" errors="{e}" failures="{f}" skipped="{s}" tests="{t}" time="1.0"></testsuite></testsuites>"""
+
+
+def test_lane_counts_come_from_pytests_junit_report(tmp_path):
+    report = tmp_path / "lane.xml"
+    report.write_text(JUNIT.format(e=1, f=2, s=3, t=20))
+    assert matrix._counts(report) == (14, 3, 3)
+    assert matrix._counts(tmp_path / "missing.xml") is None
+    report.write_text("<testsuites")
+    assert matrix._counts(report) is None
+
+
+def test_unknown_lanes_are_refused_by_name(capsys):
+    with pytest.raises(SystemExit):
+        matrix.main(["--lanes", "4.2,9.9", "--list"])
+    assert "9.9" in capsys.readouterr().err
+
+
+def test_list_names_every_lanes_pins(capsys):
+    assert matrix.main(["--list"]) == 0
+    out = capsys.readouterr().out
+    assert all(pin in out for lane in matrix.LANES for pin in lane.pins)
