@@ -177,7 +177,8 @@ def main(argv=None):
     lanes = [lane for lane in LANES if not chosen or lane.blender in chosen]
     if args.list:
         for lane in lanes:
-            print(f"Blender {lane.blender}: Python {lane.python}, {' '.join(lane.pins)}; suites {', '.join(lane.suites)}")
+            pins, suites = " ".join(lane.pins), ", ".join(lane.suites)
+            print(f"Blender {lane.blender}: Python {lane.python}, {pins}; suites {suites}")
         return 0
     if args.setup_only:
         LOGS.mkdir(parents=True, exist_ok=True)
@@ -198,7 +199,8 @@ def main(argv=None):
     started = time.monotonic()
     results = []
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        futures = [pool.submit(run_lane, lane, extra) for lane in lanes]
+        # The lanes with the most suites first, so that two lanes at once finish together.
+        futures = [pool.submit(run_lane, lane, extra) for lane in sorted(lanes, key=lambda x: -len(x.suites))]
         for future in concurrent.futures.as_completed(futures):
             lane, counts, seconds, log_path = future.result()
             results.append((lane, counts, seconds, log_path))
