@@ -1,4 +1,8 @@
-"""Run every benchmark: ``python -m bench`` (or ``make bench``)."""
+"""Run every benchmark: ``python -m bench [-v] [NAME…]`` (or ``make bench``).
+
+What Blender prints is captured, so only the benchmarks' own lines show; ``-v`` / ``--verbose``
+shows Blender's output too (on stderr).
+"""
 
 import importlib
 import sys
@@ -6,12 +10,17 @@ import sys
 BENCHES = ("bench_core", "bench_synthesis", "bench_drape")
 
 
-def main(names=None):
-    for name in names or BENCHES:
-        print(f"== {name} ==")
-        importlib.import_module(f"bench.{name}").run()
-        print()
+def main(names=None, verbose=False):
+    from ellimann_addon.blender.chatter import program
+
+    with program(show=verbose):
+        for name in names or BENCHES:
+            print(f"== {name} ==")
+            importlib.import_module(f"bench.{name}").run()
+            print()
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    arguments = sys.argv[1:]
+    flags = {"-v", "--verbose"}
+    main([a for a in arguments if a not in flags], verbose=bool(flags & set(arguments)))

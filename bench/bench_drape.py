@@ -79,7 +79,8 @@ def compare(mannequin, body_vertices, body_faces, frames=FRAMES, repeat=REPEAT, 
     import bpy
 
     from ellimann_addon.blender import drape
-    from ellimann_addon.blender.output import empty_scene, stdout_to_stderr
+    from ellimann_addon.blender.chatter import blender_output
+    from ellimann_addon.blender.output import empty_scene
 
     exact = BodyPieces(mannequin, cushions=True, subdivisions=4)
     own = {True: exact, False: BodyPieces(mannequin)}  # the exact pieces of each kind of collider
@@ -97,7 +98,7 @@ def compare(mannequin, body_vertices, body_faces, frames=FRAMES, repeat=REPEAT, 
 
     def simulate(garment, pieces):
         settings = drape.DrapeSettings(frames=frames, edge=EDGE)
-        with stdout_to_stderr():
+        with blender_output():
             empty_scene()
             _, obj = drape.setup(garment, pieces, settings, "bench")
             wall, cpu = drape.bake(bpy.context.scene, obj, frames)

@@ -225,10 +225,12 @@ def blender(reference, exact):
 
     import ellimann_addon
     from ellimann_addon.blender import convert, output
+    from ellimann_addon.blender.chatter import blender_output  # what Blender prints stays off the bench's lines
 
     ellimann_addon.register()
     try:
-        bpy.ops.wm.read_homefile(use_empty=True)
+        with blender_output():
+            bpy.ops.wm.read_homefile(use_empty=True)
         mannequins = [exact.mannequin(i) for i in range(40)]
         start = time.perf_counter()
         collections = [convert.mannequin_to_collection(m) for m in mannequins]
@@ -251,13 +253,14 @@ def blender(reference, exact):
                 from devkit.synthetic import write_reference_folder
 
                 props.references = str(write_reference_folder(os.path.join(folder, "rm")))
-            bpy.ops.ellimann.synthesize_mannequin()
-            props.live = True
             times = []
-            for value in np.linspace(150.0, 170.0, 21):
-                start = time.perf_counter()
-                props.he = float(value)
-                times.append(time.perf_counter() - start)
+            with blender_output():
+                bpy.ops.ellimann.synthesize_mannequin()
+                props.live = True
+                for value in np.linspace(150.0, 170.0, 21):
+                    start = time.perf_counter()
+                    props.he = float(value)
+                    times.append(time.perf_counter() - start)
             times = np.array(times) * 1e3
             print(f"  live update from the panel (exact) {np.median(times):8.2f} ms median, {times.max():.2f} ms max "
                   f"over {len(times)} slider steps")
@@ -288,7 +291,10 @@ def measure_in_blender(bpy, convert, collections):
             bpy.context.view_layer.objects.active = collection.objects[0]
             bpy.ops.ellimann.measure_mannequin(source="ELLIPSOIDS")
 
-    t_op = best_of(operator, repeat=3) / 10
+    from ellimann_addon.blender.chatter import blender_output
+
+    with blender_output():  # the operator reports m_T on stdout
+        t_op = best_of(operator, repeat=3) / 10
     print(f"  Measure operator (ellipsoids)      {1 / t_op:10,.0f} mannequins/s  ({t_op * 1e3:7.2f} ms)")
 
 
@@ -309,30 +315,33 @@ def live_with_cushions(bpy, props):
     interleaved over the same slider steps; then the exact rebuild once the slider stops."""
     from ellimann_addon.blender import convert, output, synthesize
     from ellimann_addon.blender.built import built_objects
+    from ellimann_addon.blender.chatter import blender_output
 
     props.live = False
     props.output = "CUSHIONS"
     props.he = 159.0  # not a slider step: the last step leaves the cushions out of date
-    bpy.ops.ellimann.synthesize_mannequin()
-    before_target = props.target
-    bpy.ops.ellimann.synthesize_mannequin()
-    props.live = True  # the second one is the live target
-    pairs = len(built_objects(props.target, "CUSHION"))
     now, before = [], []
-    for value in np.linspace(150.0, 170.0, 21):
-        start = time.perf_counter()
-        props.he = float(value)  # the panel's update callback
-        now.append(time.perf_counter() - start)
-        start = time.perf_counter()
-        old_live_update(props, before_target, output, convert)
-        before.append(time.perf_counter() - start)
+    with blender_output():
+        bpy.ops.ellimann.synthesize_mannequin()
+        before_target = props.target
+        bpy.ops.ellimann.synthesize_mannequin()
+        props.live = True  # the second one is the live target
+        pairs = len(built_objects(props.target, "CUSHION"))
+        for value in np.linspace(150.0, 170.0, 21):
+            start = time.perf_counter()
+            props.he = float(value)  # the panel's update callback
+            now.append(time.perf_counter() - start)
+            start = time.perf_counter()
+            old_live_update(props, before_target, output, convert)
+            before.append(time.perf_counter() - start)
     now, before = np.array(now) * 1e3, np.array(before) * 1e3
     print(f"  live update with {pairs} cushions, {len(now)} slider steps (interleaved, same requests):")
     print(f"    before: rebuild every cushion     {np.median(before):8.2f} ms median, {before.max():.2f} ms max")
     print(f"    now: move them in place          {np.median(now):8.2f} ms median, {now.max():.2f} ms max")
     print(f"    {np.median(before) / np.median(now):.1f}x faster (median), {before.max() / now.max():.1f}x (max)")
     start = time.perf_counter()
-    rebuilt = synthesize.settle_live(bpy.context.scene)
+    with blender_output():
+        rebuilt = synthesize.settle_live(bpy.context.scene)
     print(f"    exact rebuild once the slider stops ({rebuilt} cushions, "
           f"{synthesize.LIVE_SETTLE_SECONDS:g} s later): {(time.perf_counter() - start) * 1e3:.0f} ms")
     calls = []
@@ -341,7 +350,8 @@ def live_with_cushions(bpy, props):
     try:
         preset = synthesize.SHIPPED_PRESETS / "Table 2.5 (1).py"
         start = time.perf_counter()
-        bpy.ops.script.execute_preset(filepath=str(preset), menu_idname="ELLIMANN_MT_measurement_presets")
+        with blender_output():
+            bpy.ops.script.execute_preset(filepath=str(preset), menu_idname="ELLIMANN_MT_measurement_presets")
         seconds = time.perf_counter() - start
     finally:
         synthesize.live_update = real

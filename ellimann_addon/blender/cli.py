@@ -7,8 +7,10 @@ Subcommands: ``synth`` (one mannequin), ``batch`` (a CSV of measurements), ``mea
 file), ``demo`` (the paper's Table 2.5 mannequins with a report and a line-up picture) and
 ``drape`` (a garment on a mannequin with Blender's cloth simulation).
 Blender is imported only when a .blend/.glb/.obj file, a drape or a picture is involved, so
-``--help`` and JSON/MJCF work start at once. User mistakes end with a one-line reason and a
-non-zero exit code: 1 for bad input or a failed row, 2 for a malformed command line.
+``--help`` and JSON/MJCF work start at once. What Blender prints is captured (``chatter``) and shown
+only with ``--verbose``. User mistakes end with a one-line reason and a non-zero exit code: 1 for
+bad input or a failed row, 2 for a malformed command line, 3 when exact mode misses a request (the
+files are written), 130 when interrupted (Ctrl-C).
 """
 
 import argparse
@@ -17,6 +19,7 @@ import csv
 import dataclasses
 import io
 import json
+import math
 import os
 import re
 import sys
@@ -26,29 +29,32 @@ import time
 from ..core.constants import CM_PER_M, MEASUREMENT_LABELS, MEASUREMENTS, RANGES, TABLE_2_5
 from ..core.ellipsoid import bounds
 from ..core.errors import ElliMannError, MeasurementError, ReferenceSetError
-from ..core.files import atomic_write_text
+from ..core.files import atomic_write_text, clean_stale_temporaries, incomplete
 from ..core.garments import BUILDERS as GARMENTS
 from ..core.mannequin import Mannequin
 from ..core.measure import as_dict
 from ..core.synthesis import (
     DEFAULT_NORMALIZE,
     DEFAULT_POWER,
+    EXACT_TOLERANCE,
     METRICS,
     MODES,
     NORMALIZATIONS,
     PAPER_NORMALIZE,
     load_reference_set,
     relative_error,
-    synthesize,
     synthesize_batch,
     validate_request,
 )
 from ..core.writers import EXTENSIONS, core_format, write_core_file
+from .chatter import blender_output, program
 
 PROG = "ellimann"
 FORMATS = ("blend", "glb", "obj", "json", "mjcf")  # --format names; the file extension is the name but for mjcf
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,99}$")
 CHUNK = 256  # rows synthesized per core batch
+MISSED = 3  # exit code: written, but exact mode missed a requested measurement by more than its tolerance
+INTERRUPTED = 130  # exit code after Ctrl-C, as shells report SIGINT
 
 
 class UsageError(ElliMannError):
@@ -66,7 +72,13 @@ def _number(text):
     return value
 
 
+def _add_verbose(parser):
+    parser.add_argument("-v", "--verbose", action="store_true",
+                        help="also show what Blender prints (on stderr); without it only ElliMann's lines show")
+
+
 def _add_synthesis_options(parser):
+    _add_verbose(parser)
     parser.add_argument("--mode", choices=MODES, default="exact",
                         help="exact (default): refine until m_T matches the request; idw: the paper's "
                              "interpolation alone")
@@ -106,8 +118,10 @@ def build_parser():
     batch = commands.add_parser("batch", help="synthesize every row of a CSV",
                                 description="One mannequin per CSV row. The header names the columns "
                                             "He,Sh,Br,Wa,Hi (cm) and optionally name. Writes the files and "
-                                            "DIR/report.csv (requested vs measured). Bad rows are reported and "
-                                            "skipped; the exit code is 1 if any row failed.")
+                                            "DIR/report.csv (requested vs measured), row by row into "
+                                            "DIR/report.partial.csv while it runs. Bad or failed rows are "
+                                            "reported and skipped; the exit code is 1 if any row failed, 3 if "
+                                            "exact mode missed a row's request, 130 if interrupted.")
     batch.add_argument("csv", metavar="MEASUREMENTS.csv")
     batch.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
     batch.add_argument("--format", default="json",
@@ -116,6 +130,9 @@ def build_parser():
     batch.add_argument("--shard", metavar="I/N",
                        help="process only rows I, I+N, I+2N… (I from 1 to N), for a render farm; the report "
                             "is DIR/report-I-of-N.csv")
+    batch.add_argument("--resume", action="store_true",
+                       help="skip rows whose files (every --format) are already in DIR and whole, e.g. after an "
+                            "interrupted run with the same CSV and options; without it every row is written again")
     _add_synthesis_options(batch)
     batch.set_defaults(run=run_batch)
 
@@ -125,6 +142,7 @@ def build_parser():
     measure.add_argument("--json", action="store_true",
                          help='print exactly {"He": …, "Sh": …, "Br": …, "Wa": …, "Hi": …}')
     measure.add_argument("--collection", help="the mannequin collection to measure in a .blend holding several")
+    _add_verbose(measure)
     measure.set_defaults(run=run_measure)
 
     demo = commands.add_parser("demo", help="the paper's ten Table 2.5 mannequins, a report and a line-up",
@@ -155,6 +173,7 @@ def build_parser():
     drape.add_argument("--collection", help="the mannequin collection in a .blend holding several (.blend only)")
     drape.add_argument("-o", "--output", required=True, metavar="OUT.blend")
     drape.add_argument("--render", metavar="OUT.png", help="also a Workbench picture of the last frame")
+    _add_verbose(drape)
     drape.set_defaults(run=run_drape)
     return parser
 
@@ -179,7 +198,8 @@ def _drape_defaults():
 
 
 def main(argv=None):
-    """Run the CLI; returns the exit code (0 success, 1 bad input or failed rows, 2 bad command line)."""
+    """Run the CLI; returns the exit code (0 success, 1 bad input or failed rows, 2 bad command line,
+    3 exact mode missed a request, 130 interrupted)."""
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
     try:
@@ -187,10 +207,14 @@ def main(argv=None):
     except SystemExit as exit_:  # argparse has printed usage or help
         return int(exit_.code or 0)
     try:
-        return args.run(args)
+        with program(show=args.verbose):
+            return args.run(args)
     except (ElliMannError, OSError) as error:
-        print(f"{PROG} {args.command}: error: {_one_line(error)}", file=sys.stderr)
+        _say(f"{PROG} {args.command}: error: {_one_line(error)}")
         return 1
+    except KeyboardInterrupt:
+        _say(f"{PROG} {args.command}: interrupted")
+        return INTERRUPTED
 
 
 def _one_line(error):
@@ -199,17 +223,31 @@ def _one_line(error):
     return " ".join(str(error).split())
 
 
+_UNPRINTABLE = re.compile(r"[\x00-\x1f\x7f-\x9f\u061c\u200e\u200f\u2028-\u202e\u2066-\u2069]")
+
+
+def printable(text):
+    """``text`` with control characters (terminal escapes, carriage returns, bidi overrides) as \\x1b, \\n…"""
+    return _UNPRINTABLE.sub(lambda m: m.group().encode("unicode_escape").decode("ascii"), str(text))
+
+
+def _say(text, file=None, end="\n"):
+    """Print one of ElliMann's lines (stderr unless ``file``), escaping what a terminal would act on."""
+    print(printable(text), file=file or sys.stderr, end=end, flush=True)
+
+
 # ------------------------------------------------------------------------------------------------ helpers
 
 
 def _ensure_registered():
     """Import bpy; under ``python -m`` register the add-on once so ElliMann's properties exist."""
-    import bpy
+    with blender_output():
+        import bpy
 
-    if not hasattr(bpy.types.Collection, "ellimann"):
-        from .. import register
+        if not hasattr(bpy.types.Collection, "ellimann"):
+            from .. import register
 
-        register()
+            register()
     return bpy
 
 
@@ -296,12 +334,29 @@ def _file_in_the_way(folder):
     return None if os.path.isdir(path) else path
 
 
-def _output_folder(folder):
-    """Make the output folder and check that files can be created in it, before any work is done."""
+def _output_folder(folder, command):
+    """Make the output folder and check that files can be created in it, before any work is done; remove
+    the temporaries a killed run of ElliMann left there (not those of one still running)."""
     with _writing(folder, folder=True):
         os.makedirs(folder, exist_ok=True)
         with tempfile.TemporaryFile(prefix=".ellimann-", dir=folder):
             pass
+    removed = clean_stale_temporaries(folder)
+    if removed:
+        _say(f"{PROG} {command}: removed {len(removed)} temporary file(s) an interrupted run left in {folder}")
+
+
+def _misses(measured, requested):
+    """The requested measurements exact mode missed by more than its tolerance (EXACT_TOLERANCE, the
+    criterion it stops at): [(key, m_T cm, requested cm, error %)]."""
+    return [(key, float(m), float(r), abs(m - r) / r * 100.0) for key, m, r in zip(MEASUREMENTS, measured, requested)
+            if abs(math.log(max(float(m), 1e-12) / float(r))) > EXACT_TOLERANCE]
+
+
+def _missed_text(misses):
+    return ("exact mode missed " + ", ".join(f"{key} by {error:.2f}% (m_T {m:.2f} cm for {r:g} cm)"
+                                             for key, m, r, error in misses)
+            + f" (tolerance {EXACT_TOLERANCE * 100:g}%; the file is the closest it found)")
 
 
 # ------------------------------------------------------------------------------------------------ synth
@@ -309,17 +364,19 @@ def _output_folder(folder):
 
 def run_synth(args):
     kind = _output_kind(args.output)
-    request = {key: getattr(args, key) for key in MEASUREMENTS}
+    request = [getattr(args, key) for key in MEASUREMENTS]
+    warnings = validate_request(request)
     reference = _references(args)
-    mannequin, measured, warnings = synthesize(reference, request, args.mode, args.metric, args.power, args.name,
-                                               args.normalize)
-    for warning in warnings:
-        print(f"{PROG} synth: warning: {warning}", file=sys.stderr)
+    result = synthesize_batch(reference, [request], args.mode, args.metric, args.power, normalize=args.normalize)
+    mannequin, measured = result.mannequin(0, args.name), as_dict(result.measured[0])
+    misses = _misses(result.measured[0], request) if args.mode == "exact" else []
+    for warning in warnings + ([_missed_text(misses)] if misses else []):
+        _say(f"{PROG} synth: warning: {warning}")
     _write(mannequin, [args.output], measured, args.cushions and kind != "json")
-    error = relative_error(measured, request).max()
-    print(f"wrote {args.output}: '{mannequin.name}' ({args.mode}), m_T {_format_me(measured.values())} cm, "
-          f"max error {error:.3f}%")
-    return 0
+    error = relative_error(result.measured[0], request).max()
+    _say(f"wrote {args.output}: '{mannequin.name}' ({args.mode}), m_T {_format_me(measured.values())} cm, "
+         f"max error {error:.3f}%", file=sys.stdout)
+    return MISSED if misses else 0
 
 
 # ------------------------------------------------------------------------------------------------ batch
@@ -415,50 +472,71 @@ def run_batch(args):
     reference = _references(args)
     rows = name_rows(rows)  # over the whole CSV, so every shard agrees on which rows are bad
     mine = [row for index, row in enumerate(rows) if index % shards == shard - 1]
-    jobs, report = [], []
+    _output_folder(args.output, "batch")
+    report_name = "report.csv" if shards == 1 else f"report-{shard}-of-{shards}.csv"
+    report = _Report(os.path.join(args.output, report_name))
+    jobs = []
     for line, name, values, error, warnings in mine:
         if error is not None:
-            print(f"{PROG} batch: line {line}: skipped: {error}", file=sys.stderr)
-            report.append(_report_row(line, name, "error", error, values))
+            _say(f"{PROG} batch: line {line}: skipped: {error}")
+            report.add(_report_row(line, name, "error", error, values))
             continue
         for warning in warnings:
-            print(f"{PROG} batch: line {line}: warning: {warning}", file=sys.stderr)
+            _say(f"{PROG} batch: line {line}: warning: {warning}")
         jobs.append((line, name, values, warnings))
-    _output_folder(args.output)
     progress = _Progress(len(jobs), "batch")
-    failed = sum(1 for r in report if r["status"] == "error")
-    for start in range(0, len(jobs), CHUNK):
-        chunk = jobs[start:start + CHUNK]
-        result = synthesize_batch(reference, [values for _, _, values, _ in chunk], args.mode, args.metric,
-                                  args.power, normalize=args.normalize)
-        for i, (line, name, values, warnings) in enumerate(chunk):
-            mannequin = result.mannequin(i, name)
-            paths = [os.path.join(args.output, f"{name}.{_extension(kind)}") for kind in formats]
-            measured = as_dict(result.measured[i])
-            note = "; ".join(warnings)
-            if not result.converged[i]:
-                note = "; ".join(filter(None, [note, "exact mode did not fully converge"]))
-            try:
-                _write(mannequin, paths, measured, args.cushions)
-                report.append(_report_row(line, name, "ok", note, values, result.measured[i], paths))
-            except (ElliMannError, OSError) as error:
-                failed += 1
-                print(f"{PROG} batch: line {line}: failed: {_one_line(error)}", file=sys.stderr)
-                report.append(_report_row(line, name, "error", _one_line(error), values))
-            progress.step(name)
+    try:
+        for start in range(0, len(jobs), CHUNK):
+            chunk = jobs[start:start + CHUNK]
+            result = synthesize_batch(reference, [values for _, _, values, _ in chunk], args.mode, args.metric,
+                                      args.power, normalize=args.normalize)
+            for i, (line, name, values, warnings) in enumerate(chunk):
+                report.add(_batch_row(args, formats, result, i, line, name, values, warnings))
+                progress.step(name)
+    except KeyboardInterrupt:
+        progress.done()
+        report.finish()
+        _say(f"{PROG} batch: interrupted: {report.count('ok', 'missed')} of {len(mine)} rows done, report "
+             f"{report.path}; run it again with --resume to finish")
+        return INTERRUPTED
     progress.done()
-    report.sort(key=lambda r: r["line"])
-    report_name = "report.csv" if shards == 1 else f"report-{shard}-of-{shards}.csv"
-    report_path = os.path.join(args.output, report_name)
-    with _writing(report_path):
-        atomic_write_text(report_path, _report_csv(report))
-    done = len(report) - failed
-    print(f"{PROG} batch: {done} of {len(report)} mannequins written to {args.output}"
-          + (f" (shard {shard}/{shards} of {len(rows)} rows)" if shards > 1 else "") + f"; report {report_path}")
+    report.finish()
+    done, failed, missed = report.count("ok", "missed"), report.count("error"), report.count("missed")
+    _say(f"{PROG} batch: {done} of {len(mine)} mannequins written to {args.output}"
+         + (f" ({report.count('kept')} already complete, kept)" if args.resume else "")
+         + (f" (shard {shard}/{shards} of {len(rows)} rows)" if shards > 1 else "") + f"; report {report.path}",
+         file=sys.stdout)
     if failed:
-        print(f"{PROG} batch: error: {failed} row(s) failed; see {report_path}", file=sys.stderr)
+        _say(f"{PROG} batch: error: {failed} row(s) failed; see {report.path}")
         return 1
+    if missed:
+        _say(f"{PROG} batch: warning: exact mode missed the request of {missed} row(s) by more than "
+             f"{EXACT_TOLERANCE * 100:g}%; see {report.path}")
+        return MISSED
     return 0
+
+
+def _batch_row(args, formats, result, i, line, name, values, warnings):
+    """Write (or, with --resume, keep) the files of one synthesized row; its report row. A failure is
+    that row's: one line on stderr and status "error", and the batch goes on."""
+    paths = [os.path.join(args.output, f"{name}.{_extension(kind)}") for kind in formats]
+    notes = list(warnings)
+    misses = _misses(result.measured[i], values) if args.mode == "exact" else []  # = not result.converged[i]
+    if misses:
+        notes.append(_missed_text(misses))
+        _say(f"{PROG} batch: line {line}: warning: {_missed_text(misses)}")
+    status = "missed" if misses else "ok"
+    if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths):
+        row = _report_row(line, name, status, "; ".join(notes + ["kept (--resume)"]), values, result.measured[i],
+                          paths)
+        row["kept"] = True
+        return row
+    try:
+        _write(result.mannequin(i, name), paths, as_dict(result.measured[i]), args.cushions)
+    except (ElliMannError, OSError, RuntimeError) as error:
+        _say(f"{PROG} batch: line {line}: failed: {_one_line(error)}")
+        return _report_row(line, name, "error", _one_line(error), values)
+    return _report_row(line, name, status, "; ".join(notes), values, result.measured[i], paths)
 
 
 REPORT_COLUMNS = (["line", "name", "status", "message"] + list(MEASUREMENTS)
@@ -466,7 +544,9 @@ REPORT_COLUMNS = (["line", "name", "status", "message"] + list(MEASUREMENTS)
 
 
 def _report_row(line, name, status, message, requested=None, measured=None, paths=()):
-    row = {"line": line, "name": name, "status": status, "message": message or "", "files": " ".join(paths)}
+    """One report row; text from the CSV or messages is made safe for spreadsheets and terminals (:func:`_cell`)."""
+    row = {"line": line, "name": _cell(name), "status": status, "message": _cell(message or ""),
+           "files": _cell(" ".join(paths))}
     error = relative_error(measured, requested) if measured is not None else None
     for i, key in enumerate(MEASUREMENTS):
         row[key] = f"{requested[i]:g}" if requested is not None else ""
@@ -475,12 +555,67 @@ def _report_row(line, name, status, message, requested=None, measured=None, path
     return row
 
 
+def _cell(text):
+    """A report cell: control characters escaped (:func:`printable`), and text a spreadsheet would take for
+    a formula (starting with =, +, - or @) neutralised with a leading apostrophe, as OWASP recommends."""
+    text = printable(text)
+    return "'" + text if text[:1] in ("=", "+", "-", "@") else text
+
+
 def _report_csv(rows):
     stream = io.StringIO()
-    writer = csv.DictWriter(stream, fieldnames=REPORT_COLUMNS, lineterminator="\n")
+    writer = csv.DictWriter(stream, fieldnames=REPORT_COLUMNS, lineterminator="\n", extrasaction="ignore")
     writer.writeheader()
     writer.writerows(rows)
     return stream.getvalue()
+
+
+class _Report:
+    """A batch report, written as rows finish: each row is appended to REPORT.partial.csv and flushed, so a
+    killed run leaves a record of what it did; :meth:`finish` writes REPORT.csv whole (sorted by line,
+    atomically) and removes the partial file."""
+
+    def __init__(self, path):
+        self.path, self.rows = path, []
+        root, extension = os.path.splitext(path)
+        self.partial = f"{root}.partial{extension}"
+        with _writing(self.partial):
+            self.stream = open(self.partial, "w", newline="", encoding="utf-8")
+        self.writer = csv.DictWriter(self.stream, fieldnames=REPORT_COLUMNS, lineterminator="\n",
+                                     extrasaction="ignore")
+        self._append(self.writer.writeheader)
+
+    def add(self, row):
+        self.rows.append(row)
+        self._append(lambda: self.writer.writerow(row))
+
+    def _append(self, write):
+        if self.stream is None:
+            return
+        try:
+            write()
+            self.stream.flush()
+        except OSError:  # the partial record is a courtesy; the report itself is written at the end
+            self._close()
+
+    def _close(self):
+        if self.stream is not None:
+            with contextlib.suppress(OSError):
+                self.stream.close()
+            self.stream = None
+
+    def count(self, *statuses):
+        if statuses == ("kept",):
+            return sum(1 for row in self.rows if row.get("kept"))
+        return sum(1 for row in self.rows if row["status"] in statuses)
+
+    def finish(self):
+        self._close()
+        self.rows.sort(key=lambda row: row["line"])
+        with _writing(self.path):
+            atomic_write_text(self.path, _report_csv(self.rows))
+        with contextlib.suppress(OSError):
+            os.unlink(self.partial)
 
 
 class _Progress:
@@ -489,7 +624,8 @@ class _Progress:
     def __init__(self, total, command, every=None):
         self.total, self.count, self.start = total, 0, time.perf_counter()
         self.command = command
-        self.tty = sys.stderr.isatty()
+        self.stream = sys.stderr  # ElliMann's stderr, also from inside blender_output() (where sys.stderr is Blender's)
+        self.tty = self.stream.isatty()
         self.every = every or max(1, total // 20)
 
     def step(self, name, count=None):
@@ -499,13 +635,13 @@ class _Progress:
         self.count = self.count + 1 if count is None else count
         if self.tty or self.count % self.every == 0 or self.count == self.total:
             rate = self.count / max(time.perf_counter() - self.start, 1e-9)
-            text = f"{PROG} {self.command}: {self.count}/{self.total} ({rate:.1f}/s) {name}"
-            print(f"\r{text[:100]:<100}" if self.tty else text, end="" if self.tty else "\n", file=sys.stderr,
+            text = printable(f"{PROG} {self.command}: {self.count}/{self.total} ({rate:.1f}/s) {name}")
+            print(f"\r{text[:100]:<100}" if self.tty else text, end="" if self.tty else "\n", file=self.stream,
                   flush=True)
 
     def done(self):
         if self.tty and self.total:
-            print(file=sys.stderr)
+            print(file=self.stream)
 
 
 # ------------------------------------------------------------------------------------------------ measure
@@ -526,7 +662,7 @@ def run_measure(args):
     if args.json:
         print(json.dumps({key: round(values[key], 4) for key in MEASUREMENTS}))
     else:
-        print(f"{mannequin.name or path}: m_T")
+        _say(f"{mannequin.name or path}: m_T", file=sys.stdout)
         for key in MEASUREMENTS:
             print(f"  {key} {MEASUREMENT_LABELS[key]:<17} {values[key]:9.2f} cm")
     return 0
@@ -535,10 +671,8 @@ def run_measure(args):
 def _load_blend_mannequin(path, collection_name=None):
     bpy = _ensure_registered()
     from .convert import collection_to_mannequin, mannequin_collections
-    from .output import stdout_to_stderr
-
     try:
-        with stdout_to_stderr():
+        with blender_output():
             bpy.ops.wm.open_mainfile(filepath=os.path.abspath(path), load_ui=False)
     except RuntimeError as error:
         raise UsageError(f"{path}: Blender cannot open it ({_one_line(error)})") from None
@@ -561,18 +695,24 @@ def _load_blend_mannequin(path, collection_name=None):
 def run_demo(args):
     reference = _references(args)
     out = args.output
-    _output_folder(out)
+    _output_folder(out, "demo")
     result = synthesize_batch(reference, [list(row) for row in TABLE_2_5], args.mode, args.metric, args.power,
                               normalize=args.normalize)
-    rows, mannequins = [], []
+    rows, mannequins, missed = [], [], 0
     for i in range(len(result)):
         name = f"table_2_5_{i + 1:02d}"
         mannequin = result.mannequin(i)
         paths = [os.path.join(out, f"{name}.{kind}") for kind in ("blend", "json")]
         _write(mannequin, paths, as_dict(result.measured[i]), args.cushions)
-        rows.append(_report_row(i + 1, name, "ok", mannequin.name, result.requests[i], result.measured[i], paths))
+        misses = _misses(result.measured[i], result.requests[i]) if args.mode == "exact" else []
+        if misses:
+            missed += 1
+            _say(f"{PROG} demo: {name}: warning: {_missed_text(misses)}")
+        rows.append(_report_row(i + 1, name, "missed" if misses else "ok",
+                                "; ".join([mannequin.name] + ([_missed_text(misses)] if misses else [])),
+                                result.requests[i], result.measured[i], paths))
         mannequins.append(mannequin)
-        print(f"{PROG} demo: wrote {name} ({mannequin.name})", file=sys.stderr)
+        _say(f"{PROG} demo: wrote {name} ({mannequin.name})")
     for name, text in (("report.csv", _report_csv(rows)), ("report.md", _report_markdown(result, reference, args))):
         with _writing(os.path.join(out, name)):
             atomic_write_text(os.path.join(out, name), text)
@@ -583,9 +723,9 @@ def run_demo(args):
             render_lineup(mannequins, os.path.join(out, "lineup.png"),
                           labels=[f"({i + 1})" for i in range(len(rows))], cushions=args.cushions)
     error = result.relative_error()
-    print(f"{PROG} demo: {len(rows)} mannequins in {out} ({args.mode}); m_T error mean {error.mean():.3f}%, "
-          f"max {error.max():.3f}%; see {os.path.join(out, 'report.md')}")
-    return 0
+    _say(f"{PROG} demo: {len(rows)} mannequins in {out} ({args.mode}); m_T error mean {error.mean():.3f}%, "
+         f"max {error.max():.3f}%; see {os.path.join(out, 'report.md')}", file=sys.stdout)
+    return MISSED if missed else 0
 
 
 def _report_markdown(result, reference, args):
@@ -642,7 +782,7 @@ def run_drape(args):
     bpy = _ensure_registered()
     from .atomic import atomic_output
     from .drape import drape
-    from .output import add_mannequin, empty_scene, stdout_to_stderr
+    from .output import add_mannequin, empty_scene
 
     settings = drape_settings(args)
     if kind == ".json":
@@ -650,30 +790,29 @@ def run_drape(args):
         add_mannequin(mannequin, cushions=settings.cushions and bool(mannequin.topology.cushion_pairs))
     else:
         mannequin = _load_blend_mannequin(args.mannequin, args.collection)
-    print(f"{PROG} drape: {args.garment} on '{mannequin.name}', {settings.frames} frames, cloth edge "
-          f"{settings.edge * CM_PER_M:g} cm, colliding with {'cushions' if settings.cushions else 'ellipsoids'}",
-          file=sys.stderr, flush=True)
+    _say(f"{PROG} drape: {args.garment} on '{mannequin.name}', {settings.frames} frames, cloth edge "
+         f"{settings.edge * CM_PER_M:g} cm, colliding with {'cushions' if settings.cushions else 'ellipsoids'}")
     progress = _Progress(settings.frames, "drape", every=max(10, settings.frames // 20))  # 10 frames, 5% past 200
 
     def frame_done(frame):
         progress.step("frames simulated" + ("; baking and measuring the fit" if frame == settings.frames else ""),
                       frame)
 
-    with stdout_to_stderr():
+    with blender_output():
         try:
             result = drape(mannequin, args.garment, settings, progress=frame_done)
         finally:
             progress.done()
         with _writing(args.output), atomic_output(args.output) as temp:
             bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)
-    print(f"wrote {args.output}: {result.garment.name} on '{mannequin.name}', {result.summary()}")
+    _say(f"wrote {args.output}: {result.garment.name} on '{mannequin.name}', {result.summary()}", file=sys.stdout)
     if args.render:
         from .render import render_view
 
         low, high = bounds(mannequin.rotation, mannequin.center, mannequin.semi_axes)
         with _writing(args.render):
             render_view(args.render, low.min(axis=0), high.max(axis=0))
-        print(f"wrote {args.render}")
+        _say(f"wrote {args.render}", file=sys.stdout)
     return 0
 
 

@@ -7,15 +7,14 @@ carries ElliMann's extras. JSON and MJCF come from the core (:func:`core.writers
 and need no scene.
 """
 
-import contextlib
 import os
-import sys
 
 import bpy
 
 from ..core.cushion import DEFAULT_SUBDIVISIONS
 from ..core.errors import ElliMannError
 from .atomic import atomic_output
+from .chatter import blender_output
 from .convert import mannequin_to_collection, objects_recursive, write_measured
 from .cushions import build_cushions
 from .export import export_gltf
@@ -24,27 +23,9 @@ BLENDER_FORMATS = ("blend", "glb", "obj")
 LIVE_SUBDIVISIONS = 3
 
 
-@contextlib.contextmanager
-def stdout_to_stderr():
-    """Send what Blender prints to stderr, so stdout stays machine-readable.
-
-    Blender prints both from C (file descriptor 1) and through Python's ``sys.stdout`` (reports).
-    """
-    sys.stdout.flush()
-    saved = os.dup(1)
-    try:
-        os.dup2(2, 1)
-        with contextlib.redirect_stdout(sys.stderr):
-            yield
-    finally:
-        sys.stdout.flush()
-        os.dup2(saved, 1)
-        os.close(saved)
-
-
 def empty_scene():
     """Start from an empty file (add-ons stay registered)."""
-    with stdout_to_stderr():
+    with blender_output():
         bpy.ops.wm.read_homefile(use_empty=True)
     return bpy.context.scene
 
@@ -131,10 +112,10 @@ def extension(path):
 def _write_blender_file(path, collection):
     kind = extension(path)
     if kind == "glb":  # atomic itself; leaves out what renders do not show (ellipsoids a cushion replaces)
-        with stdout_to_stderr():
+        with blender_output():
             export_gltf(collection, path)
         return
-    with atomic_output(path) as temp, stdout_to_stderr():
+    with atomic_output(path) as temp, blender_output():
         if kind == "blend":
             bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)
         else:

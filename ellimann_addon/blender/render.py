@@ -8,7 +8,8 @@ import numpy as np
 
 from ..core.ellipsoid import bounds
 from .atomic import atomic_output
-from .output import add_mannequin, empty_scene, stdout_to_stderr
+from .chatter import blender_output
+from .output import add_mannequin, empty_scene
 
 BACKGROUND = (1.0, 1.0, 1.0)
 LABEL_COLOR = (0.15, 0.15, 0.15, 1.0)
@@ -102,7 +103,7 @@ def _workbench(scene):
 
 
 def _render(scene, filepath):
-    with atomic_output(filepath) as temp, stdout_to_stderr():
+    with atomic_output(filepath) as temp, blender_output():
         scene.render.filepath = temp
         bpy.ops.render.render(write_still=True)
     return os.path.abspath(filepath)

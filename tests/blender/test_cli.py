@@ -448,3 +448,279 @@ def test_demo_writes_files_report_and_lineup(tmp_path, capsys, references):
     assert "| 10 | 165.25 | 47.25 | 135.75 | 122.25 | 117.5 |" in markdown and "max, paper IDW" in markdown
     assert (out / "lineup.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "10 mannequins" in stdout
+
+
+# ------------------------------------------------------------------------------------------------ Blender's chatter
+
+BLENDER_LINES = ("Info:", "INFO", "Writing to", "OBJ export", "EGL", ".ellimann-", "Saved copy", "File exported")
+
+
+def assert_no_blender_lines(text):
+    assert not [line for line in text.splitlines() if any(word in line for word in BLENDER_LINES)], text
+
+
+def test_synth_glb_prints_only_its_own_line_and_verbose_shows_blender(tmp_path, references):
+    out = tmp_path / "m.glb"
+    done = python_m("synth", *REQUEST, "-o", str(out), "--references", references)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith(f"wrote {out}: ") and done.stdout.count("\n") == 1
+    assert done.stderr == ""
+    verbose = python_m("synth", *REQUEST, "-o", str(out), "--references", references, "--verbose")
+    assert verbose.returncode == 0 and verbose.stdout.count("\n") == 1  # stdout stays ElliMann's
+    assert "| INFO: Starting glTF 2.0 export" in verbose.stderr
+
+
+def test_batch_in_every_blender_format_prints_only_ellimann_lines(tmp_path, references):
+    source = write_csv(tmp_path / "in.csv", GOOD_ROWS[:2])
+    out = tmp_path / "out"
+    done = python_m("batch", source, "-o", str(out), "--format", "blend,glb,obj", "--references", references)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.count("\n") == 1 and done.stdout.startswith("ellimann batch: 2 of 2 mannequins written")
+    assert all(line.startswith("ellimann batch: ") for line in done.stderr.splitlines()), done.stderr
+    assert_no_blender_lines(done.stdout + done.stderr)
+    verbose = python_m("batch", source, "-o", str(out), "--format", "blend,glb,obj", "--references", references,
+                       "-v")
+    assert verbose.returncode == 0 and verbose.stdout == done.stdout
+    for line in ('Info: Saved copy as "average.blend"', "| INFO: Finished glTF 2.0 export", "OBJ export of"):
+        assert line in verbose.stderr
+
+
+def test_demo_shows_no_blender_output_at_the_file_descriptors(tmp_path, capfd, references):
+    """In-process, capfd sees what Blender's C code writes to fds 1 and 2 (Info lines, EGL errors)."""
+    code = cli.main(["demo", "-o", str(tmp_path / "demo"), "--references", references])
+    out, err = capfd.readouterr()
+    assert code == 0, err
+    assert out.count("\n") == 1 and out.startswith("ellimann demo: 10 mannequins")
+    assert all(line.startswith("ellimann demo: ") for line in err.splitlines()), err
+
+
+def test_measure_of_a_blend_prints_the_json_alone_at_the_file_descriptors(tmp_path, capfd, references):
+    out = tmp_path / "m.blend"
+    assert cli.main(["synth", *REQUEST, "-o", str(out), "--references", references]) == 0
+    capfd.readouterr()
+    assert cli.main(["measure", str(out), "--json"]) == 0
+    stdout, stderr = capfd.readouterr()
+    assert json.loads(stdout) == pytest.approx(VALUES, rel=1e-4) and stderr == ""
+
+
+# ------------------------------------------------------------------------------------------------ whole writes
+
+FSIZE_RUN = """
+import resource, signal, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails (EFBIG) instead of ending us
+from ellimann_addon.blender.cli import main
+import bpy  # loaded (and Python's caches written) before the limit
+resource.setrlimit(resource.RLIMIT_FSIZE, ({limit}, {limit}))
+sys.exit(main({argv!r}))
+"""
+
+
+@pytest.mark.skipif(not hasattr(os, "setrlimit") and sys.platform == "win32", reason="needs RLIMIT_FSIZE")
+@pytest.mark.parametrize("kind", ["blend", "glb", "obj", "json"])
+def test_a_write_cut_short_is_one_line_exit_1_and_the_old_file_stays(tmp_path, references, kind):
+    """RLIMIT_FSIZE stops every write at 4 KiB, as a full disk does: Blender's .blend and .obj writers
+    return normally from a cut-short file, the glTF exporter and the core raise; each ends in one line."""
+    pytest.importorskip("resource")
+    out = tmp_path / f"m.{kind}"
+    out.write_bytes(b"the user's")
+    argv = ["synth", *REQUEST, "-o", str(out), "--references", references]
+    done = subprocess.run([sys.executable, "-c", FSIZE_RUN.format(limit=4096, argv=argv)], cwd=ROOT,
+                          capture_output=True, text=True, timeout=300)
+    assert_one_line_error(done.returncode, done.stderr, f"cannot write {out}: ")
+    assert done.stdout == "" and ".ellimann-" not in done.stderr
+    assert any(words in done.stderr for words in ("incomplete", "File too large")), done.stderr
+    assert out.read_bytes() == b"the user's"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [f"m.{kind}"]
+
+
+@pytest.mark.skipif(not (hasattr(os, "geteuid") and os.geteuid() == 0), reason="mounting a tmpfs needs root")
+def test_a_full_disk_is_caught_on_a_64k_tmpfs(tmp_path, references):
+    full = tmp_path / "full"
+    full.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(full)],
+                      capture_output=True).returncode:
+        pytest.skip("cannot mount a tmpfs here")
+    try:
+        for kind in ("blend", "obj"):
+            done = python_m("synth", *REQUEST, "-o", str(full / f"m.{kind}"), "--references", references)
+            assert_one_line_error(done.returncode, done.stderr, f"cannot write {full / f'm.{kind}'}: ",
+                                  "No space left on device")
+            assert not list(full.iterdir())
+    finally:
+        subprocess.run(["umount", str(full)], check=True)
+
+
+@pytest.mark.parametrize("kind", ["blend", "glb", "obj", "json"])
+def test_a_name_too_long_for_the_file_system_is_one_line(tmp_path, capsys, references, kind):
+    out = tmp_path / ("a" * 300 + f".{kind}")
+    code, stdout, err = run(["synth", *REQUEST, "-o", str(out), "--references", references], capsys)
+    assert_one_line_error(code, err, f"cannot write {out}: ", "File name too long")
+    assert stdout == "" and ".ellimann-" not in err and not list(tmp_path.iterdir())
+
+
+def test_blender_write_errors_become_one_line_os_errors():
+    from ellimann_addon.blender.atomic import blender_write_error
+
+    temp, target = "/out/.ellimann-1@h-abcdefgh/m.glb", "out/m.glb"
+    gltf = RuntimeError("Error: Python: Traceback (most recent call last):\n  File \"x.py\", line 85, in save_gltf\n"
+                        f"OSError: [Errno 28] No space left on device: '{temp}'\nLocation: ops.py:109\n")
+    error = blender_write_error(gltf, temp, target)
+    assert (error.errno, error.strerror, error.filename) == (28, "No space left on device", target)
+    blend = RuntimeError(f"Error: Cannot open file {temp}@ for writing: File name too long\n")
+    assert blender_write_error(blend, temp, target).strerror == "File name too long"
+    other = blender_write_error(RuntimeError(f"Error: OBJ Export: Cannot open file '{temp}'\n"), "/tmp", target)
+    assert other.filename == target and temp not in other.strerror  # the probe names the real reason
+
+
+# ------------------------------------------------------------------------------------------------ batch: failures
+
+
+def test_a_batch_row_blender_fails_to_write_is_reported_and_the_batch_goes_on(tmp_path, capsys, references,
+                                                                             monkeypatch):
+    from ellimann_addon.blender import atomic, output
+
+    real = output.export_gltf
+
+    def full_disk_for_t1(collection, path):
+        if os.path.basename(path) == "t1.glb":
+            with atomic.atomic_output(path) as temp:  # what a bpy.ops call raises when the disk is full
+                raise RuntimeError(f"Error: Python: Traceback (most recent call last):\nOSError: [Errno 28] No "
+                                   f"space left on device: '{temp}'\nLocation: ops.py:109\n")
+        return real(collection, path)
+
+    monkeypatch.setattr(output, "export_gltf", full_disk_for_t1)
+    source = write_csv(tmp_path / "in.csv", GOOD_ROWS)
+    out = tmp_path / "out"
+    code, stdout, err = run(["batch", source, "-o", str(out), "--format", "json,glb", "--references", references],
+                            capsys)
+    assert code == 1 and "Traceback" not in err
+    assert f"line 3: failed: cannot write {out / 't1.glb'}: No space left on device" in err
+    assert "2 of 3 mannequins written" in stdout
+    assert [r["status"] for r in read_report(out / "report.csv")] == ["ok", "error", "ok"]
+    assert (out / "row-00003.glb").is_file() and not (out / "t1.glb").exists()
+    assert not [p for p in out.iterdir() if p.name.startswith(".") or "partial" in p.name]
+
+
+def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_path, capsys, references,
+                                                                           monkeypatch):
+    real, calls = cli._write, []
+
+    def interrupted_on_the_second_row(*args):
+        calls.append(args)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*args)
+
+    monkeypatch.setattr(cli, "_write", interrupted_on_the_second_row)
+    source = write_csv(tmp_path / "in.csv", GOOD_ROWS + [(160, 40, "abc", 90, 100, "bad")])
+    out = tmp_path / "out"
+    code, stdout, err = run(["batch", source, "-o", str(out), "--references", references], capsys)
+    assert code == 130 and stdout == ""
+    assert err.strip().splitlines()[-1] == (f"ellimann batch: interrupted: 1 of 4 rows done, report "
+                                            f"{out / 'report.csv'}; run it again with --resume to finish")
+    assert [(r["line"], r["status"]) for r in read_report(out / "report.csv")] == [("2", "ok"), ("5", "error")]
+    assert sorted(p.name for p in out.iterdir()) == ["average.json", "report.csv"]
+    first = (out / "average.json").stat()
+    monkeypatch.setattr(cli, "_write", real)
+    code, stdout, err = run(["batch", source, "-o", str(out), "--resume", "--references", references], capsys)
+    assert code == 1 and "3 of 4 mannequins written" in stdout and "(1 already complete, kept)" in stdout
+    assert (out / "average.json").stat().st_ino == first.st_ino  # kept, not written again
+    report = read_report(out / "report.csv")
+    assert [r["status"] for r in report] == ["ok", "ok", "ok", "error"] and "kept (--resume)" in report[0]["message"]
+
+
+KILLED_RUN = """
+import os, signal, sys, tempfile
+from ellimann_addon.blender import cli
+from ellimann_addon.core.files import temp_prefix
+real, calls = cli._write, []
+def killed_on_the_third_row(mannequin, paths, *args):
+    calls.append(paths)
+    if len(calls) == 3:  # killed while writing: a temporary is on disk
+        tempfile.mkstemp(prefix=temp_prefix(), suffix=".tmp", dir=os.path.dirname(paths[0]))
+        os.kill(os.getpid(), signal.SIGKILL)
+    return real(mannequin, paths, *args)
+cli._write = killed_on_the_third_row
+sys.exit(cli.main({argv!r}))
+"""
+
+
+@pytest.mark.skipif(os.name != "posix", reason="SIGKILL")
+def test_a_killed_batch_leaves_a_partial_report_and_resume_cleans_up_and_finishes(tmp_path, references):
+    rows = [(150 + i, 40, 110, 95, 110, f"m{i}") for i in range(5)]
+    source = write_csv(tmp_path / "in.csv", rows)
+    out = tmp_path / "out"
+    argv = ["batch", source, "-o", str(out), "--references", references]
+    done = subprocess.run([sys.executable, "-c", KILLED_RUN.format(argv=argv)], cwd=ROOT, capture_output=True,
+                          text=True, timeout=300)
+    assert done.returncode == -9
+    assert [r["name"] for r in read_report(out / "report.partial.csv")] == ["m0", "m1"]
+    assert len([p for p in out.iterdir() if p.name.startswith(".ellimann-")]) == 1
+    (out / "m1.json").write_text((out / "m1.json").read_text()[:100])  # and a file cut short
+    kept = (out / "m0.json").stat().st_ino
+    again = python_m(*argv, "--resume")
+    assert again.returncode == 0, again.stderr
+    assert f"removed 1 temporary file(s) an interrupted run left in {out}" in again.stderr
+    assert "5 of 5 mannequins written" in again.stdout and "(1 already complete, kept)" in again.stdout
+    assert (out / "m0.json").stat().st_ino == kept
+    assert Mannequin.load(out / "m1.json").measurements["He"] == 151.0  # written again, whole
+    assert sorted(p.name for p in out.iterdir()) == [f"m{i}.json" for i in range(5)] + ["report.csv"]
+    assert [r["status"] for r in read_report(out / "report.csv")] == ["ok"] * 5
+
+
+def test_batch_without_resume_writes_every_row_again(tmp_path, capsys, references):
+    source = write_csv(tmp_path / "in.csv", GOOD_ROWS[:1])
+    out = tmp_path / "out"
+    assert run(["batch", source, "-o", str(out), "--references", references], capsys)[0] == 0
+    first = (out / "average.json").stat().st_ino
+    code, stdout, _ = run(["batch", source, "-o", str(out), "--references", references], capsys)
+    assert code == 0 and "kept" not in stdout and (out / "average.json").stat().st_ino != first
+
+
+# ------------------------------------------------------------------------------------------------ untrusted text
+
+
+def test_names_from_a_csv_cannot_become_formulas_or_terminal_escapes(tmp_path, capsys, references):
+    rows = [(159, 43, 117, 104, 117, name) for name in
+            ('=HYPERLINK("http://evil","x")', "+1+2", "-2+3", "@SUM(A1)", "\x1b[2J\x1b[31mred", "ok\u202eevil")]
+    source = write_csv(tmp_path / "in.csv", rows + [GOOD_ROWS[1]])
+    out = tmp_path / "out"
+    code, _, err = run(["batch", source, "-o", str(out), "--references", references], capsys)
+    assert code == 1
+    assert "\x1b" not in err and "\u202e" not in err and "\\x1b[2J" in err
+    text = (out / "report.csv").read_text()
+    assert "\x1b" not in text and "\u202e" not in text
+    report = read_report(out / "report.csv")
+    assert [r["name"][:2] for r in report[:4]] == ["'=", "'+", "'-", "'@"]
+    assert report[4]["name"] == "\\x1b[2J\\x1b[31mred" and report[5]["name"] == "ok\\u202eevil"
+    assert report[6]["status"] == "ok" and report[6]["name"] == "t1"
+
+
+def test_text_from_the_command_line_and_files_is_printed_without_control_characters(tmp_path, capsys, references):
+    out = tmp_path / "m.json"
+    code, stdout, _ = run(["synth", *REQUEST, "--name", "\x1b]0;owned\x07\rx", "-o", str(out),
+                           "--references", references], capsys)
+    assert code == 0 and "\x1b" not in stdout and "\\x1b]0;owned\\x07\\rx" in stdout
+    code, stdout, _ = run(["measure", str(out)], capsys)
+    assert code == 0 and "\x1b" not in stdout and stdout.startswith("\\x1b]0;owned")
+
+
+# ------------------------------------------------------------------------------------------------ exact mode misses
+
+ABSURD = ["--he", "50", "--sh", "10", "--br", "300", "--wa", "300", "--hi", "300"]  # plausible alone, not together
+
+
+def test_exact_mode_missing_a_request_warns_naming_it_and_exits_3(tmp_path, capsys, references):
+    out = tmp_path / "m.json"
+    code, stdout, err = run(["synth", *ABSURD, "-o", str(out), "--references", references], capsys)
+    assert code == cli.MISSED == 3
+    warning = [line for line in err.splitlines() if "exact mode missed" in line]
+    assert len(warning) == 1 and "Sh by 18.6" in warning[0] and "(m_T " in warning[0]
+    assert "tolerance 0.001%" in warning[0]
+    assert stdout.startswith(f"wrote {out}") and out.is_file()  # the closest mannequin, written
+    code, _, err = run(["synth", *ABSURD, "--mode", "idw", "-o", str(out), "--references", references], capsys)
+    assert code == 0 and "missed" not in err  # IDW promises no match
+    source = write_csv(tmp_path / "in.csv", [GOOD_ROWS[0], (50, 10, 300, 300, 300, "absurd")])
+    code, _, err = run(["batch", source, "-o", str(tmp_path / "out"), "--references", references], capsys)
+    assert code == 3 and "line 3: warning: exact mode missed" in err
+    assert [r["status"] for r in read_report(tmp_path / "out" / "report.csv")] == ["ok", "missed"]
