@@ -28,9 +28,10 @@ import time
 
 from ..core.constants import CM_PER_M, MEASUREMENT_LABELS, MEASUREMENTS, RANGES, TABLE_2_5
 from ..core.ellipsoid import bounds
-from ..core.errors import ElliMannError, MeasurementError, ReferenceSetError
+from ..core.errors import ElliMannError, MannequinError, MeasurementError, ReferenceSetError
 from ..core.files import atomic_write_text, clean_stale_temporaries, incomplete
 from ..core.garments import BUILDERS as GARMENTS
+from ..core.garments import EDGE_RANGE
 from ..core.mannequin import Mannequin
 from ..core.measure import as_dict
 from ..core.synthesis import (
@@ -653,19 +654,32 @@ def run_measure(args):
     if not os.path.isfile(path):
         raise UsageError(f"{path}: no such file")
     if kind == ".json":
-        mannequin = Mannequin.load(path)
+        mannequin = _load_json_mannequin(path)
     elif kind == ".blend":
         mannequin = _load_blend_mannequin(path, args.collection)
     else:
         raise UsageError(f"FILE must be a .json or .blend mannequin, got {path!r}")
     values = mannequin.measure()
     if args.json:
-        print(json.dumps({key: round(values[key], 4) for key in MEASUREMENTS}))
+        try:
+            text = json.dumps({key: round(values[key], 4) for key in MEASUREMENTS}, allow_nan=False)
+        except ValueError:  # NaN or infinity: not JSON, and not a measurement
+            raise UsageError(f"{path}: m_T is not finite ({_format_me(values.values())} cm)") from None
+        print(text)
     else:
         _say(f"{mannequin.name or path}: m_T", file=sys.stdout)
         for key in MEASUREMENTS:
             print(f"  {key} {MEASUREMENT_LABELS[key]:<17} {values[key]:9.2f} cm")
     return 0
+
+
+def _load_json_mannequin(path):
+    """Mannequin.load, its error naming the file."""
+    try:
+        return Mannequin.load(path)
+    except MannequinError as error:
+        text = _one_line(error)
+        raise UsageError(text if path in text else f"{path}: {text}") from None
 
 
 def _load_blend_mannequin(path, collection_name=None):
@@ -778,10 +792,10 @@ def run_drape(args):
     if not os.path.isfile(args.mannequin):
         raise UsageError(f"{args.mannequin}: no such file")
     if kind == ".json":
-        mannequin = Mannequin.load(args.mannequin)
+        mannequin = _load_json_mannequin(args.mannequin)
     bpy = _ensure_registered()
     from .atomic import atomic_output
-    from .drape import drape
+    from .drape import WARN_CLOTH_VERTICES, check_cloth_size, drape
     from .output import add_mannequin, empty_scene
 
     settings = drape_settings(args)
@@ -790,6 +804,10 @@ def run_drape(args):
         add_mannequin(mannequin, cushions=settings.cushions and bool(mannequin.topology.cushion_pairs))
     else:
         mannequin = _load_blend_mannequin(args.mannequin, args.collection)
+    vertices, size = check_cloth_size(mannequin, args.garment, settings)  # refuses a cloth too large to drape
+    if vertices > WARN_CLOTH_VERTICES:
+        _say(f"{PROG} drape: warning: the cloth will have about {vertices:,} vertices and need about "
+             f"{size / 1e9:.1f} GB; it is slow (a larger --edge is faster)")
     _say(f"{PROG} drape: {args.garment} on '{mannequin.name}', {settings.frames} frames, cloth edge "
          f"{settings.edge * CM_PER_M:g} cm, colliding with {'cushions' if settings.cushions else 'ellipsoids'}")
     progress = _Progress(settings.frames, "drape", every=max(10, settings.frames // 20))  # 10 frames, 5% past 200
@@ -820,6 +838,9 @@ def drape_settings(args):
     """DrapeSettings from the command line: what is not given keeps DrapeSettings' default (the panel's too)."""
     from .drape import DrapeSettings
 
+    low, high = (bound * CM_PER_M for bound in EDGE_RANGE)
+    if args.edge is not None and not low <= args.edge <= high:  # in the flag's unit, not DrapeSettings' metres
+        raise UsageError(f"--edge: the cloth's edge length must be from {low:g} to {high:g} cm, got {args.edge:g} cm")
     given = {"frames": args.frames, "edge": None if args.edge is None else args.edge / CM_PER_M,
              "cushions": args.cushions}
     return dataclasses.replace(DrapeSettings(), **{k: v for k, v in given.items() if v is not None}).checked()

@@ -170,9 +170,12 @@ def write_collection_props(collection, mannequin):
     props = collection.ellimann
     props.is_mannequin = True
     props.role = mannequin.role
-    props.has_target = bool(mannequin.measurements)
-    if mannequin.measurements:
-        props.target = [float(mannequin.measurements[m]) for m in MEASUREMENTS]
+    target = mannequin.measurements or {}
+    # A collection holds all five target measurements or none: a partial target (a hand-written JSON may
+    # give only some; the core allows it) is not kept rather than filled in.
+    props.has_target = all(m in target for m in MEASUREMENTS)
+    if props.has_target:
+        props.target = [float(target[m]) for m in MEASUREMENTS]
 
 
 def new_ellipsoid_object(part, rotation, center, semi_axes, collection, mesh=None):

@@ -42,6 +42,14 @@ CLEARING_SUBDIVISIONS = 3  # cushion hulls a new garment is moved clear of (insc
 # for far points: the fit's distances are exact up to FIT_CUTOFF, the clearing's near the body.
 FIT_CUTOFF = 0.2
 CLEARING_CUTOFF = 0.05
+# Cloth size. Peak memory grows by about 85 kB per garment vertex (measured with both garments on the
+# shipped Average RM at 2, 1 and 0.5 cm edges: building, clearing, Blender's cloth and the fit
+# together, on top of some 0.3 GB for Blender itself), and time at least as fast: 27,000 vertices (a
+# tube dress at 0.5 cm) took 2.6 GB and 2.5 minutes for 3 frames. A drape is refused above
+# MAX_CLOTH_VERTICES (about 4 GB) before anything is built; the command line warns above WARN_CLOTH_VERTICES.
+BYTES_PER_VERTEX = 85_000
+MAX_CLOTH_VERTICES = 50_000
+WARN_CLOTH_VERTICES = 20_000
 
 
 @dataclass
@@ -63,6 +71,7 @@ class DrapeSettings:
     collision_quality: int = 3
     distance: float = 0.005
     sewing_force: float = 20.0
+    max_vertices: int = MAX_CLOTH_VERTICES  # a larger cloth is refused (see cloth_size)
 
     def checked(self):
         if isinstance(self.frames, bool) or not isinstance(self.frames, (int, np.integer)) or not (
@@ -80,6 +89,9 @@ class DrapeSettings:
             raise ElliMannError(f"collision_quality: must be from 1 to 20 passes, got {self.collision_quality!r}")
         if not 0.001 <= self.distance <= 0.05:
             raise ElliMannError(f"distance: must be from 0.001 to 0.05 m, got {self.distance!r}")
+        if isinstance(self.max_vertices, bool) or not isinstance(self.max_vertices, (int, np.integer)) or \
+                self.max_vertices < 100:
+            raise ElliMannError(f"max_vertices: must be an integer of at least 100, got {self.max_vertices!r}")
         return self
 
 
@@ -253,6 +265,51 @@ def evaluated_vertices(obj):
     return co.reshape(-1, 3).astype(float) @ matrix[:3, :3].T + matrix[:3, 3]
 
 
+# ------------------------------------------------------------------------------------------------ size
+
+
+def cloth_size(mannequin, garment, settings):
+    """(vertices, bytes): the cloth's vertex count (estimated from the garment's size and the edge for a
+    BUILDERS key, :func:`garments.estimate_vertices`; counted for a Garment) and the memory it needs."""
+    if isinstance(garment, str):
+        vertices = garments.estimate_vertices(mannequin, garment, settings.edge)
+    else:
+        vertices = len(garment.vertices)
+    return vertices, vertices * BYTES_PER_VERTEX
+
+
+def check_cloth_size(mannequin, garment, settings):
+    """Refuse a cloth of more than ``settings.max_vertices`` vertices, before anything is built: ElliMannError
+    with the estimate, the limit and the edge that would fit. Returns (vertices, bytes) otherwise."""
+    vertices, size = cloth_size(mannequin, garment, settings)
+    limit = settings.max_vertices
+    if vertices <= limit:
+        return vertices, size
+    what = garment if isinstance(garment, str) else garment.name
+    text = (f"cloth: a {what} with {settings.edge * 100:g} cm edges would have about {vertices:,} vertices and need "
+            f"about {_gigabytes(size)} (limit {limit:,} vertices, about {_gigabytes(limit * BYTES_PER_VERTEX)})")
+    if isinstance(garment, str):
+        fits = _fitting_edge(mannequin, garment, settings.edge, vertices, limit)
+        text += (f"; an edge of {fits * 100:g} cm or more fits" if fits is not None
+                 else "; no edge up to the largest allowed fits")
+    raise ElliMannError(text)
+
+
+def _fitting_edge(mannequin, kind, edge, vertices, limit):
+    """The smallest edge (m, in steps of 0.1 mm) at which the estimate is within ``limit``, or None."""
+    step = 1e-4
+    trial = np.ceil(edge * np.sqrt(vertices / limit) / step) * step  # vertices go with 1 / edge^2
+    while trial <= garments.EDGE_RANGE[1]:
+        if garments.estimate_vertices(mannequin, kind, float(trial)) <= limit:
+            return round(float(trial), 6)
+        trial += step
+    return None
+
+
+def _gigabytes(size):
+    return f"{size / 1e9:.1f} GB" if size >= 1e8 else f"{size / 1e6:.0f} MB"
+
+
 # ------------------------------------------------------------------------------------------------ drape
 
 
@@ -265,7 +322,8 @@ def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None,
     Returns a :class:`DrapeResult` whose ``fit`` compares the final garment with the exact pieces
     (ellipsoids in closed form, cushions at a fine resolution): negative distances are inside;
     distances beyond FIT_CUTOFF (20 cm, a garment hanging far off the body) are lower bounds.
-    Raises ElliMannError (MannequinError naming the parts) before anything is built. ``progress(frame)``
+    Raises ElliMannError (MannequinError naming the parts, or a cloth of more than ``settings.max_vertices``
+    vertices: :func:`check_cloth_size`) before anything is built. ``progress(frame)``
     is called as each frame is simulated (see :func:`bake`). Should anything fail once building has
     begun (simulating, or measuring the fit), everything the drape made is removed, the scene goes
     back to its frame and the error goes on; a RuntimeError of Blender's becomes an ElliMannError
@@ -274,6 +332,7 @@ def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None,
     settings = (settings or DrapeSettings()).checked()
     scene = scene or bpy.context.scene
     mannequin.check()
+    check_cloth_size(mannequin, garment, settings)
     cushions = settings.cushions and bool(mannequin.topology.cushion_pairs)
     if isinstance(garment, str):
         garment = garments.make_garment(mannequin, garment, edge=settings.edge)

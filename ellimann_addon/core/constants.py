@@ -49,6 +49,16 @@ ABSURD_LIMITS = {
 }
 
 
+# Plausibility limits of a piece (m), the geometry's counterpart of ABSURD_LIMITS: a mannequin with a
+# piece outside them is refused (JSON files, Blender collections, synthesis results), naming the part,
+# the field and the range. No body (He at most 2.5 m) has a semi-axis beyond half its height; 10 um is
+# far below any piece of a body and far above where float32 (Blender's matrices) loses a scale. Centres
+# may be anywhere a scene puts a mannequin beside others (a line-up of dozens spans tens of metres);
+# at 100 m Blender's float32 locations still resolve 8 um.
+SEMI_AXIS_LIMITS = (1e-5, 3.0)
+CENTER_LIMIT = 100.0  # largest |x|, |y| or |z| of a piece's centre
+
+
 def quartile_points(key):
     """The three inner quartile points of L for one measurement (the paper's 243 grid)."""
     low, high = RANGES[key]

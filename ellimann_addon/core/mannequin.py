@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .constants import MEASUREMENTS
+from .constants import ABSURD_LIMITS, CENTER_LIMIT, MEASUREMENTS, SEMI_AXIS_LIMITS
 from .errors import MannequinError, Problem
 from .files import atomic_write_text
 
@@ -63,6 +63,10 @@ class Part:
         for key, kind in (("side", str), ("region", str), ("girth", bool), ("depends", list)):
             if not isinstance(data.get(key), kind):
                 problems.append(Problem(name, key, f"missing or not a {kind.__name__}"))
+        depends = data.get("depends")
+        if isinstance(depends, list) and not all(isinstance(m, str) for m in depends):
+            problems.append(Problem(name, "depends", f"must list measurement names among {', '.join(MEASUREMENTS)}, "
+                                                     f"got {_short(depends)}"))
         partner = data.get("partner") or ""
         if not isinstance(partner, str):
             problems.append(Problem(name, "partner", "must be a name or empty"))
@@ -242,25 +246,37 @@ class Mannequin:
             return out
         if self.role not in ROLES:
             out.append(Problem("", "role", f"is '{self.role}'; expected one of {', '.join(ROLES)}"))
-        with np.errstate(invalid="ignore"):  # a non-finite frame is reported below, not warned about
+        with np.errstate(invalid="ignore", over="ignore"):  # a non-finite or huge frame is reported below
             det = np.linalg.det(self.rotation)
             gram = np.swapaxes(self.rotation, -1, -2) @ self.rotation
             ortho_error = np.abs(gram - np.eye(3)).max(axis=(1, 2))
+        low, high = SEMI_AXIS_LIMITS
+        with np.errstate(invalid="ignore"):
+            implausible_axes = np.any((self.semi_axes < low) | (self.semi_axes > high), axis=1)
+            far = np.any(np.abs(self.center) > CENTER_LIMIT, axis=1)
         for i, part in enumerate(self.topology):
+            finite = {}
             for attr in ("rotation", "center", "semi_axes"):
-                if not np.all(np.isfinite(getattr(self, attr)[i])):
+                finite[attr] = bool(np.all(np.isfinite(getattr(self, attr)[i])))
+                if not finite[attr]:
                     out.append(Problem(part.name, attr, "contains NaN or infinity"))
             if np.any(self.semi_axes[i] <= 0.0):
                 out.append(Problem(part.name, "semi_axes", f"must be > 0, got {self.semi_axes[i].tolist()}"))
+            elif finite["semi_axes"] and implausible_axes[i]:
+                value = next(v for v in self.semi_axes[i] if not low <= v <= high)
+                out.append(Problem(part.name, "semi_axes", f"{value:g} m is not a plausible semi-axis (accepted range "
+                                                           f"{low:g} to {high:g} m)"))
+            if finite["center"] and far[i]:
+                axis = int(np.argmax(np.abs(self.center[i])))
+                out.append(Problem(part.name, "center", f"{'xyz'[axis]} = {self.center[i, axis]:g} m is too far from "
+                                                        f"the origin (accepted range {-CENTER_LIMIT:g} to "
+                                                        f"{CENTER_LIMIT:g} m)"))
             if np.all(np.isfinite(self.rotation[i])):
                 if ortho_error[i] > ROTATION_TOL:
                     out.append(Problem(part.name, "rotation", f"is not orthonormal (error {ortho_error[i]:.2g})"))
                 elif det[i] < 0.0:
                     out.append(Problem(part.name, "rotation", "is a left-handed frame (det -1)"))
-        if self.measurements is not None:
-            for key, value in self.measurements.items():
-                if key not in MEASUREMENTS or not _positive_number(value):
-                    out.append(Problem("", "measurements", f"{key}={value!r} is not a positive measurement"))
+        out += measurement_problems(self.measurements)
         return out
 
     def check(self):
@@ -302,15 +318,39 @@ class Mannequin:
 
     @classmethod
     def from_dict(cls, data, check=True):
-        if not isinstance(data, dict) or data.get("format") != FORMAT:
+        """A mannequin from its JSON dict; MannequinError names every field that is missing, of the wrong
+        type or implausible (never another exception, whatever ``data`` holds)."""
+        if not isinstance(data, dict):
+            raise MannequinError([Problem("", "file", f"holds {_json_type(data)}, not an ElliMann mannequin "
+                                                      f"(an object with format '{FORMAT}')")])
+        if data.get("format") != FORMAT:
             raise MannequinError([Problem("", "format", f"not an ElliMann mannequin (expected format '{FORMAT}')")])
         version = data.get("version")
-        if not isinstance(version, int) or version > FORMAT_VERSION:
-            raise MannequinError([Problem("", "version", f"is {version!r}; this ElliMann reads up to "
+        if isinstance(version, bool) or not isinstance(version, int) or not 1 <= version <= FORMAT_VERSION:
+            raise MannequinError([Problem("", "version", f"is {_short(version)}; this ElliMann reads versions 1 to "
                                                          f"{FORMAT_VERSION}")])
+        problems = []
+        units = data.get("units", "m")
+        if units != "m":
+            problems.append(Problem("", "units", f"is {_short(units)}; mannequin files are in metres ('m')"))
+        name, role = (data.get("name") or "", data.get("role") or "synthesized")  # null as if absent
+        for key, value, kinds in (("name", name, "a string"), ("role", role, f"one of {', '.join(ROLES)}")):
+            if not isinstance(value, str):
+                problems.append(Problem("", key, f"must be {kinds}, got {_json_type(value)}"))
+        measurements = data.get("measurements_cm")
+        if measurements is not None and not isinstance(measurements, dict):
+            problems.append(Problem("", "measurements_cm", "must be an object of He, Sh, Br, Wa, Hi in cm (or null), "
+                                                           f"got {_json_type(measurements)}"))
         items = data.get("ellipsoids")
         if not isinstance(items, list) or not items:
-            raise MannequinError([Problem("", "ellipsoids", "missing or empty")])
+            got = "it is missing" if items is None else "it is empty" if items == [] else f"got {_json_type(items)}"
+            problems.append(Problem("", "ellipsoids", f"must be a non-empty list of ellipsoid objects; {got}"))
+        else:
+            problems += [Problem("", f"ellipsoids[{i}]", f"must be an object (name, side, region, girth, depends, "
+                                                         f"center, axes, semi_axes), got {_json_type(item)}")
+                         for i, item in enumerate(items) if not isinstance(item, dict)]
+        if problems:
+            raise MannequinError(problems)
         topology = Topology.from_list(items)
         problems = []
         arrays = {"center": [], "axes": [], "semi_axes": []}
@@ -318,7 +358,7 @@ class Mannequin:
             for key, shape in (("center", (3,)), ("axes", (3, 3)), ("semi_axes", (3,))):
                 try:
                     value = np.array(item.get(key), dtype=float)
-                except (TypeError, ValueError):
+                except (TypeError, ValueError, OverflowError, RecursionError):
                     value = None
                 if value is None or value.shape != shape:
                     problems.append(Problem(item["name"], key, f"missing or not a {'x'.join(map(str, shape))} array"))
@@ -327,8 +367,7 @@ class Mannequin:
         if problems:
             raise MannequinError(problems)
         mannequin = cls(topology, np.swapaxes(np.array(arrays["axes"]), 1, 2), np.array(arrays["center"]),
-                        np.array(arrays["semi_axes"]), name=str(data.get("name", "")),
-                        role=str(data.get("role", "synthesized")), measurements=data.get("measurements_cm"))
+                        np.array(arrays["semi_axes"]), name=name, role=role, measurements=measurements)
         return mannequin.check() if check else mannequin
 
     def to_json(self):
@@ -339,16 +378,92 @@ class Mannequin:
 
     @classmethod
     def load(cls, path, check=True):
+        """Read a mannequin JSON file (UTF-8). Whatever the file holds, a bad one raises MannequinError naming
+        the file or the field (OSError if it cannot be opened)."""
+        with open(path, "rb") as stream:
+            raw = stream.read()
         try:
-            with open(path, encoding="utf-8") as stream:
-                data = json.load(stream)
-        except json.JSONDecodeError as error:
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError as error:
+            encoding = _bom_encoding(raw)
+            what = f"is {encoding} text" if encoding else f"is not UTF-8 text (byte {error.start} is " \
+                                                          f"{raw[error.start]:#04x})"
+            raise MannequinError([Problem("", "file", f"{path} {what}; mannequin files are JSON in UTF-8")]) from None
+        try:
+            data = json.loads(text)
+        except RecursionError:
+            raise MannequinError([Problem("", "file", f"{path} is nested too deeply to be a mannequin (its "
+                                                      "JSON is 4 levels deep)")]) from None
+        except ValueError as error:  # JSONDecodeError, or an integer too long to convert
             raise MannequinError([Problem("", "file", f"{path} is not valid JSON ({error})")]) from None
         return cls.from_dict(data, check=check)
 
 
+def measurement_problems(measurements):
+    """Problems of target measurements: None, or a dict of some of He, Sh, Br, Wa, Hi in cm, each a number
+    within ``ABSURD_LIMITS`` (the limits a synthesis request must meet)."""
+    if measurements is None:
+        return []
+    if not isinstance(measurements, dict):
+        return [Problem("", "measurements", f"must be a dict of He, Sh, Br, Wa, Hi in cm (or None), got "
+                                            f"{_json_type(measurements)}")]
+    out = []
+    for key, value in measurements.items():
+        if key not in MEASUREMENTS:
+            out.append(Problem("", "measurements", f"{_short(key)} is not a measurement; expected some of "
+                                                   f"{', '.join(MEASUREMENTS)}"))
+            continue
+        low, high = ABSURD_LIMITS[key]
+        accepted = f"accepted range {low:g}-{high:g} cm"
+        if not _positive_number(value):
+            out.append(Problem("", "measurements", f"{key}={_short(value)} is not a positive measurement ({accepted})"))
+        elif not low <= value <= high:
+            out.append(Problem("", "measurements", f"{key}={value:g} cm is not a plausible value ({accepted})"))
+    return out
+
+
 def _positive_number(value):
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value > 0
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        return math.isfinite(value) and value > 0
+    except OverflowError:  # an int beyond float's range
+        return False
+
+
+def _bom_encoding(raw):
+    """'UTF-16' or 'UTF-32' if ``raw`` starts with that byte-order mark or looks like that encoding, else ''."""
+    if raw[:4] in (b"\xff\xfe\x00\x00", b"\x00\x00\xfe\xff"):
+        return "UTF-32"
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff") or (len(raw) >= 2 and b"\x00" in raw[:2]):
+        return "UTF-16"
+    return ""
+
+
+def _json_type(value):
+    """What a JSON value is, for messages: 'a list', 'a string', 'null', ..."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, (int, float)):
+        return "a number"
+    if isinstance(value, str):
+        return "a string"
+    if isinstance(value, (list, tuple)):
+        return "a list"
+    if isinstance(value, dict):
+        return "an object"
+    return f"a {type(value).__name__}"
+
+
+def _short(value, limit=60):
+    """repr of ``value`` cut to ``limit`` characters (a hostile file's values may be huge or deeply nested)."""
+    try:
+        text = repr(value)
+    except (RecursionError, ValueError):  # ValueError: an int too long to print
+        text = f"a {type(value).__name__}"
+    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def stack(mannequins):

@@ -53,7 +53,17 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from .clean import asymmetry
-from .constants import ABSURD_LIMITS, CM_PER_M, GIRTHS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
+from .constants import (
+    ABSURD_LIMITS,
+    CENTER_LIMIT,
+    CM_PER_M,
+    GIRTHS,
+    MEASUREMENTS,
+    RANGES,
+    REFERENCE_MEASUREMENTS,
+    SECTION_FRACTIONS,
+    SEMI_AXIS_LIMITS,
+)
 from .ellipsoid import axis_extent, section_at_height
 from .errors import ElliMannError, MannequinError, MeasurementError, ReferenceSetError
 from .frames import SAGITTAL_REFLECTION, rotation_mean, symmetrize_central
@@ -346,6 +356,9 @@ def _reference_measurements(mannequin, source):
 def load_reference_set(folder=None, names=REFERENCE_NAMES):
     """The five RMs from ``folder`` (default: the shipped ``reference_blends/``), one JSON file each."""
     folder = pathlib.Path(folder) if folder is not None else REFERENCE_FOLDER
+    if folder.exists() and not folder.is_dir():
+        raise ReferenceSetError(str(folder), "path", f"is a file, not a folder (a reference set is the folder "
+                                f"holding {', '.join(f'{n}.json' for n in names)})")
     if not folder.is_dir():
         raise ReferenceSetError(str(folder), "folder", "does not exist")
     mannequins, sources = [], []
@@ -732,6 +745,25 @@ def validate_requests(requests):
     return requests
 
 
+def check_plausible(topology, requests, rotation, center, semi_axes):
+    """Refuse synthesis results (B, n, ...) with a piece outside the plausibility limits (SEMI_AXIS_LIMITS,
+    CENTER_LIMIT) or not finite, as a file or a collection holding them would be: ElliMannError naming the
+    request, the part, the field and the range. One vectorised test; the message comes from
+    ``Mannequin.problems`` of the first bad result."""
+    low, high = SEMI_AXIS_LIMITS
+    with np.errstate(invalid="ignore"):
+        good = (np.all(np.isfinite(semi_axes), axis=-1) & np.all((semi_axes >= low) & (semi_axes <= high), axis=-1)
+                & np.all(np.isfinite(center), axis=-1) & np.all(np.abs(center) <= CENTER_LIMIT, axis=-1)
+                & np.all(np.isfinite(rotation), axis=(-1, -2)))
+    if np.all(good):
+        return
+    row = int(np.argwhere(~good)[0][0])
+    mannequin = Mannequin(topology, rotation[row], center[row], semi_axes[row])
+    problems = [p for p in mannequin.problems() if p.field in ("rotation", "center", "semi_axes")]
+    request = ", ".join(f"{k} {v:g}" for k, v in zip(MEASUREMENTS, requests[row]))
+    raise ElliMannError(f"synthesis at {request} cm gives an implausible mannequin: {MannequinError(problems)}")
+
+
 def synthesize_batch(reference, requests, mode="idw", metric="raw", power=DEFAULT_POWER, measure=True,
                      tolerance=EXACT_TOLERANCE, normalize=DEFAULT_NORMALIZE):
     """Synthesize many mannequins at once: requests (B, 5) cm -> Synthesis with (B, n, ...) arrays.
@@ -750,6 +782,7 @@ def synthesize_batch(reference, requests, mode="idw", metric="raw", power=DEFAUL
                         jacobian=reference.refine_jacobian())
         center, semi_axes, measured = result.center, result.semi_axes, result.measured
         factors, converged = result.factors, result.converged
+    check_plausible(reference.topology, requests, rotation, center, semi_axes)
     return Synthesis(reference.topology, requests, rotation, center, semi_axes, measured, factors, converged, mode)
 
 

@@ -89,7 +89,8 @@ def test_infinity_in_a_file_and_in_the_measurements_is_refused(toy):
     with pytest.raises(MannequinError, match="'2.b Belly' center: contains NaN or infinity"):
         Mannequin.from_dict(json.loads(json.dumps(data)))
     bad = toy.copy(measurements={"He": float("inf"), "Sh": 40.0})
-    assert [str(p) for p in bad.problems()] == ["measurements: He=inf is not a positive measurement"]
+    assert [str(p) for p in bad.problems()] == [
+        "measurements: He=inf is not a positive measurement (accepted range 50-250 cm)"]
 
 
 @pytest.mark.parametrize("name", ["", None, 7])
