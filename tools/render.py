@@ -185,4 +185,6 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from ellimann_addon.blender import teardown
+
+    teardown.exit_with(main())

@@ -38,6 +38,13 @@ def atomic_output(path):
             try:
                 yield temp
             except RuntimeError as error:  # what a bpy.ops call raises when Blender could not write
+                if disk_full(folder):
+                    raise OSError(errno.ENOSPC, "No space left on device", target) from error
+                # Blender 4.x reports a full disk as "No such file or directory" (it has removed its
+                # partial file by then): a write of the size of a small .blend tells.
+                no_room = _no_room_for(scratch, PROBE_BYTES)
+                if no_room:
+                    raise OSError(no_room.errno, no_room.strerror, target) from error
                 raise blender_write_error(error, temp, target) from error
             problem = incomplete(temp) if os.path.isfile(temp) else "Blender wrote nothing"
             full = disk_full(folder)
@@ -49,6 +56,23 @@ def atomic_output(path):
             os.replace(temp, path)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
+
+
+PROBE_BYTES = 1 << 20
+
+
+def _no_room_for(folder, size):
+    """The OSError (no space, quota or file size limit) that writing ``size`` bytes in ``folder`` meets
+    now, or None (a scratch file, removed at once)."""
+    try:
+        with tempfile.TemporaryFile(dir=folder) as probe:
+            probe.write(bytes(size))
+            probe.flush()
+            os.fsync(probe.fileno())
+    except OSError as error:
+        if error.errno in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
+            return error
+    return None
 
 
 def blender_write_error(error, temp, target):

@@ -3,7 +3,8 @@
 Blender 4.2-4.5 as a module crash (SIGSEGV) in their own teardown at interpreter exit once any
 property with a Python callback (``update=``, ``poll=``) has been registered, unregistered or not:
 the work is done and the files are written, but the exit code is 139. 5.0 and later exit cleanly.
-On those versions the process leaves through :func:`exit_without_teardown` instead.
+On those versions the process leaves through :func:`exit_without_teardown` instead: scripts end
+with ``teardown.exit_with(code)`` where they would ``sys.exit(code)``.
 """
 
 import os
@@ -31,3 +32,10 @@ def exit_without_teardown(code):
     if tempdir and os.path.basename(os.path.normpath(tempdir)).startswith("blender_"):
         shutil.rmtree(tempdir, ignore_errors=True)
     os._exit(code)
+
+
+def exit_with(code):
+    """``sys.exit(code)``, skipping Blender's teardown where it crashes."""
+    if needs_workaround():
+        exit_without_teardown(code)
+    sys.exit(code)
