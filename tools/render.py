@@ -11,7 +11,6 @@ traced over); several slots stand side by side along X for a line-up.
 
 import argparse
 import math
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
