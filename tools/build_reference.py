@@ -29,6 +29,7 @@ import argparse
 import pathlib
 import sys
 import time
+import zlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,20 +56,23 @@ from . import reference_topology as rt
 from .bodies import (
     REFERENCE_BODY,
     RM_BODIES,
+    Body,
     body_measurements,
     hidden_vertices,
-    load_body,
     load_labels,
     vertex_areas,
     vertex_normals,
 )
-from .fitting import hull_surface, inscribed_ellipsoid
+from .bodies import load_body as load_obj_body
+from .fitting import cell_share, hull_surface, inscribed_ellipsoid
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 DEFAULT_REFMODELS = REPO.parent / "shared" / "refmodels"
 BASE_FILE = "base_mannequin"
 REFERENCE_RM = "average"  # the RM whose axes the others are relabelled against
-ADJUST_TOLERANCE = 1e-5  # relative m_T error the adjustment aims at
+# Relative m_T error the adjustment aims at: where Newton has converged, so where it stops (an
+# iteration more or less) moves no part by more than rounding; at 1e-5 that was ~0.4 um.
+ADJUST_TOLERANCE = 1e-12
 ADJUST_ITERATIONS = 40
 FILL_SPACING = 0.008  # m: grid sampling each body's volume, which the parts are placed to fill
 FILL_PASSES = 2  # placements of every part: the first alone, the others around the rest
@@ -138,11 +142,10 @@ def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
     specs = [spec for spec, _ in rt.expanded()]
     fitted = [i for i, part in enumerate(topology) if part.side != "R"]
     twins = topology.twin_indices
-    covers = np.zeros((n, len(inside)), dtype=bool)
+    covers = np.zeros((n, len(inside)))  # share of each cell inside each part (fitting.cell_share)
 
     def cover(i):
-        local = (inside - center[i]) @ rotation[i] / semi_axes[i]
-        return np.einsum("pk,pk->p", local, local) < 1.0
+        return cell_share((inside - center[i]) @ rotation[i], semi_axes[i], FILL_SPACING)
 
     for round_ in range(FILL_PASSES):
         for i in fitted:
@@ -167,8 +170,8 @@ def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
                 walls, wall_areas = body.vertices[walls] + spec.depth * normals[walls], areas[walls]
             weight = np.ones(len(inside))
             if round_:
-                others = np.delete(covers, [i, twins[i]], axis=0).any(axis=0)
-                weight = np.where(others, FILL_SHARED, 1.0)
+                others = np.delete(covers, [i, twins[i]], axis=0).max(axis=0)
+                weight = 1.0 + (FILL_SHARED - 1.0) * others
             for key in spec.depends:
                 if key in SECTION_FRACTIONS and (spec.girth or key == "Sh"):
                     near = np.abs(inside[:, 2] - bottom - SECTION_FRACTIONS[key] * height) < SLAB * height
@@ -176,7 +179,7 @@ def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
             rotation[i], center[i], semi_axes[i], kept_out[i] = inscribed_ellipsoid(
                 points, weights, walls, wall_areas, ref_rotation, margin=spec.margin, inside_fraction=spec.inside,
                 frame=spec.frame, match=match, floor=floor, ceiling=ceiling, level=level, span=spec.span,
-                fill=inside, fill_weight=weight)
+                fill=inside, fill_weight=weight, fill_spacing=FILL_SPACING)
             if twins[i] != i:
                 rotation[twins[i]], center[twins[i]] = mirror_frame(rotation[i], center[i])
                 semi_axes[twins[i]] = semi_axes[i]
@@ -185,10 +188,22 @@ def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
         kept_out[twins[i]] if part.side == "R" else kept_out[i] for i, part in enumerate(topology)]
 
 
-def build(refmodels=DEFAULT_REFMODELS, log=print):
-    """Build BM and the five RMs. Returns (base, {name: rm}, report dict)."""
+def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
+    """Build BM and the five RMs. Returns (base, {name: rm}, report dict).
+
+    ``jitter`` (m): every body vertex moved by a seeded uniform offset up to that much, to test that
+    the build does not amplify rounding (tests/tools/test_build_reference.py).
+    """
     started = time.perf_counter()
     labels = load_labels(refmodels)
+
+    def load_body(folder, name):
+        body = load_obj_body(folder, name)
+        if not jitter:
+            return body
+        rng = np.random.default_rng(zlib.crc32(name.encode()))
+        return Body(body.name, body.vertices + rng.uniform(-jitter, jitter, body.vertices.shape), body.faces)
+
     reference_body = load_body(refmodels, REFERENCE_BODY)
     tracing = Tracing.on(reference_body, labels)
 
