@@ -145,6 +145,9 @@ def hidden_vertices(vertices, faces, normals, candidates, reach=0.1, cell=0.01):
         q = np.cross(s, edge1)
         v = np.einsum("ij,ij->i", d, q) * inv
         t = np.einsum("ij,ij->i", q, edge2) * inv
-    # the vertex's own triangles meet the ray at t = 0
-    hit = (np.abs(det) > 1e-14) & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 1e-4) & (t < reach)
+    # the vertex's own triangles meet the ray at t = 0. A ray through an edge meets the surface: on a
+    # symmetric mesh the midline's rays run along its edges, where the sign of u or v is rounding's.
+    edge = 1e-9
+    hit = ((np.abs(det) > 1e-14) & (u >= -edge) & (v >= -edge) & (u + v <= 1 + edge) & (t > 1e-4)
+           & (t < reach))
     return np.bincount(ray[hit], minlength=len(candidates)) > 0

@@ -29,6 +29,7 @@ _BUCKET = 0.01  # m: cell of the triangle index used by the vertical rays
 _SURFACE_SAMPLES = 1000  # points per ellipsoid surface, for the depth outside the body
 _CUSHION_SUBDIVISIONS = 3  # hull meshes for the metrics (642 support points per ellipsoid)
 _NUDGE = (1.3e-7, 0.7e-7)  # m: moves a query line off the mesh edges that lie in the sagittal plane
+DEPTH_TIE = 1e-7  # m: depths closer than this are equal (the docs print 0.1 mm; rounding is ~1e-15)
 _NEAREST_VERTICES = 4  # the nearest triangle is searched among those around this many nearest vertices
 
 # Each chain is a list of links, each link the labels (names without number and side) of its parts;
@@ -264,7 +265,8 @@ def fill_metrics(body, grid, mannequin, cavity=None):
     for key, cushions, depths in (("ellipsoids", False, depth), ("cushions", True, cushion_depth)):
         occupied = occupancy(grid, mannequin, cushions, hulls)
         covered = np.count_nonzero(occupied & grid.inside)
-        deepest = max(depths, key=depths.get)
+        # mirror twins reach equally deep up to rounding: the first (the left one) within DEPTH_TIE is named
+        deepest = next(name for name, d in depths.items() if d >= max(depths.values()) - DEPTH_TIE)
         out[key] = {"coverage": covered / np.count_nonzero(grid.inside),
                     "excess": 1.0 - covered / max(np.count_nonzero(occupied), 1),
                     "depth": depths[deepest], "deepest": deepest}

@@ -28,10 +28,16 @@ from ellimann_addon.core.frames import relabel_to_reference
 DEGENERATE = 0.12  # relative gap below which two principal variances do not fix their axes
 GROWTH = 1.15  # largest growth of a semi-axis per round: keeps the ascent from favouring one axis
 ROUNDS = 60  # of the growth towards a maximal ellipsoid, at most
-CONVERGED = 1e-3  # relative growth below which the ascent stops
-_FRACTIONS = np.linspace(0.0, 1.0, 33)[1:]  # how far towards a round's proposal to grow: all tried at once
+# Relative growth below which the ascent has stopped: so small that stopping a round earlier or later
+# moves nothing, so the result does not hinge on rounding (a coarser test would).
+STALLED = 1e-12
+ENTRY_NEWTON = 30  # Newton steps to where a point enters the growing ellipsoid (converges from one side)
+# A step stops where the point it meets is this far out (in sum (x_k / D_k)^2 - 1): far above rounding,
+# so that point is outside in every later test, not inside or outside by the last bit.
+CONTACT = 1e-12
 PATTERN_STEPS = 5  # halvings of the centre search step
 SHAPE_STEP = 0.4  # first step of the search over the starting shape (log ratio of semi-axes)
+TIE = 1e-10  # relative difference below which two values of the search are the same (rounding is ~1e-14)
 
 
 FRAMES = ("limb", "main", "axis", "fixed")
@@ -126,7 +132,10 @@ def _grow(local, area, limit, start, allowed, up=None, reach=np.inf):
             sq, area, radius = all_sq[near], all_area[near], radius[near]
             cap = limit.copy()
             if len(sq):
-                room = 1.0 - radius[:, None] + sq * inv  # (m, 3): with the other two axes as they are
+                # a point a step stopped at (CONTACT out) is on the surface: it blocks every axis it has a
+                # component along, rather than letting one creep on by a margin that rounding would set
+                on = np.where(radius < 1.0 + 2.0 * CONTACT, np.minimum(radius, 1.0), radius)
+                room = 1.0 - on[:, None] + sq * inv  # (m, 3): with the other two axes as they are
                 # a point with room > 0 stays outside while semi_i <= |p_i| / sqrt(room)
                 bound = np.where(room > 0.0, np.sqrt(sq / room), np.inf)
                 if allowed > 0.0:
@@ -140,20 +149,63 @@ def _grow(local, area, limit, start, allowed, up=None, reach=np.inf):
                 rest = reach ** 2 - up2 @ semi ** 2 + up2 * semi ** 2
                 cap = np.where(up2 > 0.0, np.minimum(cap, np.sqrt(np.maximum(rest, 0.0) / up2)), cap)
             proposal = np.maximum(semi, np.minimum(semi * GROWTH, cap))
-            if np.all(proposal <= semi * (1.0 + CONVERGED)):
+            if np.all(proposal <= semi * (1.0 + STALLED)):
                 break
-            # as far towards the proposal as stays feasible (geometric steps, all tried at once)
-            candidates = semi * (proposal / semi) ** _FRACTIONS[:, None]
-            ok = feasible(sq, area, candidates)
-            if not ok[0]:
+            rate = np.log(proposal / semi)
+            t = _furthest_feasible(sq * inv, area, rate, allowed)
+            if bounded:
+                t = min(t, _within_reach(up2 * semi ** 2, rate, reach2))
+            if np.all(t * rate <= STALLED):  # blocked: the next round would propose the same
                 break
-            semi = candidates[-1] if ok.all() else candidates[np.argmin(ok) - 1]
+            semi = semi * np.exp(t * rate)
     return semi
+
+
+def _furthest_feasible(scaled, area, rate, allowed):
+    """Largest t in [0, 1] for which the points of total ``area`` inside the ellipsoid of semi-axes
+    semi * exp(t * rate) stay within ``allowed``; ``scaled`` (m, 3): squared coordinates over semi^2.
+
+    The exact time each point meets the surface (CONTACT outside it), a continuous function of the
+    points, where trying a fixed set of steps would jump from one step to the next as a point moves
+    across it: along the path every semi-axis grows, so each point's g(t) = sum_k scaled_k
+    exp(-2 rate_k t) decreases, convex; Newton from t = 0 approaches g = 1 + CONTACT from below.
+    """
+    g0 = scaled.sum(axis=1)
+    g1 = scaled @ np.exp(-2.0 * rate)
+    entering = (g0 >= 1.0) & (g1 < 1.0 + CONTACT)
+    inside = area[g0 < 1.0].sum()
+    if inside > allowed:
+        return 0.0
+    if inside + area[entering].sum() <= allowed:
+        return 1.0
+    a, b = scaled[entering], 2.0 * rate
+    t = np.zeros(len(a))
+    for _ in range(ENTRY_NEWTON):
+        terms = a * np.exp(-np.outer(t, b))
+        step = (terms.sum(axis=1) - 1.0 - CONTACT) / np.maximum(terms @ b, 1e-300)
+        t = np.clip(t + step, 0.0, 1.0)
+    order = np.argsort(t, kind="stable")
+    over = inside + np.cumsum(area[entering][order]) > allowed
+    return float(t[order][np.argmax(over)])
+
+
+def _within_reach(weighted, rate, reach2):
+    """Largest t in [0, 1] with sum_k weighted_k exp(2 rate_k t) <= reach2 (the half-height bound)."""
+    def height2(t):
+        return weighted @ np.exp(2.0 * rate * t)
+
+    if height2(1.0) <= reach2:
+        return 1.0
+    lo, hi = 0.0, 1.0
+    for _ in range(60):  # bisection to 1e-18: fixed, so the result moves smoothly with the inputs
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if height2(mid) <= reach2 else (lo, mid)
+    return lo
 
 
 def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=None, margin=0.1,
                         inside_fraction=0.002, frame="main", match=None, floor=-np.inf,
-                        ceiling=np.inf, level=None, span=False, fill=None, fill_weight=None):
+                        ceiling=np.inf, level=None, span=False, fill=None, fill_weight=None, fill_spacing=None):
     """A maximal ellipsoid, in the part's frame, inside the body and the selection's box.
 
     ``selected`` (k, 3) vertices of the part with area ``weights``; ``obstacles`` (m, 3) body
@@ -167,9 +219,9 @@ def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=N
     ``span``: the semi-axis along the axis taken from the points is the box's half-length along it
     (less if ``floor`` or ``ceiling`` allow less), and the centre the box's middle there: a limb's
     part reaches from one end of its segment to the other, however the limb tapers (only the
-    cross-section grows). ``fill``: points (p, 3) sampling
-    the body's volume (e.g. a regular grid inside it); if given, the centre is chosen for the
-    ellipsoid to cover most of them within the box, instead of for the largest ellipsoid: a part
+    cross-section grows). ``fill``: the centres (p, 3) of the cells of a regular grid of
+    ``fill_spacing`` sampling the body's volume; if given, the centre is chosen for the
+    ellipsoid to cover most of them (by :func:`cell_share`) within the box, instead of for the largest ellipsoid: a part
     fills its region rather than settling where the body is thickest. ``fill_weight`` (p,): what
     covering each point is worth (default 1), e.g. less where other parts already cover it.
     Returns (rotation, center, semi_axes, kept axis index).
@@ -189,7 +241,8 @@ def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=N
     allowed = inside_fraction * area.sum()
     if fill is not None:
         fill = (np.asarray(fill) - centroid) @ rotation
-        in_box = np.all((fill > lo) & (fill < hi), axis=1)
+        # every cell the ellipsoid (inside the box) can share, however the box moves
+        in_box = np.all((fill > lo - fill_spacing) & (fill < hi + fill_spacing), axis=1)
         fill = fill[in_box]
         fill_weight = np.ones(len(fill)) if fill_weight is None else np.asarray(fill_weight)[in_box]
 
@@ -206,7 +259,7 @@ def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=N
         if fill is None or not np.all(semi > 0.0):
             return float(np.prod(semi)), semi
         # covered volume; the ellipsoid's own volume (tiny weight) breaks ties
-        covered = fill_weight @ (np.sum(((fill - centre) / semi) ** 2, axis=1) < 1.0)
+        covered = fill_weight @ cell_share(fill - centre, semi, fill_spacing)
         return covered + 1e-3 * float(np.prod(semi)) / float(np.prod(half)), semi
 
     centre = box_centre.copy()
@@ -236,13 +289,32 @@ def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=N
             # best of the moves (not the first improving one), so the search has no preferred axis or sign
             trials = [x + sign * step[k] * np.eye(len(x))[k] for k in range(len(x)) for sign in (1.0, -1.0)]
             results = [solve(*unpack(trial)) for trial in trials]
-            k = int(np.argmax([value for value, _ in results]))
-            if results[k][0] <= best * (1.0 + 1e-9):
+            values = np.array([value for value, _ in results])
+            # Trials within TIE of the best are equal: different starting shapes often grow into the same
+            # ellipsoid, equal up to rounding, and rounding must not pick one. The first of them is taken.
+            k = int(np.argmax(values >= values.max() - TIE * abs(values.max())))
+            if values[k] <= best * (1.0 + 1e-9):
                 break
             x, (best, semi) = trials[k], results[k]
         step = 0.5 * step
     centre, _ = unpack(x)
     return rotation, centroid + rotation @ centre, semi, kept
+
+
+def cell_share(local, semi_axes, spacing):
+    """Share (0..1) of the cells of size ``spacing`` centred at ``local`` (p, 3) inside the ellipsoid of
+    ``semi_axes`` (3,) about the origin, in its frame: 1/2 + signed distance to the surface / spacing,
+    clipped, the distance to first order (1 - g) / |grad g| of g = sum (x_k / D_k)^2.
+
+    A share, not an inside test, so the volume an ellipsoid covers changes continuously as it or the
+    cells move: with a count, a cell centre crossing the surface by rounding would decide a search.
+    """
+    scaled = local / semi_axes
+    g = np.einsum("pk,pk->p", scaled, scaled)
+    gradient = 2.0 * np.linalg.norm(scaled / semi_axes, axis=1)
+    with np.errstate(divide="ignore"):
+        distance = (1.0 - g) / gradient  # +inf at the centre
+    return np.clip(0.5 + distance / spacing, 0.0, 1.0)
 
 
 def hull_surface(points, depth=0.0, spacing=0.003):

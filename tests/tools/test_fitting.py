@@ -131,7 +131,7 @@ def test_fill_weights_draw_the_part_to_the_volume_that_counts():
     grid = np.stack(np.meshgrid(np.linspace(-0.3, 0.3, 61), np.linspace(-0.05, 0.05, 11),
                                 np.linspace(-0.05, 0.05, 11), indexing="ij"), axis=-1).reshape(-1, 3)
     inside = grid[np.hypot(grid[:, 1], grid[:, 2]) < 0.05]
-    fit = dict(frame="fixed", inside_fraction=0.0, margin=0.0, fill=inside)
+    fit = dict(frame="fixed", inside_fraction=0.0, margin=0.0, fill=inside, fill_spacing=0.01)
     _, even, _, _ = inscribed_ellipsoid(points, weights, points, weights, **fit)
     _, right, _, _ = inscribed_ellipsoid(points, weights, points, weights, **fit,
                                          fill_weight=(inside[:, 0] > 0.1).astype(float))
