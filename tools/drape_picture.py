@@ -37,9 +37,9 @@ def main(argv=None):
     import bpy
 
     import ellimann_addon
-    from ellimann_addon.blender import drape, render
-    from ellimann_addon.blender.convert import mesh_from_arrays
-    from ellimann_addon.blender.output import add_mannequin, empty_scene
+    from ellimann_addon.blender.bridge.convert import mesh_from_arrays
+    from ellimann_addon.blender.services import drape, render
+    from ellimann_addon.blender.services.scene import add_mannequin, empty_scene
 
     ellimann_addon.register()
     mannequin = Mannequin.load(REFERENCE_FOLDER / f"{BODY}.json")

@@ -19,7 +19,7 @@ import numpy as np
 from mathutils import Matrix
 
 import ellimann_addon
-from ellimann_addon.blender.convert import mannequin_to_collection
+from ellimann_addon.blender.bridge.convert import mannequin_to_collection
 from ellimann_addon.core.mannequin import Mannequin
 
 GHOST_COLOR = (0.55, 0.55, 0.58, 0.22)
@@ -184,6 +184,6 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    from ellimann_addon.blender import teardown
+    from ellimann_addon.blender.services import teardown
 
     teardown.exit_with(main())
