@@ -28,7 +28,7 @@ import numpy as np
 
 from ellimann_addon.core import garments
 from ellimann_addon.core.collision import collision_pieces, triangle_count
-from ellimann_addon.core.fit_metrics import BodyPieces, fit_statistics, mesh_distance
+from ellimann_addon.core.garment_fit import BodyPieces, fit_statistics, mesh_distance
 from ellimann_addon.core.mannequin import Mannequin
 from ellimann_addon.core.synthesis import REFERENCE_FOLDER
 from tools.bodies import load_obj

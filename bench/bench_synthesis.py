@@ -304,11 +304,12 @@ def measure_in_blender(bpy, convert, collections):
 def old_live_update(props, target, output, convert):
     """A live update as it was before in-place cushions: every cushion rebuilt at 642 vertices."""
     from ellimann_addon.blender.features.synthesize.request import synthesize_request
+    from ellimann_addon.core.constants import LIVE_CUSHION_LEVEL
 
     mannequin, measured, _ = synthesize_request(props)
     convert.update_collection_geometry(target, mannequin)
     convert.write_measured(target, measured)
-    output.refresh_cushions(target, output.LIVE_SUBDIVISIONS)
+    output.refresh_cushions(target, LIVE_CUSHION_LEVEL)
     if target.name != mannequin.name:
         target.name = mannequin.name
 

@@ -18,7 +18,7 @@ from bench.bench_drape import BODY, EDGE, REFMODELS
 from ellimann_addon.core import garments
 from ellimann_addon.core.collision import collision_pieces
 from ellimann_addon.core.ellipsoid import bounds
-from ellimann_addon.core.fit_metrics import BodyPieces, mesh_distance
+from ellimann_addon.core.garment_fit import BodyPieces, mesh_distance
 from ellimann_addon.core.mannequin import Mannequin
 from ellimann_addon.core.synthesis import REFERENCE_FOLDER
 from tools.bodies import load_obj

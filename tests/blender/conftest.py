@@ -46,7 +46,7 @@ def pytest_sessionfinish(session, exitstatus):
 @pytest.hookimpl(trylast=True)
 def pytest_unconfigure(config):
     # Blender 4.x as a module segfaults in its own teardown after the tests have run and reported
-    # (ellimann_addon/blender/teardown.py): leave with pytest's own exit status instead.
+    # (ellimann_addon/blender/services/teardown.py): leave with pytest's own exit status instead.
     from ellimann_addon.blender.services import teardown
 
     if teardown.needs_workaround() and "code" in _exit_status:

@@ -17,8 +17,15 @@ from ellimann_addon.blender.bridge.built import is_stale
 from ellimann_addon.blender.bridge.selection import part_lookup
 from ellimann_addon.blender.features.synthesize import live, panel, presets
 from ellimann_addon.blender.features.synthesize import props as synthesis_props
-from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS, TABLE_2_5
-from ellimann_addon.core.cushion import DEFAULT_SUBDIVISIONS, cushion_vertices
+from ellimann_addon.core.constants import (
+    ABSURD_LIMITS,
+    CUSHION_LEVEL,
+    MEASUREMENTS,
+    RANGES,
+    REFERENCE_MEASUREMENTS,
+    TABLE_2_5,
+)
+from ellimann_addon.core.cushion import cushion_vertices
 from ellimann_addon.core.mesh import convexity_defect, is_closed_manifold
 from ellimann_addon.core.synthesis import synthesize as core_synthesize
 
@@ -152,7 +159,7 @@ def test_live_moves_the_cushions_in_place_then_rebuilds_them_exactly(props):
     for obj in cushions:  # vertices: the support points of the moved ellipsoids, in the first one's frame
         first, second = names.index(obj.ellimann.part_name), names.index(obj.ellimann.partner)
         expected = cushion_vertices(mannequin.rotation, mannequin.center, mannequin.semi_axes, [(first, second)],
-                                    DEFAULT_SUBDIVISIONS)[0]
+                                    CUSHION_LEVEL)[0]
         np.testing.assert_allclose(local_vertices(obj), expected, atol=1e-6)
         assert np.abs(local_vertices(obj) - before[obj.name][1]).max() > 1e-4
         np.testing.assert_allclose(np.array(obj.matrix_world)[:3, 3], mannequin.center[first], atol=1e-6)

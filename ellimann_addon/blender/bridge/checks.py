@@ -7,13 +7,13 @@ reported by part name, and can be repaired exactly: the repaired ellipsoid is th
 
 import numpy as np
 
+from ...core.constants import UNIT_SPHERE_LEVEL
 from ...core.ellipsoid import repair_matrix_world
 from ...core.errors import FrameError, MannequinError, Problem
 from ...core.fit import fit_affine
 from ...core.mannequin import Topology
 from ...core.mesh import icosphere
 from .convert import (
-    UNIT_SPHERE_SUBDIVISIONS,
     collection_to_mannequin,
     ellipsoid_frame,
     ellipsoid_objects,
@@ -56,7 +56,7 @@ def repaired_frame(obj):
     if obj.type != "MESH":
         raise FrameError("object", f"is a {obj.type.lower()}, not a mesh", "matrix")
     if not is_unit_sphere(obj.data):
-        unit, _ = icosphere(UNIT_SPHERE_SUBDIVISIONS)
+        unit, _ = icosphere(UNIT_SPHERE_LEVEL)
         vertices = mesh_vertices(obj.data)
         if len(vertices) != len(unit):
             raise FrameError("mesh", f"has {len(vertices)} vertices, not the unit sphere's {len(unit)}: it was "

@@ -9,14 +9,13 @@ import bpy
 import numpy as np
 from mathutils import Matrix
 
-from ...core.constants import MEASUREMENTS
+from ...core.constants import MEASUREMENTS, UNIT_SPHERE_LEVEL
 from ...core.ellipsoid import decompose_matrices_world, decompose_matrix_world, matrix_world
 from ...core.errors import FrameError, MannequinError, Problem
 from ...core.mannequin import NAME_PATTERN, Mannequin, Part, Topology
 from ...core.mesh import icosphere
 
 UNIT_SPHERE_NAME = "ElliMann Unit Sphere"
-UNIT_SPHERE_SUBDIVISIONS = 3
 UNIT_SPHERE_TOLERANCE = 1e-4  # single-precision vertices of the icosphere are within 1e-7
 SIDE_COLORS = {"L": (0.85, 0.55, 0.45, 1.0), "R": (0.45, 0.6, 0.85, 1.0), "C": (0.8, 0.78, 0.72, 1.0)}
 
@@ -32,7 +31,7 @@ def unit_sphere_mesh():
     for mesh in candidates:
         if mesh.get("ellimann_unit_sphere") and is_unit_sphere(mesh):
             return mesh
-    mesh = mesh_from_arrays(UNIT_SPHERE_NAME, *icosphere(UNIT_SPHERE_SUBDIVISIONS))
+    mesh = mesh_from_arrays(UNIT_SPHERE_NAME, *icosphere(UNIT_SPHERE_LEVEL))
     mesh.shade_smooth()
     mesh["ellimann_unit_sphere"] = 1
     return mesh

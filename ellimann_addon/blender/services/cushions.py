@@ -5,7 +5,8 @@ Shared by the Build Cushions operator, the Synthesize feature (live updates) and
 
 from mathutils import Matrix
 
-from ...core.cushion import DEFAULT_SUBDIVISIONS, mannequin_cushions
+from ...core.constants import CUSHION_LEVEL
+from ...core.cushion import mannequin_cushions
 from ...core.errors import MannequinError, Problem
 from ...core.frames import rigid_matrix
 from ..bridge.built import built_collection, new_cushion_object, remove_built
@@ -18,7 +19,7 @@ def rigid_frame(rotation, center):
     return Matrix(rigid_matrix(rotation, center).tolist())
 
 
-def build_cushions(collection, subdivisions=DEFAULT_SUBDIVISIONS, mannequin=None):
+def build_cushions(collection, subdivisions=CUSHION_LEVEL, mannequin=None):
     """Build (or rebuild) the cushions of a mannequin collection; returns (new objects, number replaced).
 
     ``mannequin``: the core mannequin the collection was just made from, when the caller has it (the

@@ -27,8 +27,9 @@ from mathutils import Matrix
 
 from ...core import garments
 from ...core.collision import CollisionPiece, check_subdivisions, collision_pieces, triangle_count
+from ...core.constants import CLEARING_CUSHION_LEVEL, FIT_CUSHION_LEVEL
 from ...core.errors import ElliMannError
-from ...core.fit_metrics import BodyPieces, fit_statistics
+from ...core.garment_fit import BodyPieces, fit_statistics
 from ..bridge.convert import mesh_from_arrays, new_collection
 
 DRAPE_KEY = "ellimann_drape"  # ID property on a drape collection: the garment's name
@@ -36,8 +37,6 @@ PIN_GROUP = "Pin"
 CLOTH_NAME = "Cloth"
 GARMENT_COLOR = (0.22, 0.45, 0.75, 1.0)
 FRAME_RANGE = (2, 2000)
-EXACT_SUBDIVISIONS = 4  # cushion hulls the fit statistics are measured against (finer than the colliders)
-CLEARING_SUBDIVISIONS = 3  # cushion hulls a new garment is moved clear of (inscribed in the level-4 ones)
 # Distances to a cushion beyond these (m) are only bounded from below, which spares the exact search
 # for far points: the fit's distances are exact up to FIT_CUTOFF, the clearing's near the body.
 FIT_CUTOFF = 0.2
@@ -337,10 +336,10 @@ def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None,
     if isinstance(garment, str):
         garment = garments.make_garment(mannequin, garment, edge=settings.edge)
         # The builders wrap the ellipsoids, a few mm off; a cushion also fills the hollow between its two.
-        clearing = BodyPieces(mannequin, cushions, CLEARING_SUBDIVISIONS)
+        clearing = BodyPieces(mannequin, cushions, CLEARING_CUSHION_LEVEL)
         garment = garments.clear_of(garment, lambda points: clearing.signed_distance(points, CLEARING_CUTOFF)[0])
     pieces = collision_pieces(mannequin, cushions, settings.sphere_subdivisions, settings.cushion_subdivisions)
-    exact = BodyPieces(mannequin, cushions, EXACT_SUBDIVISIONS)
+    exact = BodyPieces(mannequin, cushions, FIT_CUSHION_LEVEL)
     name = name or f"Drape {garment.name} on {mannequin.name}"
     frame = scene.frame_current
     stage = "building"

@@ -38,8 +38,8 @@ def render_lineup(mannequins, filepath, labels=None, cushions=False, width=2000)
         x += hi[0] - lo[0] + GAP
     low[2] -= 0.12  # room for the labels
     _frame_front(scene, low, high, width)
-    _workbench(scene)
-    return _render(scene, filepath)
+    workbench(scene)
+    return write_png(scene, filepath)
 
 
 def _add_label(text, location, size=0.07):
@@ -83,11 +83,13 @@ def render_view(filepath, low, high, width=800, azimuth=0.0):
     """Workbench picture of the current scene as it is, framing the box low..high (m), written atomically."""
     scene = bpy.context.scene
     _frame_front(scene, low, high, width, azimuth=azimuth)
-    _workbench(scene)
-    return _render(scene, filepath)
+    workbench(scene)
+    return write_png(scene, filepath)
 
 
-def _workbench(scene):
+def workbench(scene):
+    """Workbench settings of every ElliMann picture (studio light, object colours, cavity, white world,
+    PNG); returns the new world."""
     scene.render.engine = "BLENDER_WORKBENCH"
     shading = scene.display.shading
     shading.light = "STUDIO"
@@ -100,10 +102,12 @@ def _workbench(scene):
     scene.render.image_settings.file_format = "PNG"
     scene.display_settings.display_device = "sRGB"
     scene.view_settings.view_transform = "Standard"
+    return world
 
 
-def _render(scene, filepath):
+def write_png(scene, filepath):
+    """Render ``scene`` (not necessarily the context's) to ``filepath``, atomically; returns the absolute path."""
     with atomic_output(filepath) as temp, blender_output():
         scene.render.filepath = temp
-        bpy.ops.render.render(write_still=True)
+        bpy.ops.render.render(write_still=True, scene=scene.name)
     return os.path.abspath(filepath)

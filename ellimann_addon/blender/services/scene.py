@@ -7,13 +7,11 @@ Used by the Synthesize feature (live updates), the CLI, the render service and t
 
 import bpy
 
-from ...core.cushion import DEFAULT_SUBDIVISIONS
+from ...core.constants import CUSHION_LEVEL, LIVE_CUSHION_LEVEL
 from ...core.errors import ElliMannError
 from ..bridge.convert import mannequin_to_collection, objects_recursive, write_measured
 from .chatter import blender_output
 from .cushions import build_cushions
-
-LIVE_SUBDIVISIONS = 3
 
 
 def empty_scene():
@@ -41,7 +39,7 @@ def add_mannequin(mannequin, measured=None, cushions=False):
     return collection
 
 
-def _add_cushions(collection, subdivisions=DEFAULT_SUBDIVISIONS, view_layer=None, mannequin=None):
+def _add_cushions(collection, subdivisions=CUSHION_LEVEL, view_layer=None, mannequin=None):
     """Build the cushions and hide the ellipsoids they replace in ``view_layer`` (default: the context's).
 
     Checked before anything changes: every ellipsoid to hide is in ``view_layer`` (ElliMannError otherwise),
@@ -64,13 +62,13 @@ def _add_cushions(collection, subdivisions=DEFAULT_SUBDIVISIONS, view_layer=None
         obj.hide_render = True
 
 
-def refresh_cushions(collection, subdivisions=LIVE_SUBDIVISIONS, view_layer=None):
+def refresh_cushions(collection, subdivisions=LIVE_CUSHION_LEVEL, view_layer=None):
     """Rebuild a mannequin's cushions after its ellipsoids moved (replaces only the cushions ElliMann built).
 
     Live updates call it rarely: while a slider is dragged they move the cushions in place
     (``features.synthesize.live.move_cushions``), and rebuild them here only once the fields are still
     (``features.synthesize.live.settle_live``) or when the cushions cannot be moved (one is missing). They rebuild at
-    ``subdivisions`` = LIVE_SUBDIVISIONS (642 vertices), or the cushions' own level if coarser, since
+    ``subdivisions`` = LIVE_CUSHION_LEVEL (642 vertices), or the cushions' own level if coarser, since
     a rebuild at Synthesize's 2,562 takes seconds; Synthesize builds them at full resolution.
 
     The ellipsoids they replace are hidden in ``view_layer`` (default: the context's; a timer passes the

@@ -3,7 +3,7 @@
 import bpy
 from bpy.props import IntProperty
 
-from ....core.cushion import DEFAULT_SUBDIVISIONS
+from ....core.constants import CUSHION_LEVEL, CUSHION_LEVELS
 from ....core.errors import MannequinError
 from ... import ids
 from ...services.cushions import build_cushions
@@ -17,7 +17,8 @@ class ELLIMANN_OT_build_cushions(MannequinOperator, bpy.types.Operator):
     bl_label = "Build Cushions"
     bl_options = {"REGISTER", "UNDO"}
 
-    subdivisions: IntProperty(name="Resolution", default=DEFAULT_SUBDIVISIONS, min=1, max=6,
+    subdivisions: IntProperty(name="Resolution", default=CUSHION_LEVEL, min=CUSHION_LEVELS[0],
+                              max=CUSHION_LEVELS[1],
                               description="Icosphere subdivisions of the hull's directions "
                                           "(vertices = 10 * 4^n + 2)")
 

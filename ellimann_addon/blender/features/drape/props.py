@@ -3,7 +3,7 @@
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
-from ....core.collision import SUBDIVISION_RANGE
+from ....core.constants import COLLIDER_LEVELS
 from ....core.garments import EDGE_RANGE
 from ...services.drape import FRAME_RANGE, DrapeSettings
 
@@ -16,7 +16,7 @@ DEFAULTS = DrapeSettings()
 
 
 def _subdivisions(name, default, what):
-    low, high = SUBDIVISION_RANGE
+    low, high = COLLIDER_LEVELS
     return IntProperty(name=name, default=default, min=low, max=high,
                        description=f"Icosphere level of the {what} colliders ({low}: coarsest, {high}: finest; "
                                    "triangles = 20 * 4^level)")

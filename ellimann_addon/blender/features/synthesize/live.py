@@ -20,14 +20,15 @@ import time
 import bpy
 import numpy as np
 
-from ....core.cushion import DEFAULT_SUBDIVISIONS, cushion_vertices
+from ....core.constants import CUSHION_LEVEL, LIVE_CUSHION_LEVEL
+from ....core.cushion import cushion_vertices
 from ....core.errors import ElliMannError
 from ....core.mesh import icosphere_level
 from ...bridge.built import built_objects, is_stale
 from ...bridge.convert import update_collection_geometry, write_measured
 from ...bridge.selection import part_lookup
 from ...services.cushions import rigid_frame
-from ...services.scene import LIVE_SUBDIVISIONS, refresh_cushions
+from ...services.scene import refresh_cushions
 from .request import synthesize_request
 
 LIVE_SETTLE_SECONDS = 0.5  # fields still this long: the live target's cushions are rebuilt exactly
@@ -77,7 +78,7 @@ def live_update(scene):
             if move_cushions(mannequin, cushions):  # out of date until the fields are still
                 _settle_later(scene)
             else:  # rebuilt exactly once; afterwards they move in place
-                refresh_cushions(target, min(_level(cushions), LIVE_SUBDIVISIONS), scene_view_layer(scene))
+                refresh_cushions(target, min(_level(cushions), LIVE_CUSHION_LEVEL), scene_view_layer(scene))
         rename_live_target(target, mannequin.name)
     except ElliMannError as error:
         props.status = f"Live update failed: {error}"
@@ -89,10 +90,10 @@ def live_update(scene):
 
 
 def _level(cushions):
-    """The resolution most of the cushions have (DEFAULT_SUBDIVISIONS if none is an icosphere's)."""
+    """The resolution most of the cushions have (CUSHION_LEVEL if none is an icosphere's)."""
     levels = [icosphere_level(len(o.data.vertices)) for o in cushions if o.type == "MESH"]
     levels = [level for level in levels if level is not None]
-    return max(set(levels), key=levels.count) if levels else DEFAULT_SUBDIVISIONS
+    return max(set(levels), key=levels.count) if levels else CUSHION_LEVEL
 
 
 def move_cushions(mannequin, cushions):
@@ -162,7 +163,7 @@ def settle_live(scene):
 
     Live updates call this through a timer once the fields have been still for LIVE_SETTLE_SECONDS,
     and so does an undo, a redo or opening a file that brings moved cushions back (:func:`settle_restored`).
-    The hulls are rebuilt at output.LIVE_SUBDIVISIONS (642 vertices; or their own resolution if
+    The hulls are rebuilt at LIVE_CUSHION_LEVEL (642 vertices; or their own resolution if
     coarser): at Synthesize's 2,562 the rebuild takes seconds on a 40-part mannequin, at 642 about
     half a second. Synthesize again for full-resolution cushions. The ellipsoids the cushions replace
     are hidden in ``scene``'s view layer (:func:`scene_view_layer`), whatever the context's is. Returns
@@ -177,7 +178,7 @@ def settle_live(scene):
     if not _has_stale(target, cushions):
         return 0
     try:
-        refresh_cushions(target, min(_level(cushions), LIVE_SUBDIVISIONS), scene_view_layer(scene))
+        refresh_cushions(target, min(_level(cushions), LIVE_CUSHION_LEVEL), scene_view_layer(scene))
     except (ElliMannError, RuntimeError) as error:
         message = " ".join(str(error).split())
         props.status = f"Cushions not rebuilt: {message}"

@@ -5,7 +5,7 @@ from hypothesis import strategies as st
 from scipy.spatial import cKDTree
 
 from devkit.toy import rotation_from_vector
-from ellimann_addon.core import fit_metrics as fm
+from ellimann_addon.core import garment_fit as fm
 from ellimann_addon.core.cushion import cushion_mesh
 from ellimann_addon.core.ellipsoid import contains
 from ellimann_addon.core.errors import ElliMannError

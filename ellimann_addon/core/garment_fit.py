@@ -19,6 +19,7 @@ is then off that plane) and the closed form at t = -a_min^2 is used.
 
 import numpy as np
 
+from .constants import DISTANCE_CUSHION_LEVEL
 from .cushion import mannequin_cushions
 from .errors import ElliMannError
 from .mesh import face_normals
@@ -243,7 +244,7 @@ class BodyPieces:
     per piece, or :func:`cushion.cushion_name` for a cushion.
     """
 
-    def __init__(self, mannequin, cushions=False, subdivisions=3):
+    def __init__(self, mannequin, cushions=False, subdivisions=DISTANCE_CUSHION_LEVEL):
         topology = mannequin.topology
         self.singles = np.array(topology.single_parts(cushions), dtype=int)
         self.frames = (mannequin.rotation[self.singles], mannequin.center[self.singles],
@@ -268,7 +269,7 @@ class BodyPieces:
         return table[np.arange(len(points)), nearest], nearest
 
 
-def mannequin_signed_distance(points, mannequin, cushions=False, subdivisions=3):
+def mannequin_signed_distance(points, mannequin, cushions=False, subdivisions=DISTANCE_CUSHION_LEVEL):
     """Signed distance from points to a mannequin's pieces (see :class:`BodyPieces`).
 
     Returns (distance (P,), names of the nearest pieces). Build a BodyPieces once instead when
