@@ -60,7 +60,7 @@ class MannequinOperator(ElliMannOperator):
 
     @classmethod
     def poll(cls, context):
-        return (not cls.OBJECT_MODE_ONLY or context.mode == "OBJECT") and active_mannequin(context) is not None
+        return has_mannequin(context, cls.OBJECT_MODE_ONLY)
 
     def execute(self, context):
         collection = active_mannequin(context)
@@ -71,6 +71,12 @@ class MannequinOperator(ElliMannOperator):
 
     def run(self, context, collection):
         raise NotImplementedError
+
+
+def has_mannequin(context, object_mode_only=True):
+    """MannequinOperator's poll: an active mannequin (in Object Mode, unless ``object_mode_only`` is False).
+    An operator whose poll adds a condition calls this."""
+    return (not object_mode_only or context.mode == "OBJECT") and active_mannequin(context) is not None
 
 
 @contextlib.contextmanager

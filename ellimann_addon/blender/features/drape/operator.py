@@ -7,7 +7,7 @@ import bpy
 from ....core.errors import ElliMannError, MannequinError
 from ... import ids
 from ...services.drape import drape
-from ..base import MannequinOperator, OperatorError, mannequin_or_cancel
+from ..base import MannequinOperator, OperatorError, has_mannequin, mannequin_or_cancel
 
 PENETRATION_WARNING = 0.01  # fraction of garment vertices inside the body worth a warning
 
@@ -32,7 +32,7 @@ class ELLIMANN_OT_drape_garment(MannequinOperator, bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return hasattr(context.scene, "ellimann_drape") and super().poll(context)
+        return hasattr(context.scene, "ellimann_drape") and has_mannequin(context, cls.OBJECT_MODE_ONLY)
 
     def run(self, context, collection):
         props = context.scene.ellimann_drape
