@@ -11,7 +11,7 @@ BENCHES = ("bench_core", "bench_synthesis", "bench_drape")
 
 
 def main(names=None, verbose=False):
-    from ellimann_addon.blender.chatter import program
+    from ellimann_addon.blender.services.chatter import program
 
     with program(show=verbose):
         for name in names or BENCHES:

@@ -28,7 +28,7 @@ import numpy as np
 
 from ellimann_addon.core import garments
 from ellimann_addon.core.collision import collision_pieces, triangle_count
-from ellimann_addon.core.fit_metrics import BodyPieces, fit_statistics, mesh_distance
+from ellimann_addon.core.garment_fit import BodyPieces, fit_statistics, mesh_distance
 from ellimann_addon.core.mannequin import Mannequin
 from ellimann_addon.core.synthesis import REFERENCE_FOLDER
 from tools.bodies import load_obj
@@ -78,9 +78,9 @@ def compare(mannequin, body_vertices, body_faces, frames=FRAMES, repeat=REPEAT, 
     """Drape each garment of ``kinds`` on every collider of ``sweep`` and on the dense body; print the table."""
     import bpy
 
-    from ellimann_addon.blender import drape
-    from ellimann_addon.blender.chatter import blender_output
-    from ellimann_addon.blender.output import empty_scene
+    from ellimann_addon.blender.services import drape
+    from ellimann_addon.blender.services.chatter import blender_output
+    from ellimann_addon.blender.services.scene import empty_scene
 
     exact = BodyPieces(mannequin, cushions=True, subdivisions=4)
     own = {True: exact, False: BodyPieces(mannequin)}  # the exact pieces of each kind of collider

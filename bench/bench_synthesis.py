@@ -224,8 +224,11 @@ def blender(reference, exact):
     import bpy
 
     import ellimann_addon
-    from ellimann_addon.blender import convert, output
-    from ellimann_addon.blender.chatter import blender_output  # what Blender prints stays off the bench's lines
+    from ellimann_addon.blender.bridge import convert
+    from ellimann_addon.blender.services import files
+    from ellimann_addon.blender.services.chatter import (
+        blender_output,  # what Blender prints stays off the bench's lines
+    )
 
     ellimann_addon.register()
     try:
@@ -270,7 +273,7 @@ def blender(reference, exact):
                 if kind == "json":  # the core writes it, without Blender
                     t = best_of(lambda path=path: write_core_file(mannequins[0], path), repeat=3)
                 else:
-                    t = best_of(lambda path=path: output.write_mannequin(mannequins[0], [path]), repeat=3)
+                    t = best_of(lambda path=path: files.write_mannequin(mannequins[0], [path]), repeat=3)
                 print(f"  write .{kind:<5} (one mannequin)          {t * 1e3:8.2f} ms")
     finally:
         ellimann_addon.unregister()
@@ -291,7 +294,7 @@ def measure_in_blender(bpy, convert, collections):
             bpy.context.view_layer.objects.active = collection.objects[0]
             bpy.ops.ellimann.measure_mannequin(source="ELLIPSOIDS")
 
-    from ellimann_addon.blender.chatter import blender_output
+    from ellimann_addon.blender.services.chatter import blender_output
 
     with blender_output():  # the operator reports m_T on stdout
         t_op = best_of(operator, repeat=3) / 10
@@ -300,12 +303,13 @@ def measure_in_blender(bpy, convert, collections):
 
 def old_live_update(props, target, output, convert):
     """A live update as it was before in-place cushions: every cushion rebuilt at 642 vertices."""
-    from ellimann_addon.blender import synthesize
+    from ellimann_addon.blender.features.synthesize.request import synthesize_request
+    from ellimann_addon.core.constants import LIVE_CUSHION_LEVEL
 
-    mannequin, measured, _ = synthesize._synthesize(props)
+    mannequin, measured, _ = synthesize_request(props)
     convert.update_collection_geometry(target, mannequin)
     convert.write_measured(target, measured)
-    output.refresh_cushions(target, output.LIVE_SUBDIVISIONS)
+    output.refresh_cushions(target, LIVE_CUSHION_LEVEL)
     if target.name != mannequin.name:
         target.name = mannequin.name
 
@@ -313,9 +317,11 @@ def old_live_update(props, target, output, convert):
 def live_with_cushions(bpy, props):
     """Live updates of a cushion mannequin: before (rebuild every cushion) and now (move them in place),
     interleaved over the same slider steps; then the exact rebuild once the slider stops."""
-    from ellimann_addon.blender import convert, output, synthesize
-    from ellimann_addon.blender.built import built_objects
-    from ellimann_addon.blender.chatter import blender_output
+    from ellimann_addon.blender.bridge import convert
+    from ellimann_addon.blender.bridge.built import built_objects
+    from ellimann_addon.blender.features.synthesize import live, presets
+    from ellimann_addon.blender.services import scene as output
+    from ellimann_addon.blender.services.chatter import blender_output
 
     props.live = False
     props.output = "CUSHIONS"
@@ -341,20 +347,20 @@ def live_with_cushions(bpy, props):
     print(f"    {np.median(before) / np.median(now):.1f}x faster (median), {before.max() / now.max():.1f}x (max)")
     start = time.perf_counter()
     with blender_output():
-        rebuilt = synthesize.settle_live(bpy.context.scene)
+        rebuilt = live.settle_live(bpy.context.scene)
     print(f"    exact rebuild once the slider stops ({rebuilt} cushions, "
-          f"{synthesize.LIVE_SETTLE_SECONDS:g} s later): {(time.perf_counter() - start) * 1e3:.0f} ms")
+          f"{live.LIVE_SETTLE_SECONDS:g} s later): {(time.perf_counter() - start) * 1e3:.0f} ms")
     calls = []
-    real = synthesize.live_update
-    synthesize.live_update = lambda scene: calls.append(time.perf_counter()) or real(scene)
+    real = live.live_update
+    live.live_update = lambda scene: calls.append(time.perf_counter()) or real(scene)
     try:
-        preset = synthesize.SHIPPED_PRESETS / "Table 2.5 (1).py"
+        preset = presets.SHIPPED_PRESETS / "Table 2.5 (1).py"
         start = time.perf_counter()
         with blender_output():
             bpy.ops.script.execute_preset(filepath=str(preset), menu_idname="ELLIMANN_MT_measurement_presets")
         seconds = time.perf_counter() - start
     finally:
-        synthesize.live_update = real
+        live.live_update = real
     print(f"    a preset (five fields): {len(calls)} live update, {seconds * 1e3:.0f} ms")
     props.live = False
     props.output = "ELLIPSOIDS"

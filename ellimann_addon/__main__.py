@@ -1,6 +1,6 @@
 """``python -m ellimann_addon …``: the ElliMann command line (the bpy module is needed for .blend/.glb/.obj)."""
 
-from .blender import teardown
 from .blender.cli import main
+from .blender.services import teardown
 
 teardown.exit_with(main())

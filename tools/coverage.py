@@ -20,7 +20,7 @@ from scipy.spatial import cKDTree
 
 from ellimann_addon.core.cushion import cushion_mesh, cushion_name
 from ellimann_addon.core.ellipsoid import bounds, fibonacci_sphere, sample_surface, support
-from ellimann_addon.core.fit_metrics import closest_points_on_triangles
+from ellimann_addon.core.garment_fit import closest_points_on_triangles
 from ellimann_addon.core.mannequin import NAME_PATTERN
 
 GRID_SPACING = 0.005  # m: 5 mm resolves fingers and toes; a body is ~0.5 million points

@@ -18,7 +18,7 @@ from bench.bench_drape import BODY, EDGE, REFMODELS
 from ellimann_addon.core import garments
 from ellimann_addon.core.collision import collision_pieces
 from ellimann_addon.core.ellipsoid import bounds
-from ellimann_addon.core.fit_metrics import BodyPieces, mesh_distance
+from ellimann_addon.core.garment_fit import BodyPieces, mesh_distance
 from ellimann_addon.core.mannequin import Mannequin
 from ellimann_addon.core.synthesis import REFERENCE_FOLDER
 from tools.bodies import load_obj
@@ -37,9 +37,9 @@ def main(argv=None):
     import bpy
 
     import ellimann_addon
-    from ellimann_addon.blender import drape, render
-    from ellimann_addon.blender.convert import mesh_from_arrays
-    from ellimann_addon.blender.output import add_mannequin, empty_scene
+    from ellimann_addon.blender.bridge.convert import mesh_from_arrays
+    from ellimann_addon.blender.services import drape, render
+    from ellimann_addon.blender.services.scene import add_mannequin, empty_scene
 
     ellimann_addon.register()
     mannequin = Mannequin.load(REFERENCE_FOLDER / f"{BODY}.json")

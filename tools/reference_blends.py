@@ -27,7 +27,7 @@ def write_blends(mannequins, folder):
     import bpy
 
     import ellimann_addon
-    from ellimann_addon.blender import convert
+    from ellimann_addon.blender.bridge import convert
 
     folder = pathlib.Path(folder)
     bpy.context.preferences.filepaths.save_version = 0  # no .blend1 backups of the files it replaces
@@ -74,6 +74,6 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    from ellimann_addon.blender import teardown
+    from ellimann_addon.blender.services import teardown
 
     teardown.exit_with(main())

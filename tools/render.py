@@ -19,11 +19,11 @@ import numpy as np
 from mathutils import Matrix
 
 import ellimann_addon
-from ellimann_addon.blender.convert import mannequin_to_collection
+from ellimann_addon.blender.bridge.convert import mannequin_to_collection
+from ellimann_addon.blender.services.render import workbench, write_png
 from ellimann_addon.core.mannequin import Mannequin
 
 GHOST_COLOR = (0.55, 0.55, 0.58, 0.22)
-BACKGROUND = (1.0, 1.0, 1.0)
 VIEWS = {"FRONT": 0.0, "SIDE": 90.0, "THREE_QUARTER": 35.0}  # camera turn about Z, degrees
 
 
@@ -109,24 +109,13 @@ def render(path, slots, resolution=(800, 1000), view="FRONT", spacing=None, marg
         camera.rotation_euler = (math.pi / 2.0, 0.0, turn)
         scene.camera = camera
 
-        world = bpy.data.worlds.new("ElliMann render world")
-        world.color = BACKGROUND
-        scene.world = world
-        made_data.append(world)
-        scene.render.engine = "BLENDER_WORKBENCH"
-        scene.display.shading.light = "STUDIO"
-        scene.display.shading.color_type = "OBJECT"
-        scene.display.shading.show_cavity = True
+        made_data.append(workbench(scene))  # the add-on's picture settings (blender.services.render)
         scene.display.render_aa = aa_samples
-        scene.view_settings.view_transform = "Standard"
         scene.render.resolution_x, scene.render.resolution_y = resolution
         scene.render.resolution_percentage = 100
-        scene.render.image_settings.file_format = "PNG"
         scene.render.image_settings.color_mode = "RGB"
         scene.render.image_settings.compression = 100
-        scene.render.filepath = str(Path(path).resolve())
-        Path(path).parent.mkdir(parents=True, exist_ok=True)
-        bpy.ops.render.render(write_still=True, scene=scene.name)
+        write_png(scene, path)  # atomic, folders made as needed
     finally:
         for obj in made_objects:
             bpy.data.objects.remove(obj)
@@ -184,6 +173,6 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    from ellimann_addon.blender import teardown
+    from ellimann_addon.blender.services import teardown
 
     teardown.exit_with(main())

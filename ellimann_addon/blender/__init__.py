@@ -1,20 +1,26 @@
-"""The bpy layer: properties, operators, panels and the CLI command. Depends on core, never the reverse."""
-
-import importlib
-
-# Registered in this order, unregistered in reverse.
-_MODULES = ("props", "operators", "panels", "menus", "synthesize", "synthesize_panel", "drape_panel", "cli")
-
-
-def _modules():
-    return [importlib.import_module(f".{name}", __package__) for name in _MODULES]
+"""The bpy layer: scene bridge, services, one package per feature, and the registry. Depends on core, never
+the reverse. Imported lazily (``registry`` pulls in bpy), so ``services.teardown`` and friends load alone."""
 
 
 def register():
-    for module in _modules():
-        module.register()
+    """Register ``registry.CLASSES`` in order, then run each of ``registry.HOOKS``."""
+    import bpy
+
+    from . import registry
+
+    for cls in registry.CLASSES:
+        bpy.utils.register_class(cls)
+    for add, _ in registry.HOOKS:
+        add()
 
 
 def unregister():
-    for module in reversed(_modules()):
-        module.unregister()
+    """The reverse of :func:`register`."""
+    import bpy
+
+    from . import registry
+
+    for _, remove in reversed(registry.HOOKS):
+        remove()
+    for cls in reversed(registry.CLASSES):
+        bpy.utils.unregister_class(cls)

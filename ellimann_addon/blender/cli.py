@@ -48,7 +48,7 @@ from ..core.synthesis import (
     validate_request,
 )
 from ..core.writers import EXTENSIONS, core_format, write_core_file
-from .chatter import blender_output, program
+from .services.chatter import blender_output, program
 
 PROG = "ellimann"
 FORMATS = ("blend", "glb", "obj", "json", "mjcf")  # --format names; the file extension is the name but for mjcf
@@ -289,7 +289,7 @@ def _write(mannequin, paths, measured, cushions):
     blender = [p for p in paths if core_format(p) is None]
     if blender:
         _ensure_registered()
-        from .output import write_mannequin
+        from .services.files import write_mannequin
 
         try:
             write_mannequin(mannequin, blender, measured, cushions)
@@ -684,7 +684,7 @@ def _load_json_mannequin(path):
 
 def _load_blend_mannequin(path, collection_name=None):
     bpy = _ensure_registered()
-    from .convert import collection_to_mannequin, mannequin_collections
+    from .bridge.convert import collection_to_mannequin, mannequin_collections
     try:
         with blender_output():
             bpy.ops.wm.open_mainfile(filepath=os.path.abspath(path), load_ui=False)
@@ -731,7 +731,7 @@ def run_demo(args):
         with _writing(os.path.join(out, name)):
             atomic_write_text(os.path.join(out, name), text)
     if args.picture:
-        from .render import render_lineup
+        from .services.render import render_lineup
 
         with _writing(os.path.join(out, "lineup.png")):
             render_lineup(mannequins, os.path.join(out, "lineup.png"),
@@ -794,9 +794,9 @@ def run_drape(args):
     if kind == ".json":
         mannequin = _load_json_mannequin(args.mannequin)
     bpy = _ensure_registered()
-    from .atomic import atomic_output
-    from .drape import WARN_CLOTH_VERTICES, check_cloth_size, drape
-    from .output import add_mannequin, empty_scene
+    from .services.drape import WARN_CLOTH_VERTICES, check_cloth_size, drape
+    from .services.files import atomic_output
+    from .services.scene import add_mannequin, empty_scene
 
     settings = drape_settings(args)
     if kind == ".json":
@@ -825,7 +825,7 @@ def run_drape(args):
             bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)
     _say(f"wrote {args.output}: {result.garment.name} on '{mannequin.name}', {result.summary()}", file=sys.stdout)
     if args.render:
-        from .render import render_view
+        from .services.render import render_view
 
         low, high = bounds(mannequin.rotation, mannequin.center, mannequin.semi_axes)
         with _writing(args.render):

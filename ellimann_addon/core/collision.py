@@ -11,14 +11,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .constants import COLLIDER_LEVELS
 from .cushion import mannequin_cushions
 from .ellipsoid import matrix_world
 from .frames import rigid_matrix
 from .mesh import check_subdivision_level, icosphere
-
-# Icosphere levels of cloth colliders: 20 to 20,480 triangles per piece; the solver's cost grows
-# with the triangles, 4x a level (MJCF's cushion levels differ: export_mjcf.SUBDIVISION_RANGE).
-SUBDIVISION_RANGE = (0, 5)
 
 
 @dataclass
@@ -36,13 +33,13 @@ class CollisionPiece:
 
 
 def check_subdivisions(name, value):
-    """A collision mesh level (SUBDIVISION_RANGE) as an int, else ElliMannError naming ``name``."""
-    return check_subdivision_level(name, value, SUBDIVISION_RANGE)
+    """A collision mesh level (constants.COLLIDER_LEVELS) as an int, else ElliMannError naming ``name``."""
+    return check_subdivision_level(name, value, COLLIDER_LEVELS)
 
 
 def collision_pieces(mannequin, cushions=False, sphere_subdivisions=2, cushion_subdivisions=2):
     """The mannequin's pieces as meshes: cushions (``cushions``, one per cushion pair) and the ellipsoids
-    not in a cushion, in topology order, cushions last. Names as :class:`fit_metrics.BodyPieces`."""
+    not in a cushion, in topology order, cushions last. Names as :class:`garment_fit.BodyPieces`."""
     mannequin.check()
     sphere_subdivisions = check_subdivisions("sphere_subdivisions", sphere_subdivisions)
     cushion_subdivisions = check_subdivisions("cushion_subdivisions", cushion_subdivisions)

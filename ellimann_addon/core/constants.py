@@ -85,3 +85,14 @@ PAPER_TABLE_2_4 = {
     "max": {"He": 0.4, "Sh": 6.6, "Br": 7.0, "Wa": 1.5, "Hi": 2.2},
     "min": {"He": 0.0, "Sh": 0.1, "Br": 0.0, "Wa": 0.0, "Hi": 0.1},
 }
+
+# Icosphere levels (core.mesh.icosphere: 10 * 4^n + 2 vertices, 20 * 4^n triangles), one name per use.
+UNIT_SPHERE_LEVEL = 3  # the unit-sphere mesh every ellipsoid object shares (642 vertices)
+CUSHION_LEVEL = 4  # cushion hulls by default (Build Cushions, Synthesize): 2,562 vertices, capsule volume within 0.5%
+CUSHION_LEVELS = (1, 6)  # cushion hulls one may ask for (Build Cushions, MJCF): 42 to 40,962 vertices
+LIVE_CUSHION_LEVEL = 3  # cushions rebuilt during Synthesize's live updates (642 vertices: about half a second)
+MJCF_CUSHION_LEVEL = 3  # cushion meshes in an MJCF file by default
+COLLIDER_LEVELS = (0, 5)  # cloth colliders: 20 to 20,480 triangles per piece (the solver's cost grows 4x a level)
+DISTANCE_CUSHION_LEVEL = 3  # cushion hulls of garment_fit.BodyPieces by default
+FIT_CUSHION_LEVEL = 4  # cushion hulls a drape's fit statistics are measured against (finer than the colliders)
+CLEARING_CUSHION_LEVEL = 3  # cushion hulls a new garment is moved clear of (inscribed in the level-4 ones)

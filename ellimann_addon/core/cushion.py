@@ -19,10 +19,10 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .constants import CUSHION_LEVEL
 from .ellipsoid import support_and_point
 from .mesh import directed_edges, face_normals, icosphere
 
-DEFAULT_SUBDIVISIONS = 4  # 2,562 vertices; capsule volume within 0.5% (see tests)
 _MAX_FLIP_ROUNDS = 200
 
 
@@ -31,7 +31,7 @@ def cushion_name(first, second):
     return f"{first} + {second}"
 
 
-def cushion_mesh(first, second, subdivisions=DEFAULT_SUBDIVISIONS):
+def cushion_mesh(first, second, subdivisions=CUSHION_LEVEL):
     """Hull of two ellipsoids, each given as (rotation, center, semi_axes).
 
     Returns (vertices (V, 3) in world coordinates, faces (F, 3)), counter-clockwise seen from
@@ -40,7 +40,7 @@ def cushion_mesh(first, second, subdivisions=DEFAULT_SUBDIVISIONS):
     return cushion_meshes([(first, second)], subdivisions)[0]
 
 
-def cushion_meshes(pairs, subdivisions=DEFAULT_SUBDIVISIONS):
+def cushion_meshes(pairs, subdivisions=CUSHION_LEVEL):
     """:func:`cushion_mesh` of every (first, second) in ``pairs``: a list of (vertices, faces).
 
     The meshes are those of one call per pair, built faster: the pairs share one direction sphere
@@ -62,7 +62,7 @@ def cushion_meshes(pairs, subdivisions=DEFAULT_SUBDIVISIONS):
     return meshes
 
 
-def cushion_vertices(rotation, center, semi_axes, pairs, subdivisions=DEFAULT_SUBDIVISIONS):
+def cushion_vertices(rotation, center, semi_axes, pairs, subdivisions=CUSHION_LEVEL):
     """The vertices :func:`cushion_meshes` builds the hulls of a mannequin's ``pairs`` on, each in its
     first ellipsoid's frame (as :func:`to_frame`), without the faces: (P, V, 3).
 
@@ -96,7 +96,7 @@ class CushionMesh(NamedTuple):
     faces: np.ndarray
 
 
-def mannequin_cushions(mannequin, subdivisions=DEFAULT_SUBDIVISIONS, local=False):
+def mannequin_cushions(mannequin, subdivisions=CUSHION_LEVEL, local=False):
     """The hull of every cushion pair of ``mannequin``, in topology order, built in one batch: a list
     of :class:`CushionMesh`. Vertices are in world coordinates, or with ``local`` in the first
     ellipsoid's frame (the paper's S_o, as :func:`to_frame`).

@@ -21,7 +21,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from .constants import MEASUREMENTS
+from .constants import CUSHION_LEVELS, MEASUREMENTS, MJCF_CUSHION_LEVEL
 from .cushion import mannequin_cushions
 from .errors import ElliMannError
 from .files import atomic_write_text
@@ -38,8 +38,6 @@ SOLREF = (0.002, 1.0)  # time constant (s), damping ratio
 FRICTION = (1.0, 0.005, 0.0001)  # sliding, torsional, rolling
 # Cushion hull resolution: level 3 = 642 vertices, volume within about 1% (inscribed) of the exact
 # hull and about 38 kB of XML per cushion; level 4 (2,562 vertices) gets 0.25% at four times the size.
-MJCF_SUBDIVISIONS = 3
-SUBDIVISION_RANGE = (1, 6)  # cushion resolution: 42 to 40,962 hull vertices (about 2.4 MB of XML each)
 SIDE_RGBA = {"L": (0.85, 0.55, 0.45, 1.0), "R": (0.45, 0.6, 0.85, 1.0), "C": (0.8, 0.78, 0.72, 1.0)}
 CUSHION_RGBA = (0.72, 0.7, 0.82, 1.0)
 MANNEQUIN_CLASS = "ellimann"
@@ -49,7 +47,7 @@ def _fmt(values, digits=9):
     return " ".join(f"{float(v):.{digits}g}" for v in np.ravel(values))
 
 
-def mannequin_to_mjcf(mannequin, cushions=False, subdivisions=MJCF_SUBDIVISIONS, floor=True,
+def mannequin_to_mjcf(mannequin, cushions=False, subdivisions=MJCF_CUSHION_LEVEL, floor=True,
                       timestep=TIMESTEP):
     """MJCF text for ``mannequin`` (validated first: MannequinError names every problem).
 
@@ -57,7 +55,7 @@ def mannequin_to_mjcf(mannequin, cushions=False, subdivisions=MJCF_SUBDIVISIONS,
     (icosphere level of the support directions, 1..6); ``floor`` adds a plane at z = 0.
     """
     mannequin.check()
-    subdivisions = check_subdivision_level("subdivisions", subdivisions, SUBDIVISION_RANGE)
+    subdivisions = check_subdivision_level("subdivisions", subdivisions, CUSHION_LEVELS)
     if isinstance(timestep, bool) or not (isinstance(timestep, (int, float)) and 0.0 < timestep <= 0.05):
         raise ElliMannError(f"timestep: must be a number in (0, 0.05] seconds, got {timestep!r}")
     topology = mannequin.topology
@@ -117,7 +115,7 @@ def mannequin_to_mjcf(mannequin, cushions=False, subdivisions=MJCF_SUBDIVISIONS,
     return ET.tostring(root, encoding="unicode") + "\n"
 
 
-def write_mjcf(mannequin, path, cushions=False, subdivisions=MJCF_SUBDIVISIONS, floor=True,
+def write_mjcf(mannequin, path, cushions=False, subdivisions=MJCF_CUSHION_LEVEL, floor=True,
                timestep=TIMESTEP):
     """Write :func:`mannequin_to_mjcf` to ``path`` atomically (nothing is written if it fails)."""
     text = mannequin_to_mjcf(mannequin, cushions=cushions, subdivisions=subdivisions, floor=floor,

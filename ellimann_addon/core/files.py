@@ -2,7 +2,7 @@
 
 A file is written to a temporary name in its folder, checked to be whole (:func:`incomplete`) and
 only then renamed onto its target. Temporary names are ``.ellimann-PID@HOST-XXXXXXXX.tmp`` (files)
-and ``.ellimann-PID@HOST-XXXXXXXX/`` (the folders Blender writes into, ``blender.atomic``), so
+and ``.ellimann-PID@HOST-XXXXXXXX/`` (the folders Blender writes into, ``blender.services.files.atomic_output``), so
 :func:`clean_stale_temporaries` can tell what a killed run left from what a running one is writing.
 """
 

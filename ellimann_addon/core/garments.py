@@ -33,7 +33,7 @@ import numpy as np
 from .constants import CM_PER_M, MEASUREMENTS, SECTION_FRACTIONS
 from .ellipsoid import axis_extent, section_at_height
 from .errors import ElliMannError, MeasurementError
-from .fit_metrics import ellipsoid_signed_distance
+from .garment_fit import ellipsoid_signed_distance
 from .measure import hull_perimeter, section_heights
 from .mesh import face_normals
 

@@ -11,7 +11,7 @@ import pytest  # noqa: E402
 
 import ellimann_addon  # noqa: E402
 from devkit.blender_scene import parts  # noqa: E402
-from ellimann_addon.blender.convert import mannequin_to_collection  # noqa: E402
+from ellimann_addon.blender.bridge.convert import mannequin_to_collection  # noqa: E402
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -46,8 +46,8 @@ def pytest_sessionfinish(session, exitstatus):
 @pytest.hookimpl(trylast=True)
 def pytest_unconfigure(config):
     # Blender 4.x as a module segfaults in its own teardown after the tests have run and reported
-    # (ellimann_addon/blender/teardown.py): leave with pytest's own exit status instead.
-    from ellimann_addon.blender import teardown
+    # (ellimann_addon/blender/services/teardown.py): leave with pytest's own exit status instead.
+    from ellimann_addon.blender.services import teardown
 
     if teardown.needs_workaround() and "code" in _exit_status:
         teardown.exit_without_teardown(_exit_status["code"])

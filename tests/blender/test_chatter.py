@@ -5,7 +5,7 @@ import sys
 
 import pytest
 
-from ellimann_addon.blender.chatter import blender_output, program
+from ellimann_addon.blender.services.chatter import blender_output, program
 from ellimann_addon.core.errors import ElliMannError
 
 

@@ -7,9 +7,9 @@ import pytest
 from devkit.blender_scene import parts, select, state
 from devkit.toy import rotation_from_vector
 from devkit.ui_recorder import draw_operator
-from ellimann_addon.blender.convert import collection_to_mannequin, ellipsoid_frame, mannequin_to_collection
-from ellimann_addon.blender.operators.clean import ELLIMANN_OT_relabel_axes
-from ellimann_addon.core.clean import register
+from ellimann_addon.blender.bridge.convert import collection_to_mannequin, ellipsoid_frame, mannequin_to_collection
+from ellimann_addon.blender.features.clean.operators import ELLIMANN_OT_relabel_axes
+from ellimann_addon.core.clean import register_to_world
 from ellimann_addon.core.ellipsoid import shape_matrix
 from ellimann_addon.core.frames import axis_agreement
 
@@ -112,7 +112,7 @@ def test_register_moves_the_mannequin_and_its_cushions_like_the_core(toy):
     cushion_before = np.array(cushion.matrix_world)
     assert bpy.ops.ellimann.register_mannequin() == {"FINISHED"}
     got = collection_to_mannequin(collection).reordered(toy.topology)
-    expected = register(shifted)
+    expected = register_to_world(shifted)
     assert np.allclose(got.center, expected.center, atol=1e-6)
     offset = expected.center[0] - shifted.center[0]
     assert np.allclose(np.array(cushion.matrix_world)[:3, 3], cushion_before[:3, 3] + offset, atol=1e-6)

@@ -17,8 +17,8 @@ import pytest
 
 from devkit import synthetic
 from ellimann_addon.blender import cli
-from ellimann_addon.blender.drape import DrapeSettings
-from ellimann_addon.blender.export import EXTRAS_KEY, read_glb_json
+from ellimann_addon.blender.services.drape import DrapeSettings
+from ellimann_addon.blender.services.files import EXTRAS_KEY, read_glb_json
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.mannequin import Mannequin
 from ellimann_addon.core.synthesis import relative_error
@@ -84,9 +84,10 @@ def test_python_m_bad_input_is_one_line_and_exit_code_1(tmp_path, references):
 
 
 def test_the_add_on_registers_main_as_the_blender_command(monkeypatch):
-    from ellimann_addon import blender
+    from ellimann_addon.blender import registry
 
-    assert "cli" in blender._MODULES and cli._handle is not None  # the add-on's register() ran cli.register()
+    # the add-on's register() ran cli.register()
+    assert (cli.register, cli.unregister) in registry.HOOKS and cli._handle is not None
     calls = []
     monkeypatch.setattr(cli, "_handle", None)  # the real handle is restored afterwards
     monkeypatch.setattr(bpy.utils, "register_cli_command", lambda *args: calls.append(("register", args)) or "H")
@@ -511,7 +512,7 @@ def test_measure_of_a_blend_prints_the_json_alone_at_the_file_descriptors(tmp_pa
 FSIZE_RUN = """
 import resource, signal, sys
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails (EFBIG) instead of ending us
-from ellimann_addon.blender import teardown
+from ellimann_addon.blender.services import teardown
 from ellimann_addon.blender.cli import main
 import bpy  # loaded (and Python's caches written) before the limit
 resource.setrlimit(resource.RLIMIT_FSIZE, ({limit}, {limit}))
@@ -563,7 +564,7 @@ def test_a_name_too_long_for_the_file_system_is_one_line(tmp_path, capsys, refer
 
 
 def test_blender_write_errors_become_one_line_os_errors():
-    from ellimann_addon.blender.atomic import blender_write_error
+    from ellimann_addon.blender.services.files import blender_write_error
 
     temp, target = "/out/.ellimann-1@h-abcdefgh/m.glb", "out/m.glb"
     gltf = RuntimeError("Error: Python: Traceback (most recent call last):\n  File \"x.py\", line 85, in save_gltf\n"
@@ -581,18 +582,18 @@ def test_blender_write_errors_become_one_line_os_errors():
 
 def test_a_batch_row_blender_fails_to_write_is_reported_and_the_batch_goes_on(tmp_path, capsys, references,
                                                                              monkeypatch):
-    from ellimann_addon.blender import atomic, output
+    from ellimann_addon.blender.services import files
 
-    real = output.export_gltf
+    real = files.export_gltf
 
     def full_disk_for_t1(collection, path):
         if os.path.basename(path) == "t1.glb":
-            with atomic.atomic_output(path) as temp:  # what a bpy.ops call raises when the disk is full
+            with files.atomic_output(path) as temp:  # what a bpy.ops call raises when the disk is full
                 raise RuntimeError(f"Error: Python: Traceback (most recent call last):\nOSError: [Errno 28] No "
                                    f"space left on device: '{temp}'\nLocation: ops.py:109\n")
         return real(collection, path)
 
-    monkeypatch.setattr(output, "export_gltf", full_disk_for_t1)
+    monkeypatch.setattr(files, "export_gltf", full_disk_for_t1)
     source = write_csv(tmp_path / "in.csv", GOOD_ROWS)
     out = tmp_path / "out"
     code, stdout, err = run(["batch", source, "-o", str(out), "--format", "json,glb", "--references", references],
@@ -645,7 +646,7 @@ def killed_on_the_third_row(mannequin, paths, *args):
         os.kill(os.getpid(), signal.SIGKILL)
     return real(mannequin, paths, *args)
 cli._write = killed_on_the_third_row
-from ellimann_addon.blender import teardown
+from ellimann_addon.blender.services import teardown
 teardown.exit_with(cli.main({argv!r}))
 """
 

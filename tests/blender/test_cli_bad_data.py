@@ -18,9 +18,9 @@ from mathutils import Matrix
 from devkit import synthetic
 from devkit.blender_scene import parts
 from ellimann_addon.blender import cli
-from ellimann_addon.blender import drape as drape_module
-from ellimann_addon.blender.convert import collection_to_mannequin
-from ellimann_addon.blender.drape import MAX_CLOTH_VERTICES, DrapeSettings, check_cloth_size, drape
+from ellimann_addon.blender.bridge.convert import collection_to_mannequin
+from ellimann_addon.blender.services import drape as drape_module
+from ellimann_addon.blender.services.drape import MAX_CLOTH_VERTICES, DrapeSettings, check_cloth_size, drape
 from ellimann_addon.core import garments
 from ellimann_addon.core.errors import ElliMannError, MannequinError
 from ellimann_addon.core.mannequin import Mannequin
@@ -223,7 +223,7 @@ def test_a_collection_far_from_the_origin_is_refused(toy_collection):
 
 
 def test_a_partial_target_is_not_kept_by_a_collection(toy):
-    from ellimann_addon.blender.convert import mannequin_to_collection
+    from ellimann_addon.blender.bridge.convert import mannequin_to_collection
 
     # Before: KeyError in write_collection_props (drape of a JSON whose measurements_cm lacks a key).
     collection = mannequin_to_collection(toy.copy(measurements={"He": 160.0}))

@@ -2,7 +2,7 @@ import bpy
 import numpy as np
 import pytest
 
-from ellimann_addon.blender import convert
+from ellimann_addon.blender.bridge import convert
 from ellimann_addon.core.errors import MannequinError
 
 

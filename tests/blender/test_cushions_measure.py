@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from devkit.blender_scene import parts, select, state
-from ellimann_addon.blender.built import BUILT_KEY, built_objects
-from ellimann_addon.blender.convert import mannequin_to_collection, world_triangles
+from ellimann_addon.blender.bridge.built import BUILT_KEY, built_objects
+from ellimann_addon.blender.bridge.convert import mannequin_to_collection, world_triangles
 from ellimann_addon.core import mesh
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.cushion import cushion_mesh

@@ -14,11 +14,12 @@ import pytest
 from devkit.blender_scene import parts, select, state
 from devkit.poses import make_apose_toy
 from devkit.ui_recorder import draw_panel
-from ellimann_addon.blender import cli, drape_panel, ids
-from ellimann_addon.blender import drape as drape_module
-from ellimann_addon.blender.convert import mannequin_to_collection
-from ellimann_addon.blender.drape import CLOTH_NAME, PIN_GROUP, DrapeSettings, drape, evaluated_vertices
-from ellimann_addon.blender.operators import drape as drape_operator
+from ellimann_addon.blender import cli, ids
+from ellimann_addon.blender.bridge.convert import mannequin_to_collection
+from ellimann_addon.blender.features.drape import operator as drape_operator
+from ellimann_addon.blender.features.drape import panel as drape_panel
+from ellimann_addon.blender.services import drape as drape_module
+from ellimann_addon.blender.services.drape import CLOTH_NAME, PIN_GROUP, DrapeSettings, drape, evaluated_vertices
 from ellimann_addon.core.errors import ElliMannError
 
 COARSE = {"edge": 0.04}

@@ -7,10 +7,8 @@ import bpy
 import numpy as np
 import pytest
 
-from ellimann_addon.blender import convert
-from ellimann_addon.blender.atomic import atomic_output
-from ellimann_addon.blender.export import EXTRAS_KEY, export_gltf, read_glb_json
-from ellimann_addon.blender.output import write_mannequin
+from ellimann_addon.blender.bridge import convert
+from ellimann_addon.blender.services.files import EXTRAS_KEY, atomic_output, export_gltf, read_glb_json, write_mannequin
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.errors import ElliMannError, MannequinError
 from ellimann_addon.core.quaternion import quaternion_to_rotation

@@ -8,15 +8,16 @@ import pytest
 
 from devkit.blender_scene import parts, select, state
 from devkit.ui_recorder import draw_menu_function, draw_operator, draw_panel
-from ellimann_addon.blender import ids, menus, panels
-from ellimann_addon.blender.convert import mannequin_to_collection
-from ellimann_addon.blender.export import EXTRAS_KEY, read_glb_json
-from ellimann_addon.blender.operators.export import (
+from ellimann_addon.blender import ids, registry
+from ellimann_addon.blender.bridge.convert import mannequin_to_collection
+from ellimann_addon.blender.features import main_panel, menus
+from ellimann_addon.blender.features.export.operator import (
     ELLIMANN_OT_export_mannequin,
     default_path,
     reconcile,
     with_extension,
 )
+from ellimann_addon.blender.services.files import EXTRAS_KEY, read_glb_json
 
 
 def geoms(path):
@@ -155,10 +156,10 @@ def test_extension_and_format_follow_each_other():
 
 
 def test_reachable_from_file_export_the_object_menu_and_the_main_panel(toy_collection):
-    export_entry = dict(menus.MENU_ENTRIES)["TOPBAR_MT_file_export"]
+    export_entry = dict(registry.MENU_ENTRIES)["TOPBAR_MT_file_export"]
     assert draw_menu_function(export_entry).operators() == [ids.EXPORT_MANNEQUIN]
     assert ids.EXPORT_MANNEQUIN in draw_panel(menus.ELLIMANN_MT_object).operators()
-    assert ids.EXPORT_MANNEQUIN in draw_panel(panels.ELLIMANN_PT_main).operators()
+    assert ids.EXPORT_MANNEQUIN in draw_panel(main_panel.ELLIMANN_PT_main).operators()
 
 
 def test_options_draw():

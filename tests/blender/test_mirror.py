@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from devkit.blender_scene import parts, select, state
-from ellimann_addon.blender.convert import collection_to_mannequin, ellipsoid_frame
+from ellimann_addon.blender.bridge.convert import collection_to_mannequin, ellipsoid_frame
 from ellimann_addon.core.clean import asymmetry
 from ellimann_addon.core.frames import is_rotation
 

@@ -6,7 +6,7 @@ import bpy
 import numpy as np
 import pytest
 
-from ellimann_addon.blender import convert
+from ellimann_addon.blender.bridge import convert
 from ellimann_addon.core.mannequin import Mannequin
 
 FOLDER = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"

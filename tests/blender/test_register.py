@@ -3,12 +3,12 @@
 import bpy
 
 import ellimann_addon
-from ellimann_addon.blender import drape_panel, menus, operators, panels, props, synthesize
+from ellimann_addon.blender import registry
+from ellimann_addon.blender.features.synthesize import live
 
 
 def all_classes():
-    return (list(props.classes) + operators.classes() + list(panels.classes) + [menus.ELLIMANN_MT_object]
-            + list(drape_panel.classes))
+    return list(registry.CLASSES)
 
 
 def leftovers():
@@ -19,19 +19,21 @@ def leftovers():
               if hasattr(owner, "ellimann")]
     found += [f"Scene.{name}" for name in ("ellimann_synthesis", "ellimann_drape") if hasattr(bpy.types.Scene, name)]
     found += [f"bpy.ops.ellimann.{name}" for name in dir(bpy.ops.ellimann) if not name.startswith("_")]
-    found += [f"{menu} entry" for menu, draw in menus.MENU_ENTRIES
+    found += [f"{menu} entry" for menu, draw in registry.MENU_ENTRIES
               if draw in getattr(bpy.types, menu)._dyn_ui_initialize()]
     found += [f"bpy.app.handlers.{name}: {handler.__name__}" for name in dir(bpy.app.handlers)
               if isinstance(getattr(bpy.app.handlers, name), list) for handler in getattr(bpy.app.handlers, name)
               if getattr(handler, "__module__", "").startswith(ellimann_addon.__name__)]
-    found += ["bpy.app.timers: settle"] if bpy.app.timers.is_registered(synthesize._settle_timer) else []
+    found += ["bpy.app.timers: settle"] if bpy.app.timers.is_registered(live._settle_timer) else []
     return found
 
 
 def test_disable_leaves_nothing_and_enable_works_again():
-    assert len(all_classes()) == 2 + 14 + 6 + 1 + 2
+    # property groups, operators, panels, menus (the Synthesize feature's among them)
+    assert len(all_classes()) == 2 + 14 + 6 + 1 + 2 + 6
+    assert len(all_classes()) == len(set(all_classes()))
     assert not [c.__name__ for c in all_classes() if not c.is_registered]
-    synthesize._settle_later(bpy.context.scene)  # a live update's timer, still waiting
+    live._settle_later(bpy.context.scene)  # a live update's timer, still waiting
     assert {"Object.ellimann", "Scene.ellimann_drape", "bpy.ops.ellimann.drape_garment",
             "VIEW3D_MT_add entry", "TOPBAR_MT_file_export entry", "bpy.app.timers: settle",
             "bpy.app.handlers.undo_post: settle_restored", "bpy.app.handlers.redo_post: settle_restored",
@@ -42,7 +44,7 @@ def test_disable_leaves_nothing_and_enable_works_again():
     finally:
         ellimann_addon.register()
     assert not [c.__name__ for c in all_classes() if not c.is_registered]
-    assert [h for h in bpy.app.handlers.undo_post if h is synthesize.settle_restored] == [synthesize.settle_restored]
+    assert [h for h in bpy.app.handlers.undo_post if h is live.settle_restored] == [live.settle_restored]
     bpy.ops.ellimann.new_mannequin(name="Again")
     assert bpy.ops.ellimann.add_ellipsoid() == {"FINISHED"}
     assert bpy.data.collections["Again"].ellimann.is_mannequin

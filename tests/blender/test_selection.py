@@ -3,8 +3,8 @@
 import bpy
 
 from devkit.blender_scene import parts, select
-from ellimann_addon.blender.convert import mannequin_to_collection, new_collection
-from ellimann_addon.blender.selection import active_mannequin, set_active_collection
+from ellimann_addon.blender.bridge.convert import mannequin_to_collection, new_collection
+from ellimann_addon.blender.bridge.selection import active_mannequin, set_active_collection
 
 
 def test_active_mannequin_follows_the_active_object_then_the_active_collection(toy):

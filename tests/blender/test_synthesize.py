@@ -11,12 +11,21 @@ import pytest
 from devkit import synthetic
 from devkit.blender_scene import state
 from devkit.ui_recorder import Recorder, draw_panel
-from ellimann_addon.blender import convert, ids, synthesize
-from ellimann_addon.blender import synthesize_panel as panel
-from ellimann_addon.blender.built import is_stale
-from ellimann_addon.blender.selection import part_lookup
-from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS, TABLE_2_5
-from ellimann_addon.core.cushion import DEFAULT_SUBDIVISIONS, cushion_vertices
+from ellimann_addon.blender import ids
+from ellimann_addon.blender.bridge import convert
+from ellimann_addon.blender.bridge.built import is_stale
+from ellimann_addon.blender.bridge.selection import part_lookup
+from ellimann_addon.blender.features.synthesize import live, panel, presets
+from ellimann_addon.blender.features.synthesize import props as synthesis_props
+from ellimann_addon.core.constants import (
+    ABSURD_LIMITS,
+    CUSHION_LEVEL,
+    MEASUREMENTS,
+    RANGES,
+    REFERENCE_MEASUREMENTS,
+    TABLE_2_5,
+)
+from ellimann_addon.core.cushion import cushion_vertices
 from ellimann_addon.core.mesh import convexity_defect, is_closed_manifold
 from ellimann_addon.core.synthesis import synthesize as core_synthesize
 
@@ -30,8 +39,8 @@ def folder(tmp_path_factory):
 def no_settle_timer_left():
     """Live updates leave the settle timer registered; it must not fire in a later test."""
     yield
-    if bpy.app.timers.is_registered(synthesize._settle_timer):
-        bpy.app.timers.unregister(synthesize._settle_timer)
+    if bpy.app.timers.is_registered(live._settle_timer):
+        bpy.app.timers.unregister(live._settle_timer)
 
 
 @pytest.fixture
@@ -44,7 +53,7 @@ def props(folder):
 
 
 def test_fields_are_in_cm_with_soft_limits_from_L_and_hard_limits_from_the_absurd_ones():
-    rna = synthesize.ELLIMANN_PG_synthesis.bl_rna.properties
+    rna = synthesis_props.ELLIMANN_PG_synthesis.bl_rna.properties
     for key in MEASUREMENTS:
         field = rna[key.lower()]
         assert (field.soft_min, field.soft_max) == pytest.approx(RANGES[key])
@@ -53,7 +62,7 @@ def test_fields_are_in_cm_with_soft_limits_from_L_and_hard_limits_from_the_absur
 
 
 def test_every_option_and_choice_has_a_tooltip():
-    rna = synthesize.ELLIMANN_PG_synthesis.bl_rna.properties
+    rna = synthesis_props.ELLIMANN_PG_synthesis.bl_rna.properties
     for name in ("mode", "output", "normalize", "metric", "power", "live", "target", "references"):
         assert len(rna[name].description) > 20, name
     for name in ("mode", "output", "normalize", "metric"):
@@ -150,7 +159,7 @@ def test_live_moves_the_cushions_in_place_then_rebuilds_them_exactly(props):
     for obj in cushions:  # vertices: the support points of the moved ellipsoids, in the first one's frame
         first, second = names.index(obj.ellimann.part_name), names.index(obj.ellimann.partner)
         expected = cushion_vertices(mannequin.rotation, mannequin.center, mannequin.semi_axes, [(first, second)],
-                                    DEFAULT_SUBDIVISIONS)[0]
+                                    CUSHION_LEVEL)[0]
         np.testing.assert_allclose(local_vertices(obj), expected, atol=1e-6)
         assert np.abs(local_vertices(obj) - before[obj.name][1]).max() > 1e-4
         np.testing.assert_allclose(np.array(obj.matrix_world)[:3, 3], mannequin.center[first], atol=1e-6)
@@ -158,15 +167,15 @@ def test_live_moves_the_cushions_in_place_then_rebuilds_them_exactly(props):
     # The kept faces were convex for the old ellipsoids: out of date until the fields are still.
     parts = part_lookup(collection)
     assert all(is_stale(o, parts) for o in cushions)
-    assert bpy.app.timers.is_registered(synthesize._settle_timer)
-    bpy.app.timers.unregister(synthesize._settle_timer)
-    assert synthesize._settle_timer() is None  # what the timer runs, once
+    assert bpy.app.timers.is_registered(live._settle_timer)
+    bpy.app.timers.unregister(live._settle_timer)
+    assert live._settle_timer() is None  # what the timer runs, once
     settled = cushion_objects()
     assert len(settled) == len(cushions) and not any(is_stale(o, parts) for o in settled)
     for obj in settled:
         vertices, triangles = convert.mesh_vertices(obj.data), np.array([tuple(p.vertices) for p in obj.data.polygons])
         assert is_closed_manifold(triangles) and convexity_defect(vertices, triangles) < 1e-6
-    assert synthesize.settle_live(bpy.context.scene) == 0  # nothing left to do
+    assert live.settle_live(bpy.context.scene) == 0  # nothing left to do
     bpy.data.collections.remove(props.target)
     props.hi = 120.0  # no target left: nothing to update, no error
     assert props.target is None
@@ -186,9 +195,9 @@ def test_the_settle_timer_works_in_the_live_scene_whatever_scene_the_context_sho
     scene = bpy.context.scene
     target = moved_live_cushions(props)
     other = bpy.data.scenes.new("Other")
-    bpy.app.timers.unregister(synthesize._settle_timer)
+    bpy.app.timers.unregister(live._settle_timer)
     with bpy.context.temp_override(scene=other, view_layer=other.view_layers[0]):  # another window's context
-        assert synthesize._settle_timer() is None
+        assert live._settle_timer() is None
     assert cushion_objects() and not any(is_stale(o, part_lookup(target)) for o in cushion_objects())
     layer = scene.view_layers[0]
     paired = [o for o in target.objects if o.ellimann.partner]
@@ -201,7 +210,7 @@ def test_cushions_that_cannot_be_settled_are_left_as_they_were_with_one_line_on_
     bpy.context.view_layer.layer_collection.children[target.name].exclude = True  # not in the view layer
     before = state()
     capsys.readouterr()
-    assert synthesize.settle_live(bpy.context.scene) == 0
+    assert live.settle_live(bpy.context.scene) == 0
     assert state() == before and all(is_stale(o, part_lookup(target)) for o in cushion_objects())
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"ElliMann: cushions of '{target.name}' not rebuilt: cannot hide ") and "\n" not in err
@@ -218,9 +227,9 @@ def live_stale():
 
 def fire_settle_timer():
     """What Blender does once the timer is due: it is registered, and runs once."""
-    assert bpy.app.timers.is_registered(synthesize._settle_timer)
-    bpy.app.timers.unregister(synthesize._settle_timer)
-    assert synthesize._settle_timer() is None
+    assert bpy.app.timers.is_registered(live._settle_timer)
+    bpy.app.timers.unregister(live._settle_timer)
+    assert live._settle_timer() is None
     assert live_stale() and not any(live_stale())
 
 
@@ -243,8 +252,8 @@ def test_undo_and_redo_to_moved_cushions_settle_them_again(props):
     props.live = False  # with Live off the handler leaves out-of-date cushions alone
     next(o for o in props.target.objects if o.ellimann.partner).location.x += 0.01
     bpy.context.view_layer.update()
-    synthesize.settle_restored(bpy.context.scene, None)
-    assert any(live_stale()) and not bpy.app.timers.is_registered(synthesize._settle_timer)
+    live.settle_restored(bpy.context.scene, None)
+    assert any(live_stale()) and not bpy.app.timers.is_registered(live._settle_timer)
 
 
 def test_a_file_saved_before_the_cushions_settled_settles_them_when_opened(props, tmp_path):
@@ -252,7 +261,7 @@ def test_a_file_saved_before_the_cushions_settled_settles_them_when_opened(props
     path = tmp_path / "live.blend"
     assert bpy.ops.wm.save_as_mainfile(filepath=str(path)) == {"FINISHED"}
     bpy.ops.wm.read_homefile(use_empty=True)  # a file load removes the timer
-    assert not bpy.app.timers.is_registered(synthesize._settle_timer)
+    assert not bpy.app.timers.is_registered(live._settle_timer)
     assert bpy.ops.wm.open_mainfile(filepath=str(path)) == {"FINISHED"}
     assert all(live_stale())
     fire_settle_timer()
@@ -266,21 +275,21 @@ def test_live_rebuilds_the_cushions_once_if_one_is_missing(props):
     props.live = True  # turning Live on updates once: all cushions rebuilt, exact
     cushions = cushion_objects()
     assert len(cushions) == count and not any(is_stale(o, part_lookup(props.target)) for o in cushions)
-    assert not bpy.app.timers.is_registered(synthesize._settle_timer)  # exact already: nothing to settle
+    assert not bpy.app.timers.is_registered(live._settle_timer)  # exact already: nothing to settle
     moved = {o.name: (o.data.as_pointer(), local_vertices(o)) for o in cushions}
     props.he = 162.0  # complete again: moved in place
     assert {o.name: o.data.as_pointer() for o in cushion_objects()} == {k: v[0] for k, v in moved.items()}
     assert all(np.abs(local_vertices(o) - moved[o.name][1]).max() > 1e-5 for o in cushion_objects())
-    assert bpy.app.timers.is_registered(synthesize._settle_timer)  # moved: out of date until settled
+    assert bpy.app.timers.is_registered(live._settle_timer)  # moved: out of date until settled
 
 
 def test_a_preset_makes_one_live_update(props, monkeypatch):
     bpy.ops.ellimann.synthesize_mannequin()
     props.live = True
     calls = []
-    real = synthesize.live_update
-    monkeypatch.setattr(synthesize, "live_update", lambda scene: calls.append(scene) or real(scene))
-    preset = synthesize.SHIPPED_PRESETS / "Table 2.5 (3).py"
+    real = live.live_update
+    monkeypatch.setattr(live, "live_update", lambda scene: calls.append(scene) or real(scene))
+    preset = presets.SHIPPED_PRESETS / "Table 2.5 (3).py"
     bpy.ops.script.execute_preset(filepath=str(preset), menu_idname="ELLIMANN_MT_measurement_presets")
     assert len(calls) == 1
     assert tuple(props.target.ellimann.measured) == pytest.approx(TABLE_2_5[2], rel=1e-4)
@@ -299,13 +308,13 @@ def test_a_preset_is_one_undo_step_with_its_live_update(props):
     props.live = True
     bpy.ops.ed.undo_push(message="Before")
     before = state()
-    preset = synthesize.SHIPPED_PRESETS / "Table 2.5 (3).py"
+    preset = presets.SHIPPED_PRESETS / "Table 2.5 (3).py"
     # As the preset menu runs it (a click: undo=True); script.execute_preset alone pushes no step.
     assert bpy.ops.ellimann.apply_measurement_preset("EXEC_DEFAULT", True, filepath=str(preset)) == {"FINISHED"}
     after = state()
     measured = tuple(bpy.context.scene.ellimann_synthesis.target.ellimann.measured)
     assert after != before and measured == pytest.approx(TABLE_2_5[2], rel=1e-4)
-    assert synthesize.ELLIMANN_MT_measurement_presets.bl_label == "Table 2.5 (3)"  # the menu shows it
+    assert presets.ELLIMANN_MT_measurement_presets.bl_label == "Table 2.5 (3)"  # the menu shows it
     assert bpy.ops.ed.undo() == {"FINISHED"}
     assert state() == before
     assert [getattr(bpy.context.scene.ellimann_synthesis, m.lower()) for m in MEASUREMENTS] == [
@@ -334,7 +343,7 @@ def test_a_live_target_whose_name_is_taken_keeps_its_suffix(props):
     props.live = True
     props.he = 160.0
     assert target.name == taken + ".001" and mine.name == taken
-    assert not synthesize.rename_live_target(target, taken)  # next updates leave the name alone
+    assert not live.rename_live_target(target, taken)  # next updates leave the name alone
     props.mode = "IDW"
     assert target.name == taken + ".001" and mine.name == taken
     props.he = 161.0
@@ -345,7 +354,7 @@ def test_a_live_target_whose_name_is_taken_keeps_its_suffix(props):
 
 
 def shipped_presets():
-    return sorted(synthesize.SHIPPED_PRESETS.glob("*.py"))
+    return sorted(presets.SHIPPED_PRESETS.glob("*.py"))
 
 
 def test_shipped_presets_hold_the_reference_and_table_2_5_measurements(props):
@@ -361,13 +370,13 @@ def test_shipped_presets_hold_the_reference_and_table_2_5_measurements(props):
 def test_users_can_save_and_remove_their_own_presets(props):
     props.he, props.hi = 161.5, 121.0
     assert bpy.ops.ellimann.add_measurement_preset(name="My Client") == {"FINISHED"}
-    user = pathlib.Path(bpy.utils.user_resource("SCRIPTS", path=os.path.join("presets", synthesize.PRESET_SUBDIR)))
+    user = pathlib.Path(bpy.utils.user_resource("SCRIPTS", path=os.path.join("presets", presets.PRESET_SUBDIR)))
     saved = user / "My_Client.py"
     assert saved.is_file()
     props.he = props.hi = 150.0
     bpy.ops.script.execute_preset(filepath=str(saved), menu_idname="ELLIMANN_MT_measurement_presets")
     assert (props.he, props.hi) == pytest.approx((161.5, 121.0))
-    menu = draw_panel(synthesize.ELLIMANN_MT_measurement_presets)
+    menu = draw_panel(presets.ELLIMANN_MT_measurement_presets)
     assert set(menu.operators()) == {ids.APPLY_MEASUREMENT_PRESET}  # an undo step per preset
     assert str(saved) in [kw["props"].get("filepath") for kind, kw in menu.log if kind == "operator"]
     names = [kw.get("text") for kind, kw in menu.log if kind == "operator"]
@@ -384,7 +393,7 @@ def test_the_panel_draws_request_options_and_measured_values(props):
         assert name in recorder.props()
     assert "ellimann.synthesize_mannequin" in recorder.operators()
     assert "ellimann.add_measurement_preset" in recorder.operators()
-    label = synthesize.ELLIMANN_MT_measurement_presets.bl_label  # the last preset chosen
+    label = presets.ELLIMANN_MT_measurement_presets.bl_label  # the last preset chosen
     assert ("menu", {"menu": "ELLIMANN_MT_measurement_presets", "text": label}) in recorder.log
     assert "m_T (cm)" not in recorder.labels()
     bpy.ops.ellimann.synthesize_mannequin()
@@ -393,12 +402,12 @@ def test_the_panel_draws_request_options_and_measured_values(props):
 
 
 def test_the_panel_is_a_sub_panel_registered_with_the_add_on():
-    """Registered after its parent ELLIMANN_PT_main (``synthesize_panel`` after ``panels`` in _MODULES), between
-    the authoring tools' panels and Drape (test_ids checks the ids themselves)."""
-    from ellimann_addon import blender
-    from ellimann_addon.blender import ids
+    """Registered after its parent ELLIMANN_PT_main (``registry.CLASSES``), between the authoring tools' panels
+    and Drape (test_ids checks the ids themselves)."""
+    from ellimann_addon.blender import ids, registry
 
-    assert blender._MODULES.index("panels") < blender._MODULES.index("synthesize_panel")
+    classes = list(registry.CLASSES)
+    assert classes.index(registry.main_panel.ELLIMANN_PT_main) < classes.index(panel.ELLIMANN_PT_synthesize)
     assert hasattr(bpy.types, ids.PANEL_SYNTHESIZE) and hasattr(bpy.types, ids.PANEL_MAIN)
     cls = panel.ELLIMANN_PT_synthesize
     assert (cls.bl_idname, cls.bl_parent_id) == (ids.PANEL_SYNTHESIZE, ids.PANEL_MAIN)

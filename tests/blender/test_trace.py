@@ -6,8 +6,8 @@ import pytest
 
 from devkit.blender_scene import edit_with_selection, parts, reference_mesh, state
 from devkit.toy import rotation_from_vector
-from ellimann_addon.blender.convert import collection_to_mannequin, ellipsoid_frame
-from ellimann_addon.blender.operators.trace import FIT_MODE_ITEMS, next_part_name
+from ellimann_addon.blender.bridge.convert import collection_to_mannequin, ellipsoid_frame
+from ellimann_addon.blender.features.trace.operators import FIT_MODE_ITEMS, next_part_name
 from ellimann_addon.core.fit import FIT_MODES, fit_ellipsoid
 from ellimann_addon.core.frames import is_rotation
 
@@ -109,7 +109,7 @@ def test_fit_goes_into_the_active_mannequin(toy_collection):
     obj = reference_mesh(np.eye(3), (0.0, 0.0, 1.0), np.array((0.1, 0.1, 0.1)))
     obj.select_set(True)
     bpy.context.view_layer.objects.active = obj
-    from ellimann_addon.blender.selection import set_active_collection
+    from ellimann_addon.blender.bridge.selection import set_active_collection
 
     set_active_collection(bpy.context, toy_collection)
     edit_with_selection(obj, slice(None))

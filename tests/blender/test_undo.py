@@ -12,7 +12,7 @@ from devkit import synthetic
 from devkit.blender_scene import edit_with_selection, parts, reference_mesh, select, state
 from devkit.poses import make_apose_toy
 from devkit.toy import rotation_from_vector
-from ellimann_addon.blender.convert import mannequin_to_collection
+from ellimann_addon.blender.bridge.convert import mannequin_to_collection
 
 CYCLE = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])  # relabels axes (x, y, z) -> (y, z, x)
 

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from devkit.blender_scene import parts, select, state
-from ellimann_addon.blender.checks import frame_issue
-from ellimann_addon.blender.convert import UNIT_SPHERE_NAME, ellipsoid_frame, is_unit_sphere, mesh_vertices
+from ellimann_addon.blender.bridge.checks import frame_issue
+from ellimann_addon.blender.bridge.convert import UNIT_SPHERE_NAME, ellipsoid_frame, is_unit_sphere, mesh_vertices
 from ellimann_addon.core.ellipsoid import shape_matrix
 from ellimann_addon.core.frames import is_rotation
 
@@ -16,11 +16,11 @@ def world_set(obj):
     matrix = np.array(obj.matrix_world)
     vertices = mesh_vertices(obj.data)
     if not is_unit_sphere(obj.data):
-        from ellimann_addon.blender.convert import UNIT_SPHERE_SUBDIVISIONS
+        from ellimann_addon.core.constants import UNIT_SPHERE_LEVEL
         from ellimann_addon.core.fit import fit_affine
         from ellimann_addon.core.mesh import icosphere
 
-        matrix = matrix @ fit_affine(icosphere(UNIT_SPHERE_SUBDIVISIONS)[0], vertices)[0]
+        matrix = matrix @ fit_affine(icosphere(UNIT_SPHERE_LEVEL)[0], vertices)[0]
     linear = matrix[:3, :3]
     return matrix[:3, 3], linear @ linear.T
 

@@ -19,7 +19,7 @@ def disturbed(toy, seed):
 
 
 def test_register_puts_feet_on_the_floor_and_shoulders_on_the_axis(toy):
-    m = clean.register(disturbed(toy, 1))
+    m = clean.register_to_world(disturbed(toy, 1))
     lowest = np.min(m.center[:, 2] - axis_extent(m.rotation, m.semi_axes, 2))
     assert lowest == pytest.approx(0.0, abs=1e-12)
     idx = clean.landmark_indices(m.topology)
@@ -52,7 +52,7 @@ def test_missing_landmarks_are_reported(toy):
     from ellimann_addon.core.errors import MannequinError
 
     with pytest.raises(MannequinError, match="no 'Deltoid' ellipsoids"):
-        clean.register(toy, label="Deltoid")
+        clean.register_to_world(toy, label="Deltoid")
 
 
 def test_clean_registers_after_mirroring(toy):

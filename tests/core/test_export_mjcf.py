@@ -8,12 +8,12 @@ import pytest
 
 from devkit.toy import make_toy_mannequin
 from ellimann_addon.core import mesh
-from ellimann_addon.core.constants import MEASUREMENTS
+from ellimann_addon.core.constants import MEASUREMENTS, MJCF_CUSHION_LEVEL
 from ellimann_addon.core.cushion import cushion_mesh, cushion_name
 from ellimann_addon.core.ellipsoid import bounds, contains
 from ellimann_addon.core.errors import ElliMannError, MannequinError
-from ellimann_addon.core.export_mjcf import MJCF_SUBDIVISIONS, mannequin_to_mjcf, write_mjcf
-from ellimann_addon.core.fit_metrics import BodyPieces
+from ellimann_addon.core.export_mjcf import mannequin_to_mjcf, write_mjcf
+from ellimann_addon.core.garment_fit import BodyPieces
 from ellimann_addon.core.mannequin import Mannequin
 
 mujoco = pytest.importorskip("mujoco")  # a dev dependency (requirements-dev.txt); CI always has it
@@ -78,7 +78,7 @@ def test_cushions_become_convex_mesh_geoms_of_the_right_volume(make):
         assert np.allclose(data.xpos[body.id], mannequin.center[first], atol=1e-8)
         assert np.allclose(data.xmat[body.id].reshape(3, 3), mannequin.rotation[first], atol=1e-8)
         frames = [(mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i]) for i in (first, second)]
-        vertices, faces = cushion_mesh(*frames, subdivisions=MJCF_SUBDIVISIONS)
+        vertices, faces = cushion_mesh(*frames, subdivisions=MJCF_CUSHION_LEVEL)
         # MuJoCo's own mass properties of the mesh: its volume is the core's (float32 vertices).
         assert model.body_mass[body.id] / DENSITY == pytest.approx(mesh.volume(vertices, faces), rel=1e-4)
         # MuJoCo keeps the mesh in its inertial frame; placed by the geom pose it is the cushion.
@@ -168,7 +168,7 @@ def drop_balls(mannequin, cushions):
     ball_geoms = {model.geom(n).id for n in names}
     floor = model.geom("floor").id
     body_geoms = set(range(model.ngeom)) - ball_geoms - {floor}
-    pieces = BodyPieces(mannequin, cushions=cushions, subdivisions=MJCF_SUBDIVISIONS)
+    pieces = BodyPieces(mannequin, cushions=cushions, subdivisions=MJCF_CUSHION_LEVEL)
     closest = np.full(len(names), np.inf)  # smallest centre-to-body signed distance along the fall
     hit_body = set()
     deepest_contact = 0.0

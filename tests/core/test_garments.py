@@ -9,7 +9,7 @@ from ellimann_addon.core import garments, mesh
 from ellimann_addon.core.constants import SECTION_FRACTIONS
 from ellimann_addon.core.ellipsoid import axis_extent
 from ellimann_addon.core.errors import ElliMannError, MeasurementError, ReferenceSetError
-from ellimann_addon.core.fit_metrics import BodyPieces, mannequin_signed_distance
+from ellimann_addon.core.garment_fit import BodyPieces, mannequin_signed_distance
 from ellimann_addon.core.measure import section_heights
 from ellimann_addon.core.synthesis import load_reference_set
 

@@ -1,0 +1,16 @@
+"""Synthesize: five measurements in, a mannequin out; presets, and Live updates of the last one."""
+
+from . import live, operators, panel, presets, props
+
+# Registered in this order (the property group before the pointer to it), unregistered in reverse.
+classes = props.classes + operators.classes + presets.classes + panel.classes
+
+
+def register_hooks():
+    props.register_hooks()
+    live.register_hooks()
+
+
+def unregister_hooks():
+    live.unregister_hooks()
+    props.unregister_hooks()

@@ -1,0 +1,45 @@
+"""The Synthesize operator: a new mannequin collection named after the request, from the scene's
+``Scene.ellimann_synthesis`` (:mod:`.props`); it becomes the target that Live updates (:mod:`.live`)."""
+
+import bpy
+
+from ....core.constants import MEASUREMENTS
+from ....core.errors import ElliMannError
+from ....core.synthesis import relative_error
+from ... import ids
+from ...bridge.convert import ellipsoid_objects
+from ...services.scene import add_mannequin
+from .request import request_of, synthesize_request
+
+
+class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
+    """Build a new mannequin from the five measurements (segmented IDW over the Reference Mannequins)"""
+
+    bl_idname = ids.SYNTHESIZE_MANNEQUIN
+    bl_label = "Synthesize"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.scene is not None and hasattr(context.scene, "ellimann_synthesis")
+
+    def execute(self, context):
+        props = context.scene.ellimann_synthesis
+        try:
+            mannequin, measured, warnings = synthesize_request(props)
+            collection = add_mannequin(mannequin, measured, cushions=props.output == "CUSHIONS")
+        except ElliMannError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        props.target = collection
+        props.status = "; ".join(warnings)
+        for warning in warnings:
+            self.report({"WARNING"}, warning)
+        worst = relative_error(measured, request_of(props)).max()
+        values = ", ".join(f"{k} {measured[k]:.2f}" for k in MEASUREMENTS)
+        self.report({"INFO"}, f"Synthesized '{collection.name}' ({len(ellipsoid_objects(collection))} ellipsoids, "
+                              f"{props.mode.lower()}): m_T {values} cm, max error {worst:.2f}%")
+        return {"FINISHED"}
+
+
+classes = (ELLIMANN_OT_synthesize_mannequin,)

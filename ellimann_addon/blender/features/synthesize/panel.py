@@ -1,0 +1,62 @@
+"""The Synthesize sub-panel of the ElliMann sidebar tab: presets, the request and its m_T, options, Live."""
+
+import bpy
+
+from ....core.constants import MEASUREMENT_LABELS, MEASUREMENTS
+from ... import ids
+from ..base import SubPanel
+from .presets import ELLIMANN_MT_measurement_presets
+from .request import FIELDS
+
+
+class ELLIMANN_PT_synthesize(SubPanel, bpy.types.Panel):
+    """Type five measurements, get a mannequin"""
+
+    bl_idname = ids.PANEL_SYNTHESIZE
+    bl_label = "Synthesize"
+    bl_order = ids.SYNTHESIZE_ORDER
+
+    @classmethod
+    def poll(cls, context):
+        return hasattr(context.scene, "ellimann_synthesis")
+
+    def draw(self, context):
+        layout = self.layout
+        props = context.scene.ellimann_synthesis
+        target = props.target
+        measured = tuple(target.ellimann.measured) if target is not None and target.ellimann.has_measured else None
+
+        row = layout.row(align=True)
+        row.menu(ids.MENU_MEASUREMENT_PRESETS, text=ELLIMANN_MT_measurement_presets.bl_label)
+        row.operator(ids.ADD_MEASUREMENT_PRESET, text="", icon="ADD")
+        row.operator(ids.ADD_MEASUREMENT_PRESET, text="", icon="REMOVE").remove_active = True
+
+        header = layout.row()
+        header.label(text="Request (cm)")
+        header.label(text="m_T (cm)" if measured else "")
+        column = layout.column(align=True)
+        for index, key in enumerate(MEASUREMENTS):
+            row = column.row()
+            row.prop(props, FIELDS[key], text=MEASUREMENT_LABELS[key])
+            row.label(text=f"{measured[index]:.2f}" if measured else "")
+
+        layout.row().prop(props, "mode", expand=True)
+        layout.row().prop(props, "output", expand=True)
+        options = layout.column(align=True)
+        options.prop(props, "normalize")
+        options.prop(props, "metric")
+        options.prop(props, "power")
+        options.prop(props, "references")
+
+        layout.operator(ids.SYNTHESIZE_MANNEQUIN, icon="OUTLINER_OB_ARMATURE")
+        row = layout.row()
+        row.prop(props, "live")
+        if target is not None:
+            row.label(text=f"{target.name}" + (f" ({props.live_ms:.1f} ms)" if props.live_ms else ""))
+        if props.status:
+            box = layout.box()
+            for line in props.status.split("; "):
+                box.label(text=line, icon="ERROR")
+
+
+classes = (ELLIMANN_PT_synthesize,)

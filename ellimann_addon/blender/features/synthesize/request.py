@@ -1,0 +1,20 @@
+"""The synthesis request of a scene (``Scene.ellimann_synthesis``): its five fields in cm, and the
+core synthesis it asks for (segmented IDW over the Reference Mannequins, :func:`core.synthesis.synthesize`)."""
+
+import bpy
+
+from ....core.constants import MEASUREMENTS
+from ....core.synthesis import cached_reference_set, synthesize
+
+FIELDS = {key: key.lower() for key in MEASUREMENTS}  # He -> props.he
+
+
+def request_of(props):
+    return {key: float(getattr(props, attr)) for key, attr in FIELDS.items()}
+
+
+def synthesize_request(props):
+    folder = bpy.path.abspath(props.references) if props.references else None
+    reference = cached_reference_set(folder)
+    return synthesize(reference, request_of(props), props.mode.lower(), props.metric.lower(), props.power,
+                      normalize=props.normalize.lower())

@@ -1,0 +1,307 @@
+"""Every file Blender writes for ElliMann (.blend, .glb, .obj, .png), put in place atomically.
+
+Three parts, one module: the atomic write every Blender output goes through (``atomic_output``; JSON
+and MJCF go through ``core.files`` and need no scene), the glTF export with ElliMann's extras
+(``export_gltf``) and ``write_mannequin``, which writes one mannequin to .blend, .glb and .obj from
+an empty scene (the CLI's and scripts' writer).
+
+Atomic output: every output of the add-on goes through here or through ``core.files`` (JSON, MJCF),
+so a failed write never leaves a half-written file and every format gets the same permissions.
+
+Writing mannequins: Blender files are written from an empty scene holding only that mannequin (and
+its cushions when asked), to a temporary file in the target folder that is renamed into place once
+complete (:func:`atomic_output`). A .glb goes through :func:`export_gltf`, so it always carries
+ElliMann's extras.
+
+glTF export: glTF export of a mannequin collection that keeps piece names and measurements (as glTF ``extras``).
+
+Blender's glTF exporter, asked for one collection (``collection=``, Blender 4.2+) with
+``export_extras=True``, writes each object's custom properties as its node's ``extras`` and the
+collection's as the glTF scene's ``extras``. ElliMann's own data lives in a registered property
+group named ``ellimann``, which Blender 5.0+ keeps apart from custom properties but 4.x stores as the
+custom property of that name (and refuses to have replaced by a dict). So the export leaves the
+objects alone and writes ``extras.ellimann`` into the written file's JSON chunk afterwards, the same
+on every Blender; the user's own custom properties still travel as the exporter writes them.
+
+What a three.js / game-engine user finds in the .glb:
+- one node per piece, named after the part (``"7.a Thigh.L"``); ellipsoids share one unit-sphere
+  mesh, so the node's translation/rotation/scale *is* the ellipsoid (in glTF's Y-up axes);
+  ``node.extras.ellimann`` = {part, kind, side, region, girth, depends, partner} and, for
+  ellipsoids, the frame in ElliMann's Z-up axes: center_m, axes (the three local axes as rows),
+  semi_axes_m;
+- ``scene.extras.ellimann`` = {format, version, name, role, units, up, target_cm, measured_cm}
+  (target_cm only when the mannequin has a target; measured_cm is m_T of the ellipsoids).
+"""
+
+import contextlib
+import errno
+import json
+import os
+import re
+import shutil
+import struct
+import tempfile
+
+import bpy
+import numpy as np
+
+from ...core.constants import MEASUREMENTS
+from ...core.errors import ElliMannError
+from ...core.files import disk_full, incomplete, temp_prefix
+from ..bridge.built import built_objects, is_stale
+from ..bridge.convert import collection_to_mannequin, objects_recursive
+from ..bridge.selection import part_lookup
+from .chatter import blender_output
+from .scene import add_mannequin, empty_scene, shown_objects
+
+BLENDER_FORMATS = ("blend", "glb", "obj")
+
+
+# ------------------------------------------------------------------------------------------------ atomic output
+
+
+@contextlib.contextmanager
+def atomic_output(path):
+    """Yield a temporary path for Blender to write; once it has, rename it onto ``path`` (same folder).
+
+    The temporary file sits in a private folder beside the target, so Blender writes a fresh file
+    (no backup of an existing one, normal permissions) and one rename on the same file system puts it
+    in place. It is renamed only if it is whole (``core.files.incomplete``: Blender can return
+    normally from a write the disk cut short) and the disk did not fill up. Nothing is left behind on
+    failure. An OSError on the way (making the folder, writing, renaming), or a RuntimeError of the
+    Blender operator that wrote, is raised as an OSError with ``filename`` = ``path`` as given, not
+    the temporary file's, and a one-line reason.
+    """
+    target = os.fspath(path)
+    with _naming(target):
+        path = os.path.abspath(target)
+        folder = os.path.dirname(path)
+        os.makedirs(folder, exist_ok=True)
+        scratch = tempfile.mkdtemp(prefix=temp_prefix(), dir=folder)
+    temp = os.path.join(scratch, os.path.basename(path))
+    try:
+        with _naming(target):
+            try:
+                yield temp
+            except RuntimeError as error:  # what a bpy.ops call raises when Blender could not write
+                if disk_full(folder):
+                    raise OSError(errno.ENOSPC, "No space left on device", target) from error
+                # Blender 4.x reports a full disk as "No such file or directory" (it has removed its
+                # partial file by then): a write of the size of a small .blend tells.
+                no_room = _no_room_for(scratch, PROBE_BYTES)
+                if no_room:
+                    raise OSError(no_room.errno, no_room.strerror, target) from error
+                raise blender_write_error(error, temp, target) from error
+            problem = incomplete(temp) if os.path.isfile(temp) else "Blender wrote nothing"
+            full = disk_full(folder)
+            if full:
+                reason = f"the file Blender wrote is incomplete: {problem}" if problem else "the disk filled up"
+                raise OSError(errno.ENOSPC, f"No space left on device ({reason})", target)
+            if problem:
+                raise OSError(errno.EIO, f"the file Blender wrote is incomplete: {problem}", target)
+            os.replace(temp, path)
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+
+
+PROBE_BYTES = 1 << 20
+
+
+def _no_room_for(folder, size):
+    """The OSError (no space, quota or file size limit) that writing ``size`` bytes in ``folder`` meets
+    now, or None (a scratch file, removed at once)."""
+    try:
+        with tempfile.TemporaryFile(dir=folder) as probe:
+            probe.write(bytes(size))
+            probe.flush()
+            os.fsync(probe.fileno())
+    except OSError as error:
+        if error.errno in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
+            return error
+    return None
+
+
+def blender_write_error(error, temp, target):
+    """An OSError naming ``target`` for a Blender operator's RuntimeError while it wrote ``temp``.
+
+    The reason is the errno Blender reports ("[Errno 28] …", "…: File name too long"), else what
+    opening ``temp`` says, else Blender's first line with the temporary path replaced by ``target``.
+    """
+    text = str(error)
+    match = re.search(r"\[Errno (\d+)\] ([^:\n'\"]+)", text)
+    if match:
+        return OSError(int(match.group(1)), match.group(2).strip(), target)
+    names = {os.strerror(number): number for number in errno.errorcode}
+    for line in text.splitlines():
+        tail = line.rstrip().rsplit(": ", 1)[-1]
+        if tail in names:
+            return OSError(names[tail], tail, target)
+    try:
+        with open(temp, "ab"):
+            pass
+    except OSError as probe:
+        return OSError(probe.errno, probe.strerror or str(probe), target)
+    first = next((line.strip() for line in text.splitlines() if line.strip()), "Blender could not write it")
+    first = re.sub(r"^Error:\s*", "", first).replace(temp, target).replace(os.path.dirname(temp), ".")
+    return OSError(errno.EIO, f"Blender could not write it ({first[:200]})", target)
+
+
+@contextlib.contextmanager
+def _naming(target):
+    try:
+        yield
+    except OSError as error:
+        if error.filename == target and error.filename2 is None:
+            raise
+        raise OSError(error.errno, error.strerror or str(error), target) from error
+
+
+# ------------------------------------------------------------------------------------------------ glTF
+
+
+EXTRAS_KEY = "ellimann"
+EXTRAS_FORMAT = "ellimann.gltf-extras"
+EXTRAS_VERSION = 1
+
+
+def part_extras(obj):
+    """The node extras of one ElliMann object (ellipsoid or cushion)."""
+    props = obj.ellimann
+    extras = {"part": props.part_name, "kind": props.kind, "side": props.side, "region": props.region,
+              "girth": bool(props.girth), "depends": [m for m in MEASUREMENTS if m in props.depends],
+              "partner": props.partner}
+    if props.kind == "ELLIPSOID":
+        matrix = np.array(obj.matrix_world)
+        semi = np.linalg.norm(matrix[:3, :3], axis=0)
+        extras.update(center_m=matrix[:3, 3].tolist(), axes=(matrix[:3, :3] / semi).T.tolist(),
+                      semi_axes_m=semi.tolist())
+    return extras
+
+
+def scene_extras(mannequin):
+    out = {"format": EXTRAS_FORMAT, "version": EXTRAS_VERSION, "name": mannequin.name, "role": mannequin.role,
+           "units": "m (geometry), cm (measurements)",
+           "up": "ElliMann data is Z-up, facing -Y; glTF nodes are Y-up as glTF requires",
+           "measured_cm": mannequin.measure()}
+    if mannequin.measurements:
+        out["target_cm"] = {k: float(v) for k, v in mannequin.measurements.items()}
+    return out
+
+
+def export_gltf(collection, path):
+    """Write a mannequin collection (and its child collections) to a binary glTF (.glb), atomically
+    (:func:`atomic_output`, like every file Blender writes for ElliMann).
+
+    Objects hidden from renders are left out: in a mannequin shown with cushions those are the
+    ellipsoids the cushions replace, so the file holds each convex piece once.
+
+    Raises ElliMannError for a path not ending in .glb or for built cushions that are out of date
+    (their ellipsoids moved since they were built: a live update, an undo or a reload can leave them
+    so), and MannequinError (naming the parts) for a collection that is not a valid mannequin;
+    nothing is written then, and the file is unchanged. Returns the path.
+    """
+    path = os.fspath(path)
+    if not path.lower().endswith(".glb"):
+        raise ElliMannError(f"path: a glTF export is written as binary glTF and must end in .glb, got {path!r}")
+    bpy.context.view_layer.update()  # matrix_world of objects a script just moved
+    mannequin = collection_to_mannequin(collection)
+    parts = part_lookup(collection)
+    stale = [c.name for c in built_objects(collection, "CUSHION") if is_stale(c, parts)]
+    if stale:
+        more = f" and {len(stale) - 1} more" if len(stale) > 1 else ""
+        raise ElliMannError(f"the cushions of '{collection.name}' are out of date ('{stale[0]}'{more}: their "
+                            "ellipsoids moved since they were built): Build Cushions first")
+    objects = [o for o in objects_recursive(collection) if o.ellimann.is_part]
+    node_extras = {o.name: part_extras(o) for o in objects}
+    with atomic_output(path) as temp:
+        result = bpy.ops.export_scene.gltf(filepath=temp, export_format="GLB", export_extras=True,
+                                           collection=collection.name, export_yup=True, use_renderable=True)
+        if result != {"FINISHED"}:
+            raise ElliMannError(f"path: Blender's glTF exporter did not finish ({result})")
+        _set_extras(temp, node_extras, scene_extras(mannequin))
+    return path
+
+
+def _set_extras(path, node_extras, scene_extras_):
+    """Put ``extras.ellimann`` on the scene of a .glb file and on each of its nodes named in ``node_extras``
+    (the exporter leaves out what is hidden from renders: those objects have no node to carry it)."""
+    with open(path, "rb") as stream:
+        data = stream.read()
+    doc, rest = _split_glb(data, path)
+    for node in doc.get("nodes", []):
+        if node.get("name") in node_extras:
+            node.setdefault("extras", {})[EXTRAS_KEY] = node_extras[node["name"]]
+    for scene in doc.get("scenes", []):
+        scene.setdefault("extras", {})[EXTRAS_KEY] = scene_extras_
+    chunk = json.dumps(doc, separators=(",", ":"), allow_nan=False).encode()
+    chunk += b" " * (-len(chunk) % 4)  # chunks are 4-byte aligned; glTF pads JSON with spaces
+    header = struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(chunk) + len(rest))
+    with open(path, "wb") as stream:
+        stream.write(header + struct.pack("<I4s", len(chunk), b"JSON") + chunk + rest)
+
+
+def _split_glb(data, path):
+    """(the JSON chunk as a dict, every chunk after it as bytes) of a .glb file's bytes."""
+    if len(data) < 20:
+        raise ElliMannError(f"path: {path} is not a binary glTF file")
+    magic, _, total = struct.unpack_from("<4sII", data)
+    length, kind = struct.unpack_from("<I4s", data, 12)
+    if magic != b"glTF" or kind != b"JSON" or total != len(data) or 20 + length > len(data):
+        raise ElliMannError(f"path: {path} is not a whole binary glTF file")
+    return json.loads(data[20:20 + length]), data[20 + length:]
+
+
+def read_glb_json(path):
+    """The JSON chunk of a .glb file as a dict (for tests and tools that check the extras)."""
+    with open(path, "rb") as stream:
+        return _split_glb(stream.read(), path)[0]
+
+
+# ------------------------------------------------------------------------------------------------ mannequin files
+
+
+def write_mannequin(mannequin, paths, measured=None, cushions=False):
+    """Write one mannequin to every .blend, .glb and .obj in ``paths`` (format from the extension), all
+    from one empty scene. Returns the paths. (.json and MJCF need no Blender: ``core.writers``.)
+
+    ``cushions``: the files show the cushions instead of the ellipsoids they replace. A path of another
+    kind raises ElliMannError before anything is written; an OSError names the file that failed
+    (``filename``, as given in ``paths``).
+    """
+    paths = [os.fspath(p) for p in paths]
+    other = [p for p in paths if extension(p) not in BLENDER_FORMATS]
+    if other:
+        raise ElliMannError(f"path: {other[0]!r} is not a .blend, .glb or .obj file")
+    if paths:
+        empty_scene()
+        collection = add_mannequin(mannequin, measured, cushions)
+        for path in paths:
+            _write_blender_file(path, collection)
+    return paths
+
+
+def extension(path):
+    return os.path.splitext(os.fspath(path))[1].lower().lstrip(".")
+
+
+def _write_blender_file(path, collection):
+    kind = extension(path)
+    if kind == "glb":  # atomic itself; leaves out what renders do not show (ellipsoids a cushion replaces)
+        with blender_output():
+            export_gltf(collection, path)
+        return
+    with atomic_output(path) as temp, blender_output():
+        if kind == "blend":
+            bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)
+        else:
+            _select_only(shown_objects(collection))
+            bpy.ops.wm.obj_export(filepath=temp, export_selected_objects=True, export_materials=False,
+                                  check_existing=False)
+
+
+def _select_only(objects):
+    bpy.context.view_layer.update()  # give newly linked objects their view-layer bases before selecting
+    for obj in bpy.context.view_layer.objects:
+        obj.select_set(False)
+    for obj in objects:
+        obj.select_set(True)
