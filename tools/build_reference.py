@@ -344,26 +344,13 @@ def save_all(mannequins, out):
     return changed
 
 
-def write_blends(mannequins, folder):
-    """One .blend per mannequin (a collection of ellipsoid objects), through the add-on's converter.
+def write_blends(stems, folder):
+    """The .blend twins of ``folder``'s ``<stem>.json`` files, saved by the oldest supported Blender
+    (tools/reference_blends.py: no Blender opens a newer one's file)."""
+    from . import reference_blends
 
-    ``mannequins`` maps file stems to mannequins. Needs the bpy module.
-    """
-    import bpy
-
-    import ellimann_addon
-    from ellimann_addon.blender import convert
-
-    folder = pathlib.Path(folder)
-    bpy.context.preferences.filepaths.save_version = 0  # no .blend1 backups of the files it replaces
-    ellimann_addon.register()
-    try:
-        for stem, mannequin in mannequins.items():
-            bpy.ops.wm.read_homefile(use_empty=True)
-            convert.mannequin_to_collection(mannequin, name=mannequin.name)
-            bpy.ops.wm.save_as_mainfile(filepath=str(folder / f"{stem}.blend"), compress=True)
-    finally:
-        ellimann_addon.unregister()
+    if reference_blends.main(["--folder", str(folder), *stems]):
+        raise SystemExit("the .blend twins could not be written")
 
 
 def write_lineup(files, path):
@@ -699,7 +686,7 @@ def main(argv=None):
         stale = {stem: m for stem, m in mannequins.items()
                  if stem in changed or not (args.out / f"{stem}.blend").is_file()}
         if stale:
-            write_blends(stale, args.out)
+            write_blends(sorted(stale), args.out)
         print(f"{len(stale)} .blend files written")
         lineup = args.docs / "images" / "reference_lineup.png"
         if set(changed) & set(RM_BODIES) or not lineup.is_file():
