@@ -3,7 +3,7 @@
 import importlib
 
 # Registered in this order, unregistered in reverse.
-_MODULES = ("props", "operators", "panels", "menus", "synthesize", "synthesize_panel", "drape_panel", "cli")
+_MODULES = ("props", "operators", "panels", "menus", "synthesize", "synthesize_panel", "drape_panel", "cli_command")
 
 
 def _modules():

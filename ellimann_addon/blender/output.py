@@ -13,13 +13,13 @@ import bpy
 
 from ..core.cushion import DEFAULT_SUBDIVISIONS
 from ..core.errors import ElliMannError
-from .atomic import atomic_output
+from ..core.files import atomic_output
+from ..core.formats import BLENDER_FORMATS
 from .chatter import blender_output
 from .convert import mannequin_to_collection, objects_recursive, write_measured
 from .cushions import build_cushions
 from .export import export_gltf
 
-BLENDER_FORMATS = ("blend", "glb", "obj")
 LIVE_SUBDIVISIONS = 3
 
 

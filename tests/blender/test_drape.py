@@ -14,8 +14,9 @@ import pytest
 from devkit.blender_scene import parts, select, state
 from devkit.poses import make_apose_toy
 from devkit.ui_recorder import draw_panel
-from ellimann_addon.blender import cli, drape_panel, ids
+from ellimann_addon import cli
 from ellimann_addon.blender import drape as drape_module
+from ellimann_addon.blender import drape_panel, ids
 from ellimann_addon.blender.convert import mannequin_to_collection
 from ellimann_addon.blender.drape import CLOTH_NAME, PIN_GROUP, DrapeSettings, drape, evaluated_vertices
 from ellimann_addon.blender.operators import drape as drape_operator

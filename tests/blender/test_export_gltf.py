@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from ellimann_addon.blender import convert
-from ellimann_addon.blender.atomic import atomic_output
 from ellimann_addon.blender.export import EXTRAS_KEY, export_gltf, read_glb_json
 from ellimann_addon.blender.output import write_mannequin
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.errors import ElliMannError, MannequinError
+from ellimann_addon.core.files import atomic_output
 from ellimann_addon.core.quaternion import quaternion_to_rotation
 from ellimann_addon.core.writers import write_core_file
 

@@ -3,10 +3,9 @@
 import bpy
 from bpy.props import BoolProperty, EnumProperty
 
-from ...core.constants import MEASUREMENTS
 from ...core.cushion import cushion_name
 from ...core.errors import MannequinError
-from ...core.measure import as_dict, measure_meshes, section_hulls, tailor_measurements
+from ...core.measure import as_dict, measure_meshes, measurement_line, section_hulls, tailor_measurements
 from .. import ids
 from ..built import built_collection, built_objects, is_stale, new_section_object, remove_built
 from ..convert import collection_to_mannequin, ellipsoid_objects, world_triangles, write_measured
@@ -46,7 +45,7 @@ def cushion_mannequin_meshes(collection, mannequin, cushions):
 
 
 def format_measurements(values):
-    return ", ".join(f"{key} {values[key]:.2f}" for key in MEASUREMENTS) + " cm"
+    return measurement_line(values) + " cm"
 
 
 class ELLIMANN_OT_measure_mannequin(bpy.types.Operator):
