@@ -23,7 +23,7 @@ def add_parser(commands):
 
 def needs_blender(args):
     """What needs Blender in this command: its .blend files (and the line-up picture)."""
-    return "demo (its .blend files and line-up picture)"
+    return "the demo (.blend files and a line-up picture)"
 
 
 def run(args):

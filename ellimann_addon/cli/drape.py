@@ -42,7 +42,7 @@ def add_parser(commands):
 
 def needs_blender(args):
     """What needs Blender in this command: the cloth simulation."""
-    return "drape (Blender's cloth simulation)"
+    return "the cloth simulation"
 
 
 def run(args):

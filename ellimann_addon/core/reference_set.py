@@ -4,6 +4,7 @@
 import math
 import os
 import pathlib
+import sys
 
 import numpy as np
 
@@ -23,7 +24,16 @@ from .options import (
 from .refine import _deform_basis, _fd_jacobian
 
 REFERENCE_NAMES = tuple(REFERENCE_MEASUREMENTS)  # small_slim, tall_slim, small_chubby, tall_chubby, average
-REFERENCE_FOLDER = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"
+
+
+def _shipped_folder():
+    """The repository's reference_blends/ (a checkout, the extension), else where ``pip install`` put them."""
+    checkout = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"
+    installed = pathlib.Path(sys.prefix) / "share" / "ellimann" / "reference_blends"
+    return installed if not checkout.is_dir() and installed.is_dir() else checkout
+
+
+REFERENCE_FOLDER = _shipped_folder()
 SYMMETRY_TOLERANCE = 1e-6  # m: RMs must be symmetric to this for the mirrored synthesis to be exact
 _INDEX = {key: i for i, key in enumerate(MEASUREMENTS)}
 
