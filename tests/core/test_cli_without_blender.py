@@ -2,6 +2,7 @@
 run with the bpy module blocked (a meta-path finder refusing it), and never import ``ellimann_addon.blender``;
 what needs Blender (.blend/.glb/.obj, drape, demo) is refused in one line that says so."""
 
+import ast
 import json
 import pathlib
 import subprocess
@@ -106,3 +107,35 @@ def test_what_needs_blender_is_refused_in_one_line(tmp_path, argv, what):
     assert lines[0].startswith(f"ellimann {argv[0]}: error: {what.format(tmp=tmp_path)} needs Blender: the bpy "
                                "module is not installed")
     assert not list(tmp_path.iterdir())
+
+
+def test_the_cli_imports_blender_only_inside_functions():
+    """No module of ellimann_addon/cli imports bpy or the bpy layer at its top level."""
+    offenders = []
+    for path in (ROOT / "ellimann_addon" / "cli").glob("*.py"):
+        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                names = [("." * node.level) + (node.module or "")]
+            else:
+                continue
+            offenders += [f"{path.name}: {n}" for n in names if n.split(".")[0] in ("bpy", "bmesh", "mathutils")
+                          or n.lstrip(".").startswith("blender") or n.startswith("ellimann_addon.blender")]
+    assert offenders == []
+
+
+def test_one_table_for_the_options_of_the_cli_and_the_panels():
+    from ellimann_addon.cli import build_parser
+    from ellimann_addon.core import garments
+    from ellimann_addon.core.options import DRAPE, SYNTHESIS, DrapeSettings, SynthesisOptions
+
+    assert SynthesisOptions() == SynthesisOptions(**{k: o.default for k, o in SYNTHESIS.items()})
+    assert SynthesisOptions().mode == "exact"
+    args = build_parser().parse_args(["synth", *REQUEST, "-o", "x.json"])
+    assert {k: getattr(args, k) for k in SYNTHESIS} == {k: o.default for k, o in SYNTHESIS.items()}
+    assert DRAPE["garment"].values == tuple(garments.BUILDERS)
+    defaults = DrapeSettings()
+    assert all(getattr(defaults, k) == o.default for k, o in DRAPE.items() if k != "garment")
+    with pytest.raises(TypeError):
+        SynthesisOptions("exact")  # keyword-only
