@@ -158,7 +158,7 @@ def run():
     results = {}
     for title, options in VARIANTS:
         start = time.perf_counter()
-        results[title] = synthesis.synthesize_batch(reference, requests, **options)
+        results[title] = synthesis.synthesize_batch(reference, requests, mode="idw", **options)
         seconds = time.perf_counter() - start
         table(f"\nTable 2.4, {title}: synthesized + measured in {seconds:.2f} s", results[title].relative_error(),
               paper=options.get("metric", "raw") == "raw")
@@ -200,8 +200,8 @@ def run():
     print(f"  exact mode batched: {t_old / t_exact:.1f}x faster than before")
     one = requests[121:122]
     t_one = {}
-    for name, fn in (("idw, paper", lambda: synthesis.synthesize_batch(reference, one, normalize="none")),
-                     ("idw, proportional", lambda: synthesis.synthesize_batch(reference, one)),
+    for name, fn in (("idw, paper", lambda: synthesis.synthesize_batch(reference, one, mode="idw", normalize="none")),
+                     ("idw, proportional", lambda: synthesis.synthesize_batch(reference, one, mode="idw")),
                      ("exact, before", lambda: old_exact(reference, one)),
                      ("exact, now", lambda: synthesis.synthesize_batch(reference, one, mode="exact"))):
         t_one[name] = best_of(fn, repeat=5, number=5)

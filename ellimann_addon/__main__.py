@@ -1,6 +1,5 @@
-"""``python -m ellimann_addon …``: the ElliMann command line (the bpy module is needed for .blend/.glb/.obj)."""
+"""``python -m ellimann_addon …``: the ElliMann command line (numpy only; Blender's bpy for .blend/.glb/.obj)."""
 
-from .blender.cli import main
-from .blender.services import teardown
+from .cli import main_exit
 
-teardown.exit_with(main())
+main_exit()

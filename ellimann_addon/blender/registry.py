@@ -10,7 +10,7 @@ sub-panels by ``bl_order`` (``ids``), whatever the order here.
 
 import bpy
 
-from . import cli
+from . import cli_command
 from .bridge import props
 from .features import clean, cushions, drape, export, main_panel, measure, menus, part, synthesize, trace
 
@@ -53,4 +53,4 @@ def _remove_menu_entries():
 HOOKS = ((props.register_hooks, props.unregister_hooks),
          *((f.register_hooks, f.unregister_hooks) for f in FEATURES if hasattr(f, "register_hooks")),
          (_add_menu_entries, _remove_menu_entries),
-         (cli.register, cli.unregister))
+         (cli_command.register, cli_command.unregister))

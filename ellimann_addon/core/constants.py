@@ -13,8 +13,8 @@ MEASUREMENT_LABELS = {
     "Hi": "Hip perimeter",
 }
 
-# Section heights as fractions of He above the lowest point of the feet (DESIGN.md,
-# "Measurement heights"); the tools in ../shared/refmodels use the same numbers.
+# Section heights as fractions of He above the lowest point of the feet (the paper's Section 2.3.5; the
+# sections and the parts they cut: docs/topology.md); the tools in ../shared/refmodels use the same numbers.
 SECTION_FRACTIONS = {"Sh": 0.790, "Br": 0.720, "Wa": 0.645, "Hi": 0.500}
 GIRTHS = ("Br", "Wa", "Hi")
 

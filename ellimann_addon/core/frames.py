@@ -1,7 +1,7 @@
 """Frames: right-handedness, sagittal mirroring, axis relabelling, central symmetry, rotation means.
 
 All functions take stacks of rotations (..., 3, 3) whose columns are the ellipsoid's local axes.
-World conventions (DESIGN.md): sagittal plane x = 0, body left is +X, Z up.
+World conventions (README.md, "Conventions"): sagittal plane x = 0, body left is +X, Z up.
 """
 
 import itertools

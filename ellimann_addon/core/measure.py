@@ -229,6 +229,13 @@ def as_dict(values):
     return {key: float(value) for key, value in zip(MEASUREMENTS, values)}
 
 
+def measurement_line(values):
+    """"He 165.00, Sh 41.50, Br 101.25, Wa 82.75, Hi 117.50": the one way m_T (or a request) is written in a line
+    (command line, status bar, operator reports); ``values``: a dict keyed by MEASUREMENTS or 5 numbers in cm."""
+    values = [values[key] for key in MEASUREMENTS] if isinstance(values, dict) else list(values)
+    return ", ".join(f"{key} {value:.2f}" for key, value in zip(MEASUREMENTS, values))
+
+
 def section_hulls(rotation, center, semi_axes, girth, samples=256):
     """The sections m_T measures, for drawing: {key: (z, hull points (k, 2))} for Sh, Br, Wa, Hi.
 

@@ -1,20 +1,21 @@
 """Mannequin files the core writes without Blender: ElliMann's JSON and MJCF (MuJoCo's XML).
 
-Formats are named by what a user types (``--format json,mjcf``); each has one file extension.
+Formats are named by what a user types (``--format json,mjcf``); each has one file extension (``core.formats``).
 """
 
 import os
 
 from .errors import ElliMannError
 from .export_mjcf import write_mjcf
+from .formats import CORE_FORMATS, FORMATS, format_of
 
-EXTENSIONS = {"json": "json", "mjcf": "xml"}  # format -> file extension
+EXTENSIONS = {name: FORMATS[name].extension for name in CORE_FORMATS}  # format -> file extension (core.formats)
 
 
 def core_format(path):
     """The core format a path's extension names ("json", "mjcf"), or None."""
-    extension = os.path.splitext(os.fspath(path))[1].lower().lstrip(".")
-    return next((kind for kind, ext in EXTENSIONS.items() if ext == extension), None)
+    kind = format_of(path)
+    return kind.name if kind is not None and not kind.needs_blender else None
 
 
 def write_core_file(mannequin, path, cushions=False):

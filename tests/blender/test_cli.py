@@ -16,11 +16,13 @@ import bpy
 import pytest
 
 from devkit import synthetic
-from ellimann_addon.blender import cli
-from ellimann_addon.blender.services.drape import DrapeSettings
+from ellimann_addon import cli
 from ellimann_addon.blender.services.files import EXTRAS_KEY, read_glb_json
+from ellimann_addon.cli import common
+from ellimann_addon.cli import drape as drape_cli
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.options import DrapeSettings
 from ellimann_addon.core.synthesis import relative_error
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -57,7 +59,7 @@ def assert_one_line_error(code, err, *words):
 
 
 def test_python_m_help_is_fast_and_does_not_load_blender():
-    code = ("import sys\nfrom ellimann_addon.blender.cli import main\ncode = main(['--help'])\n"
+    code = ("import sys\nfrom ellimann_addon.cli import main\ncode = main(['--help'])\n"
             "print('bpy loaded' if 'bpy' in sys.modules else 'bpy not loaded', code)")
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True).stdout
     assert "synth" in out and "batch" in out and "measure" in out and "demo" in out
@@ -84,19 +86,19 @@ def test_python_m_bad_input_is_one_line_and_exit_code_1(tmp_path, references):
 
 
 def test_the_add_on_registers_main_as_the_blender_command(monkeypatch):
-    from ellimann_addon.blender import registry
+    from ellimann_addon.blender import cli_command, registry
 
-    # the add-on's register() ran cli.register()
-    assert (cli.register, cli.unregister) in registry.HOOKS and cli._handle is not None
+    # the add-on's register() ran cli_command.register()
+    assert (cli_command.register, cli_command.unregister) in registry.HOOKS and cli_command._handle is not None
     calls = []
-    monkeypatch.setattr(cli, "_handle", None)  # the real handle is restored afterwards
+    monkeypatch.setattr(cli_command, "_handle", None)  # the real handle is restored afterwards
     monkeypatch.setattr(bpy.utils, "register_cli_command", lambda *args: calls.append(("register", args)) or "H")
     monkeypatch.setattr(bpy.utils, "unregister_cli_command", lambda *args: calls.append(("unregister", args)))
-    cli.register()
-    assert calls == [("register", ("ellimann", cli.main))] and cli._handle == "H"
-    cli.unregister()
-    assert calls[1:] == [("unregister", ("H",))] and cli._handle is None
-    cli.unregister()  # twice is harmless
+    cli_command.register()
+    assert calls == [("register", ("ellimann", cli.main))] and cli_command._handle == "H"
+    cli_command.unregister()
+    assert calls[1:] == [("unregister", ("H",))] and cli_command._handle is None
+    cli_command.unregister()  # twice is harmless
     assert len(calls) == 2
 
 
@@ -198,7 +200,7 @@ def test_synth_mjcf_loads_in_mujoco_without_blender(tmp_path, references):
     pairs = len(reference.topology.cushion_pairs)
     singles = sum(1 for p in reference.topology if not p.partner)
     out = tmp_path / "m.xml"
-    code = ("import sys\nfrom ellimann_addon.blender.cli import main\n"
+    code = ("import sys\nfrom ellimann_addon.cli import main\n"
             f"code = main(['synth', *{REQUEST!r}, '--cushions', '-o', {str(out)!r}, '--references', {references!r}])\n"
             "print('bpy loaded' if 'bpy' in sys.modules else 'bpy not loaded', code)")
     done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120)
@@ -245,10 +247,10 @@ def parse(argv):
 def test_drape_defaults_are_the_drape_settings_defaults():
     """The CLI, the Drape panel and drape() from Python start from DrapeSettings()."""
     args = parse(["drape", "m.json", "-o", "m.blend"])
-    assert cli.drape_settings(args) == DrapeSettings()
+    assert drape_cli.settings_of(args) == DrapeSettings()
     args = parse(["drape", "m.json", "-o", "m.blend", "--frames", "12", "--edge", "4", "--no-cushions"])
-    assert cli.drape_settings(args) == DrapeSettings(frames=12, edge=0.04, cushions=False)
-    assert cli.drape_settings(parse(["drape", "m.json", "-o", "m.blend", "--cushions"])).cushions
+    assert drape_cli.settings_of(args) == DrapeSettings(frames=12, edge=0.04, cushions=False)
+    assert drape_cli.settings_of(parse(["drape", "m.json", "-o", "m.blend", "--cushions"])).cushions
 
 
 def test_drape_help_shows_those_defaults(capsys):
@@ -513,7 +515,7 @@ FSIZE_RUN = """
 import resource, signal, sys
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails (EFBIG) instead of ending us
 from ellimann_addon.blender.services import teardown
-from ellimann_addon.blender.cli import main
+from ellimann_addon.cli import main
 import bpy  # loaded (and Python's caches written) before the limit
 resource.setrlimit(resource.RLIMIT_FSIZE, ({limit}, {limit}))
 teardown.exit_with(main({argv!r}))
@@ -564,7 +566,7 @@ def test_a_name_too_long_for_the_file_system_is_one_line(tmp_path, capsys, refer
 
 
 def test_blender_write_errors_become_one_line_os_errors():
-    from ellimann_addon.blender.services.files import blender_write_error
+    from ellimann_addon.core.files import blender_write_error
 
     temp, target = "/out/.ellimann-1@h-abcdefgh/m.glb", "out/m.glb"
     gltf = RuntimeError("Error: Python: Traceback (most recent call last):\n  File \"x.py\", line 85, in save_gltf\n"
@@ -608,7 +610,7 @@ def test_a_batch_row_blender_fails_to_write_is_reported_and_the_batch_goes_on(tm
 
 def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_path, capsys, references,
                                                                            monkeypatch):
-    real, calls = cli._write, []
+    real, calls = common.write, []
 
     def interrupted_on_the_second_row(*args):
         calls.append(args)
@@ -616,7 +618,7 @@ def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_
             raise KeyboardInterrupt
         return real(*args)
 
-    monkeypatch.setattr(cli, "_write", interrupted_on_the_second_row)
+    monkeypatch.setattr(common, "write", interrupted_on_the_second_row)
     source = write_csv(tmp_path / "in.csv", GOOD_ROWS + [(160, 40, "abc", 90, 100, "bad")])
     out = tmp_path / "out"
     code, stdout, err = run(["batch", source, "-o", str(out), "--references", references], capsys)
@@ -626,7 +628,7 @@ def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_
     assert [(r["line"], r["status"]) for r in read_report(out / "report.csv")] == [("2", "ok"), ("5", "error")]
     assert sorted(p.name for p in out.iterdir()) == ["average.json", "report.csv"]
     first = (out / "average.json").stat()
-    monkeypatch.setattr(cli, "_write", real)
+    monkeypatch.setattr(common, "write", real)
     code, stdout, err = run(["batch", source, "-o", str(out), "--resume", "--references", references], capsys)
     assert code == 1 and "3 of 4 mannequins written" in stdout and "(1 already complete, kept)" in stdout
     assert (out / "average.json").stat().st_ino == first.st_ino  # kept, not written again
@@ -636,18 +638,18 @@ def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_
 
 KILLED_RUN = """
 import os, signal, sys, tempfile
-from ellimann_addon.blender import cli
+from ellimann_addon.cli import common, main
 from ellimann_addon.core.files import temp_prefix
-real, calls = cli._write, []
+real, calls = common.write, []
 def killed_on_the_third_row(mannequin, paths, *args):
     calls.append(paths)
     if len(calls) == 3:  # killed while writing: a temporary is on disk
         tempfile.mkstemp(prefix=temp_prefix(), suffix=".tmp", dir=os.path.dirname(paths[0]))
         os.kill(os.getpid(), signal.SIGKILL)
     return real(mannequin, paths, *args)
-cli._write = killed_on_the_third_row
+common.write = killed_on_the_third_row
 from ellimann_addon.blender.services import teardown
-teardown.exit_with(cli.main({argv!r}))
+teardown.exit_with(main({argv!r}))
 """
 
 

@@ -17,7 +17,7 @@ from mathutils import Matrix
 
 from devkit import synthetic
 from devkit.blender_scene import parts
-from ellimann_addon.blender import cli
+from ellimann_addon import cli
 from ellimann_addon.blender.bridge.convert import collection_to_mannequin
 from ellimann_addon.blender.services import drape as drape_module
 from ellimann_addon.blender.services.drape import MAX_CLOTH_VERTICES, DrapeSettings, check_cloth_size, drape

@@ -14,7 +14,8 @@ import pytest
 from devkit.blender_scene import parts, select, state
 from devkit.poses import make_apose_toy
 from devkit.ui_recorder import draw_panel
-from ellimann_addon.blender import cli, ids
+from ellimann_addon import cli
+from ellimann_addon.blender import ids
 from ellimann_addon.blender.bridge.convert import mannequin_to_collection
 from ellimann_addon.blender.features.drape import operator as drape_operator
 from ellimann_addon.blender.features.drape import panel as drape_panel

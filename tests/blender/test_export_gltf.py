@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 
 from ellimann_addon.blender.bridge import convert
-from ellimann_addon.blender.services.files import EXTRAS_KEY, atomic_output, export_gltf, read_glb_json, write_mannequin
+from ellimann_addon.blender.services.files import EXTRAS_KEY, export_gltf, read_glb_json, write_mannequin
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.errors import ElliMannError, MannequinError
+from ellimann_addon.core.files import atomic_output
 from ellimann_addon.core.quaternion import quaternion_to_rotation
 from ellimann_addon.core.writers import write_core_file
 

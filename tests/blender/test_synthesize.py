@@ -93,8 +93,8 @@ def test_idw_mode_and_cushions(props):
     cushions = [o for o in bpy.data.objects if o.ellimann.kind == "CUSHION"]
     reference = synthetic.make_reference_set()
     assert len(cushions) == len(reference.topology.cushion_pairs)
-    expected, _, _ = core_synthesize(reference, dict(zip(MEASUREMENTS, collection.ellimann.target)), "idw",
-                                     "normalized", 3.0, normalize="none")
+    expected, _, _ = core_synthesize(reference, dict(zip(MEASUREMENTS, collection.ellimann.target)), mode="idw",
+                                     metric="normalized", power=3.0, normalize="none")
     got = convert.collection_to_mannequin(collection).reordered(expected.topology)
     np.testing.assert_allclose(got.center, expected.center, atol=1e-6)
 

@@ -159,7 +159,7 @@ def test_subdivision_levels_are_integers_in_the_allowed_range():
 @pytest.mark.parametrize("subdivisions", [2, 4])
 def test_cushion_vertices_are_the_hull_builders_support_points_for_every_pair_at_once(subdivisions):
     reference = synthetic.make_reference_set()
-    mannequin, _, _ = synthesize(reference, REFERENCE_MEASUREMENTS["small_chubby"], "exact")
+    mannequin, _, _ = synthesize(reference, REFERENCE_MEASUREMENTS["small_chubby"], mode="exact")
     pairs = mannequin.topology.cushion_pairs
     batch = cushion.cushion_vertices(mannequin.rotation, mannequin.center, mannequin.semi_axes, pairs, subdivisions)
     assert batch.shape == (len(pairs), 10 * 4 ** subdivisions + 2, 3)

@@ -11,13 +11,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from devkit import synthetic
-from ellimann_addon.core import synthesis
+from ellimann_addon.core import idw, refine, synthesis
 from ellimann_addon.core.clean import asymmetry
 from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, quartile_points
 from ellimann_addon.core.ellipsoid import shape_matrix
-from ellimann_addon.core.errors import MeasurementError, ReferenceSetError
+from ellimann_addon.core.errors import ElliMannError, MeasurementError, ReferenceSetError
 from ellimann_addon.core.frames import is_rotation
 from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.measure import tailor_measurements
 
 SETS = ["synthetic"] + (["shipped"] if all((synthesis.REFERENCE_FOLDER / f"{n}.json").is_file()
                                            for n in synthesis.REFERENCE_NAMES) else [])
@@ -46,8 +47,8 @@ def random_requests(seed, count, widen=0.0):
 @pytest.mark.parametrize("metric", synthesis.METRICS)
 @pytest.mark.parametrize("power", [1.0, 2.0, 4.0])
 def test_each_reference_mannequin_is_reproduced_exactly(reference, metric, power, normalize):
-    result = synthesis.synthesize_batch(reference, reference.measurements, metric=metric, power=power, measure=False,
-                                        normalize=normalize)
+    result = synthesis.synthesize_batch(reference, reference.measurements, mode="idw", metric=metric, power=power,
+                                        measure=False, normalize=normalize)
     np.testing.assert_allclose(shape_matrix(result.rotation, result.semi_axes),
                                shape_matrix(reference.rotation, reference.semi_axes), atol=1e-12)
     np.testing.assert_allclose(result.center, reference.center, atol=1e-12)
@@ -112,7 +113,7 @@ _SYNTHETIC = synthetic.make_reference_set()
 def test_the_papers_results_stay_within_the_references(reference, metric):
     """normalize="none": every centre and semi-axis component lies within the RMs' own values."""
     requests = random_requests(3, 40, widen=0.3)
-    result = synthesis.synthesize_batch(reference, requests, metric=metric, measure=False, normalize="none")
+    result = synthesis.synthesize_batch(reference, requests, metric=metric, measure=False, normalize="none", mode="idw")
     tol = 1e-12
     for array, stack in ((result.center, reference.center), (result.semi_axes, reference.semi_axes)):
         assert np.all(array >= stack.min(axis=0) - tol)
@@ -125,11 +126,12 @@ def test_proportions_stay_within_the_references(reference, metric, normalize):
     """Normalized IDW: a part's centre divided by the request's scales and its semi-axes divided by
     their axis scales lie within the RMs' same proportions (the geometry itself may leave them)."""
     requests = random_requests(4, 40, widen=0.3)
-    result = synthesis.synthesize_batch(reference, requests, metric=metric, measure=False, normalize=normalize)
+    result = synthesis.synthesize_batch(reference, requests, mode="idw", metric=metric, measure=False,
+                                        normalize=normalize)
     src = reference._source
     horizontal, vertical = reference.size_scales(requests, normalize)
-    center = result.center[:, src] / synthesis._center_scale(horizontal, vertical)
-    semi = result.semi_axes[:, src] / synthesis._axis_scale(result.rotation[:, src], horizontal, vertical)
+    center = result.center[:, src] / idw._center_scale(horizontal, vertical)
+    semi = result.semi_axes[:, src] / idw._axis_scale(result.rotation[:, src], horizontal, vertical)
     ref_center, ref_semi = reference.normalized_geometry(normalize)
     tol = 1e-12
     for array, stack in ((center, ref_center), (semi, ref_semi)):
@@ -142,8 +144,8 @@ def test_proportions_stay_within_the_references(reference, metric, normalize):
 @pytest.mark.parametrize("normalize", synthesis.NORMALIZATIONS)
 def test_results_are_valid_symmetric_mannequins_with_the_papers_rotations(reference, normalize):
     requests = random_requests(3, 40, widen=0.3)
-    result = synthesis.synthesize_batch(reference, requests, measure=False, normalize=normalize)
-    paper = synthesis.synthesize_batch(reference, requests, measure=False, normalize="none")
+    result = synthesis.synthesize_batch(reference, requests, measure=False, normalize=normalize, mode="idw")
+    paper = synthesis.synthesize_batch(reference, requests, measure=False, normalize="none", mode="idw")
     np.testing.assert_array_equal(result.rotation, paper.rotation)
     assert np.all(is_rotation(result.rotation, tol=1e-9))
     for i in range(len(result)):
@@ -174,8 +176,8 @@ def test_proportional_idw_reproduces_proportionally_scaled_bodies_exactly(refere
     scaled = synthesis.ReferenceSet([_scaled(reference, 4, me) for me in reference.measurements],
                                     names=reference.names)
     requests = random_requests(9, 12, widen=0.3)
-    result = synthesis.synthesize_batch(scaled, requests, measure=False, normalize="proportional")
-    paper = synthesis.synthesize_batch(scaled, requests, measure=False, normalize="none")
+    result = synthesis.synthesize_batch(scaled, requests, measure=False, normalize="proportional", mode="idw")
+    paper = synthesis.synthesize_batch(scaled, requests, measure=False, normalize="none", mode="idw")
     for i, me in enumerate(requests):
         expected = _scaled(scaled, 4, me)
         np.testing.assert_allclose(result.rotation[i], expected.rotation, atol=1e-12)
@@ -198,8 +200,8 @@ def test_rotations_are_averaged_then_projected():
 
 def test_single_synthesis_matches_the_batch_and_names_the_mannequin(reference):
     request = dict(zip(MEASUREMENTS, (159.0, 43.0, 117.0, 104.0, 117.0)))
-    mannequin, measured, warnings = synthesis.synthesize(reference, request)
-    batch = synthesis.synthesize_batch(reference, [list(request.values())])
+    mannequin, measured, warnings = synthesis.synthesize(reference, request, mode="idw")
+    batch = synthesis.synthesize_batch(reference, [list(request.values())], mode="idw")
     np.testing.assert_array_equal(mannequin.center, batch.center[0])
     assert mannequin.name == "ElliMann 159-43-117-104-117"
     assert mannequin.role == "synthesized" and mannequin.measurements == request
@@ -212,7 +214,7 @@ def test_single_synthesis_matches_the_batch_and_names_the_mannequin(reference):
 
 def test_exact_mode_meets_its_target_on_a_sample_of_the_grid(reference):
     sample = GRID[np.random.default_rng(5).choice(len(GRID), 24, replace=False)]
-    idw = synthesis.synthesize_batch(reference, sample)
+    idw = synthesis.synthesize_batch(reference, sample, mode="idw")
     exact = synthesis.synthesize_batch(reference, sample, mode="exact")
     error = exact.relative_error()
     assert error.mean(axis=0).max() <= 0.1
@@ -235,15 +237,15 @@ def test_proportional_idw_starts_exact_mode_closer_than_the_papers(reference):
     sample = GRID[::7]
     paper = synthesis.synthesize_batch(reference, sample, mode="exact", normalize="none")
     proportional = synthesis.synthesize_batch(reference, sample, mode="exact")
-    idw = synthesis.synthesize_batch(reference, sample)
+    idw = synthesis.synthesize_batch(reference, sample, mode="idw")
     assert np.all(idw.relative_error().mean(axis=0) < synthesis.synthesize_batch(
-        reference, sample, normalize="none").relative_error().mean(axis=0))
+        reference, sample, mode="idw", normalize="none").relative_error().mean(axis=0))
     assert np.all(np.abs(np.log(proportional.factors)).max(axis=0) < np.abs(np.log(paper.factors)).max(axis=0))
 
 
 def test_exact_mode_changes_nothing_when_m_T_already_matches(reference):
     """At an RM's own m_T the refinement has nothing to do: the result is that RM."""
-    measured = synthesis.tailor_measurements(reference.rotation, reference.center, reference.semi_axes,
+    measured = tailor_measurements(reference.rotation, reference.center, reference.semi_axes,
                                              reference.topology.girth_mask)
     # IDW at the RM's nominal point gives the RM; ask exact mode for what that RM measures.
     rotation, center, semi_axes = synthesis.interpolate(reference, reference.measurements)
@@ -256,7 +258,7 @@ def test_exact_mode_changes_nothing_when_m_T_already_matches(reference):
 def test_an_unreachable_measurement_stops_at_the_factor_limit_without_spoiling_the_others():
     # Br far outside L: from the paper's IDW (which stays inside L) it would need the chest doubled.
     request = [[159.0, 43.0, 250.0, 104.0, 117.0]]
-    idw = synthesis.synthesize_batch(_SYNTHETIC, request, normalize="none")
+    idw = synthesis.synthesize_batch(_SYNTHETIC, request, normalize="none", mode="idw")
     exact = synthesis.synthesize_batch(_SYNTHETIC, request, mode="exact", normalize="none")
     assert not exact.converged[0]
     assert exact.factors[0, 2] == pytest.approx(synthesis.FACTOR_LIMITS[1])
@@ -271,13 +273,13 @@ def test_refinement_responds_to_each_measurement_in_its_own_neighbourhood():
     reference = _SYNTHETIC
     rotation, center, semi_axes = synthesis.interpolate(reference, reference.measurements[4:5])
     girth = reference.topology.girth_mask
-    measured = synthesis.tailor_measurements(rotation, center, semi_axes, girth)
-    basis = synthesis._deform_basis(reference.topology, rotation, center, semi_axes, measured)
+    measured = tailor_measurements(rotation, center, semi_axes, girth)
+    basis = refine._deform_basis(reference.topology, rotation, center, semi_axes, measured)
     for k, key in enumerate(MEASUREMENTS):
         factors = np.ones((1, 5))
         factors[0, k] = 1.02
         c, d = synthesis.deform(basis, center, semi_axes, factors)
-        ratio = synthesis.tailor_measurements(rotation, c, d, girth)[0] / measured[0]
+        ratio = tailor_measurements(rotation, c, d, girth)[0] / measured[0]
         assert ratio[k] == pytest.approx(1.02, abs=0.01), key  # its own measurement follows the factor
         assert np.abs(ratio - 1.0).max() == pytest.approx(abs(ratio[k] - 1.0)), key  # and moves most
 
@@ -334,7 +336,7 @@ def test_values_outside_L_are_allowed_with_a_warning_saying_how_far():
 def test_bad_options_are_refused():
     for options in ({"mode": "magic"}, {"metric": "manhattan"}, {"power": 0.0}, {"power": float("nan")},
                     {"normalize": "width"}):
-        with pytest.raises(synthesis.ElliMannError):
+        with pytest.raises(ElliMannError):
             synthesis.synthesize_batch(_SYNTHETIC, [list(GOOD.values())], **options)
 
 

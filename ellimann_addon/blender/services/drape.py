@@ -26,17 +26,17 @@ import numpy as np
 from mathutils import Matrix
 
 from ...core import garments
-from ...core.collision import CollisionPiece, check_subdivisions, collision_pieces, triangle_count
+from ...core.collision import CollisionPiece, collision_pieces, triangle_count
 from ...core.constants import CLEARING_CUSHION_LEVEL, FIT_CUSHION_LEVEL
 from ...core.errors import ElliMannError
 from ...core.garment_fit import BodyPieces, fit_statistics
+from ...core.options import FRAME_RANGE, MAX_CLOTH_VERTICES, DrapeSettings  # noqa: F401  (DrapeSettings: public here)
 from ..bridge.convert import mesh_from_arrays, new_collection
 
 DRAPE_KEY = "ellimann_drape"  # ID property on a drape collection: the garment's name
 PIN_GROUP = "Pin"
 CLOTH_NAME = "Cloth"
 GARMENT_COLOR = (0.22, 0.45, 0.75, 1.0)
-FRAME_RANGE = (2, 2000)
 # Distances to a cushion beyond these (m) are only bounded from below, which spares the exact search
 # for far points: the fit's distances are exact up to FIT_CUTOFF, the clearing's near the body.
 FIT_CUTOFF = 0.2
@@ -45,53 +45,10 @@ CLEARING_CUTOFF = 0.05
 # shipped Average RM at 2, 1 and 0.5 cm edges: building, clearing, Blender's cloth and the fit
 # together, on top of some 0.3 GB for Blender itself), and time at least as fast: 27,000 vertices (a
 # tube dress at 0.5 cm) took 2.6 GB and 2.5 minutes for 3 frames. A drape is refused above
-# MAX_CLOTH_VERTICES (about 4 GB) before anything is built; the command line warns above WARN_CLOTH_VERTICES.
+# MAX_CLOTH_VERTICES (about 4 GB, core.options) before anything is built; the command line warns above
+# WARN_CLOTH_VERTICES.
 BYTES_PER_VERTEX = 85_000
-MAX_CLOTH_VERTICES = 50_000
 WARN_CLOTH_VERTICES = 20_000
-
-
-@dataclass
-class DrapeSettings:
-    """Simulation options. Lengths in metres.
-
-    ``distance``: the cloth's collision distance (it keeps this far from the colliders);
-    ``sewing_force``: the sewing springs' force limit (0 would be unbounded, which explodes while
-    seams are far apart); ``quality``: solver steps per frame; ``collision_quality``: collision
-    passes per step.
-    """
-
-    frames: int = 60
-    edge: float = 0.025
-    cushions: bool = True
-    sphere_subdivisions: int = 2
-    cushion_subdivisions: int = 2
-    quality: int = 5
-    collision_quality: int = 3
-    distance: float = 0.005
-    sewing_force: float = 20.0
-    max_vertices: int = MAX_CLOTH_VERTICES  # a larger cloth is refused (see cloth_size)
-
-    def checked(self):
-        if isinstance(self.frames, bool) or not isinstance(self.frames, (int, np.integer)) or not (
-                FRAME_RANGE[0] <= self.frames <= FRAME_RANGE[1]):
-            raise ElliMannError(f"frames: must be an integer from {FRAME_RANGE[0]} to {FRAME_RANGE[1]}, "
-                                f"got {self.frames!r}")
-        low, high = garments.EDGE_RANGE
-        if isinstance(self.edge, bool) or not isinstance(self.edge, (int, float)) or not low <= self.edge <= high:
-            raise ElliMannError(f"edge: the cloth's edge length must be from {low} to {high} m, got {self.edge!r}")
-        check_subdivisions("sphere_subdivisions", self.sphere_subdivisions)
-        check_subdivisions("cushion_subdivisions", self.cushion_subdivisions)
-        if not 1 <= self.quality <= 50:
-            raise ElliMannError(f"quality: must be from 1 to 50 steps per frame, got {self.quality!r}")
-        if not 1 <= self.collision_quality <= 20:
-            raise ElliMannError(f"collision_quality: must be from 1 to 20 passes, got {self.collision_quality!r}")
-        if not 0.001 <= self.distance <= 0.05:
-            raise ElliMannError(f"distance: must be from 0.001 to 0.05 m, got {self.distance!r}")
-        if isinstance(self.max_vertices, bool) or not isinstance(self.max_vertices, (int, np.integer)) or \
-                self.max_vertices < 100:
-            raise ElliMannError(f"max_vertices: must be an integer of at least 100, got {self.max_vertices!r}")
-        return self
 
 
 @dataclass

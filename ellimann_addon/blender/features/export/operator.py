@@ -13,6 +13,7 @@ from bpy_extras.io_utils import ExportHelper
 
 from ....core.errors import ElliMannError
 from ....core.export_mjcf import write_mjcf
+from ....core.formats import FORMATS
 from ... import ids
 from ...bridge.built import built_objects
 from ...bridge.convert import collection_to_mannequin
@@ -26,7 +27,7 @@ FORMAT_ITEMS = (
     ("MJCF", "MJCF (.xml)", "MuJoCo model: a native ellipsoid geom per part (or a convex mesh per cushion pair), "
                             "welded to the world, measurements in <custom>"),
 )
-EXTENSIONS = {"GLB": ".glb", "MJCF": ".xml"}
+EXTENSIONS = {kind: "." + FORMATS[kind.lower()].extension for kind in ("GLB", "MJCF")}  # core.formats
 NAMES = {"GLB": "glTF", "MJCF": "MJCF"}
 
 

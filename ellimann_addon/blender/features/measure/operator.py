@@ -3,9 +3,8 @@
 import bpy
 from bpy.props import BoolProperty, EnumProperty
 
-from ....core.constants import MEASUREMENTS
 from ....core.cushion import cushion_name
-from ....core.measure import as_dict, measure_meshes, section_hulls, tailor_measurements
+from ....core.measure import as_dict, measure_meshes, measurement_line, section_hulls, tailor_measurements
 from ... import ids
 from ...bridge.built import built_collection, built_objects, is_stale, new_section_object, remove_built
 from ...bridge.convert import ellipsoid_objects, world_triangles, write_measured
@@ -45,7 +44,7 @@ def cushion_mannequin_meshes(collection, mannequin, cushions):
 
 
 def format_measurements(values):
-    return ", ".join(f"{key} {values[key]:.2f}" for key in MEASUREMENTS) + " cm"
+    return measurement_line(values) + " cm"
 
 
 class ELLIMANN_OT_measure_mannequin(MannequinOperator, bpy.types.Operator):

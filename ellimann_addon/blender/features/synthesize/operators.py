@@ -3,8 +3,8 @@
 
 import bpy
 
-from ....core.constants import MEASUREMENTS
 from ....core.errors import ElliMannError
+from ....core.measure import measurement_line
 from ....core.synthesis import relative_error
 from ... import ids
 from ...bridge.convert import ellipsoid_objects
@@ -36,7 +36,7 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
         for warning in warnings:
             self.report({"WARNING"}, warning)
         worst = relative_error(measured, request_of(props)).max()
-        values = ", ".join(f"{k} {measured[k]:.2f}" for k in MEASUREMENTS)
+        values = measurement_line(measured)
         self.report({"INFO"}, f"Synthesized '{collection.name}' ({len(ellipsoid_objects(collection))} ellipsoids, "
                               f"{props.mode.lower()}): m_T {values} cm, max error {worst:.2f}%")
         return {"FINISHED"}

@@ -1,0 +1,77 @@
+"""The ElliMann command line: one ``main(argv) -> int`` behind three entry points.
+
+- ``ellimann …`` (``pip install .``: :func:`main_exit`) and ``python -m ellimann_addon …``
+- ``blender --background --command ellimann …`` (registered by ``blender/cli_command.py``)
+
+Subcommands, a module each: ``synth`` (one mannequin), ``batch`` (a CSV of measurements), ``measure`` (m_T of
+a file), ``demo`` (the paper's Table 2.5 mannequins with a report and a line-up picture) and ``drape`` (a
+garment on a mannequin with Blender's cloth simulation); ``common`` holds what they share. This package needs
+numpy only: Blender (the bpy module and ``ellimann_addon.blender``) is imported only when a .blend/.glb/.obj
+file, a drape or a picture is involved, and a command that needs it without it is refused in one line.
+What Blender prints is captured (``chatter``) and shown only with ``--verbose``. User mistakes end with a
+one-line reason and a non-zero exit code: 1 for bad input or a failed row, 2 for a malformed command line, 3
+when exact mode missed a request (the files are written), 130 when interrupted (Ctrl-C).
+"""
+
+import argparse
+import contextlib
+import sys
+
+from ..core.errors import ElliMannError
+from . import batch, demo, drape, measure, synth
+from .common import INTERRUPTED, MISSED, PROG, UsageError, blender_available, no_blender, one_line, say
+
+__all__ = ["INTERRUPTED", "MISSED", "PROG", "UsageError", "build_parser", "main", "main_exit"]
+SUBCOMMANDS = (synth, batch, measure, demo, drape)
+
+
+def build_parser():
+    parser = argparse.ArgumentParser(prog=PROG, description="ElliMann: measurement-driven mannequins from "
+                                     "convex ellipsoids and cushions (measurements in cm).")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for command in SUBCOMMANDS:
+        command.add_parser(commands)
+    return parser
+
+
+def main(argv=None):
+    """Run the CLI; returns the exit code (0 success, 1 bad input or failed rows, 2 bad command line,
+    3 exact mode missed a request, 130 interrupted)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exit_:  # argparse has printed usage or help
+        return int(exit_.code or 0)
+    try:
+        needs = args.blender(args)  # what of this command needs Blender, if anything
+        if needs and not blender_available():
+            raise no_blender(needs)
+        with _captured(args.verbose, needs):
+            return args.run(args)
+    except (ElliMannError, OSError) as error:
+        say(f"{PROG} {args.command}: error: {one_line(error)}")
+        return 1
+    except KeyboardInterrupt:
+        say(f"{PROG} {args.command}: interrupted")
+        return INTERRUPTED
+
+
+def _captured(show, blender):
+    """What Blender prints, kept out of ElliMann's lines (``blender.chatter.program``) when Blender is used."""
+    if not blender:
+        return contextlib.nullcontext()
+    from ..blender.services.chatter import program
+
+    return program(show=show)
+
+
+def main_exit(argv=None):
+    """The ``ellimann`` console command: :func:`main`, then leave (skipping Blender 4.x's teardown, which
+    crashes there once bpy was loaded: ``blender.teardown.exit_with``)."""
+    code = main(argv)
+    if "bpy" in sys.modules:
+        from ..blender.services import teardown
+
+        teardown.exit_with(code)
+    sys.exit(code)

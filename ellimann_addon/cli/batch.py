@@ -1,0 +1,262 @@
+"""``ellimann batch``: one mannequin per row of a measurements CSV, the files in every --format, and a report
+(requested vs measured) written row by row; --shard for a render farm, --resume after an interruption."""
+
+import contextlib
+import csv
+import io
+import os
+import re
+import sys
+
+from ..core.constants import MEASUREMENTS
+from ..core.errors import ElliMannError, MeasurementError
+from ..core.files import atomic_write_text, incomplete
+from ..core.formats import FORMATS
+from ..core.measure import as_dict
+from ..core.refine import EXACT_TOLERANCE
+from ..core.request import validate_request
+from . import common
+from .common import PROG, UsageError
+
+NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,99}$")
+CHUNK = 256  # rows synthesized per core batch
+
+
+def add_parser(commands):
+    batch = commands.add_parser("batch", help="synthesize every row of a CSV",
+                                description="One mannequin per CSV row. The header names the columns "
+                                            "He,Sh,Br,Wa,Hi (cm) and optionally name. Writes the files and "
+                                            "DIR/report.csv (requested vs measured), row by row into "
+                                            "DIR/report.partial.csv while it runs. Bad or failed rows are "
+                                            "reported and skipped; the exit code is 1 if any row failed, 3 if "
+                                            "exact mode missed a row's request, 130 if interrupted.")
+    batch.add_argument("csv", metavar="MEASUREMENTS.csv")
+    batch.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
+    batch.add_argument("--format", default="json",
+                       help=f"comma-separated output formats among {','.join(FORMATS)} (default json; mjcf "
+                            "writes NAME.xml)")
+    batch.add_argument("--shard", metavar="I/N",
+                       help="process only rows I, I+N, I+2N… (I from 1 to N), for a render farm; the report "
+                            "is DIR/report-I-of-N.csv")
+    batch.add_argument("--resume", action="store_true",
+                       help="skip rows whose files (every --format) are already in DIR and whole, e.g. after an "
+                            "interrupted run with the same CSV and options; without it every row is written again")
+    common.add_synthesis_options(batch)
+    batch.set_defaults(run=run, blender=needs_blender)
+
+
+def needs_blender(args):
+    """What needs Blender in this command (None: nothing)."""
+    try:
+        formats = parse_formats(args.format)
+    except UsageError:
+        return None
+    blender = [f for f in formats if FORMATS[f].needs_blender]
+    return f"--format {blender[0]}" if blender else None
+
+
+def parse_shard(text):
+    if text is None:
+        return 1, 1
+    match = re.fullmatch(r"\s*(\d+)\s*/\s*(\d+)\s*", text)
+    if not match or not 1 <= int(match.group(1)) <= int(match.group(2)):
+        raise UsageError(f"--shard must be I/N with 1 <= I <= N, got {text!r}")
+    return int(match.group(1)), int(match.group(2))
+
+
+def parse_formats(text):
+    formats = [f.strip().lower().lstrip(".") for f in text.split(",") if f.strip()]
+    unknown = [f for f in formats if f not in FORMATS]
+    if unknown or not formats:
+        raise UsageError(f"--format takes a comma-separated list of {', '.join(FORMATS)}, got {text!r}")
+    return list(dict.fromkeys(formats))
+
+
+def read_rows(path):
+    """Rows of a measurements CSV: list of (line, name, values or None, error or None)."""
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as stream:
+            text = stream.read()
+    except UnicodeDecodeError:
+        raise UsageError(f"{path} is not a UTF-8 text CSV") from None
+    reader = csv.reader(io.StringIO(text))
+    header = next(reader, None)
+    if not header:
+        raise UsageError(f"{path} is empty; expected a header row He,Sh,Br,Wa,Hi[,name]")
+    columns = {}
+    for index, title in enumerate(header):
+        key = title.strip()
+        canonical = next((m for m in MEASUREMENTS + ("name",) if m.lower() == key.lower()), None)
+        if canonical in columns:
+            raise UsageError(f"{path}: column {canonical} appears twice in the header")
+        if canonical:
+            columns[canonical] = index
+    missing = [m for m in MEASUREMENTS if m not in columns]
+    if missing:
+        raise UsageError(f"{path}: header lacks column(s) {', '.join(missing)}; expected He,Sh,Br,Wa,Hi[,name]")
+    rows = []
+    for line, record in enumerate(reader, start=2):
+        if not any(cell.strip() for cell in record):
+            continue
+        name = record[columns["name"]].strip() if "name" in columns and columns["name"] < len(record) else ""
+        try:
+            values = []
+            for key in MEASUREMENTS:
+                cell = record[columns[key]].strip() if columns[key] < len(record) else ""
+                if not cell:
+                    raise MeasurementError(key, "is empty")
+                try:
+                    values.append(float(cell))
+                except ValueError:
+                    raise MeasurementError(key, f"{cell!r} is not a number (cm)") from None
+            warnings = validate_request(values)
+            if name and not NAME_PATTERN.match(name):
+                raise MeasurementError("name", f"{name!r} must be letters, digits, '.', '_' or '-' (a file name)")
+            rows.append((line, name, values, None, warnings))
+        except MeasurementError as error:
+            rows.append((line, name, None, str(error), []))
+    return rows
+
+
+def name_rows(rows):
+    """Give every row its output name (``row-NNNNN`` from its line when the CSV has none) and refuse a row
+    whose name an earlier row already uses (letter case ignored: the files would clash on macOS and
+    Windows). Runs over the whole CSV before sharding, so every shard refuses the same rows."""
+    seen, named = {}, []
+    for line, name, values, error, warnings in rows:
+        name = name or f"row-{line - 1:05d}"
+        key = name.casefold()
+        if error is None and key in seen:
+            first_line, first_name = seen[key]
+            same = "" if first_name == name else f" (as {first_name!r}; file names ignore case on some systems)"
+            error = f"name: {name!r} is already used on line {first_line}{same}"
+        if error is None:
+            seen[key] = (line, name)
+        named.append((line, name, values, error, warnings))
+    return named
+
+
+def run(args):
+    from ..core.synthesis import synthesize_batch
+
+    formats = parse_formats(args.format)
+    shard, shards = parse_shard(args.shard)
+    rows = read_rows(args.csv)
+    if not rows:
+        raise UsageError(f"{args.csv} has a header but no rows")
+    reference = common.references(args)
+    options = common.synthesis_options(args)
+    rows = name_rows(rows)  # over the whole CSV, so every shard agrees on which rows are bad
+    mine = [row for index, row in enumerate(rows) if index % shards == shard - 1]
+    common.output_folder(args.output, "batch")
+    report_name = "report.csv" if shards == 1 else f"report-{shard}-of-{shards}.csv"
+    report = Report(os.path.join(args.output, report_name))
+    jobs = []
+    for line, name, values, error, warnings in mine:
+        if error is not None:
+            common.say(f"{PROG} batch: line {line}: skipped: {error}")
+            report.add(common.report_row(line, name, "error", error, values))
+            continue
+        for warning in warnings:
+            common.say(f"{PROG} batch: line {line}: warning: {warning}")
+        jobs.append((line, name, values, warnings))
+    progress = common.Progress(len(jobs), "batch")
+    try:
+        for start in range(0, len(jobs), CHUNK):
+            chunk = jobs[start:start + CHUNK]
+            result = synthesize_batch(reference, [values for _, _, values, _ in chunk], options)
+            for i, (line, name, values, warnings) in enumerate(chunk):
+                report.add(_row(args, formats, result, i, line, name, values, warnings))
+                progress.step(name)
+    except KeyboardInterrupt:
+        progress.done()
+        report.finish()
+        common.say(f"{PROG} batch: interrupted: {report.count('ok', 'missed')} of {len(mine)} rows done, report "
+             f"{report.path}; run it again with --resume to finish")
+        return common.INTERRUPTED
+    progress.done()
+    report.finish()
+    done, failed, missed = report.count("ok", "missed"), report.count("error"), report.count("missed")
+    common.say(f"{PROG} batch: {done} of {len(mine)} mannequins written to {args.output}"
+         + (f" ({report.count('kept')} already complete, kept)" if args.resume else "")
+         + (f" (shard {shard}/{shards} of {len(rows)} rows)" if shards > 1 else "") + f"; report {report.path}",
+         file=sys.stdout)
+    if failed:
+        common.say(f"{PROG} batch: error: {failed} row(s) failed; see {report.path}")
+        return 1
+    if missed:
+        common.say(f"{PROG} batch: warning: exact mode missed the request of {missed} row(s) by more than "
+             f"{EXACT_TOLERANCE * 100:g}%; see {report.path}")
+        return common.MISSED
+    return 0
+
+
+def _row(args, formats, result, i, line, name, values, warnings):
+    """Write (or, with --resume, keep) the files of one synthesized row; its report row. A failure is
+    that row's: one line on stderr and status "error", and the batch goes on."""
+    paths = [os.path.join(args.output, f"{name}.{common.extension(kind)}") for kind in formats]
+    notes = list(warnings)
+    misses = common.misses(result.measured[i], values) if args.mode == "exact" else []  # = not result.converged[i]
+    if misses:
+        notes.append(common.missed_text(misses))
+        common.say(f"{PROG} batch: line {line}: warning: {common.missed_text(misses)}")
+    status = "missed" if misses else "ok"
+    if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths):
+        row = common.report_row(line, name, status, "; ".join(notes + ["kept (--resume)"]), values, result.measured[i],
+                          paths)
+        row["kept"] = True
+        return row
+    try:
+        common.write(result.mannequin(i, name), paths, as_dict(result.measured[i]), args.cushions)
+    except (ElliMannError, OSError, RuntimeError) as error:
+        common.say(f"{PROG} batch: line {line}: failed: {common.one_line(error)}")
+        return common.report_row(line, name, "error", common.one_line(error), values)
+    return common.report_row(line, name, status, "; ".join(notes), values, result.measured[i], paths)
+
+
+class Report:
+    """A batch report, written as rows finish: each row is appended to REPORT.partial.csv and flushed, so a
+    killed run leaves a record of what it did; :meth:`finish` writes REPORT.csv whole (sorted by line,
+    atomically) and removes the partial file."""
+
+    def __init__(self, path):
+        self.path, self.rows = path, []
+        root, extension = os.path.splitext(path)
+        self.partial = f"{root}.partial{extension}"
+        with common.writing(self.partial):
+            self.stream = open(self.partial, "w", newline="", encoding="utf-8")
+        self.writer = csv.DictWriter(self.stream, fieldnames=common.REPORT_COLUMNS, lineterminator="\n",
+                                     extrasaction="ignore")
+        self._append(self.writer.writeheader)
+
+    def add(self, row):
+        self.rows.append(row)
+        self._append(lambda: self.writer.writerow(row))
+
+    def _append(self, write):
+        if self.stream is None:
+            return
+        try:
+            write()
+            self.stream.flush()
+        except OSError:  # the partial record is a courtesy; the report itself is written at the end
+            self._close()
+
+    def _close(self):
+        if self.stream is not None:
+            with contextlib.suppress(OSError):
+                self.stream.close()
+            self.stream = None
+
+    def count(self, *statuses):
+        if statuses == ("kept",):
+            return sum(1 for row in self.rows if row.get("kept"))
+        return sum(1 for row in self.rows if row["status"] in statuses)
+
+    def finish(self):
+        self._close()
+        self.rows.sort(key=lambda row: row["line"])
+        with common.writing(self.path):
+            atomic_write_text(self.path, common.report_csv(self.rows))
+        with contextlib.suppress(OSError):
+            os.unlink(self.partial)

@@ -1,0 +1,312 @@
+"""What the subcommands share: the one-line errors and exit codes, ElliMann's printed lines, writing files
+(core formats without Blender, Blender's through ``blender.output`` only when asked), the output folder, the
+report CSV and the progress line. Blender (bpy, ``ellimann_addon.blender``) is imported only inside functions
+that need it."""
+
+import argparse
+import contextlib
+import csv
+import importlib.util
+import io
+import math
+import os
+import re
+import sys
+import tempfile
+import time
+
+from ..core.constants import MEASUREMENTS
+from ..core.errors import ElliMannError, ReferenceSetError
+from ..core.files import atomic_write_text, clean_stale_temporaries
+from ..core.formats import FORMATS, format_of
+from ..core.measure import measurement_line
+from ..core.options import SYNTHESIS, SynthesisOptions
+from ..core.refine import EXACT_TOLERANCE
+from ..core.request import relative_error
+from ..core.writers import core_format, write_core_file
+
+PROG = "ellimann"
+MISSED = 3  # exit code: written, but exact mode missed a requested measurement by more than its tolerance
+INTERRUPTED = 130  # exit code after Ctrl-C, as shells report SIGINT
+
+
+class UsageError(ElliMannError):
+    """A mistake on the command line or in an input file, reported in one line."""
+
+
+# ------------------------------------------------------------------------------------------------ printing
+
+
+def one_line(error):
+    if isinstance(error, OSError) and error.filename:
+        return f"{error.strerror or error}: {error.filename}"
+    return " ".join(str(error).split())
+
+
+_UNPRINTABLE = re.compile(r"[\x00-\x1f\x7f-\x9f\u061c\u200e\u200f\u2028-\u202e\u2066-\u2069]")
+
+
+def printable(text):
+    """``text`` with control characters (terminal escapes, carriage returns, bidi overrides) as \\x1b, \\n…"""
+    return _UNPRINTABLE.sub(lambda m: m.group().encode("unicode_escape").decode("ascii"), str(text))
+
+
+def say(text, file=None, end="\n"):
+    """Print one of ElliMann's lines (stderr unless ``file``), escaping what a terminal would act on."""
+    print(printable(text), file=file or sys.stderr, end=end, flush=True)
+
+
+def format_me(values):
+    """The m_T line (``core.measure.measurement_line``)."""
+    return measurement_line(values)
+
+
+# ------------------------------------------------------------------------------------------------ parser pieces
+
+
+def number(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    return value
+
+
+def add_verbose(parser):
+    parser.add_argument("-v", "--verbose", action="store_true",
+                        help="also show what Blender prints (on stderr); without it only ElliMann's lines show")
+
+
+def add_synthesis_options(parser):
+    """--mode, --metric, --power, --normalize from ``core.options.SYNTHESIS``; --cushions, --references."""
+    add_verbose(parser)
+    for name, option in SYNTHESIS.items():
+        if option.choices:
+            parser.add_argument(f"--{name}", choices=option.values, default=option.default,
+                                help=option.help.format(default=option.default))
+        else:
+            parser.add_argument(f"--{name}", type=number, default=option.default,
+                                help=option.help.format(default=option.default))
+    parser.add_argument("--cushions", action="store_true",
+                        help="cushions (convex hulls of the cushion pairs) instead of their ellipsoids: shown in "
+                             ".blend/.glb/.obj outputs, convex mesh geoms in MJCF")
+    parser.add_argument("--references", metavar="DIR",
+                        help="folder with the five Reference Mannequin .json files (default: the shipped "
+                             "reference_blends/)")
+
+
+def synthesis_options(args, name=None):
+    """The SynthesisOptions of the command line (built once per command)."""
+    return SynthesisOptions(mode=args.mode, metric=args.metric, power=args.power, normalize=args.normalize,
+                            name=name)
+
+
+def references(args):
+    from ..core.reference_set import load_reference_set
+
+    try:
+        return load_reference_set(args.references)
+    except ReferenceSetError as error:
+        if args.references:
+            raise
+        raise UsageError(f"{error} (the shipped Reference Mannequins; use --references DIR for others)") from None
+
+
+# ------------------------------------------------------------------------------------------------ Blender
+
+
+def blender_available():
+    """Whether the bpy module can be imported (without importing it)."""
+    if "bpy" in sys.modules:
+        return sys.modules["bpy"] is not None
+    try:
+        return importlib.util.find_spec("bpy") is not None
+    except (ImportError, ValueError):
+        return False
+
+
+def no_blender(what):
+    return UsageError(f"{what} needs Blender: the bpy module is not installed (pip install bpy, or run "
+                      f"blender --background --command {PROG} …)")
+
+
+def ensure_registered(what="this"):
+    """Import bpy; under ``python -m`` register the add-on once so ElliMann's properties exist."""
+    from ..blender.services.chatter import blender_output
+
+    with blender_output():
+        try:
+            import bpy
+        except ImportError:
+            raise no_blender(what) from None
+
+        if not hasattr(bpy.types.Collection, "ellimann"):
+            from .. import register
+
+            register()
+    return bpy
+
+
+# ------------------------------------------------------------------------------------------------ writing
+
+
+def output_kind(path):
+    kind = format_of(path)
+    if kind is None:
+        raise UsageError(f"OUT must end in .blend, .glb, .obj, .json or .xml (MJCF), got {path!r}")
+    return kind.name
+
+
+def extension(kind):
+    return FORMATS[kind].extension
+
+
+def write(mannequin, paths, measured, cushions):
+    """Write every path (format from the extension); Blender is loaded only for .blend/.glb/.obj.
+
+    A path that cannot be written raises UsageError naming it (not the temporary file behind it).
+    """
+    for path in paths:
+        if core_format(path):
+            with writing(path):
+                write_core_file(mannequin, path, cushions)
+    blender = [p for p in paths if core_format(p) is None]
+    if blender:
+        ensure_registered(f"writing {blender[0]}")
+        from ..blender.services.files import write_mannequin
+
+        try:
+            write_mannequin(mannequin, blender, measured, cushions)
+        except OSError as error:  # atomic_output names the file that failed
+            if error.filename is None:
+                raise
+            raise cannot_write(error.filename, error) from None
+    return paths
+
+
+@contextlib.contextmanager
+def writing(target, folder=False):
+    """Turn an OSError while writing ``target`` (a file, or a folder with ``folder``) into one line naming it."""
+    try:
+        yield
+    except OSError as error:
+        raise cannot_write(target, error, folder) from None
+
+
+def cannot_write(target, error, folder=False):
+    where = os.path.abspath(target if folder else os.path.dirname(os.path.abspath(target)))
+    blocker = _file_in_the_way(where)
+    what = f"the folder {target}" if folder else target
+    if not folder and os.path.isdir(target):
+        reason = "it is a folder"
+    elif blocker is not None:
+        reason = "it is a file" if blocker == where and folder else f"{blocker} is a file, not a folder"
+    else:
+        reason = error.strerror or one_line(error)
+        if error.filename and os.path.abspath(error.filename) not in (os.path.abspath(target), where):
+            reason += f" (creating a file in {where})"  # the temporary file it is written through
+    return UsageError(f"cannot write {what}: {reason}")
+
+
+def _file_in_the_way(folder):
+    """The nearest existing path at or above ``folder`` if it is not a folder (nothing can be made under it)."""
+    path = folder
+    while not os.path.lexists(path):
+        parent = os.path.dirname(path)
+        if parent == path:
+            return None
+        path = parent
+    return None if os.path.isdir(path) else path
+
+
+def output_folder(folder, command):
+    """Make the output folder and check that files can be created in it, before any work is done; remove
+    the temporaries a killed run of ElliMann left there (not those of one still running)."""
+    with writing(folder, folder=True):
+        os.makedirs(folder, exist_ok=True)
+        with tempfile.TemporaryFile(prefix=".ellimann-", dir=folder):
+            pass
+    removed = clean_stale_temporaries(folder)
+    if removed:
+        say(f"{PROG} {command}: removed {len(removed)} temporary file(s) an interrupted run left in {folder}")
+
+
+# ------------------------------------------------------------------------------------------------ exact mode
+
+
+def misses(measured, requested):
+    """The requested measurements exact mode missed by more than its tolerance (EXACT_TOLERANCE, the
+    criterion it stops at): [(key, m_T cm, requested cm, error %)]."""
+    return [(key, float(m), float(r), abs(m - r) / r * 100.0) for key, m, r in zip(MEASUREMENTS, measured, requested)
+            if abs(math.log(max(float(m), 1e-12) / float(r))) > EXACT_TOLERANCE]
+
+
+def missed_text(missed):
+    return ("exact mode missed " + ", ".join(f"{key} by {error:.2f}% (m_T {m:.2f} cm for {r:g} cm)"
+                                             for key, m, r, error in missed)
+            + f" (tolerance {EXACT_TOLERANCE * 100:g}%; the file is the closest it found)")
+
+
+# ------------------------------------------------------------------------------------------------ report CSV
+
+
+REPORT_COLUMNS = (["line", "name", "status", "message"] + list(MEASUREMENTS)
+                  + [f"{k}_measured" for k in MEASUREMENTS] + [f"{k}_error_pct" for k in MEASUREMENTS] + ["files"])
+
+
+def report_row(line, name, status, message, requested=None, measured=None, paths=()):
+    """One report row; text from the CSV or messages is made safe for spreadsheets and terminals (:func:`cell`)."""
+    row = {"line": line, "name": cell(name), "status": status, "message": cell(message or ""),
+           "files": cell(" ".join(paths))}
+    error = relative_error(measured, requested) if measured is not None else None
+    for i, key in enumerate(MEASUREMENTS):
+        row[key] = f"{requested[i]:g}" if requested is not None else ""
+        row[f"{key}_measured"] = f"{measured[i]:.4f}" if measured is not None else ""
+        row[f"{key}_error_pct"] = f"{error[i]:.4f}" if error is not None else ""
+    return row
+
+
+def cell(text):
+    """A report cell: control characters escaped (:func:`printable`), and text a spreadsheet would take for
+    a formula (starting with =, +, - or @) neutralised with a leading apostrophe, as OWASP recommends."""
+    text = printable(text)
+    return "'" + text if text[:1] in ("=", "+", "-", "@") else text
+
+
+def report_csv(rows):
+    stream = io.StringIO()
+    writer = csv.DictWriter(stream, fieldnames=REPORT_COLUMNS, lineterminator="\n", extrasaction="ignore")
+    writer.writeheader()
+    writer.writerows(rows)
+    return stream.getvalue()
+
+
+def write_text(path, text):
+    with writing(path):
+        atomic_write_text(path, text)
+
+
+class Progress:
+    """One progress line on stderr: rewritten in place on a terminal, every ~5% in a log."""
+
+    def __init__(self, total, command, every=None):
+        self.total, self.count, self.start = total, 0, time.perf_counter()
+        self.command = command
+        self.stream = sys.stderr  # ElliMann's stderr, also from inside blender_output() (where sys.stderr is Blender's)
+        self.tty = self.stream.isatty()
+        self.every = every or max(1, total // 20)
+
+    def step(self, name, count=None):
+        """One more done (``name``: what), or ``count`` done so far; repeated counts are ignored."""
+        if count is not None and count <= self.count:
+            return
+        self.count = self.count + 1 if count is None else count
+        if self.tty or self.count % self.every == 0 or self.count == self.total:
+            rate = self.count / max(time.perf_counter() - self.start, 1e-9)
+            text = printable(f"{PROG} {self.command}: {self.count}/{self.total} ({rate:.1f}/s) {name}")
+            print(f"\r{text[:100]:<100}" if self.tty else text, end="" if self.tty else "\n", file=self.stream,
+                  flush=True)
+
+    def done(self):
+        if self.tty and self.total:
+            print(file=self.stream)

@@ -1,0 +1,110 @@
+"""``ellimann drape``: a garment sized from a mannequin, draped with Blender's cloth (Blender), saved as a .blend;
+its options and defaults are the Drape panel's (``core.options.DRAPE`` and ``DrapeSettings``)."""
+
+import argparse
+import dataclasses
+import os
+import sys
+
+from ..core.constants import CM_PER_M
+from ..core.ellipsoid import bounds
+from ..core.files import atomic_output
+from ..core.garments import EDGE_RANGE
+from ..core.options import DRAPE, DrapeSettings, garment_help
+from . import common
+from .common import PROG, UsageError
+from .measure import load_blend_mannequin, load_json_mannequin
+
+
+def add_parser(commands):
+    defaults = DrapeSettings()
+    drape = commands.add_parser("drape", help="drape a garment on a mannequin with Blender's cloth simulation",
+                                description="Build a garment sized from the mannequin's m_T, drape it with "
+                                            "Blender cloth (the mannequin's convex pieces as colliders), bake the "
+                                            "frames and save the scene as a .blend; prints the fit (garment-to-"
+                                            "body distances, vertices inside the body). Defaults are the Drape "
+                                            "panel's (DrapeSettings).")
+    drape.add_argument("mannequin", metavar="MANNEQUIN", help="a .json or .blend mannequin")
+    garment = DRAPE["garment"]
+    drape.add_argument("--garment", choices=garment.values, default=garment.default, help=garment_help())
+    drape.add_argument("--frames", type=int, help=DRAPE["frames"].help.format(default=defaults.frames))
+    drape.add_argument("--cushions", action=argparse.BooleanOptionalAction,
+                       help=DRAPE["cushions"].help.format(
+                           default_text="cushions" if defaults.cushions else "every ellipsoid"))
+    drape.add_argument("--edge", type=common.number, metavar="CM",
+                       help=DRAPE["edge"].help.format(default_cm=defaults.edge * CM_PER_M))
+    drape.add_argument("--collection", help="the mannequin collection in a .blend holding several (.blend only)")
+    drape.add_argument("-o", "--output", required=True, metavar="OUT.blend")
+    drape.add_argument("--render", metavar="OUT.png", help="also a Workbench picture of the last frame")
+    common.add_verbose(drape)
+    drape.set_defaults(run=run, blender=needs_blender)
+
+
+def needs_blender(args):
+    """What needs Blender in this command: the cloth simulation."""
+    return "the cloth simulation"
+
+
+def run(args):
+    for path, ending, what in ((args.output, ".blend", "-o"), (args.render, ".png", "--render")):
+        if path is not None and not path.lower().endswith(ending):
+            raise UsageError(f"{what} must end in {ending}, got {path!r}")
+    kind = os.path.splitext(args.mannequin)[1].lower()
+    if kind not in (".json", ".blend"):
+        raise UsageError(f"MANNEQUIN must be a .json or .blend mannequin, got {args.mannequin!r}")
+    if kind == ".json" and args.collection is not None:
+        raise UsageError(f"--collection picks one of the mannequins in a .blend; {args.mannequin} is a .json file "
+                         "holding one mannequin (leave --collection out)")
+    if not os.path.isfile(args.mannequin):
+        raise UsageError(f"{args.mannequin}: no such file")
+    if kind == ".json":
+        mannequin = load_json_mannequin(args.mannequin)
+    bpy = common.ensure_registered("drape")
+    from ..blender.services.chatter import blender_output
+    from ..blender.services.drape import WARN_CLOTH_VERTICES, check_cloth_size, drape
+    from ..blender.services.scene import add_mannequin, empty_scene
+
+    settings = settings_of(args)
+    if kind == ".json":
+        empty_scene()
+        add_mannequin(mannequin, cushions=settings.cushions and bool(mannequin.topology.cushion_pairs))
+    else:
+        mannequin = load_blend_mannequin(args.mannequin, args.collection)
+    vertices, size = check_cloth_size(mannequin, args.garment, settings)  # refuses a cloth too large to drape
+    if vertices > WARN_CLOTH_VERTICES:
+        common.say(f"{PROG} drape: warning: the cloth will have about {vertices:,} vertices and need about "
+             f"{size / 1e9:.1f} GB; it is slow (a larger --edge is faster)")
+    common.say(f"{PROG} drape: {args.garment} on '{mannequin.name}', {settings.frames} frames, cloth edge "
+         f"{settings.edge * CM_PER_M:g} cm, colliding with {'cushions' if settings.cushions else 'ellipsoids'}")
+    progress = common.Progress(settings.frames, "drape", every=max(10, settings.frames // 20))  # 10 frames, 5% past 200
+
+    def frame_done(frame):
+        progress.step("frames simulated" + ("; baking and measuring the fit" if frame == settings.frames else ""),
+                      frame)
+
+    with blender_output():
+        try:
+            result = drape(mannequin, args.garment, settings, progress=frame_done)
+        finally:
+            progress.done()
+        with common.writing(args.output), atomic_output(args.output) as temp:
+            bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)
+    common.say(f"wrote {args.output}: {result.garment.name} on '{mannequin.name}', {result.summary()}", file=sys.stdout)
+    if args.render:
+        from ..blender.services.render import render_view
+
+        low, high = bounds(mannequin.rotation, mannequin.center, mannequin.semi_axes)
+        with common.writing(args.render):
+            render_view(args.render, low.min(axis=0), high.max(axis=0))
+        common.say(f"wrote {args.render}", file=sys.stdout)
+    return 0
+
+
+def settings_of(args):
+    """DrapeSettings from the command line: what is not given keeps DrapeSettings' default (the panel's too)."""
+    low, high = (bound * CM_PER_M for bound in EDGE_RANGE)
+    if args.edge is not None and not low <= args.edge <= high:  # in the flag's unit, not DrapeSettings' metres
+        raise UsageError(f"--edge: the cloth's edge length must be from {low:g} to {high:g} cm, got {args.edge:g} cm")
+    given = {"frames": args.frames, "edge": None if args.edge is None else args.edge / CM_PER_M,
+             "cushions": args.cushions}
+    return dataclasses.replace(DrapeSettings(), **{k: v for k, v in given.items() if v is not None}).checked()

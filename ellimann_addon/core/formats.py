@@ -1,0 +1,46 @@
+"""The mannequin file formats, in one table: each format's name (``--format``), its file extension, who writes
+it (the core: JSON and MJCF, ``core.writers``; Blender: .blend, .glb, .obj, ``blender.output.write_mannequin``)
+and so whether it needs the bpy module. The command line, the writers and the export operator read it."""
+
+import os
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Format:
+    name: str  # what a user types (``--format json,mjcf``)
+    extension: str  # the file extension, without the dot
+    writer: str  # "core" (numpy only) or "blender" (needs bpy)
+    title: str  # what it is, for help texts
+
+    @property
+    def needs_blender(self):
+        return self.writer == "blender"
+
+
+FORMATS = {f.name: f for f in (
+    Format("blend", "blend", "blender", "Blender file"),
+    Format("glb", "glb", "blender", "binary glTF with ElliMann's extras"),
+    Format("obj", "obj", "blender", "Wavefront OBJ"),
+    Format("json", "json", "core", "ElliMann's mannequin JSON"),
+    Format("mjcf", "xml", "core", "MJCF, for MuJoCo"),
+)}
+CORE_FORMATS = tuple(name for name, f in FORMATS.items() if not f.needs_blender)  # json, mjcf
+BLENDER_FORMATS = tuple(name for name, f in FORMATS.items() if f.needs_blender)  # blend, glb, obj
+EXTENSIONS = {name: f.extension for name, f in FORMATS.items()}  # format -> file extension
+
+
+def extension_of(path):
+    """A path's extension, lower case, without the dot ("" if none)."""
+    return os.path.splitext(os.fspath(path))[1].lower().lstrip(".")
+
+
+def format_of(path):
+    """The Format a path's extension names, or None."""
+    extension = extension_of(path)
+    return next((f for f in FORMATS.values() if f.extension == extension), None)
+
+
+def needs_blender(paths):
+    """Whether writing ``paths`` needs the bpy module (one of them is a Blender format)."""
+    return any(f is not None and f.needs_blender for f in map(format_of, paths))

@@ -1,0 +1,246 @@
+"""Exact mode: deform an interpolated mannequin gently until its m_T matches the request (quasi-Newton on five
+factors; see ``core.synthesis`` for the method)."""
+
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from .constants import (
+    CM_PER_M,
+    GIRTHS,
+    MEASUREMENTS,
+    SECTION_FRACTIONS,
+)
+from .ellipsoid import axis_extent, section_at_height
+from .measure import section_heights, tailor_measurements
+
+# Exact mode.
+EXACT_TOLERANCE = 1e-5  # relative m_T error at which refinement stops (0.001 %)
+EXACT_MAX_ITERATIONS = 12
+_JACOBIAN_REFRESH = 4  # Broyden steps before a slow mannequin gets a fresh finite-difference Jacobian
+FACTOR_LIMITS = (0.75, 4.0 / 3.0)  # the refinement never scales beyond these (it would show)
+_MAX_STEP = 0.1  # largest change of a log factor per Newton step
+_FD_STEP = 1e-4  # log-factor step of the finite-difference Jacobian
+_TIKHONOV = 1e-10  # keeps the Newton system solvable when a measurement does not respond
+_TAPER = 1.0  # how strongly a section's factor lengthens the parts it cuts off their middle
+_DAMPING = 1e-3  # initial Levenberg-Marquardt damping (relative to each factor's own curvature)
+# Hat functions of the girth blend, in fractions of He: full effect at a section, none beyond the
+# neighbouring knots. Below the hip section the blend fades over the thighs, above the breast over
+# the upper chest (as far above Br as Wa is below it).
+_KNOTS = (
+    SECTION_FRACTIONS["Hi"] - (SECTION_FRACTIONS["Wa"] - SECTION_FRACTIONS["Hi"]),
+    SECTION_FRACTIONS["Hi"],
+    SECTION_FRACTIONS["Wa"],
+    SECTION_FRACTIONS["Br"],
+    SECTION_FRACTIONS["Br"] + (SECTION_FRACTIONS["Br"] - SECTION_FRACTIONS["Wa"]),
+)
+_GIRTH_KNOT = {"Hi": 1, "Wa": 2, "Br": 3}
+_INDEX = {key: i for i, key in enumerate(MEASUREMENTS)}
+
+
+@dataclass
+class _DeformBasis:
+    """What the deformation needs from the unrefined geometry (held fixed while factors change)."""
+
+    bottom: np.ndarray  # (B,) m
+    shoulder_half: np.ndarray  # (B,) m, half of Sh
+    girth_weight: np.ndarray  # (B, n, 3) hat weight of each part for Br, Wa, Hi (GIRTHS order)
+    origin_y: np.ndarray  # (B, n) y of the vertical axis the girth scaling is about, at each part
+    vertical: np.ndarray  # (B, n, 3) share of each local axis along world z (R[2, k]^2)
+    lateral: np.ndarray  # (B, n, 3) share along world x
+    taper: np.ndarray  # (B, n, 3) how far off its middle each girth part is cut by Br, Wa, Hi (0..1)
+    anchor: np.ndarray  # (B, n, 3) z of the end of the part farther from each section
+    shoulder_scaled: np.ndarray  # (n,) parts that widen with Sh
+    shoulder_carried: np.ndarray  # (n,) parts moved sideways with Sh (arms)
+
+    _SHARED = ("shoulder_scaled", "shoulder_carried")  # per part, not per mannequin
+
+    def take(self, rows):
+        return _DeformBasis(**{f.name: getattr(self, f.name) if f.name in self._SHARED else getattr(self, f.name)[rows]
+                               for f in fields(self)})
+
+    def tile(self, count):
+        def rep(a):
+            return np.tile(a, (count,) + (1,) * (a.ndim - 1))
+
+        return _DeformBasis(**{f.name: getattr(self, f.name) if f.name in self._SHARED else rep(getattr(self, f.name))
+                               for f in fields(self)})
+
+
+def _hat(fraction, knot):
+    """Piecewise-linear hat over _KNOTS, 1 at _KNOTS[knot], 0 at its neighbours and beyond."""
+    return np.interp(fraction, _KNOTS, np.eye(len(_KNOTS))[knot])
+
+
+# Points across an ellipsoid's height (in half-extents) and their weights, proportional to the area
+# of the horizontal section there (1 - t^2): the blend weight of a part is the hat averaged over it.
+_SPAN = np.linspace(-1.0, 1.0, 9)[1:-1]
+_SPAN_WEIGHT = (1.0 - _SPAN**2) / np.sum(1.0 - _SPAN**2)
+
+
+def _deform_basis(topology, rotation, center, semi_axes, measured):
+    bottom, height, z = section_heights(rotation, center, semi_axes)
+    span = center[..., 2, None] + axis_extent(rotation, semi_axes, 2)[..., None] * _SPAN  # (B, n, q)
+    fraction = (span - bottom[:, None, None]) / height[:, None, None]
+    girth = topology.girth_mask
+    weight = np.stack([_hat(fraction, _GIRTH_KNOT[key]) @ _SPAN_WEIGHT for key in GIRTHS], axis=-1)
+    weight = weight * girth[:, None]
+    fraction = (center[..., 2] - bottom[:, None]) / height[:, None]
+    # Each girth section's own centre in y (middle of its extent), interpolated between sections.
+    centre_y = []
+    for key in GIRTHS:
+        c2, k2, hit = section_at_height(rotation, center, semi_axes, z[key][:, None])
+        active = hit & girth
+        half = np.sqrt(k2[..., 1, 1])
+        top = np.where(active, c2[..., 1] + half, -np.inf).max(axis=-1)
+        low = np.where(active, c2[..., 1] - half, np.inf).min(axis=-1)
+        centre_y.append(np.where(np.isfinite(top), 0.5 * (top + low), 0.0))
+    centre_y = np.stack(centre_y, axis=-1)  # (B, 3) in GIRTHS order: Br, Wa, Hi
+    order = [GIRTHS.index(key) for key in ("Hi", "Wa", "Br")]
+    fractions = [SECTION_FRACTIONS[key] for key in ("Hi", "Wa", "Br")]
+    origin_y = np.stack([np.interp(fraction[b], fractions, centre_y[b, order]) for b in range(len(bottom))])
+    # Where each section cuts each girth part, relative to the part's middle (-1 bottom .. 1 top).
+    half_z = axis_extent(rotation, semi_axes, 2)  # (B, n)
+    cut = np.stack([(z[key][:, None] - center[..., 2]) / half_z for key in GIRTHS], axis=-1)  # (B, n, 3)
+    crossing = (np.abs(cut) < 1.0) & girth[:, None]
+    taper = np.where(crossing, np.abs(cut), 0.0)
+    anchor = center[..., 2, None] - np.sign(cut) * half_z[..., None]
+    depends_sh = topology.dependency_mask[:, _INDEX["Sh"]]
+    return _DeformBasis(
+        bottom=bottom, shoulder_half=0.5 * measured[:, _INDEX["Sh"]] / CM_PER_M, girth_weight=weight,
+        origin_y=origin_y, vertical=rotation[..., 2, :] ** 2, lateral=rotation[..., 0, :] ** 2,
+        taper=taper, anchor=anchor, shoulder_scaled=depends_sh & girth, shoulder_carried=depends_sh & ~girth)
+
+
+def deform(basis, center, semi_axes, factors):
+    """Apply refinement factors (B, 5) (He, Sh, Br, Wa, Hi; 1 = unchanged) -> (center, semi_axes).
+
+    Rotations are unchanged. Symmetric about x = 0 by construction.
+    """
+    f = np.asarray(factors, dtype=float)
+    center = center.copy()
+    semi = semi_axes.copy()
+    girth_f = f[:, [_INDEX[key] for key in GIRTHS]]  # (B, 3)
+    # Br, Wa, Hi, first: a part cut by a section away from its middle is lengthened or shortened
+    # from its far end, which widens or narrows it there much more than in its middle (a rib cage
+    # ending higher narrows the waist, not the bust).
+    for g in range(len(GIRTHS)):
+        v = girth_f[:, g, None] ** (_TAPER * basis.taper[..., g])  # (B, n)
+        anchor = basis.anchor[..., g]
+        center[..., 2] = anchor + v * (center[..., 2] - anchor)
+        semi *= 1.0 + (v[..., None] - 1.0) * basis.vertical
+    # He: vertical stretch about the floor.
+    he = f[:, _INDEX["He"], None]
+    center[..., 2] = basis.bottom[:, None] + he * (center[..., 2] - basis.bottom[:, None])
+    semi *= 1.0 + (he[..., None] - 1.0) * basis.vertical
+    # Br, Wa, Hi: horizontal scaling blended with height.
+    sigma = 1.0 + np.einsum("bng,bg->bn", basis.girth_weight, girth_f - 1.0)
+    center[..., 0] *= sigma
+    center[..., 1] = basis.origin_y + sigma * (center[..., 1] - basis.origin_y)
+    semi *= 1.0 + (sigma[..., None] - 1.0) * (1.0 - basis.vertical)
+    # Sh: the shoulders widen along x; the arms hanging from them move out with their edge.
+    sh = f[:, _INDEX["Sh"], None]
+    scaled = basis.shoulder_scaled[None, :]
+    center[..., 0] = np.where(scaled, center[..., 0] * sh, center[..., 0])
+    semi = np.where(scaled[..., None], semi * (1.0 + (sh[..., None] - 1.0) * basis.lateral), semi)
+    shift = np.sign(center[..., 0]) * (sh - 1.0) * basis.shoulder_half[:, None]
+    center[..., 0] += np.where(basis.shoulder_carried[None, :], shift, 0.0)
+    return center, semi
+
+
+@dataclass
+class Refinement:
+    center: np.ndarray
+    semi_axes: np.ndarray
+    measured: np.ndarray  # (B, 5) cm, m_T of the refined mannequins
+    factors: np.ndarray  # (B, 5) the deformation factors found (1 = unchanged)
+    iterations: int
+    converged: np.ndarray  # (B,) bool: every measurement within the tolerance
+
+
+def refine(topology, rotation, center, semi_axes, targets, measured=None, tolerance=EXACT_TOLERANCE,
+           max_iterations=EXACT_MAX_ITERATIONS, jacobian=None):
+    """Deform mannequins (B, n, ...) so that m_T matches ``targets`` (B, 5) cm (exact mode).
+
+    Solves r(x) = log m_T(deform(exp x)) - log target = 0 for the log factors x, Levenberg-Marquardt
+    style: starting from ``jacobian`` ((5, 5) or (B, 5, 5), e.g. ``ReferenceSet.refine_jacobian``)
+    or, without one, a forward-difference Jacobian (5 m_T per mannequin); Broyden updates after
+    every step (one m_T each), a step kept only if it lowers |r| (else more damping), a
+    forward-difference Jacobian if a mannequin is slow to converge. The result is never further from
+    the request than the IDW mannequin it starts from. All batched; mannequins already within
+    ``tolerance`` are returned unchanged.
+    """
+    girth = topology.girth_mask
+    targets = np.atleast_2d(np.asarray(targets, dtype=float))
+    if measured is None:
+        measured = tailor_measurements(rotation, center, semi_axes, girth)
+    basis = _deform_basis(topology, rotation, center, semi_axes, measured)
+    count = len(MEASUREMENTS)
+    x = np.zeros((len(targets), count))
+    current = measured.copy()
+    residual = np.log(np.maximum(current, 1e-12) / targets)
+    if jacobian is None:
+        jacobian = np.zeros((len(targets), count, count))
+        age = np.full(len(targets), -1)  # steps since the Jacobian was computed (-1: never)
+    else:
+        jacobian = np.broadcast_to(np.asarray(jacobian, dtype=float), (len(targets), count, count)).copy()
+        age = np.zeros(len(targets), dtype=int)
+    damping = np.full(len(targets), _DAMPING)
+    # A factor that reaches FACTOR_LIMITS is frozen there and its measurement left as close as that
+    # allows; the other factors keep solving their own measurements (no trading one for another).
+    free = np.ones((len(targets), count), dtype=bool)
+    out_center, out_semi = center.copy(), semi_axes.copy()
+    lo, hi = np.log(FACTOR_LIMITS)
+    eye = np.eye(count)
+    iterations = 0
+    for _ in range(max_iterations):
+        todo = np.nonzero((np.abs(residual) * free).max(axis=1) > tolerance)[0]
+        if not len(todo):
+            break
+        iterations += 1
+        stale = todo[(age[todo] < 0) | (age[todo] >= _JACOBIAN_REFRESH)]
+        if len(stale):
+            jacobian[stale] = _fd_jacobian(basis, rows=stale, rotation=rotation, center=center, semi_axes=semi_axes,
+                                           x=x, base=np.log(np.maximum(current[stale], 1e-12)), girth=girth)
+            age[stale] = 0
+        j = jacobian[todo]
+        mask = free[todo]
+        reduced = j * mask[:, :, None] * mask[:, None, :]
+        rt = np.swapaxes(reduced, -1, -2)
+        normal = rt @ reduced
+        scale = np.diagonal(normal, axis1=-2, axis2=-1) + _TIKHONOV  # Marquardt: each factor by its own scale
+        system = normal + (damping[todo, None] * scale + ~mask)[..., None] * eye
+        # A stacked right-hand side as explicit column vectors: numpy 2 no longer broadcasts (t, f) against (t, f, f).
+        rhs = np.einsum("tfm,tm->tf", rt, residual[todo] * mask)
+        step = -np.linalg.solve(system, rhs[..., None])[..., 0]
+        wanted = x[todo] + np.clip(step, -_MAX_STEP, _MAX_STEP)
+        new_x = np.clip(wanted, lo, hi)
+        c, d = deform(basis.take(todo), center[todo], semi_axes[todo], np.exp(new_x))
+        m = tailor_measurements(rotation[todo], c, d, girth)
+        new_residual = np.log(np.maximum(m, 1e-12) / targets[todo])
+        # Broyden: the secant of this step corrects the Jacobian along the step, kept or not.
+        dx = new_x - x[todo]
+        norm = np.einsum("tf,tf->t", dx, dx)
+        miss = new_residual - residual[todo] - np.einsum("tmf,tf->tm", j, dx)
+        jacobian[todo] = j + np.divide(miss[:, :, None] * dx[:, None, :], norm[:, None, None],
+                                       out=np.zeros_like(j), where=norm[:, None, None] > 0)
+        age[todo] += 1
+        better = np.sum((new_residual * mask) ** 2, axis=1) < np.sum((residual[todo] * mask) ** 2, axis=1)
+        damping[todo] = np.where(better, damping[todo] / 3.0, damping[todo] * 4.0)
+        keep = todo[better]
+        x[keep], residual[keep], current[keep] = new_x[better], new_residual[better], m[better]
+        out_center[keep], out_semi[keep] = c[better], d[better]
+        free[keep] &= new_x[better] == wanted[better]
+    converged = np.abs(residual).max(axis=1) <= tolerance
+    return Refinement(out_center, out_semi, current, np.exp(x), iterations, converged)
+
+
+def _fd_jacobian(basis, rows, rotation, center, semi_axes, x, base, girth):
+    """d log m_T / d log factor (T, measurement, factor) by forward differences at x[rows]."""
+    count = len(MEASUREMENTS)
+    probes = np.concatenate([x[rows] + _FD_STEP * np.eye(count)[j] for j in range(count)])
+    c, d = deform(basis.take(rows).tile(count), np.tile(center[rows], (count, 1, 1)),
+                  np.tile(semi_axes[rows], (count, 1, 1)), np.exp(probes))
+    m = tailor_measurements(np.tile(rotation[rows], (count, 1, 1, 1)), c, d, girth)
+    m = np.log(np.maximum(m, 1e-12)).reshape(count, len(rows), count)
+    return np.moveaxis((m - base[None]) / _FD_STEP, 0, -1)

@@ -1,0 +1,141 @@
+"""The command line needs numpy only: synth to .json/.xml, batch to json/mjcf, measure of a .json and every --help
+run with the bpy module blocked (a meta-path finder refusing it), and never import ``ellimann_addon.blender``;
+what needs Blender (.blend/.glb/.obj, drape, demo) is refused in one line that says so."""
+
+import ast
+import json
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+from devkit import synthetic
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]
+
+# Runs the CLI as ``python -m ellimann_addon`` does (its __main__), with Blender's modules blocked, and
+# reports on stderr's last line which ElliMann modules of the bpy layer were imported.
+WITHOUT_BLENDER = """
+import atexit, runpy, sys
+class NoBlender:
+    def find_spec(self, name, path=None, target=None):
+        if name.split(".")[0] in ("bpy", "bmesh", "mathutils", "bpy_extras", "gpu"):
+            raise ImportError(f"No module named {name!r} (blocked by the test)")
+        return None
+sys.meta_path.insert(0, NoBlender())
+def report():
+    loaded = sorted(m for m in sys.modules if m == "bpy" or m.startswith("ellimann_addon.blender"))
+    print("LOADED", loaded, file=sys.stderr)
+atexit.register(report)
+sys.argv = ["ellimann", *sys.argv[1:]]
+runpy.run_module("ellimann_addon", run_name="__main__", alter_sys=True)
+"""
+
+
+@pytest.fixture(scope="module")
+def references(tmp_path_factory):
+    return str(synthetic.write_reference_folder(tmp_path_factory.mktemp("rm")))
+
+
+def without_blender(*args):
+    done = subprocess.run([sys.executable, "-c", WITHOUT_BLENDER, *args], cwd=ROOT, capture_output=True, text=True,
+                          timeout=120)
+    *lines, loaded = done.stderr.strip().splitlines()
+    assert loaded == "LOADED []", done.stderr
+    return done.returncode, done.stdout, "\n".join(lines)
+
+
+def test_the_blocker_blocks():
+    code = "import sys\n" + WITHOUT_BLENDER.split("sys.meta_path.insert(0, NoBlender())")[0] + (
+        "sys.meta_path.insert(0, NoBlender())\ntry:\n    import bpy\nexcept ImportError:\n    print('blocked')\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "blocked"
+
+
+@pytest.mark.parametrize("kind", ["json", "xml"])
+def test_synth_and_measure_run_without_blender(tmp_path, references, kind):
+    out = tmp_path / f"woman.{kind}"
+    code, stdout, stderr = without_blender("synth", *REQUEST, "--cushions", "-o", str(out), "--references",
+                                           references)
+    assert code == 0, stderr
+    assert stdout.startswith(f"wrote {out}: 'ElliMann 165-41.5-101.25-82.75-117.5' (exact), m_T He 165.00, ")
+    assert out.is_file()
+    if kind == "json":
+        code, stdout, stderr = without_blender("measure", str(out), "--json")
+        assert code == 0 and stderr == ""
+        assert json.loads(stdout) == pytest.approx(dict(zip(("He", "Sh", "Br", "Wa", "Hi"),
+                                                            (165, 41.5, 101.25, 82.75, 117.5))), rel=1e-4)
+        code, stdout, _ = without_blender("measure", str(out))
+        assert code == 0 and "He Height" in stdout
+
+
+def test_batch_to_core_formats_runs_without_blender(tmp_path, references):
+    source = tmp_path / "in.csv"
+    source.write_text("He,Sh,Br,Wa,Hi,name\n160,40,95,80,105,a\n170,42,100,85,110,b\n", encoding="utf-8")
+    code, stdout, stderr = without_blender("batch", str(source), "-o", str(tmp_path / "out"), "--format",
+                                           "json,mjcf", "--references", references)
+    assert code == 0, stderr
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["a.json", "a.xml", "b.json", "b.xml",
+                                                                    "report.csv"]
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["synth", "--help"], ["batch", "--help"], ["measure", "--help"],
+                                  ["demo", "--help"], ["drape", "--help"]])
+def test_help_runs_without_blender(argv):
+    code, stdout, _ = without_blender(*argv)
+    assert code == 0 and "usage: ellimann" in stdout
+    if argv[0] == "drape":
+        assert "(default 60, at 24 fps)" in " ".join(stdout.split())
+
+
+@pytest.mark.parametrize("argv, what", [
+    (["synth", *REQUEST, "-o", "{tmp}/w.blend"], "writing {tmp}/w.blend"),
+    (["synth", *REQUEST, "-o", "{tmp}/w.glb"], "writing {tmp}/w.glb"),
+    (["synth", *REQUEST, "-o", "{tmp}/w.obj"], "writing {tmp}/w.obj"),
+    (["batch", "{tmp}/in.csv", "-o", "{tmp}/out", "--format", "json,blend"], "--format blend"),
+    (["measure", "{tmp}/w.blend"], "reading {tmp}/w.blend"),
+    (["drape", "{tmp}/w.json", "-o", "{tmp}/d.blend"], "the cloth simulation"),
+    (["demo", "-o", "{tmp}/demo"], "the demo (.blend files and a line-up picture)"),
+])
+def test_what_needs_blender_is_refused_in_one_line(tmp_path, argv, what):
+    code, stdout, stderr = without_blender(*(a.format(tmp=tmp_path) for a in argv))
+    assert code == 1 and stdout == ""
+    lines = stderr.splitlines()
+    assert len(lines) == 1 and "Traceback" not in stderr, stderr
+    assert lines[0].startswith(f"ellimann {argv[0]}: error: {what.format(tmp=tmp_path)} needs Blender: the bpy "
+                               "module is not installed")
+    assert not list(tmp_path.iterdir())
+
+
+def test_the_cli_imports_blender_only_inside_functions():
+    """No module of ellimann_addon/cli imports bpy or the bpy layer at its top level."""
+    offenders = []
+    for path in (ROOT / "ellimann_addon" / "cli").glob("*.py"):
+        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                names = [("." * node.level) + (node.module or "")]
+            else:
+                continue
+            offenders += [f"{path.name}: {n}" for n in names if n.split(".")[0] in ("bpy", "bmesh", "mathutils")
+                          or n.lstrip(".").startswith("blender") or n.startswith("ellimann_addon.blender")]
+    assert offenders == []
+
+
+def test_one_table_for_the_options_of_the_cli_and_the_panels():
+    from ellimann_addon.cli import build_parser
+    from ellimann_addon.core import garments
+    from ellimann_addon.core.options import DRAPE, SYNTHESIS, DrapeSettings, SynthesisOptions
+
+    assert SynthesisOptions() == SynthesisOptions(**{k: o.default for k, o in SYNTHESIS.items()})
+    assert SynthesisOptions().mode == "exact"
+    args = build_parser().parse_args(["synth", *REQUEST, "-o", "x.json"])
+    assert {k: getattr(args, k) for k in SYNTHESIS} == {k: o.default for k, o in SYNTHESIS.items()}
+    assert DRAPE["garment"].values == tuple(garments.BUILDERS)
+    defaults = DrapeSettings()
+    assert all(getattr(defaults, k) == o.default for k, o in DRAPE.items() if k != "garment")
+    with pytest.raises(TypeError):
+        SynthesisOptions("exact")  # keyword-only
