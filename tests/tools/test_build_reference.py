@@ -67,7 +67,7 @@ def test_check_flags_numbers_moved_beyond_its_tolerance(shift, flagged):
     center[3, 1] += shift
     mannequins["average"] = average.copy(center=center)
     problems = build_reference.check_shipped(base, mannequins, SHIPPED)
-    assert problems == (["average: center differs by up to {:.3g}".format(shift)] if flagged else [])
+    assert problems == ([f"average: center differs by up to {shift:.3g}"] if flagged else [])
 
 
 def test_docs_are_compared_at_their_printed_precision():
