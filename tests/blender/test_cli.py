@@ -516,7 +516,11 @@ import resource, signal, sys
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails (EFBIG) instead of ending us
 from ellimann_addon.blender.services import teardown
 from ellimann_addon.cli import main
+import os
+quiet, stdout = os.open(os.devnull, os.O_WRONLY), os.dup(1)
+os.dup2(quiet, 1)  # Blender 5.3 prints its colour configuration on import, which the CLI would have captured
 import bpy  # loaded (and Python's caches written) before the limit
+os.dup2(stdout, 1)
 resource.setrlimit(resource.RLIMIT_FSIZE, ({limit}, {limit}))
 teardown.exit_with(main({argv!r}))
 """

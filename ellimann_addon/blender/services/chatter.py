@@ -17,6 +17,7 @@ No bpy here: the CLI uses it before Blender is loaded.
 
 import contextlib
 import ctypes
+import gc
 import os
 import sys
 import tempfile
@@ -140,6 +141,13 @@ def blender_output():
     try:
         yield
     except BaseException as error:
+        # A failed Python exporter's frames (and the file it had open: Blender 5.3's glTF exporter on a
+        # full disk) stay alive in sys.last_* where Blender printed its error; freed here, their
+        # "Exception ignored" lines go to Blender's output, not after ElliMann's one line.
+        for name in ("last_exc", "last_type", "last_value", "last_traceback"):
+            if hasattr(sys, name):
+                delattr(sys, name)
+        gc.collect()
         sys.stdout, sys.stderr = saved
         text = running.since(start).strip()
         if text and hasattr(error, "add_note"):
