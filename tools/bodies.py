@@ -80,7 +80,7 @@ def vertex_normals(vertices, faces):
 
 
 def body_measurements(body, labels):
-    """The body's own tailor measurements (cm), measured as DESIGN.md says.
+    """The body's own tailor measurements (cm), measured as ../shared/refmodels/README.md measured them.
 
     Girths: perimeter of the convex hull of the section of the torso-mask triangles (all three
     vertices in the torso); shoulder width: extent along X of the section of all triangles.

@@ -44,7 +44,7 @@ from ellimann_addon.core.clean import (
     asymmetry,
     clean,
     landmark_indices,
-    register,
+    register_to_world,
     registration_offset,
     relabel,
     symmetrize,
@@ -218,7 +218,7 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
     log(f"base mannequin fitted ({len(base)} parts)")
     base = symmetrize(base)  # symmetric first: mirroring may move the lowest point
     shifts = {BASE_FILE: registration_offset(base)}  # body -> mannequin translation, to compare them
-    base = register(base)
+    base = register_to_world(base)
 
     bodies, raw, adjusted, factors = {}, {}, [], {}
     for name in RM_BODIES:
@@ -228,7 +228,7 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
                                   measurements=dict(targets))
         fitted = symmetrize(fitted)
         shifts[name] = registration_offset(fitted)
-        raw[name] = register(fitted)
+        raw[name] = register_to_world(fitted)
         adjusted.append(adjust(raw[name], targets))
         factors[name] = adjusted[-1].factors
         log(f"{name}: fitted and adjusted")

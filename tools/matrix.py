@@ -173,6 +173,7 @@ def main(argv=None):
     parser.add_argument("--list", action="store_true", help="print the lanes and exit")
     parser.add_argument("--setup-only", action="store_true", help="make the lanes' venvs, run no test")
     args, extra = parser.parse_known_args(argv)
+    extra = extra[1:] if extra[:1] == ["--"] else extra  # what follows goes to every lane's pytest
     chosen = [s.strip() for s in args.lanes.split(",") if s.strip()]
     unknown = sorted(set(chosen) - {lane.blender for lane in LANES})
     if unknown:

@@ -92,7 +92,3 @@ def asymmetry(mannequin):
     center_error = np.linalg.norm(mannequin.center - mirrored_center, axis=1)
     shape_error = np.sqrt(np.abs(shape - mirrored_shape).max(axis=(1, 2)))
     return float(max(center_error.max(), shape_error.max()))
-
-
-# The old name, until tools/build_reference.py (edited in another branch) imports register_to_world.
-register = register_to_world
