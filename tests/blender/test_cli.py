@@ -16,6 +16,7 @@ import bpy
 import pytest
 
 from devkit import synthetic
+from devkit.cli_runs import assert_one_line_error, python_m, run
 from ellimann_addon import cli
 from ellimann_addon.blender.services.files import EXTRAS_KEY, read_glb_json
 from ellimann_addon.cli import common
@@ -33,26 +34,6 @@ VALUES = dict(zip(MEASUREMENTS, (165.0, 41.5, 101.25, 82.75, 117.5)))
 @pytest.fixture(scope="module")
 def references(tmp_path_factory):
     return str(synthetic.write_reference_folder(tmp_path_factory.mktemp("rm")))
-
-
-def run(args, capsys):
-    code = cli.main(args)
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def python_m(*args, cwd=ROOT):
-    return subprocess.run([sys.executable, "-m", "ellimann_addon", *args], cwd=cwd, capture_output=True, text=True,
-                          env=dict(os.environ, BLENDER_USER_RESOURCES=os.environ["BLENDER_USER_RESOURCES"]),
-                          timeout=300)
-
-
-def assert_one_line_error(code, err, *words):
-    assert code == 1
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in err, err
-    for word in words:
-        assert word in lines[0]
 
 
 # ------------------------------------------------------------------------------------------------ entry points

@@ -3,11 +3,7 @@ accepted range or type, exit code 1, nothing written, never a traceback (issue 1
 
 import copy
 import json
-import os
-import pathlib
 import re
-import subprocess
-import sys
 import time
 
 import bpy
@@ -17,7 +13,7 @@ from mathutils import Matrix
 
 from devkit import synthetic
 from devkit.blender_scene import parts
-from ellimann_addon import cli
+from devkit.cli_runs import assert_one_line_error, python_m, run
 from ellimann_addon.blender.bridge.convert import collection_to_mannequin
 from ellimann_addon.blender.services import drape as drape_module
 from ellimann_addon.blender.services.drape import MAX_CLOTH_VERTICES, DrapeSettings, check_cloth_size, drape
@@ -26,7 +22,6 @@ from ellimann_addon.core.errors import ElliMannError, MannequinError
 from ellimann_addon.core.mannequin import Mannequin
 from ellimann_addon.core.synthesis import REFERENCE_FOLDER
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
 AVERAGE = REFERENCE_FOLDER / "average.json"
 REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]
 
@@ -34,26 +29,6 @@ REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--
 @pytest.fixture(scope="module")
 def references(tmp_path_factory):
     return str(synthetic.write_reference_folder(tmp_path_factory.mktemp("rm")))
-
-
-def run(args, capsys):
-    code = cli.main(args)
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def python_m(*args):
-    return subprocess.run([sys.executable, "-m", "ellimann_addon", *args], cwd=ROOT, capture_output=True, text=True,
-                          env=dict(os.environ, BLENDER_USER_RESOURCES=os.environ["BLENDER_USER_RESOURCES"]),
-                          timeout=300)
-
-
-def assert_one_line_error(code, err, *words):
-    assert code == 1
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in err, err
-    for word in words:
-        assert word in lines[0], lines[0]
 
 
 def _edited(change):
