@@ -58,7 +58,7 @@ def main(argv=None):
 
 
 def _captured(show, blender):
-    """What Blender prints, kept out of ElliMann's lines (``blender.chatter.program``) when Blender is used."""
+    """What Blender prints, kept out of ElliMann's lines (``blender.services.chatter.program``) when Blender is used."""
     if not blender:
         return contextlib.nullcontext()
     from ..blender.services.chatter import program
@@ -68,7 +68,7 @@ def _captured(show, blender):
 
 def main_exit(argv=None):
     """The ``ellimann`` console command: :func:`main`, then leave (skipping Blender 4.x's teardown, which
-    crashes there once bpy was loaded: ``blender.teardown.exit_with``)."""
+    crashes there once bpy was loaded: ``blender.services.teardown.exit_with``)."""
     code = main(argv)
     if "bpy" in sys.modules:
         from ..blender.services import teardown

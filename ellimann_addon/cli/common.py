@@ -1,5 +1,5 @@
 """What the subcommands share: the one-line errors and exit codes, ElliMann's printed lines, writing files
-(core formats without Blender, Blender's through ``blender.output`` only when asked), the output folder, the
+(core formats without Blender, Blender's through ``blender.services.files`` only when asked), the output folder, the
 report CSV and the progress line. Blender (bpy, ``ellimann_addon.blender``) is imported only inside functions
 that need it."""
 

@@ -1,5 +1,5 @@
 """The mannequin file formats, in one table: each format's name (``--format``), its file extension, who writes
-it (the core: JSON and MJCF, ``core.writers``; Blender: .blend, .glb, .obj, ``blender.output.write_mannequin``)
+it (the core: JSON and MJCF, ``core.writers``; Blender: .blend, .glb, .obj, ``blender.services.files.write_mannequin``)
 and so whether it needs the bpy module. The command line, the writers and the export operator read it."""
 
 import os

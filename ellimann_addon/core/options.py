@@ -140,7 +140,7 @@ PAPER = SynthesisOptions(mode="idw", metric="raw", power=2.0, normalize=PAPER_NO
 # ------------------------------------------------------------------------------------------------ drape
 
 FRAME_RANGE = (2, 2000)
-# Cloth size: a drape is refused above MAX_CLOTH_VERTICES (about 4 GB; see blender/drape.py's BYTES_PER_VERTEX).
+# Cloth size: a drape is refused above MAX_CLOTH_VERTICES (about 4 GB; see blender/services/drape.py's BYTES_PER_VERTEX).
 MAX_CLOTH_VERTICES = 50_000
 
 DRAPE = {
@@ -192,7 +192,7 @@ class DrapeSettings:
     collision_quality: int = 3
     distance: float = 0.005
     sewing_force: float = 20.0
-    max_vertices: int = MAX_CLOTH_VERTICES  # a larger cloth is refused (see blender/drape.py's cloth_size)
+    max_vertices: int = MAX_CLOTH_VERTICES  # a larger cloth is refused (see blender/services/drape.py's cloth_size)
 
     def checked(self):
         if isinstance(self.frames, bool) or not isinstance(self.frames, (int, np.integer)) or not (
