@@ -140,7 +140,8 @@ PAPER = SynthesisOptions(mode="idw", metric="raw", power=2.0, normalize=PAPER_NO
 # ------------------------------------------------------------------------------------------------ drape
 
 FRAME_RANGE = (2, 2000)
-# Cloth size: a drape is refused above MAX_CLOTH_VERTICES (about 4 GB; see blender/services/drape.py's BYTES_PER_VERTEX).
+# Cloth size: a drape is refused above MAX_CLOTH_VERTICES (about 4 GB; see BYTES_PER_VERTEX in
+# blender/services/drape.py).
 MAX_CLOTH_VERTICES = 50_000
 
 DRAPE = {
