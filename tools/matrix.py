@@ -98,9 +98,12 @@ def ensure_venv(lane, log):
     stamp = _stamp(lane)
     if stamp.is_file() and python.is_file():
         return python
-    if lane.venv.exists():
+    interpreter = find_python(lane.python)  # before anything is removed: no Python, nothing lost
+    if lane.venv.is_symlink():
+        lane.venv.unlink()  # a link to a venv elsewhere (a second work tree's): the venv itself stays
+    elif lane.venv.exists():
         shutil.rmtree(lane.venv)  # a half-made or stale venv: pip would keep whatever else is in it
-    subprocess.run([find_python(lane.python), "-m", "venv", str(lane.venv)], check=True, stdout=log, stderr=log)
+    subprocess.run([interpreter, "-m", "venv", str(lane.venv)], check=True, stdout=log, stderr=log)
     # The pins go on the same command line as the tools so that pip resolves them together: scipy or
     # mujoco may not pull in a numpy other than the one Blender bundles.
     subprocess.run([str(python), "-m", "pip", "install", "--quiet", "-r", str(REQUIREMENTS), *lane.pins],
@@ -117,7 +120,7 @@ def run_lane(lane, extra_args):
     with open(log_path, "w") as log:
         try:
             python = ensure_venv(lane, log)
-        except (subprocess.CalledProcessError, SystemExit) as error:
+        except (subprocess.CalledProcessError, SystemExit, OSError) as error:
             print(f"setup failed: {error}", file=log)
             return lane, None, time.monotonic() - started, log_path
         paths = [SUITES[s] for s in lane.suites]
@@ -193,8 +196,8 @@ def main(argv=None):
             with open(log_path, "w") as log:
                 try:
                     ensure_venv(lane, log)
-                except (subprocess.CalledProcessError, SystemExit) as error:
-                    print(f"setup failed: {error}", file=log)
+                except (subprocess.CalledProcessError, SystemExit, OSError) as error:
+                    print(f"setup failed: {error}", file=log, flush=True)
                     print(_tail(log_path), file=sys.stderr)
                     print(f"matrix: setup of Blender {lane.blender} failed", file=sys.stderr)
                     return 1

@@ -174,6 +174,9 @@ def run(args):
         common.say(f"{PROG} batch: interrupted: {report.count('ok', 'missed')} of {len(mine)} rows done, report "
              f"{report.path}; run it again with --resume to finish")
         return common.INTERRUPTED
+    except BaseException:
+        report._close()  # the partial report stays for --resume; its file is not left open
+        raise
     progress.done()
     report.finish()
     done, failed, missed = report.count("ok", "missed"), report.count("error"), report.count("missed")

@@ -285,7 +285,7 @@ def _running(pid):
         return None
     try:
         os.kill(pid, 0)
-    except ProcessLookupError:
+    except (ProcessLookupError, OverflowError):  # no such process (or no such pid at all)
         return False
     except OSError:  # PermissionError: it runs, as another user
         return True
@@ -329,10 +329,11 @@ def atomic_output(path):
                     raise OSError(no_room.errno, no_room.strerror, target) from error
                 raise blender_write_error(error, temp, target) from error
             problem = incomplete(temp) if os.path.isfile(temp) else "Blender wrote nothing"
-            full = disk_full(folder)
-            if full:
-                reason = f"the file Blender wrote is incomplete: {problem}" if problem else "the disk filled up"
-                raise OSError(errno.ENOSPC, f"No space left on device ({reason})", target)
+            # A whole file is kept even where the folder reports no free blocks (some network and FUSE
+            # file systems always do); a cut-short one on a full disk is named as such.
+            if problem and disk_full(folder):
+                raise OSError(errno.ENOSPC, f"No space left on device (the file Blender wrote is incomplete: "
+                                            f"{problem})", target)
             if problem:
                 raise OSError(errno.EIO, f"the file Blender wrote is incomplete: {problem}", target)
             os.replace(temp, path)

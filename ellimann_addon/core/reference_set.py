@@ -27,10 +27,19 @@ REFERENCE_NAMES = tuple(REFERENCE_MEASUREMENTS)  # small_slim, tall_slim, small_
 
 
 def _shipped_folder():
-    """The repository's reference_blends/ (a checkout, the extension), else where ``pip install`` put them."""
+    """The repository's reference_blends/ (a checkout, the extension), else where ``pip install`` put them
+    (``share/ellimann/reference_blends`` under the environment's prefix, or the user's with ``--user``)."""
     checkout = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"
-    installed = pathlib.Path(sys.prefix) / "share" / "ellimann" / "reference_blends"
-    return installed if not checkout.is_dir() and installed.is_dir() else checkout
+    if checkout.is_dir():
+        return checkout
+    import site
+
+    prefixes = [sys.prefix, getattr(site, "USER_BASE", None) or site.getuserbase()]
+    for prefix in prefixes:
+        installed = pathlib.Path(prefix) / "share" / "ellimann" / "reference_blends"
+        if installed.is_dir():
+            return installed
+    return checkout
 
 
 REFERENCE_FOLDER = _shipped_folder()

@@ -198,3 +198,10 @@ def test_stale_temporaries_of_killed_runs_are_removed_and_running_ones_kept(tmp_
                                       f".ellimann-{dead}@old-host-abcdefgh.tmp", ".ellimann-k2j4h6g8.tmp"])
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(set(made) - set(removed))
     assert clean_stale_temporaries(tmp_path / "missing") == []
+
+
+@pytest.mark.skipif(os.name != "posix", reason="tells running processes apart with os.kill(pid, 0)")
+def test_a_temporary_named_after_an_impossible_pid_is_a_dead_runs(tmp_path):
+    name = f".ellimann-99999999999999999999@{files._host()}-abcdefgh.tmp"  # os.kill would overflow
+    (tmp_path / name).write_bytes(b"half")
+    assert clean_stale_temporaries(tmp_path) == [name]

@@ -41,7 +41,7 @@ import numpy as np
 from ...core.constants import MEASUREMENTS
 from ...core.errors import ElliMannError
 from ...core.files import atomic_output
-from ...core.formats import BLENDER_FORMATS  # noqa: F401  (public here for the writers' callers)
+from ...core.formats import BLENDER_FORMATS, extension_of
 from ..bridge.built import built_objects, is_stale
 from ..bridge.convert import collection_to_mannequin, objects_recursive
 from ..bridge.selection import part_lookup
@@ -161,7 +161,7 @@ def write_mannequin(mannequin, paths, measured=None, cushions=False):
     (``filename``, as given in ``paths``).
     """
     paths = [os.fspath(p) for p in paths]
-    other = [p for p in paths if extension(p) not in BLENDER_FORMATS]
+    other = [p for p in paths if extension_of(p) not in BLENDER_FORMATS]
     if other:
         raise ElliMannError(f"path: {other[0]!r} is not a .blend, .glb or .obj file")
     if paths:
@@ -172,12 +172,8 @@ def write_mannequin(mannequin, paths, measured=None, cushions=False):
     return paths
 
 
-def extension(path):
-    return os.path.splitext(os.fspath(path))[1].lower().lstrip(".")
-
-
 def _write_blender_file(path, collection):
-    kind = extension(path)
+    kind = extension_of(path)
     if kind == "glb":  # atomic itself; leaves out what renders do not show (ellipsoids a cushion replaces)
         with blender_output():
             export_gltf(collection, path)
