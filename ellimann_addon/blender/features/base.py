@@ -121,17 +121,20 @@ def scope_property(default="SELECTED"):
                         description="Work on the selected ellipsoids or on the whole active mannequin")
 
 
-def targets(context, scope):
-    """Ellipsoid objects an operator with a scope works on."""
-    if scope == "SELECTED":
-        return selected_ellipsoids(context)
-    collection = active_mannequin(context)
-    return ellipsoid_objects(collection) if collection is not None else []
+class ScopedOperator(ElliMannOperator):
+    """Mixin for operators with a ``scope`` (``scope_property``): the selected ellipsoids or the whole active
+    mannequin. ``poll``: Object Mode and something to work on; :meth:`targets`: the ellipsoids in scope."""
 
+    @classmethod
+    def poll(cls, context):
+        has_targets = bool(selected_ellipsoids(context)) or active_mannequin(context) is not None
+        return context.mode == "OBJECT" and has_targets
 
-def has_targets(context):
-    """Poll for scoped operators: something selected or an active mannequin."""
-    return bool(selected_ellipsoids(context)) or active_mannequin(context) is not None
+    def targets(self, context):
+        if self.scope == "SELECTED":
+            return selected_ellipsoids(context)
+        collection = active_mannequin(context)
+        return ellipsoid_objects(collection) if collection is not None else []
 
 
 def plural(count, word):

@@ -20,14 +20,12 @@ from ...bridge.convert import (
 )
 from ...bridge.selection import active_mannequin, part_lookup
 from ..base import (
-    ElliMannOperator,
     MannequinOperator,
     OperatorError,
+    ScopedOperator,
     frames_or_cancel,
-    has_targets,
     plural,
     scope_property,
-    targets,
 )
 
 ROLE_PREFERENCE = ("base", "reference", "synthesized")
@@ -41,7 +39,7 @@ def default_reference(context):
     return others[0].name if others else ""
 
 
-class ELLIMANN_OT_relabel_axes(ElliMannOperator, bpy.types.Operator):
+class ELLIMANN_OT_relabel_axes(ScopedOperator, bpy.types.Operator):
     """Relabel and invert ellipsoid axes to agree with the same parts of a reference mannequin"""
 
     bl_idname = ids.RELABEL_AXES
@@ -51,10 +49,6 @@ class ELLIMANN_OT_relabel_axes(ElliMannOperator, bpy.types.Operator):
     scope: scope_property("MANNEQUIN")
     reference: StringProperty(name="Reference", description="Mannequin collection whose ellipsoids' axes are "
                                                             "the reference (matched by part name)")
-
-    @classmethod
-    def poll(cls, context):
-        return context.mode == "OBJECT" and has_targets(context)
 
     def invoke(self, context, event):
         if not self.reference:
@@ -69,7 +63,7 @@ class ELLIMANN_OT_relabel_axes(ElliMannOperator, bpy.types.Operator):
         reference = bpy.data.collections.get(self.reference)
         if reference is None or not reference.ellimann.is_mannequin:
             raise OperatorError(f"Choose a reference mannequin collection ('{self.reference}' is not one)")
-        objects = [o for o in targets(context, self.scope) if reference.objects.get(o.name) != o]
+        objects = [o for o in self.targets(context) if reference.objects.get(o.name) != o]
         if not objects:
             raise OperatorError("No ellipsoids to relabel outside the reference: select some, or make another "
                                 "mannequin active")
@@ -92,7 +86,7 @@ class ELLIMANN_OT_relabel_axes(ElliMannOperator, bpy.types.Operator):
         return {"FINISHED"}
 
 
-class ELLIMANN_OT_symmetrize_central(ElliMannOperator, bpy.types.Operator):
+class ELLIMANN_OT_symmetrize_central(ScopedOperator, bpy.types.Operator):
     """Make central ellipsoids symmetric about x = 0: one axis along world X, the centre on the plane"""
 
     bl_idname = ids.SYMMETRIZE_CENTRAL
@@ -101,12 +95,8 @@ class ELLIMANN_OT_symmetrize_central(ElliMannOperator, bpy.types.Operator):
 
     scope: scope_property("MANNEQUIN")
 
-    @classmethod
-    def poll(cls, context):
-        return context.mode == "OBJECT" and has_targets(context)
-
     def run(self, context):
-        objects = [o for o in targets(context, self.scope) if side_of_name(o.ellimann.part_name) == "C"]
+        objects = [o for o in self.targets(context) if side_of_name(o.ellimann.part_name) == "C"]
         if not objects:
             raise OperatorError("No central ellipsoids (names without .L/.R) to symmetrize")
         rotation, center, semi_axes = frames_or_cancel(objects)

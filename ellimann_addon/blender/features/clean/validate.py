@@ -6,7 +6,7 @@ from ....core.errors import FrameError
 from ... import ids
 from ...bridge.checks import FIXABLE, frame_issue, mannequin_problems, repaired_frame
 from ...bridge.convert import ellipsoid_objects, unit_sphere_mesh, write_frames
-from ..base import ElliMannOperator, MannequinOperator, OperatorError, has_targets, plural, scope_property, targets
+from ..base import MannequinOperator, OperatorError, ScopedOperator, plural, scope_property
 
 
 class ELLIMANN_OT_validate_mannequin(MannequinOperator, bpy.types.Operator):
@@ -26,7 +26,7 @@ class ELLIMANN_OT_validate_mannequin(MannequinOperator, bpy.types.Operator):
         return {"FINISHED"}
 
 
-class ELLIMANN_OT_fix_frames(ElliMannOperator, bpy.types.Operator):
+class ELLIMANN_OT_fix_frames(ScopedOperator, bpy.types.Operator):
     """Repair ellipsoids with an applied scale, a negative scale or shear, keeping their shape and place"""
 
     bl_idname = ids.FIX_FRAMES
@@ -35,12 +35,8 @@ class ELLIMANN_OT_fix_frames(ElliMannOperator, bpy.types.Operator):
 
     scope: scope_property("SELECTED")
 
-    @classmethod
-    def poll(cls, context):
-        return context.mode == "OBJECT" and has_targets(context)
-
     def run(self, context):
-        broken = [(o, issue) for o in targets(context, self.scope) if (issue := frame_issue(o)) is not None]
+        broken = [(o, issue) for o in self.targets(context) if (issue := frame_issue(o)) is not None]
         if not broken:
             raise OperatorError("Nothing to fix: every ellipsoid is a valid frame")
         repairs, problems = [], []
