@@ -17,6 +17,7 @@ import numpy as np
 from .constants import ABSURD_LIMITS, CENTER_LIMIT, MEASUREMENTS, SEMI_AXIS_LIMITS
 from .errors import MannequinError, Problem
 from .files import atomic_write_text
+from .trace import traces_from_dict, traces_to_dict
 
 FORMAT = "ellimann.mannequin"
 FORMAT_VERSION = 1
@@ -219,6 +220,7 @@ class Mannequin:
     name: str = ""
     role: str = "synthesized"
     measurements: dict = field(default=None)
+    traces: dict = field(default=None)  # {part name: core.trace.PartTrace}: what each part was traced from
 
     def __post_init__(self):
         self.rotation = np.asarray(self.rotation, dtype=float)
@@ -231,7 +233,8 @@ class Mannequin:
     def copy(self, **changes):
         values = dict(topology=self.topology, rotation=self.rotation.copy(), center=self.center.copy(),
                       semi_axes=self.semi_axes.copy(), name=self.name, role=self.role,
-                      measurements=dict(self.measurements) if self.measurements else None)
+                      measurements=dict(self.measurements) if self.measurements else None,
+                      traces=dict(self.traces) if self.traces else None)
         values.update(changes)
         return Mannequin(**values)
 
@@ -302,6 +305,7 @@ class Mannequin:
                          semi_axes=self.semi_axes[order])
 
     def to_dict(self):
+        traces = {"traces": traces_to_dict(self.traces)} if self.traces else {}
         return {
             "format": FORMAT,
             "version": FORMAT_VERSION,
@@ -314,6 +318,7 @@ class Mannequin:
                      axes=self.rotation[i].T.tolist(), semi_axes=self.semi_axes[i].tolist())
                 for i, part in enumerate(self.topology)
             ],
+            **traces,
         }
 
     @classmethod
@@ -367,7 +372,8 @@ class Mannequin:
         if problems:
             raise MannequinError(problems)
         mannequin = cls(topology, np.swapaxes(np.array(arrays["axes"]), 1, 2), np.array(arrays["center"]),
-                        np.array(arrays["semi_axes"]), name=name, role=role, measurements=measurements)
+                        np.array(arrays["semi_axes"]), name=name, role=role, measurements=measurements,
+                        traces=traces_from_dict(data.get("traces"), topology.names))
         return mannequin.check() if check else mannequin
 
     def to_json(self):
