@@ -28,6 +28,8 @@ Deterministic: no randomness, fixed iteration counts and orders.
 
 import argparse
 import dataclasses
+import hashlib
+import json
 import pathlib
 import re
 import sys
@@ -52,6 +54,7 @@ from ellimann_addon.core.reference_build import (
     display_name,
     relative_errors,
 )
+from ellimann_addon.core.reference_manifest import MANIFEST_FILE, legacy_manifest, read_manifest
 from ellimann_addon.core.trace import PartTrace
 
 from . import coverage
@@ -167,8 +170,21 @@ def sections_crossed(mannequin):
     return out
 
 
-def save_all(mannequins, out):
-    """Write the JSON files; returns the stems whose file is new or changed."""
+def shipped_manifest(refmodels):
+    """The shipped set's reference_set.json (core.reference_manifest): Table 2.3, today's constants, the bodies."""
+    bodies = {name: {"file": f"{name}.obj", "sha256": hashlib.sha256((pathlib.Path(refmodels) / f"{name}.obj")
+                                                                      .read_bytes()).hexdigest()}
+              for name in (REFERENCE_BODY, *RM_BODIES)}
+    manifest = legacy_manifest()
+    manifest.base = BASE_FILE
+    manifest.provenance = {"built_by": "python -m tools.build_reference", "bodies": "../shared/refmodels (Anny 0.6.2)",
+                           "traced_on": REFERENCE_BODY, "labelled_against": REFERENCE_RM, "files": bodies,
+                           "targets": "the paper's Table 2.3"}
+    return manifest
+
+
+def save_all(mannequins, out, manifest):
+    """Write the JSON files and the manifest; returns the stems whose file is new or changed."""
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     changed = []
@@ -178,6 +194,11 @@ def save_all(mannequins, out):
         if not path.is_file() or path.read_text(encoding="utf-8") != text:
             mannequin.save(path)
             changed.append(stem)
+    text = json.dumps(manifest.to_dict(), indent=1) + "\n"
+    path = out / MANIFEST_FILE
+    if not path.is_file() or path.read_text(encoding="utf-8") != text:
+        atomic_write_text(path, text)
+        changed.append(MANIFEST_FILE)
     return changed
 
 
@@ -221,6 +242,9 @@ def check_shipped(base, rms, folder, atol=CHECK_TOLERANCE):
             diff = float(np.abs(getattr(shipped, attr) - getattr(fresh, attr)).max())
             if diff > atol:
                 problems.append(f"{stem}: {attr} differs by up to {diff:.3g}")
+        if {k: t.to_dict() for k, t in (shipped.traces or {}).items()} != {
+                k: t.to_dict() for k, t in (fresh.traces or {}).items()}:
+            problems.append(f"{stem}: the recorded selections (traces) differ")
     return problems
 
 
@@ -240,9 +264,11 @@ def docs_differ(shipped, fresh):
     return False
 
 
-def check(base, rms, docs, out, docs_folder):
-    """What --check reports: shipped JSON files and docs that differ from a build (empty: none)."""
-    return check_shipped(base, rms, out) + [
+def check(base, rms, docs, out, docs_folder, refmodels=DEFAULT_REFMODELS):
+    """What --check reports: shipped JSON files, manifest and docs that differ from a build (empty: none)."""
+    manifest = read_manifest(out)
+    stale = manifest is None or manifest.to_dict() != shipped_manifest(refmodels).to_dict()
+    return check_shipped(base, rms, out) + [f"{MANIFEST_FILE} is not what the build writes"] * stale + [
         f"docs/{name} is not what the build writes" for name, text in docs.items()
         if not (docs_folder / name).is_file() or docs_differ((docs_folder / name).read_text(), text)]
 
@@ -508,13 +534,13 @@ def main(argv=None):
     print(f"built in {report['seconds']:.1f} s")
     docs = generated_docs(base, rms, report)
     if args.check:
-        problems = check(base, rms, docs, args.out, args.docs)
+        problems = check(base, rms, docs, args.out, args.docs, args.refmodels)
         print("\n".join(problems) if problems else f"identical to the files in {args.out} and {args.docs} "
               f"(within {CHECK_TOLERANCE:g} m and the docs' printed precision)")
         return 1 if problems else 0
 
     mannequins = {BASE_FILE: base, **rms}
-    changed = save_all(mannequins, args.out)
+    changed = save_all(mannequins, args.out, shipped_manifest(args.refmodels))
     args.docs.mkdir(parents=True, exist_ok=True)
     for name, text in docs.items():
         atomic_write_text(args.docs / name, text)
