@@ -35,11 +35,20 @@ def connectivity_fingerprint(polygons):
     the polygons as given (not of a triangulation), so a quad mesh has the same fingerprint in Blender
     and in its OBJ file.
     """
-    pairs = []
-    for polygon in polygons:
-        ring = np.asarray(polygon, dtype=np.int64)
-        pairs.append(np.stack([ring, np.roll(ring, -1)], axis=1))
-    edges = np.sort(np.concatenate(pairs), axis=1) if pairs else np.zeros((0, 2), dtype=np.int64)
+    sizes = np.array([len(p) for p in polygons], dtype=np.int64)
+    corners = np.concatenate([np.asarray(p, dtype=np.int64) for p in polygons]) if len(sizes) else np.zeros(0, int)
+    return loop_fingerprint(corners, np.cumsum(sizes) - sizes, sizes)
+
+
+def loop_fingerprint(corners, starts, sizes):
+    """:func:`connectivity_fingerprint` of polygons given as Blender stores them: the corners' vertex
+    indices (L,), each polygon's first corner (P,) and corner count (P,)."""
+    corners = np.asarray(corners, dtype=np.int64)
+    sizes = np.asarray(sizes, dtype=np.int64)
+    following = np.arange(1, len(corners) + 1)
+    ends = np.asarray(starts, dtype=np.int64) + sizes - 1
+    following[ends] = starts  # a polygon's last corner joins its first
+    edges = np.sort(np.stack([corners, corners[following]], axis=1), axis=1) if len(corners) else np.zeros((0, 2))
     edges = np.unique(edges, axis=0).astype("<i8")
     return zlib.crc32(edges.tobytes())
 

@@ -15,7 +15,7 @@ from .errors import MannequinError, Problem
 
 TRACES_VERSION = 1
 FRAMES = ("limb", "main", "axis", "fixed")
-METHODS = ("inscribed", "enclosing")
+METHODS = ("inscribed", "moments", "enclosing")  # Fit Ellipsoid's sizes (features/trace)
 
 
 @dataclass(frozen=True)

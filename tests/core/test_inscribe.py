@@ -1,4 +1,5 @@
-"""The reference builder's ellipsoid fits (core/inscribe.py) and body helpers (core/body_mesh.py), on meshes whose answer is known."""
+"""The reference builder's ellipsoid fits (core/inscribe.py) and body helpers (core/body_mesh.py), on meshes
+whose answer is known."""
 
 import numpy as np
 import pytest
