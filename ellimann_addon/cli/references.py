@@ -4,6 +4,7 @@
 import csv
 import hashlib
 import math
+import os
 import pathlib
 import sys
 
@@ -38,6 +39,9 @@ def add_parser(commands):
     build.add_argument("-o", "--out", required=True, metavar="DIR", help="the reference-set folder to write")
     build.add_argument("--name", help="the set's name (default: the folder's name)")
     build.add_argument("--sex", choices=("female", "male"), help="the set's sex, if it has one")
+    build.add_argument("--workers", type=int, default=os.cpu_count() or 1, metavar="N",
+                       help="processes fitting bodies at once (default: the CPUs, %(default)s here; the result is "
+                            "the same for any N)")
     build.add_argument("--reference", metavar="STEM", help="the body whose RM the others' axes are labelled "
                        "against (default: the one nearest the targets' mean)")
     common.add_verbose(build)
@@ -98,6 +102,8 @@ def run_build(args):
         if not STEM.match(pathlib.Path(path).stem):
             raise UsageError(f"{path}: its stem must be letters, digits, _ . - (it names the RM's file)")
     targets = read_targets(args.targets)
+    if args.workers < 1:
+        raise UsageError(f"--workers must be 1 or more, got {args.workers}")
     if len(args.bodies) < 3:  # before reading any mesh
         raise UsageError(f"--bodies: a reference set needs at least 3 bodies, got {len(args.bodies)}")
     try:
@@ -109,7 +115,8 @@ def run_build(args):
     def progress(fraction, text):
         common.say(f"{PROG} references build: {fraction:4.0%} {text}", file=sys.stderr)
 
-    rms, report = build_reference_set(base, bodies, targets, progress=progress, reference=args.reference)
+    rms, report = build_reference_set(base, bodies, targets, progress=progress, reference=args.reference,
+                                      workers=args.workers)
     first = next(iter(base.traces.values()))
     manifest = Manifest(
         name=args.name or out.resolve().name, mannequins=stems, sex=args.sex, base=base_stem,
