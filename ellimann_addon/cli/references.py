@@ -11,7 +11,7 @@ import sys
 from ..core.body_mesh import BodyMeshError, read_obj
 from ..core.clean import asymmetry
 from ..core.constants import ABSURD_LIMITS, MEASUREMENTS, SECTION_FRACTIONS
-from ..core.reference_build import build_reference_set, cleanliness_problems, relative_errors
+from ..core.reference_build import build_reference_set, cleanliness_problems, relative_errors, validate_inputs
 from ..core.reference_manifest import STEM, Manifest, read_manifest, targets_range, write_reference_set
 from ..core.reference_set import load_reference_set
 from . import common
@@ -110,6 +110,7 @@ def run_build(args):
         bodies = [read_obj(path) for path in args.bodies]
     except BodyMeshError as error:
         raise UsageError(str(error)) from None
+    validate_inputs(base, bodies, targets)  # before the folder is made: bad input writes nothing
     common.output_folder(str(out), "references build")
 
     def progress(fraction, text):
