@@ -16,6 +16,7 @@ from ..core.reference_manifest import STEM, Manifest, read_manifest, targets_ran
 from ..core.reference_set import load_reference_set
 from . import common
 from .common import PROG, UsageError
+from .measure import load_json_mannequin
 
 ACCEPT = 5e-3  # what ``check`` lets an RM's m_T differ from its targets by (the builder's accept tolerance)
 
@@ -93,7 +94,7 @@ def _is_number(text):
 
 def run_build(args):
     out = pathlib.Path(args.out)
-    base = common_load_base(args.base)
+    base = load_base(args.base)
     base_stem = pathlib.Path(args.base).stem
     stems = [pathlib.Path(p).stem for p in args.bodies]
     if base_stem in stems or not STEM.match(base_stem):
@@ -140,9 +141,7 @@ def run_build(args):
     return 0
 
 
-def common_load_base(path):
-    from .measure import load_json_mannequin
-
+def load_base(path):
     if not pathlib.Path(path).is_file():
         raise UsageError(f"{path}: no such file")
     return load_json_mannequin(path)

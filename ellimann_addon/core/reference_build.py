@@ -55,11 +55,10 @@ class BuildReport:
     """What the build found, per RM stem: ``shifts`` (body -> RM translation, m), ``fitted`` (m_T before
     the refinement), ``factors`` (of the refinement), ``errors`` (relative m_T error after cleaning),
     ``fill`` (coverage and excess of ellipsoids and cushions), ``seconds`` per stage; ``base`` relabelled
-    against ``reference`` (the RM the others' axes are labelled against), and the base's ``kept`` axes."""
+    against ``reference`` (the RM the others' axes are labelled against)."""
 
     base: object
     reference: str
-    kept: list
     shifts: dict = field(default_factory=dict)
     fitted: dict = field(default_factory=dict)
     factors: dict = field(default_factory=dict)
@@ -225,7 +224,7 @@ def build_reference_set(base, bodies, targets, progress=None, cancel=None, setti
     reference = reference or central_body(names, targets)
     if reference not in names:
         raise ReferenceBuildError(f"reference: '{reference}' is not one of the bodies ({', '.join(names)})")
-    report = BuildReport(base=None, reference=reference, kept=_kept(base))
+    report = BuildReport(base=None, reference=reference)
     steps = len(bodies) + (1 if settings.check_spacing else 0)
 
     def tell(done, text):

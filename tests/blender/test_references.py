@@ -100,7 +100,7 @@ def test_a_build_is_written_as_a_set_and_loaded_into_a_new_collection(tmp_path, 
         from ellimann_addon.core.reference_build import BuildReport
 
         rms = {name: rm.copy(name=name) for name, rm in zip(names, shipped.mannequins)}
-        report = BuildReport(base=base, reference=names[0], kept=[])
+        report = BuildReport(base=base, reference=names[0])
         report.errors = {name: {"He": 0.0} for name in names}
         return rms, report
 
