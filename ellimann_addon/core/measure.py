@@ -122,7 +122,7 @@ def hull_perimeter(centre, k, active):
     coefficients = _Coefficients(centre, k)
 
     # 1. Which ellipse is outermost in each grid direction.
-    step, grid = _GRID_STEP, _GRID
+    step = _GRID_STEP
     h = coefficients.support((Ellipsis, None), _GRID_COS, _GRID_SIN)  # (S, n, N)
     h = np.where(active[:, :, None], h, -np.inf)
     winner = np.argmax(h, axis=1)  # (S, N)
