@@ -22,6 +22,7 @@ from .common import PROG, UsageError
 
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,99}$")
 CHUNK = 256  # rows synthesized per core batch (and per Dask task)
+MAX_WARNING_LINES = 20  # range warnings printed before the rest go to the report only (a population has thousands)
 NPZ = "npz"  # the batch's one-file format (core.batch_file), written once at the end
 
 
@@ -167,15 +168,20 @@ def _run(args, formats, shard, shards, rows, mine, reference, options, cluster):
     report = Report(os.path.join(args.output, f"report{suffix}.csv"))
     bundle = Bundle(os.path.join(args.output, f"mannequins{suffix}.npz"), reference.topology,
                     args.mode) if NPZ in formats else None
-    jobs = []
+    jobs, shown = [], 0
     for line, name, values, error, warnings in mine:
         if error is not None:
             common.say(f"{PROG} batch: line {line}: skipped: {error}")
             report.add(common.report_row(line, name, "error", error, values))
             continue
         for warning in warnings:
-            common.say(f"{PROG} batch: line {line}: warning: {warning}")
+            shown += 1
+            if shown <= MAX_WARNING_LINES:
+                common.say(f"{PROG} batch: line {line}: warning: {warning}")
         jobs.append((line, name, values, warnings))
+    if shown > MAX_WARNING_LINES:
+        common.say(f"{PROG} batch: {shown - MAX_WARNING_LINES} more warning(s) of requests outside the reference "
+                   f"range; every row's are in {report.path}")
     progress = common.Progress(len(jobs), "batch", quiet=args.quiet)
     chunks = [jobs[start:start + CHUNK] for start in range(0, len(jobs), CHUNK)]
     requests = [[values for _, _, values, _ in chunk] for chunk in chunks]
