@@ -77,12 +77,18 @@ class _Coefficients:
         self.a, self.d = np.ascontiguousarray(k[..., 0, 0]), np.ascontiguousarray(k[..., 1, 1])
         self.b = 2.0 * k[..., 0, 1]
 
-    def support(self, index, c, s):
-        """h of the ellipses ``index`` (a tuple of index arrays, or a slice) for cos/sin broadcastable to them.
-
-        The same arithmetic, in the same order, as :func:`_support_2d`."""
-        quad = self.a[index] * c * c + self.b[index] * c * s + self.d[index] * s * s
-        return self.cx[index] * c + self.cy[index] * s + np.sqrt(np.maximum(quad, 0.0))
+    def support(self, index, c, s, cc=None, cs=None, ss=None):
+        """h of the ellipses ``index`` (a tuple of index arrays) in the directions (cos, sin) = (c, s), arrays
+        broadcastable against them; cc, cs, ss: c*c, c*s, s*s when a table has them. Elementwise only, so a
+        direction's value does not depend on what else is evaluated with it."""
+        h = self.a[index] * (c * c if cc is None else cc)
+        h += self.b[index] * (c * s if cs is None else cs)
+        h += self.d[index] * (s * s if ss is None else ss)
+        np.maximum(h, 0.0, out=h)
+        np.sqrt(h, out=h)
+        h += self.cx[index] * c
+        h += self.cy[index] * s
+        return h
 
 
 def _winners(coefficients, active, sec, theta):
@@ -94,10 +100,17 @@ def _winners(coefficients, active, sec, theta):
 
 _GRID_STEP = 2.0 * np.pi / DETECTION_SAMPLES
 _GRID = np.arange(DETECTION_SAMPLES) * _GRID_STEP
-_GRID_COS, _GRID_SIN = np.cos(_GRID), np.sin(_GRID)
 _FINE = np.arange(REFINE_FACTOR + 1) / REFINE_FACTOR  # a refined cell's samples, in cells from its start
-_FINE_THETA = (np.arange(DETECTION_SAMPLES)[:, None] + _FINE[1:-1]) * _GRID_STEP  # inner samples of every cell
-_FINE_COS, _FINE_SIN = np.cos(_FINE_THETA), np.sin(_FINE_THETA)
+
+
+def _directions(theta):
+    """cos, sin and their products c*c, c*s, s*s of the angles ``theta`` (a table for :meth:`_Coefficients.support`)."""
+    c, s = np.cos(theta), np.sin(theta)
+    return c, s, c * c, c * s, s * s
+
+
+_GRID_DIRECTIONS = _directions(_GRID)
+_FINE_DIRECTIONS = _directions((np.arange(DETECTION_SAMPLES)[:, None] + _FINE[1:-1]) * _GRID_STEP)  # (N, F - 1)
 
 
 def hull_perimeter(centre, k, active):
@@ -123,8 +136,8 @@ def hull_perimeter(centre, k, active):
 
     # 1. Which ellipse is outermost in each grid direction.
     step = _GRID_STEP
-    h = coefficients.support((Ellipsis, None), _GRID_COS, _GRID_SIN)  # (S, n, N)
-    h = np.where(active[:, :, None], h, -np.inf)
+    h = coefficients.support((Ellipsis, None), *_GRID_DIRECTIONS)  # (S, n, N)
+    np.copyto(h, -np.inf, where=~active[:, :, None])
     winner = np.argmax(h, axis=1)  # (S, N)
 
     # 2. An ellipse that is outermost only between two grid directions would be missed. Where the
@@ -132,11 +145,14 @@ def hull_perimeter(centre, k, active):
     #    largest radius of curvature), so it can only surface if its gap to the maximum is below
     #    that bound times step^2 / 8. Where the winner changes, h_max has a kink and no such bound
     #    holds. Sample both kinds of cell finely.
-    gap = h.max(axis=1)[:, None, :] - np.where(active[:, :, None], h, 0.0)
-    gap_next = np.concatenate([gap[..., 1:], gap[..., :1]], axis=2)
-    low = np.minimum(gap, gap_next)
-    reach = (_max_curvature_radius(k)[:, :, None] + np.maximum(gap, gap_next)) * (step * step / 8.0)
-    suspect = active[:, :, None] & (low > 0.0) & (low <= reach)
+    with np.errstate(invalid="ignore"):  # inactive ellipses' gaps are inf (or nan without any active one)
+        gap = h.max(axis=1)[:, None, :] - h
+        gap_next = np.concatenate([gap[..., 1:], gap[..., :1]], axis=2)
+        low = np.minimum(gap, gap_next)
+        reach = np.maximum(gap, gap_next, out=gap_next)
+        reach += _max_curvature_radius(k)[:, :, None]
+        reach *= step * step / 8.0
+        suspect = (low > 0.0) & (low <= reach) & active[:, :, None]
     changes = winner != np.concatenate([winner[:, 1:], winner[:, :1]], axis=1)
     sec_r, cell_r = np.nonzero(suspect.any(axis=1) | changes)
 
@@ -145,8 +161,9 @@ def hull_perimeter(centre, k, active):
     #    the cell's start, REFINE_FACTOR - 1 points inside, the next cell's start.
     theta_r = (cell_r[:, None] + _FINE) * step  # (R, REFINE_FACTOR + 1)
     section = (sec_r[:, None, None], np.arange(centre.shape[1]))  # (R, 1, n)
-    h_r = coefficients.support(section, _FINE_COS[cell_r, :, None], _FINE_SIN[cell_r, :, None])  # (R, F - 1, n)
-    inside = np.argmax(np.where(active[sec_r, None, :], h_r, -np.inf), axis=2)
+    h_r = coefficients.support(section, *(t[cell_r, :, None] for t in _FINE_DIRECTIONS))  # (R, F - 1, n)
+    np.copyto(h_r, -np.inf, where=~active[sec_r, None, :])
+    inside = np.argmax(h_r, axis=2)
     winner_r = np.concatenate([winner[sec_r, cell_r, None], inside,
                                winner[sec_r, (cell_r + 1) % DETECTION_SAMPLES, None]], axis=1)
     row, at = np.nonzero(winner_r[:, :-1] != winner_r[:, 1:])
@@ -165,23 +182,26 @@ def hull_perimeter(centre, k, active):
         theta = np.minimum(np.maximum(theta - update, lo), hi)
 
     # 4. Cut the circle at the kinks and at fixed cells; integrate each piece's outermost ellipse.
-    #    A piece between two fixed cuts (no kink inside) is a whole cell: its nodes' cos and sin are in a
-    #    table and its outermost ellipse is the grid's in the middle of the cell.
+    #    A piece between two fixed cuts (no kink inside) is a whole cell: its outermost ellipse is the
+    #    grid's in the middle of the cell, and every section's cells are integrated at once from a table
+    #    of the nodes' directions (the integrals of cells that a kink splits are not used).
     cut_theta, cut_sec, cell = _cuts(sections, np.mod(theta, 2.0 * np.pi), sec)
     end, next_cell = _next_in_section(cut_sec, cut_theta, cell)
     half = 0.5 * (end - cut_theta)
     whole = (cell >= 0) & (next_cell >= 0)
     split = ~whole
+    cell_winner = winner[:, _GRID_PER_CELL // 2::_GRID_PER_CELL]  # (S, cells)
+    cells = (np.arange(sections)[:, None, None], cell_winner[:, :, None])
+    cell_integral = _weighted_sum(coefficients.support(cells, *_CELL_NODE_DIRECTIONS), _GL_WEIGHTS)  # (S, cells)
     piece_winner = np.empty(len(cut_sec), dtype=np.int64)
-    piece_winner[whole] = winner[cut_sec[whole], cell[whole] * _GRID_PER_CELL + _GRID_PER_CELL // 2]
+    piece_winner[whole] = cell_winner[cut_sec[whole], cell[whole]]
     piece_winner[split] = _winners(coefficients, active, cut_sec[split], cut_theta[split] + half[split])
     nodes = (cut_theta[split] + half[split])[:, None] + half[split, None] * _GL_NODES
-    value = np.empty((len(cut_sec), GAUSS_ORDER))
-    value[whole] = coefficients.support((cut_sec[whole, None], piece_winner[whole, None]),
-                                        _CELL_NODES_COS[cell[whole]], _CELL_NODES_SIN[cell[whole]])
-    value[split] = coefficients.support((cut_sec[split, None], piece_winner[split, None]), np.cos(nodes), np.sin(nodes))
-    piece = half * _weighted_sum(value, _GL_WEIGHTS)
-    piece = np.where(active[cut_sec, piece_winner], piece, 0.0)
+    integral = np.empty(len(cut_sec))
+    integral[whole] = cell_integral[cut_sec[whole], cell[whole]]
+    integral[split] = _weighted_sum(coefficients.support((cut_sec[split, None], piece_winner[split, None]),
+                                                         np.cos(nodes), np.sin(nodes)), _GL_WEIGHTS)
+    piece = np.where(active[cut_sec, piece_winner], half * integral, 0.0)
     return np.bincount(cut_sec, weights=piece, minlength=sections)
 
 
@@ -190,15 +210,14 @@ _GRID_PER_CELL = DETECTION_SAMPLES // QUADRATURE_CELLS
 
 
 def _cell_nodes():
-    """cos and sin of the Gauss-Legendre nodes of every whole cell (QUADRATURE_CELLS, GAUSS_ORDER), computed
-    as :func:`hull_perimeter` computes a piece's."""
+    """The Gauss-Legendre nodes of every whole cell (QUADRATURE_CELLS, GAUSS_ORDER), computed as
+    :func:`hull_perimeter` computes a piece's."""
     end = np.append(_CELLS[1:], _CELLS[0] + 2.0 * np.pi)
     half = 0.5 * (end - _CELLS)
-    nodes = (_CELLS + half)[:, None] + half[:, None] * _GL_NODES
-    return np.cos(nodes), np.sin(nodes)
+    return (_CELLS + half)[:, None] + half[:, None] * _GL_NODES
 
 
-_CELL_NODES_COS, _CELL_NODES_SIN = _cell_nodes()
+_CELL_NODE_DIRECTIONS = _directions(_cell_nodes())
 
 
 def _cuts(sections, theta, sec):
@@ -221,11 +240,11 @@ def _cuts(sections, theta, sec):
 
 
 def _weighted_sum(values, weights):
-    """values (P, q) @ weights (q,), summed in a fixed order: the same bits for a row whatever the batch (a matrix
-    product's summation order depends on the array's size and alignment)."""
-    total = values[:, 0] * weights[0]
+    """values (..., q) @ weights (q,), summed in a fixed order: the same bits for a row whatever the batch (a
+    matrix product's summation order depends on the array's size and alignment)."""
+    total = values[..., 0] * weights[0]
     for j in range(1, len(weights)):
-        total += values[:, j] * weights[j]
+        total += values[..., j] * weights[j]
     return total
 
 
