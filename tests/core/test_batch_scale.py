@@ -1,7 +1,7 @@
 """Batches at population scale: --format npz (one archive, a loader returning the same mannequins as the JSON
 files, the same bytes twice), --dask on a local cluster (files byte for byte those of a serial run), a chunk the
 cluster fails reported without losing the others, an unreachable scheduler refused with nothing written, and the
-progress line."""
+progress line; exact mode on the whole 243 grid, one request at a time the same bits as the batch."""
 
 import csv
 import io
@@ -16,7 +16,11 @@ from devkit import synthetic
 from devkit.cli_runs import assert_one_line_error, run
 from ellimann_addon.cli import common, distributed
 from ellimann_addon.core.batch_file import BatchFileError, load_batch_file, read_batch_file
+from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
 from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.reference_set import REFERENCE_FOLDER, REFERENCE_NAMES, load_reference_set
+from ellimann_addon.core.refine import EXACT_TOLERANCE, FACTOR_LIMITS
+from ellimann_addon.core.synthesis import synthesize_batch
 
 
 @pytest.fixture(scope="module")
@@ -171,3 +175,21 @@ def test_progress_shows_count_rate_and_time_left_and_is_quiet_with_q(monkeypatch
     quiet.done()
     assert stream.getvalue().strip("\x00") == ""
     assert common.duration(3725) == "1 h 2 min" and common.duration(75) == "1 min 15 s"
+
+
+GRID = np.array(list(itertools.product(*[quartile_points(key) for key in MEASUREMENTS])))
+SETS = ["synthetic"] + (["shipped"] if all((REFERENCE_FOLDER / f"{n}.json").is_file() for n in REFERENCE_NAMES)
+                        else [])
+
+
+@pytest.mark.parametrize("which", SETS)
+def test_exact_mode_converges_on_the_whole_grid_and_one_at_a_time_is_the_batch_bit_for_bit(which):
+    reference = load_reference_set() if which == "shipped" else synthetic.make_reference_set()
+    batch = synthesize_batch(reference, GRID, mode="exact")
+    assert batch.converged.all()
+    assert np.abs(np.log(batch.measured / GRID)).max() <= EXACT_TOLERANCE
+    assert np.all((batch.factors >= FACTOR_LIMITS[0]) & (batch.factors <= FACTOR_LIMITS[1]))
+    for i in range(0, len(GRID), 5):  # what a chunk of a serial or Dask batch gives is what a request alone gives
+        alone = synthesize_batch(reference, GRID[i:i + 1], mode="exact")
+        for key in ("center", "semi_axes", "measured", "factors"):
+            np.testing.assert_array_equal(getattr(alone, key)[0], getattr(batch, key)[i])
