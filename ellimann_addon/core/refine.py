@@ -98,7 +98,7 @@ def _deform_basis(topology, rotation, center, semi_axes, measured):
     centre_y = np.stack(centre_y, axis=-1)  # (B, 3) in GIRTHS order: Br, Wa, Hi
     order = [GIRTHS.index(key) for key in ("Hi", "Wa", "Br")]
     fractions = [SECTION_FRACTIONS[key] for key in ("Hi", "Wa", "Br")]
-    origin_y = np.stack([np.interp(fraction[b], fractions, centre_y[b, order]) for b in range(len(bottom))])
+    origin_y = _interp_rows(fraction, fractions, centre_y[:, order])
     # Where each section cuts each girth part, relative to the part's middle (-1 bottom .. 1 top).
     half_z = axis_extent(rotation, semi_axes, 2)  # (B, n)
     cut = np.stack([(z[key][:, None] - center[..., 2]) / half_z for key in GIRTHS], axis=-1)  # (B, n, 3)
@@ -110,6 +110,18 @@ def _deform_basis(topology, rotation, center, semi_axes, measured):
         bottom=bottom, shoulder_half=0.5 * measured[:, _INDEX["Sh"]] / CM_PER_M, girth_weight=weight,
         origin_y=origin_y, vertical=rotation[..., 2, :] ** 2, lateral=rotation[..., 0, :] ** 2,
         taper=taper, anchor=anchor, shoulder_scaled=depends_sh & girth, shoulder_carried=depends_sh & ~girth)
+
+
+def _interp_rows(x, knots, values):
+    """np.interp(x[b], knots, values[b]) for every row b at once: x (B, n), knots (K,) increasing, values (B, K);
+    constant beyond the first and last knot."""
+    out = np.broadcast_to(values[:, :1], x.shape).copy()
+    for j in range(len(knots) - 1):
+        slope = (values[:, j + 1] - values[:, j]) / (knots[j + 1] - knots[j])
+        inside = x > knots[j]
+        part = values[:, j, None] + slope[:, None] * (np.minimum(x, knots[j + 1]) - knots[j])
+        out = np.where(inside, part, out)
+    return out
 
 
 def deform(basis, center, semi_axes, factors):
