@@ -8,14 +8,13 @@ from ellimann_addon.core.measure import (
     _GL_NODES,
     _GL_WEIGHTS,
     DETECTION_SAMPLES,
-    NEWTON_STEPS,
     QUADRATURE_CELLS,
     REFINE_FACTOR,
     _compact,
+    _kinks,
     _max_curvature_radius,
     _next_in_section,
     _support_2d,
-    _support_2d_with_derivative,
 )
 
 
@@ -53,16 +52,7 @@ def hull_perimeter_before(centre, k, active):
     sec = det_sec[change]
     lo, hi = det_theta[change], nxt_theta[change]
     pair = np.stack([det_winner[change], nxt_winner[change]])
-    cp, kp = centre[sec, pair], k[sec, pair]
-    g_lo, g_hi = np.subtract(*_support_2d(cp, kp, lo)), np.subtract(*_support_2d(cp, kp, hi))
-    denom = g_lo - g_hi
-    frac = np.divide(g_lo, denom, out=np.full_like(g_lo, 0.5), where=np.abs(denom) > 0.0)
-    theta = lo + (hi - lo) * np.clip(frac, 0.0, 1.0)
-    for _ in range(NEWTON_STEPS):
-        value, slope = _support_2d_with_derivative(cp, kp, theta)
-        g, dg = value[0] - value[1], slope[0] - slope[1]
-        update = np.divide(g, dg, out=np.zeros_like(g), where=np.abs(dg) > 1e-300)
-        theta = np.minimum(np.maximum(theta - update, lo), hi)
+    theta = _kinks(centre[sec, pair], k[sec, pair], lo, hi)  # unchanged: shared with today's
     cells = np.arange(QUADRATURE_CELLS) * (2.0 * np.pi / QUADRATURE_CELLS)
     cut_theta = np.concatenate([np.tile(cells, sections), np.mod(theta, 2.0 * np.pi)])
     cut_sec = np.concatenate([np.repeat(np.arange(sections), QUADRATURE_CELLS), sec])

@@ -170,16 +170,7 @@ def hull_perimeter(centre, k, active):
     sec = sec_r[row]
     lo, hi = theta_r[row, at], theta_r[row, at + 1]
     pair = np.stack([winner_r[row, at], winner_r[row, at + 1]])  # (2, K): outermost before, after
-    cp, kp = centre[sec, pair], k[sec, pair]
-    g_lo, g_hi = np.subtract(*_support_2d(cp, kp, lo)), np.subtract(*_support_2d(cp, kp, hi))
-    denom = g_lo - g_hi
-    frac = np.divide(g_lo, denom, out=np.full_like(g_lo, 0.5), where=np.abs(denom) > 0.0)
-    theta = lo + (hi - lo) * np.clip(frac, 0.0, 1.0)
-    for _ in range(NEWTON_STEPS):
-        value, slope = _support_2d_with_derivative(cp, kp, theta)
-        g, dg = value[0] - value[1], slope[0] - slope[1]
-        update = np.divide(g, dg, out=np.zeros_like(g), where=np.abs(dg) > 1e-300)
-        theta = np.minimum(np.maximum(theta - update, lo), hi)
+    theta = _kinks(centre[sec, pair], k[sec, pair], lo, hi)
 
     # 4. Cut the circle at the kinks and at fixed cells; integrate each piece's outermost ellipse.
     #    A piece between two fixed cuts (no kink inside) is a whole cell: its outermost ellipse is the
@@ -203,6 +194,21 @@ def hull_perimeter(centre, k, active):
                                                          np.cos(nodes), np.sin(nodes)), _GL_WEIGHTS)
     piece = np.where(active[cut_sec, piece_winner], half * integral, 0.0)
     return np.bincount(cut_sec, weights=piece, minlength=sections)
+
+
+def _kinks(cp, kp, lo, hi):
+    """The angles in [lo, hi] where the outermost ellipse changes from cp[0], kp[0] to cp[1], kp[1] (2, K, ...):
+    h_0 = h_1 by a secant start and NEWTON_STEPS Newton steps."""
+    g_lo, g_hi = np.subtract(*_support_2d(cp, kp, lo)), np.subtract(*_support_2d(cp, kp, hi))
+    denom = g_lo - g_hi
+    frac = np.divide(g_lo, denom, out=np.full_like(g_lo, 0.5), where=np.abs(denom) > 0.0)
+    theta = lo + (hi - lo) * np.clip(frac, 0.0, 1.0)
+    for _ in range(NEWTON_STEPS):
+        value, slope = _support_2d_with_derivative(cp, kp, theta)
+        g, dg = value[0] - value[1], slope[0] - slope[1]
+        update = np.divide(g, dg, out=np.zeros_like(g), where=np.abs(dg) > 1e-300)
+        theta = np.minimum(np.maximum(theta - update, lo), hi)
+    return theta
 
 
 _CELLS = np.arange(QUADRATURE_CELLS) * (2.0 * np.pi / QUADRATURE_CELLS)
