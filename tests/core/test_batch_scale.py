@@ -8,6 +8,8 @@ import io
 import itertools
 import os
 import socket
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -69,6 +71,14 @@ def test_a_file_that_is_not_a_batch_is_refused_naming_the_field(tmp_path):
         load_batch_file(tmp_path / "cut.npz")
 
 
+
+
+def test_the_command_line_imports_dask_only_for_dask():
+    code = ("import sys, ellimann_addon.cli as cli; cli.build_parser(); "
+            "print(sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                          cwd=os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+    assert done.stdout.strip() == "[]"
 
 
 def test_dask_local_cluster_writes_the_serial_files_byte_for_byte(tmp_path, capsys, references):
@@ -193,3 +203,26 @@ def test_exact_mode_converges_on_the_whole_grid_and_one_at_a_time_is_the_batch_b
         alone = synthesize_batch(reference, GRID[i:i + 1], mode="exact")
         for key in ("center", "semi_axes", "measured", "factors"):
             np.testing.assert_array_equal(getattr(alone, key)[0], getattr(batch, key)[i])
+
+
+def test_a_row_the_core_refuses_fails_alone_and_its_chunk_keeps_the_others(monkeypatch, references):
+    from ellimann_addon.cli import batch
+    from ellimann_addon.core import synthesis
+    from ellimann_addon.core.errors import ElliMannError
+    from ellimann_addon.core.reference_set import load_reference_set
+
+    real = synthesis.synthesize_batch
+
+    def refusing(reference, requests, options=None, **fields):  # as check_plausible refuses a whole batch
+        if any(values[0] == 161.0 for values in requests):
+            raise ElliMannError("synthesis at He 161 cm gives an implausible mannequin")
+        return real(reference, requests, options, **fields)
+
+    monkeypatch.setattr(synthesis, "synthesize_batch", refusing)
+    reference = load_reference_set(references)
+    chunk = [[160.0, 40, 95, 80, 105], [161.0, 40, 95, 80, 105], [162.0, 41, 96, 81, 106]]
+    result = batch.synthesize_chunk(reference, chunk, synthesis.SynthesisOptions())
+    assert result.errors[0] is None and result.errors[2] is None and "implausible" in result.errors[1]
+    alone = real(reference, [chunk[0], chunk[2]])
+    np.testing.assert_array_equal(result.center[[0, 2]], alone.center)
+    assert np.isnan(result.center[1]).all() and not result.converged[1]
