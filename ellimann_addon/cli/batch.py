@@ -185,7 +185,7 @@ def _run(args, formats, shard, shards, rows, mine, reference, options, cluster):
     progress = common.Progress(len(jobs), "batch", quiet=args.quiet)
     chunks = [jobs[start:start + CHUNK] for start in range(0, len(jobs), CHUNK)]
     requests = [[values for _, _, values, _ in chunk] for chunk in chunks]
-    results = (cluster.map(reference, requests, options) if cluster is not None
+    results = (cluster.map([reference] * len(requests), requests, options) if cluster is not None
                else ((index, synthesize_chunk(reference, chunk, options)) for index, chunk in enumerate(requests)))
     try:
         for index, result in results:

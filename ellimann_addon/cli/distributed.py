@@ -56,17 +56,20 @@ class Cluster:
     def __init__(self, client, local):
         self.client, self.local = client, local
 
-    def map(self, reference, requests, options):
-        """Synthesize each chunk of ``requests`` (a list of lists of 5 values) on the cluster: yields
-        (chunk index, ChunkResult) as chunks finish; a chunk that failed every attempt comes back with every
-        row's error set."""
+    def map(self, references, requests, options):
+        """Synthesize each chunk of ``requests`` (a list of lists of 5 values) from its reference set
+        (``references``, one per chunk) on the cluster: yields (chunk index, ChunkResult) as chunks finish; a
+        chunk that failed every attempt comes back with every row's error set."""
         from distributed import as_completed
 
         from .batch import ChunkResult, synthesize_chunk
 
-        shared = self.client.scatter(reference, broadcast=True)  # sent once, not with every task
-        futures = [self.client.submit(synthesize_chunk, shared, chunk, options, retries=RETRIES, pure=False)
-                   for chunk in requests]
+        shared = {}  # each reference set is sent once, not with every task
+        for reference in references:
+            if id(reference) not in shared:
+                shared[id(reference)] = self.client.scatter(reference, broadcast=True)
+        futures = [self.client.submit(synthesize_chunk, shared[id(reference)], chunk, options, retries=RETRIES,
+                                      pure=False) for reference, chunk in zip(references, requests)]
         index = {future.key: i for i, future in enumerate(futures)}
         for future in as_completed(futures):
             i = index[future.key]

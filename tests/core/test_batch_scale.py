@@ -139,7 +139,7 @@ def test_a_failed_chunk_is_reported_row_by_row_and_the_others_kept(monkeypatch, 
 
     reference = load_reference_set(references)
     chunks = [[[160, 40, 95, 80, 105]] * 2, [[165, 41, 100, 82, 110]] * 3, [[170, 42, 100, 85, 110]]]
-    results = dict(distributed.Cluster(FakeClient(), None).map(reference, chunks, SynthesisOptions()))
+    results = dict(distributed.Cluster(FakeClient(), None).map([reference] * 3, chunks, SynthesisOptions()))
     assert sorted(results) == [0, 1, 2]
     assert results[0].errors == [None, None] and results[2].errors == [None]
     assert len(results[1].errors) == 3 and all("failed on the Dask cluster" in e and "worker lost" in e
