@@ -6,7 +6,6 @@ import numpy as np
 
 from .constants import (
     MEASUREMENTS,
-    RANGES,
 )
 from .frames import SAGITTAL_REFLECTION, rotation_mean, symmetrize_central
 from .options import (
@@ -17,10 +16,10 @@ from .options import (
 ZERO_DISTANCE = 1e-9  # closer than this (cm, or range units) is the RM's own point
 
 
-def _metric_scale(metric):
+def _metric_scale(metric, ranges):
     if metric == "raw":
         return np.ones(len(MEASUREMENTS))
-    return np.array([RANGES[key][1] - RANGES[key][0] for key in MEASUREMENTS])
+    return np.array([ranges[key][1] - ranges[key][0] for key in MEASUREMENTS])
 
 
 def _inverse_distance(distance, power):
@@ -41,7 +40,7 @@ def idw_weights(reference, requests, metric="raw", power=DEFAULT_POWER):
     does not separate some RMs.
     """
     requests = np.atleast_2d(np.asarray(requests, dtype=float))
-    diff = (requests[:, None, :] - reference.measurements[None]) / _metric_scale(metric)  # (B, k, 5)
+    diff = (requests[:, None, :] - reference.measurements[None]) / _metric_scale(metric, reference.ranges)  # (B, k, 5)
     sub = np.sqrt(np.einsum("bkm,sm->bsk", diff * diff, reference._mask))
     full = np.sqrt(np.sum(diff * diff, axis=-1))
     w_sub = _inverse_distance(sub, power)  # (B, s, k)

@@ -14,12 +14,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .constants import ABSURD_LIMITS, CENTER_LIMIT, MEASUREMENTS, SEMI_AXIS_LIMITS
+from .constants import ABSURD_LIMITS, CENTER_LIMIT, FEMALE_SET, MEASUREMENTS, SECTION_FRACTIONS, SEMI_AXIS_LIMITS
 from .errors import MannequinError, Problem
 from .files import atomic_write_text
 
 FORMAT = "ellimann.mannequin"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: "measured_with" (the reference set and section heights); a version 1 file is female
 SIDES = ("L", "R", "C")
 ROLES = ("base", "reference", "synthesized")
 NAME_PATTERN = re.compile(r"^(?P<number>\d+)\.(?P<letter>[a-z]) (?P<label>[^.]+?)(?:\.(?P<side>[LR]))?$")
@@ -210,7 +210,11 @@ def _letter(name):
 
 @dataclass
 class Mannequin:
-    """A topology with geometry. ``measurements`` are the requested/target tailor measurements in cm."""
+    """A topology with geometry. ``measurements`` are the requested/target tailor measurements in cm.
+
+    ``reference_set`` and ``section_fractions``: the reference set the mannequin belongs to (synthesized from,
+    or part of) and the section heights m_T measures it at (fractions of He); the female set's by default.
+    """
 
     topology: Topology
     rotation: np.ndarray
@@ -219,8 +223,11 @@ class Mannequin:
     name: str = ""
     role: str = "synthesized"
     measurements: dict = field(default=None)
+    reference_set: str = FEMALE_SET
+    section_fractions: dict = field(default=None)
 
     def __post_init__(self):
+        self.section_fractions = dict(self.section_fractions or SECTION_FRACTIONS)
         self.rotation = np.asarray(self.rotation, dtype=float)
         self.center = np.asarray(self.center, dtype=float)
         self.semi_axes = np.asarray(self.semi_axes, dtype=float)
@@ -231,7 +238,8 @@ class Mannequin:
     def copy(self, **changes):
         values = dict(topology=self.topology, rotation=self.rotation.copy(), center=self.center.copy(),
                       semi_axes=self.semi_axes.copy(), name=self.name, role=self.role,
-                      measurements=dict(self.measurements) if self.measurements else None)
+                      measurements=dict(self.measurements) if self.measurements else None,
+                      reference_set=self.reference_set, section_fractions=dict(self.section_fractions))
         values.update(changes)
         return Mannequin(**values)
 
@@ -277,6 +285,9 @@ class Mannequin:
                 elif det[i] < 0.0:
                     out.append(Problem(part.name, "rotation", "is a left-handed frame (det -1)"))
         out += measurement_problems(self.measurements)
+        if not isinstance(self.reference_set, str) or not self.reference_set:
+            out.append(Problem("", "reference_set", f"must be a non-empty name, got {_short(self.reference_set)}"))
+        out += section_fraction_problems(self.section_fractions)
         return out
 
     def check(self):
@@ -290,7 +301,8 @@ class Mannequin:
         """m_T in cm as a dict (closed form)."""
         from .measure import as_dict, tailor_measurements
 
-        return as_dict(tailor_measurements(self.rotation, self.center, self.semi_axes, self.topology.girth_mask))
+        return as_dict(tailor_measurements(self.rotation, self.center, self.semi_axes, self.topology.girth_mask,
+                                           self.section_fractions))
 
     def reordered(self, topology):
         """The same mannequin with its parts in ``topology``'s order (which must have the same parts)."""
@@ -309,6 +321,7 @@ class Mannequin:
             "role": self.role,
             "units": "m",
             "measurements_cm": self.measurements,
+            "measured_with": {"reference_set": self.reference_set, "section_fractions": self.section_fractions},
             "ellipsoids": [
                 dict(part.to_dict(), center=self.center[i].tolist(),
                      axes=self.rotation[i].T.tolist(), semi_axes=self.semi_axes[i].tolist())
@@ -341,6 +354,16 @@ class Mannequin:
         if measurements is not None and not isinstance(measurements, dict):
             problems.append(Problem("", "measurements_cm", "must be an object of He, Sh, Br, Wa, Hi in cm (or null), "
                                                            f"got {_json_type(measurements)}"))
+        measured_with = data.get("measured_with") or {}  # absent (version 1): the female set
+        if not isinstance(measured_with, dict):
+            problems.append(Problem("", "measured_with", "must be an object (reference_set, section_fractions), got "
+                                                         f"{_json_type(measured_with)}"))
+            measured_with = {}
+        landmarks = {"reference_set": measured_with.get("reference_set", FEMALE_SET),
+                     "section_fractions": measured_with.get("section_fractions", SECTION_FRACTIONS)}
+        if not isinstance(landmarks["section_fractions"], dict):
+            problems.append(Problem("", "measured_with.section_fractions", "must be an object of Sh, Br, Wa, Hi, got "
+                                                                           f"{_json_type(landmarks['section_fractions'])}"))
         items = data.get("ellipsoids")
         if not isinstance(items, list) or not items:
             got = "it is missing" if items is None else "it is empty" if items == [] else f"got {_json_type(items)}"
@@ -367,7 +390,7 @@ class Mannequin:
         if problems:
             raise MannequinError(problems)
         mannequin = cls(topology, np.swapaxes(np.array(arrays["axes"]), 1, 2), np.array(arrays["center"]),
-                        np.array(arrays["semi_axes"]), name=name, role=role, measurements=measurements)
+                        np.array(arrays["semi_axes"]), name=name, role=role, measurements=measurements, **landmarks)
         return mannequin.check() if check else mannequin
 
     def to_json(self):
@@ -420,6 +443,23 @@ def measurement_problems(measurements):
         elif not low <= value <= high:
             out.append(Problem("", "measurements", f"{key}={value:g} cm is not a plausible value ({accepted})"))
     return out
+
+
+def section_fraction_problems(fractions):
+    """Problems of section heights: a dict of exactly Sh, Br, Wa, Hi, each a fraction of He, with
+    0 < Hi < Wa < Br < 1 and 0 < Sh < 1 (the girth blend of exact mode needs the girths in that order)."""
+    field_name = "section_fractions"
+    if not isinstance(fractions, dict) or set(fractions) != set(SECTION_FRACTIONS):
+        return [Problem("", field_name, f"must hold exactly {', '.join(SECTION_FRACTIONS)} (fractions of He), got "
+                                        f"{_short(fractions)}")]
+    for key in SECTION_FRACTIONS:
+        value = fractions[key]
+        if not _positive_number(value) or value >= 1.0:
+            return [Problem("", field_name, f"{key}={_short(value)} must be a fraction of He in (0, 1)")]
+    if not fractions["Hi"] < fractions["Wa"] < fractions["Br"]:
+        return [Problem("", field_name, f"must have Hi < Wa < Br, got Hi {fractions['Hi']:g}, Wa {fractions['Wa']:g}, "
+                                        f"Br {fractions['Br']:g}")]
+    return []
 
 
 def _positive_number(value):

@@ -10,8 +10,12 @@ import numpy as np
 
 from .clean import asymmetry
 from .constants import (
+    ABSURD_LIMITS,
+    FEMALE_SET,
     MEASUREMENTS,
+    RANGES,
     REFERENCE_MEASUREMENTS,
+    SECTION_FRACTIONS,
 )
 from .errors import MannequinError, ReferenceSetError
 from .frames import SAGITTAL_REFLECTION
@@ -50,10 +54,13 @@ class ReferenceSet:
     """The Reference Mannequins: one topology, geometry stacks (k, n, ...) and measurements (k, 5) cm.
 
     ``measurements`` are the RMs' nominal measurements (Table 2.3), the points Eq. 2.1 interpolates
-    between. Every RM is reordered to the first one's topology.
+    between. Every RM is reordered to the first one's topology. The set's landmarks travel with it:
+    ``section_fractions`` (where m_T cuts, fractions of He), ``ranges`` (L, cm) and ``absurd_limits`` (cm, what
+    a request must stay within); by default the female set's (core/constants.py), ``name`` "female".
     """
 
-    def __init__(self, mannequins, names=None, sources=None):
+    def __init__(self, mannequins, names=None, sources=None, *, name=FEMALE_SET, section_fractions=None,
+                 ranges=None, absurd_limits=None):
         mannequins = list(mannequins)
         names = list(names or [m.name or f"RM {i + 1}" for i, m in enumerate(mannequins)])
         sources = list(sources or names)
@@ -76,6 +83,10 @@ class ReferenceSet:
             if off > SYMMETRY_TOLERANCE:
                 raise ReferenceSetError(source, "geometry", f"is not symmetric about x = 0 (asymmetry "
                                         f"{off * 1e3:.3g} mm); clean it first")
+        self.name = name
+        self.section_fractions = dict(section_fractions or SECTION_FRACTIONS)
+        self.ranges = dict(ranges or RANGES)
+        self.absurd_limits = dict(absurd_limits or ABSURD_LIMITS)
         self.mannequins = ordered
         self.names = names
         self.sources = sources
@@ -138,8 +149,9 @@ class ReferenceSet:
         """
         if self._jacobian is None:
             girth = self.topology.girth_mask
-            measured = tailor_measurements(self.rotation, self.center, self.semi_axes, girth)
-            basis = _deform_basis(self.topology, self.rotation, self.center, self.semi_axes, measured)
+            fractions = self.section_fractions
+            measured = tailor_measurements(self.rotation, self.center, self.semi_axes, girth, fractions)
+            basis = _deform_basis(self.topology, self.rotation, self.center, self.semi_axes, measured, fractions)
             each = _fd_jacobian(basis, np.arange(len(self)), self.rotation, self.center, self.semi_axes,
                                 np.zeros((len(self), len(MEASUREMENTS))), np.log(measured), girth)
             self._jacobian = each.mean(axis=0)
