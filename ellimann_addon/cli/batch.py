@@ -9,7 +9,7 @@ import re
 import sys
 
 from ..core.constants import MEASUREMENTS
-from ..core.errors import ElliMannError, MeasurementError
+from ..core.errors import ElliMannError, MeasurementError, ReferenceSetError
 from ..core.files import atomic_write_text, incomplete
 from ..core.formats import FORMATS
 from ..core.measure import as_dict
@@ -25,7 +25,9 @@ CHUNK = 256  # rows synthesized per core batch
 def add_parser(commands):
     batch = commands.add_parser("batch", help="synthesize every row of a CSV",
                                 description="One mannequin per CSV row. The header names the columns "
-                                            "He,Sh,Br,Wa,Hi (cm) and optionally name. Writes the files and "
+                                            "He,Sh,Br,Wa,Hi (cm) and optionally name and references (a row's "
+                                            "reference set: female, male or a folder; empty: --references). "
+                                            "Writes the files and "
                                             "DIR/report.csv (requested vs measured), row by row into "
                                             "DIR/report.partial.csv while it runs. Bad or failed rows are "
                                             "reported and skipped; the exit code is 1 if any row failed, 3 if "
@@ -72,8 +74,11 @@ def parse_formats(text):
     return list(dict.fromkeys(formats))
 
 
-def read_rows(path):
-    """Rows of a measurements CSV: list of (line, name, values or None, error or None)."""
+def read_rows(path, reference_of):
+    """Rows of a measurements CSV: list of (line, name, values or None, error or None, warnings, reference).
+
+    ``reference_of(text)``: the ReferenceSet of a ``references`` cell ("" for the command's own), whose
+    ranges and limits the row is checked against; a cell naming no usable set is that row's error."""
     try:
         with open(path, newline="", encoding="utf-8-sig") as stream:
             text = stream.read()
@@ -86,7 +91,7 @@ def read_rows(path):
     columns = {}
     for index, title in enumerate(header):
         key = title.strip()
-        canonical = next((m for m in MEASUREMENTS + ("name",) if m.lower() == key.lower()), None)
+        canonical = next((m for m in MEASUREMENTS + ("name", "references") if m.lower() == key.lower()), None)
         if canonical in columns:
             raise UsageError(f"{path}: column {canonical} appears twice in the header")
         if canonical:
@@ -98,8 +103,14 @@ def read_rows(path):
     for line, record in enumerate(reader, start=2):
         if not any(cell.strip() for cell in record):
             continue
-        name = record[columns["name"]].strip() if "name" in columns and columns["name"] < len(record) else ""
+        name, chosen = (record[columns[c]].strip() if c in columns and columns[c] < len(record) else ""
+                        for c in ("name", "references"))
+        reference = None
         try:
+            try:
+                reference = reference_of(chosen)
+            except ReferenceSetError as error:
+                raise MeasurementError("references", common.one_line(error)) from None
             values = []
             for key in MEASUREMENTS:
                 cell = record[columns[key]].strip() if columns[key] < len(record) else ""
@@ -109,12 +120,12 @@ def read_rows(path):
                     values.append(float(cell))
                 except ValueError:
                     raise MeasurementError(key, f"{cell!r} is not a number (cm)") from None
-            warnings = validate_request(values)
+            warnings = validate_request(values, reference.ranges, reference.absurd_limits)
             if name and not NAME_PATTERN.match(name):
                 raise MeasurementError("name", f"{name!r} must be letters, digits, '.', '_' or '-' (a file name)")
-            rows.append((line, name, values, None, warnings))
+            rows.append((line, name, values, None, warnings, reference))
         except MeasurementError as error:
-            rows.append((line, name, None, str(error), []))
+            rows.append((line, name, None, str(error), [], reference))
     return rows
 
 
@@ -123,7 +134,7 @@ def name_rows(rows):
     whose name an earlier row already uses (letter case ignored: the files would clash on macOS and
     Windows). Runs over the whole CSV before sharding, so every shard refuses the same rows."""
     seen, named = {}, []
-    for line, name, values, error, warnings in rows:
+    for line, name, values, error, warnings, reference in rows:
         name = name or f"row-{line - 1:05d}"
         key = name.casefold()
         if error is None and key in seen:
@@ -132,7 +143,7 @@ def name_rows(rows):
             error = f"name: {name!r} is already used on line {first_line}{same}"
         if error is None:
             seen[key] = (line, name)
-        named.append((line, name, values, error, warnings))
+        named.append((line, name, values, error, warnings, reference))
     return named
 
 
@@ -141,10 +152,16 @@ def run(args):
 
     formats = parse_formats(args.format)
     shard, shards = parse_shard(args.shard)
-    rows = read_rows(args.csv)
+    sets = {"": common.references(args)}  # the command's set, read once, and each other set a row names
+
+    def reference_of(chosen):
+        if chosen not in sets:
+            sets[chosen] = common.references(args, chosen)
+        return sets[chosen]
+
+    rows = read_rows(args.csv, reference_of)
     if not rows:
         raise UsageError(f"{args.csv} has a header but no rows")
-    reference = common.references(args)
     options = common.synthesis_options(args)
     rows = name_rows(rows)  # over the whole CSV, so every shard agrees on which rows are bad
     mine = [row for index, row in enumerate(rows) if index % shards == shard - 1]
@@ -152,22 +169,27 @@ def run(args):
     report_name = "report.csv" if shards == 1 else f"report-{shard}-of-{shards}.csv"
     report = Report(os.path.join(args.output, report_name))
     jobs = []
-    for line, name, values, error, warnings in mine:
+    for line, name, values, error, warnings, reference in mine:
         if error is not None:
             common.say(f"{PROG} batch: line {line}: skipped: {error}")
             report.add(common.report_row(line, name, "error", error, values))
             continue
         for warning in warnings:
             common.say(f"{PROG} batch: line {line}: warning: {warning}")
-        jobs.append((line, name, values, warnings))
+        jobs.append((line, name, values, warnings, reference))
     progress = common.Progress(len(jobs), "batch")
+    # one core batch per reference set (in the order the sets first appear), in chunks
+    groups = {}
+    for job in jobs:
+        groups.setdefault(id(job[-1]), []).append(job)
     try:
-        for start in range(0, len(jobs), CHUNK):
-            chunk = jobs[start:start + CHUNK]
-            result = synthesize_batch(reference, [values for _, _, values, _ in chunk], options)
-            for i, (line, name, values, warnings) in enumerate(chunk):
-                report.add(_row(args, formats, result, i, line, name, values, warnings))
-                progress.step(name)
+        for group in groups.values():
+            for start in range(0, len(group), CHUNK):
+                chunk = group[start:start + CHUNK]
+                result = synthesize_batch(chunk[0][-1], [values for _, _, values, _, _ in chunk], options)
+                for i, (line, name, values, warnings, reference) in enumerate(chunk):
+                    report.add(_row(args, formats, result, i, line, name, values, warnings, reference.name))
+                    progress.step(name)
     except KeyboardInterrupt:
         progress.done()
         report.finish()
@@ -194,7 +216,7 @@ def run(args):
     return 0
 
 
-def _row(args, formats, result, i, line, name, values, warnings):
+def _row(args, formats, result, i, line, name, values, warnings, references):
     """Write (or, with --resume, keep) the files of one synthesized row; its report row. A failure is
     that row's: one line on stderr and status "error", and the batch goes on."""
     paths = [os.path.join(args.output, f"{name}.{common.extension(kind)}") for kind in formats]
@@ -206,7 +228,7 @@ def _row(args, formats, result, i, line, name, values, warnings):
     status = "missed" if misses else "ok"
     if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths):
         row = common.report_row(line, name, status, "; ".join(notes + ["kept (--resume)"]), values, result.measured[i],
-                          paths)
+                                paths, references)
         row["kept"] = True
         return row
     try:
@@ -214,7 +236,7 @@ def _row(args, formats, result, i, line, name, values, warnings):
     except (ElliMannError, OSError, RuntimeError) as error:
         common.say(f"{PROG} batch: line {line}: failed: {common.one_line(error)}")
         return common.report_row(line, name, "error", common.one_line(error), values)
-    return common.report_row(line, name, status, "; ".join(notes), values, result.measured[i], paths)
+    return common.report_row(line, name, status, "; ".join(notes), values, result.measured[i], paths, references)
 
 
 class Report:
