@@ -7,3 +7,4 @@ props.sh = 45.0
 props.br = 147.0
 props.wa = 142.0
 props.hi = 152.0
+props.reference_set = 'FEMALE'

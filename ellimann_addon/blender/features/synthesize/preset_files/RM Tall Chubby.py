@@ -7,3 +7,4 @@ props.sh = 53.0
 props.br = 153.0
 props.wa = 142.0
 props.hi = 150.0
+props.reference_set = 'FEMALE'

@@ -7,3 +7,4 @@ props.sh = 30.0
 props.br = 84.0
 props.wa = 63.0
 props.hi = 84.0
+props.reference_set = 'FEMALE'

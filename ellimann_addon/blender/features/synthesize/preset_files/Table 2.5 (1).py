@@ -7,3 +7,4 @@ props.sh = 35.75
 props.br = 101.25
 props.wa = 102.5
 props.hi = 134.75
+props.reference_set = 'FEMALE'

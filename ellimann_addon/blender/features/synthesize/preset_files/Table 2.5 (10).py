@@ -7,3 +7,4 @@ props.sh = 47.25
 props.br = 135.75
 props.wa = 122.25
 props.hi = 117.5
+props.reference_set = 'FEMALE'

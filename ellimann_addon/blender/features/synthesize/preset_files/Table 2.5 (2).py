@@ -7,3 +7,4 @@ props.sh = 35.75
 props.br = 118.5
 props.wa = 102.5
 props.hi = 117.5
+props.reference_set = 'FEMALE'

@@ -7,3 +7,4 @@ props.sh = 41.5
 props.br = 135.75
 props.wa = 102.5
 props.hi = 117.5
+props.reference_set = 'FEMALE'

@@ -7,3 +7,4 @@ props.sh = 47.25
 props.br = 118.5
 props.wa = 122.25
 props.hi = 134.75
+props.reference_set = 'FEMALE'

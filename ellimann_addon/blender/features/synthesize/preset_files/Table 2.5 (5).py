@@ -7,3 +7,4 @@ props.sh = 41.5
 props.br = 118.5
 props.wa = 82.75
 props.hi = 117.5
+props.reference_set = 'FEMALE'

@@ -7,3 +7,4 @@ props.sh = 35.75
 props.br = 101.25
 props.wa = 82.75
 props.hi = 117.5
+props.reference_set = 'FEMALE'

@@ -7,3 +7,4 @@ props.sh = 41.5
 props.br = 101.25
 props.wa = 122.25
 props.hi = 117.5
+props.reference_set = 'FEMALE'

@@ -7,3 +7,4 @@ props.sh = 41.5
 props.br = 118.5
 props.wa = 102.5
 props.hi = 134.75
+props.reference_set = 'FEMALE'
