@@ -227,7 +227,9 @@ class Mannequin:
     section_fractions: dict = field(default=None)
 
     def __post_init__(self):
-        self.section_fractions = dict(self.section_fractions or SECTION_FRACTIONS)
+        # a copy (mannequins never share one); anything but a dict is left for problems() to name
+        fractions = SECTION_FRACTIONS if self.section_fractions is None else self.section_fractions
+        self.section_fractions = dict(fractions) if isinstance(fractions, dict) else fractions
         self.rotation = np.asarray(self.rotation, dtype=float)
         self.center = np.asarray(self.center, dtype=float)
         self.semi_axes = np.asarray(self.semi_axes, dtype=float)
@@ -239,7 +241,7 @@ class Mannequin:
         values = dict(topology=self.topology, rotation=self.rotation.copy(), center=self.center.copy(),
                       semi_axes=self.semi_axes.copy(), name=self.name, role=self.role,
                       measurements=dict(self.measurements) if self.measurements else None,
-                      reference_set=self.reference_set, section_fractions=dict(self.section_fractions))
+                      reference_set=self.reference_set, section_fractions=self.section_fractions)
         values.update(changes)
         return Mannequin(**values)
 
