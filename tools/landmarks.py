@@ -5,8 +5,8 @@
 For each body of the female and male sets (tools/reference_sets.py), as fractions of its height He: the
 natural waist (the narrowest torso girth between 0.55 and 0.72 He; girths over the torso-mask triangles,
 convex hull perimeters, as the bodies' READMEs measure), the crotch (the lowest pelvis vertex on the
-sagittal plane), the most posterior buttock point, the bust point (the most anterior chest vertex off the midline) and the shoulder joint centre (the
-skeleton's upperarm01). With ``--picture`` (needs matplotlib): each body's torso girth against height, the
+sagittal plane), the most posterior buttock point, the bust point (the most anterior chest vertex off the
+midline) and the shoulder joint centre (the skeleton's upperarm01). With ``--picture`` (needs matplotlib): each body's torso girth against height, the
 set's section heights drawn across; below the crotch the torso mask's section takes in both thighs.
 """
 
@@ -16,10 +16,11 @@ import sys
 
 import numpy as np
 
+from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import CM_PER_M
 from ellimann_addon.core.mesh import convex_hull_2d, plane_section_points, polygon_perimeter
 
-from .bodies import RM_BODIES, load_body, load_labels
+from .bodies import RM_BODIES, load_labels
 from .reference_sets import BUILD_SETS, TRACING_FOLDER
 
 PROFILE = np.arange(0.40, 0.8201, 0.0025)  # fractions of He the girth profile is sampled at
@@ -69,7 +70,7 @@ def set_landmarks(build_set):
         skeleton = json.load(stream)["bodies"]
     out = {}
     for name in (build_set.reference_body, *RM_BODIES):
-        body = load_body(build_set.refmodels, name)
+        body = read_obj(build_set.refmodels / f"{name}.obj")
         out[name] = (landmarks(body, labels, skeleton[name]), girth_profile(body, labels))
     return out
 
