@@ -6,8 +6,9 @@ For each body of the female and male sets (tools/reference_sets.py), as fraction
 natural waist (the narrowest torso girth between 0.55 and 0.72 He; girths over the torso-mask triangles,
 convex hull perimeters, as the bodies' READMEs measure), the crotch (the lowest pelvis vertex on the
 sagittal plane), the most posterior buttock point, the bust point (the most anterior chest vertex off the
-midline) and the shoulder joint centre (the skeleton's upperarm01). With ``--picture`` (needs matplotlib): each body's torso girth against height, the
-set's section heights drawn across; below the crotch the torso mask's section takes in both thighs.
+midline) and the shoulder joint centre (the skeleton's upperarm01). With ``--picture`` (needs matplotlib):
+each body's torso girth against height, the set's section heights drawn across; below the crotch the torso
+mask's section takes in both thighs.
 """
 
 import argparse

@@ -26,9 +26,9 @@ from ellimann_addon.core.constants import (
     TABLE_2_5,
 )
 from ellimann_addon.core.cushion import cushion_vertices
+from ellimann_addon.core.mesh import convexity_defect, is_closed_manifold
 from ellimann_addon.core.reference_set import load_reference_set
 from ellimann_addon.core.shipped_sets import SHIPPED_SETS
-from ellimann_addon.core.mesh import convexity_defect, is_closed_manifold
 from ellimann_addon.core.synthesis import synthesize as core_synthesize
 
 
