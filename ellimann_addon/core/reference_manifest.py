@@ -16,7 +16,7 @@ import pathlib
 import re
 from dataclasses import dataclass, field
 
-from .constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
+from .constants import ABSURD_LIMITS, FEMALE_SET, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 from .errors import ReferenceSetError
 from .files import atomic_write_text
 
@@ -119,7 +119,7 @@ def _limits(value, key, bad):
 
 def legacy_manifest():
     """What a folder without a manifest holds: the five female RMs of Table 2.3, today's constants."""
-    return Manifest("ElliMann female (Table 2.3)", list(REFERENCE_MEASUREMENTS), sex="female",
+    return Manifest(FEMALE_SET, list(REFERENCE_MEASUREMENTS), sex="female",
                     targets_cm={stem: dict(row) for stem, row in REFERENCE_MEASUREMENTS.items()})
 
 
