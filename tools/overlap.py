@@ -30,10 +30,14 @@ def voxel_iou(mannequin, vertices, faces, spacing=volume.GRID_SPACING, cushions=
     body = volume.BodyVolume(vertices, faces)
     grid = body.grid(spacing)
     cells = grid.origin + spacing * np.argwhere(grid.inside)
-    occupied = volume.occupancy(grid, mannequin, cushions)
-    own = grid.origin + spacing * np.argwhere(occupied)
+    # first onto the body's line by the pieces' volume-weighted centres (wherever the mannequin stands),
+    # then by the centroid of the cells it fills, counting overlaps once
+    weights = np.prod(mannequin.semi_axes, axis=1)
     shift = np.zeros(3)
-    shift[:2] = cells[:, :2].mean(axis=0) - own[:, :2].mean(axis=0)
+    shift[:2] = cells[:, :2].mean(axis=0) - weights @ mannequin.center[:, :2] / weights.sum()
+    occupied = volume.occupancy(grid, mannequin.copy(center=mannequin.center + shift), cushions)
+    own = grid.origin + spacing * np.argwhere(occupied)
+    shift[:2] += cells[:, :2].mean(axis=0) - own[:, :2].mean(axis=0)
     occupied = volume.occupancy(grid, mannequin.copy(center=mannequin.center + shift), cushions)
     both = np.count_nonzero(occupied & grid.inside)
     union = np.count_nonzero(occupied | grid.inside)
