@@ -24,11 +24,14 @@ from .bodies import RM_BODIES, body_measurements, load_labels
 from .reference_sets import BUILD_SETS, TRACING_FOLDER
 
 
+MARGIN = 0.15  # m: the grid around the body, so a mannequin reaching outside it is counted whole
+
+
 def voxel_iou(mannequin, vertices, faces, spacing=volume.GRID_SPACING, cushions=False):
     """(IoU, coverage, excess) of ``mannequin`` and the closed body mesh on a grid of ``spacing`` (m), after
     moving the mannequin so that its volume's centroid lies above the body's (x, y only)."""
     body = volume.BodyVolume(vertices, faces)
-    grid = body.grid(spacing)
+    grid = body.grid(spacing, margin=MARGIN)
     cells = grid.origin + spacing * np.argwhere(grid.inside)
     # first onto the body's line by the pieces' volume-weighted centres (wherever the mannequin stands),
     # then by the centroid of the cells it fills, counting overlaps once
