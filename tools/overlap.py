@@ -23,7 +23,6 @@ from ellimann_addon.core.synthesis import synthesize_batch
 from .bodies import RM_BODIES, body_measurements, load_labels
 from .reference_sets import BUILD_SETS, TRACING_FOLDER
 
-
 MARGIN = 0.15  # m: the grid around the body, so a mannequin reaching outside it is counted whole
 
 
