@@ -116,7 +116,8 @@ def references(args, name_or_dir=None):
     except ReferenceSetError as error:
         if chosen:
             raise
-        raise UsageError(f"{error} (the shipped Reference Mannequins; use --references NAME_OR_DIR for others)") from None
+        raise UsageError(f"{error} (the shipped Reference Mannequins; use --references NAME_OR_DIR for "
+                         "others)") from None
 
 
 # ------------------------------------------------------------------------------------------------ Blender
