@@ -36,8 +36,9 @@ def load_labels(folder):
     return Labels(region, bone, np.array(data["torso_mask"], dtype=bool))
 
 
-def body_measurements(body, labels):
-    """The body's own tailor measurements (cm), measured as ../shared/refmodels/README.md measured them.
+def body_measurements(body, labels, fractions=SECTION_FRACTIONS):
+    """The body's own tailor measurements (cm), measured as ../shared/refmodels/README.md measured them
+    (at the section heights ``fractions``: the male bodies' README gives theirs).
 
     Girths: perimeter of the convex hull of the section of the torso-mask triangles (all three
     vertices in the torso); shoulder width: extent along X of the section of all triangles.
@@ -47,9 +48,9 @@ def body_measurements(body, labels):
     height = vertices[:, 2].max() - floor
     torso_faces = faces[labels.torso[faces].all(axis=1)]
     out = {"He": height * CM_PER_M}
-    points = plane_section_points(vertices, faces, floor + SECTION_FRACTIONS["Sh"] * height)
+    points = plane_section_points(vertices, faces, floor + fractions["Sh"] * height)
     out["Sh"] = float(np.ptp(points[:, 0])) * CM_PER_M
     for key in GIRTHS:
-        points = plane_section_points(vertices, torso_faces, floor + SECTION_FRACTIONS[key] * height)
+        points = plane_section_points(vertices, torso_faces, floor + fractions[key] * height)
         out[key] = polygon_perimeter(convex_hull_2d(points)) * CM_PER_M
     return {key: float(out[key]) for key in MEASUREMENTS}

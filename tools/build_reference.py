@@ -94,11 +94,13 @@ def trace_reference(reference_body, labels):
     return traces, hidden
 
 
-def trace_base(reference_body, traces):
+def trace_base(reference_body, traces, constants=None):
     """The Base Mannequin fitted over the reference body: symmetric, registered, each part's trace
-    recording the axis its frame took from the points. Returns (base, body -> base translation)."""
+    recording the axis its frame took from the points. ``constants``: the fit's (core.body_fit.FitConstants;
+    default the female set's section heights). Returns (base, body -> base translation)."""
     topology = rt.topology()
-    base, kept = fit_mannequin(reference_body, topology, traces, name=DISPLAY_NAMES[BASE_FILE], role="base")
+    base, kept = fit_mannequin(reference_body, topology, traces, constants=constants, name=DISPLAY_NAMES[BASE_FILE],
+                               role="base")
     base = symmetrize(base)  # symmetric first: mirroring may move the lowest point
     shift = registration_offset(base)
     traces = {name: dataclasses.replace(trace, fit=dataclasses.replace(trace.fit, kept=kept[topology.index[name]]))

@@ -11,7 +11,7 @@ import sys
 import numpy as np
 
 from ..core.constants import MEASUREMENTS
-from ..core.errors import ElliMannError, MeasurementError
+from ..core.errors import ElliMannError, MeasurementError, ReferenceSetError
 from ..core.files import atomic_write_text, incomplete
 from ..core.formats import FORMATS
 from ..core.measure import as_dict
@@ -29,7 +29,9 @@ NPZ = "npz"  # the batch's one-file format (core.batch_file), written once at th
 def add_parser(commands):
     batch = commands.add_parser("batch", help="synthesize every row of a CSV",
                                 description="One mannequin per CSV row. The header names the columns "
-                                            "He,Sh,Br,Wa,Hi (cm) and optionally name. Writes the files and "
+                                            "He,Sh,Br,Wa,Hi (cm) and optionally name and references (a row's "
+                                            "reference set: female, male or a folder; empty: --references). "
+                                            "Writes the files and "
                                             "DIR/report.csv (requested vs measured), row by row into "
                                             "DIR/report.partial.csv while it runs. Bad or failed rows are "
                                             "reported and skipped; the exit code is 1 if any row failed, 3 if "
@@ -80,8 +82,11 @@ def parse_formats(text):
     return list(dict.fromkeys(formats))
 
 
-def read_rows(path):
-    """Rows of a measurements CSV: list of (line, name, values or None, error or None)."""
+def read_rows(path, reference_of):
+    """Rows of a measurements CSV: list of (line, name, values or None, error or None, warnings, reference).
+
+    ``reference_of(text)``: the ReferenceSet of a ``references`` cell ("" for the command's own), whose
+    ranges and limits the row is checked against; a cell naming no usable set is that row's error."""
     try:
         with open(path, newline="", encoding="utf-8-sig") as stream:
             text = stream.read()
@@ -94,7 +99,7 @@ def read_rows(path):
     columns = {}
     for index, title in enumerate(header):
         key = title.strip()
-        canonical = next((m for m in MEASUREMENTS + ("name",) if m.lower() == key.lower()), None)
+        canonical = next((m for m in MEASUREMENTS + ("name", "references") if m.lower() == key.lower()), None)
         if canonical in columns:
             raise UsageError(f"{path}: column {canonical} appears twice in the header")
         if canonical:
@@ -106,8 +111,14 @@ def read_rows(path):
     for line, record in enumerate(reader, start=2):
         if not any(cell.strip() for cell in record):
             continue
-        name = record[columns["name"]].strip() if "name" in columns and columns["name"] < len(record) else ""
+        name, chosen = (record[columns[c]].strip() if c in columns and columns[c] < len(record) else ""
+                        for c in ("name", "references"))
+        reference = None
         try:
+            try:
+                reference = reference_of(chosen)
+            except ReferenceSetError as error:
+                raise MeasurementError("references", common.one_line(error)) from None
             values = []
             for key in MEASUREMENTS:
                 cell = record[columns[key]].strip() if columns[key] < len(record) else ""
@@ -117,12 +128,12 @@ def read_rows(path):
                     values.append(float(cell))
                 except ValueError:
                     raise MeasurementError(key, f"{cell!r} is not a number (cm)") from None
-            warnings = validate_request(values)
+            warnings = validate_request(values, reference.ranges, reference.absurd_limits)
             if name and not NAME_PATTERN.match(name):
                 raise MeasurementError("name", f"{name!r} must be letters, digits, '.', '_' or '-' (a file name)")
-            rows.append((line, name, values, None, warnings))
+            rows.append((line, name, values, None, warnings, reference))
         except MeasurementError as error:
-            rows.append((line, name, None, str(error), []))
+            rows.append((line, name, None, str(error), [], reference))
     return rows
 
 
@@ -131,7 +142,7 @@ def name_rows(rows):
     whose name an earlier row already uses (letter case ignored: the files would clash on macOS and
     Windows). Runs over the whole CSV before sharding, so every shard refuses the same rows."""
     seen, named = {}, []
-    for line, name, values, error, warnings in rows:
+    for line, name, values, error, warnings, reference in rows:
         name = name or f"row-{line - 1:05d}"
         key = name.casefold()
         if error is None and key in seen:
@@ -140,36 +151,40 @@ def name_rows(rows):
             error = f"name: {name!r} is already used on line {first_line}{same}"
         if error is None:
             seen[key] = (line, name)
-        named.append((line, name, values, error, warnings))
+        named.append((line, name, values, error, warnings, reference))
     return named
 
 
 def run(args):
     formats = parse_formats(args.format)
     shard, shards = parse_shard(args.shard)
-    rows = read_rows(args.csv)
+    sets = {"": common.references(args)}  # the command's set, read once, and each other set a row names
+
+    def reference_of(chosen):
+        if chosen not in sets:
+            sets[chosen] = common.references(args, chosen)
+        return sets[chosen]
+
+    rows = read_rows(args.csv, reference_of)
     if not rows:
         raise UsageError(f"{args.csv} has a header but no rows")
-    reference = common.references(args)
     options = common.synthesis_options(args)
     rows = name_rows(rows)  # over the whole CSV, so every shard agrees on which rows are bad
     mine = [row for index, row in enumerate(rows) if index % shards == shard - 1]
     cluster = distributed.connect(args.dask) if args.dask else None  # before anything is written
     try:
-        return _run(args, formats, shard, shards, rows, mine, reference, options, cluster)
+        return _run(args, formats, shard, shards, rows, mine, options, cluster)
     finally:
         if cluster is not None:
             cluster.close()
 
 
-def _run(args, formats, shard, shards, rows, mine, reference, options, cluster):
+def _run(args, formats, shard, shards, rows, mine, options, cluster):
     common.output_folder(args.output, "batch")
     suffix = "" if shards == 1 else f"-{shard}-of-{shards}"
     report = Report(os.path.join(args.output, f"report{suffix}.csv"))
-    bundle = Bundle(os.path.join(args.output, f"mannequins{suffix}.npz"), reference.topology,
-                    args.mode) if NPZ in formats else None
     jobs, shown = [], 0
-    for line, name, values, error, warnings in mine:
+    for line, name, values, error, warnings, reference in mine:
         if error is not None:
             common.say(f"{PROG} batch: line {line}: skipped: {error}")
             report.add(common.report_row(line, name, "error", error, values))
@@ -178,21 +193,33 @@ def _run(args, formats, shard, shards, rows, mine, reference, options, cluster):
             shown += 1
             if shown <= MAX_WARNING_LINES:
                 common.say(f"{PROG} batch: line {line}: warning: {warning}")
-        jobs.append((line, name, values, warnings))
+        jobs.append((line, name, values, warnings, reference))
     if shown > MAX_WARNING_LINES:
         common.say(f"{PROG} batch: {shown - MAX_WARNING_LINES} more warning(s) of requests outside the reference "
                    f"range; every row's are in {report.path}")
     progress = common.Progress(len(jobs), "batch", quiet=args.quiet)
-    chunks = [jobs[start:start + CHUNK] for start in range(0, len(jobs), CHUNK)]
-    requests = [[values for _, _, values, _ in chunk] for chunk in chunks]
-    results = (cluster.map([reference] * len(requests), requests, options) if cluster is not None
-               else ((index, synthesize_chunk(reference, chunk, options)) for index, chunk in enumerate(requests)))
+    # one core batch per reference set (in the order the sets first appear), in chunks
+    groups = {}
+    for job in jobs:
+        groups.setdefault(id(job[-1]), []).append(job)
+    chunks = [group[start:start + CHUNK] for group in groups.values() for start in range(0, len(group), CHUNK)]
+    sets = [chunk[0][-1] for chunk in chunks]
+    requests = [[values for _, _, values, _, _ in chunk] for chunk in chunks]
+    bundles = {}  # one batch file per reference set: mannequins.npz, or mannequins-NAME.npz when a batch uses several
+    if NPZ in formats:
+        for reference in dict.fromkeys(sets):
+            tag = f"-{reference.name}" if len(groups) > 1 else ""
+            bundles[id(reference)] = Bundle(os.path.join(args.output, f"mannequins{tag}{suffix}.npz"),
+                                            reference.topology, args.mode)
+    results = (cluster.map(sets, requests, options) if cluster is not None
+               else ((index, synthesize_chunk(sets[index], chunk, options)) for index, chunk in enumerate(requests)))
     try:
         for index, result in results:
-            for i, (line, name, values, warnings) in enumerate(chunks[index]):
-                report.add(_row(args, formats, result, i, line, name, values, warnings, bundle, index))
+            for i, (line, name, values, warnings, reference) in enumerate(chunks[index]):
+                report.add(_row(args, formats, result, i, line, name, values, warnings, reference.name,
+                                bundles.get(id(reference)), index))
                 progress.step(name)
-        if bundle is not None:
+        for bundle in bundles.values():
             bundle.write()
     except KeyboardInterrupt:
         progress.done()
@@ -277,7 +304,7 @@ class ChunkResult:
                          role="synthesized", measurements=as_dict(request))
 
 
-def _row(args, formats, result, i, line, name, values, warnings, bundle=None, chunk=0):
+def _row(args, formats, result, i, line, name, values, warnings, references, bundle=None, chunk=0):
     """Write (or, with --resume, keep) the files of one synthesized row, and add it to the batch file; its report
     row. A failure is that row's: one line on stderr and status "error", and the batch goes on."""
     if result.errors[i] is not None:
@@ -295,7 +322,7 @@ def _row(args, formats, result, i, line, name, values, warnings, bundle=None, ch
         bundle.add(chunk, name, values, result, i)
     if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths) and paths:
         row = common.report_row(line, name, status, "; ".join(notes + ["kept (--resume)"]), values, result.measured[i],
-                                listed)
+                                listed, references)
         row["kept"] = True
         return row
     try:
@@ -306,7 +333,7 @@ def _row(args, formats, result, i, line, name, values, warnings, bundle=None, ch
         if bundle is not None:
             bundle.drop(chunk, name)
         return common.report_row(line, name, "error", common.one_line(error), values)
-    return common.report_row(line, name, status, "; ".join(notes), values, result.measured[i], listed)
+    return common.report_row(line, name, status, "; ".join(notes), values, result.measured[i], listed, references)
 
 
 class Bundle:

@@ -92,9 +92,13 @@ def add_synthesis_options(parser):
     parser.add_argument("--cushions", action="store_true",
                         help="cushions (convex hulls of the cushion pairs) instead of their ellipsoids: shown in "
                              ".blend/.glb/.obj outputs, convex mesh geoms in MJCF")
-    parser.add_argument("--references", metavar="DIR",
-                        help="folder with the five Reference Mannequin .json files (default: the shipped "
-                             "reference_blends/)")
+    add_references(parser, "the reference set to synthesize from")
+
+
+def add_references(parser, what, shipped="female (the default) or male"):
+    parser.add_argument("--references", metavar="NAME_OR_DIR",
+                        help=f"{what}: a shipped set, {shipped}, or a folder of Reference Mannequin .json files "
+                             "(with its reference_set.json manifest)")
 
 
 def synthesis_options(args, name=None):
@@ -103,15 +107,19 @@ def synthesis_options(args, name=None):
                             name=name)
 
 
-def references(args):
+def references(args, name_or_dir=None):
+    """The reference set of ``name_or_dir`` (default: --references; a shipped set's name or a folder)."""
     from ..core.reference_set import load_reference_set
+    from ..core.shipped_sets import reference_folder
 
+    chosen = name_or_dir or args.references
     try:
-        return load_reference_set(args.references)
+        return load_reference_set(reference_folder(chosen))
     except ReferenceSetError as error:
-        if args.references:
+        if chosen:
             raise
-        raise UsageError(f"{error} (the shipped Reference Mannequins; use --references DIR for others)") from None
+        raise UsageError(f"{error} (the shipped Reference Mannequins; use --references NAME_OR_DIR for "
+                         "others)") from None
 
 
 # ------------------------------------------------------------------------------------------------ Blender
@@ -253,13 +261,15 @@ def missed_text(missed):
 
 
 REPORT_COLUMNS = (["line", "name", "status", "message"] + list(MEASUREMENTS)
-                  + [f"{k}_measured" for k in MEASUREMENTS] + [f"{k}_error_pct" for k in MEASUREMENTS] + ["files"])
+                  + [f"{k}_measured" for k in MEASUREMENTS] + [f"{k}_error_pct" for k in MEASUREMENTS] + ["files",
+                                                                                                     "references"])
 
 
-def report_row(line, name, status, message, requested=None, measured=None, paths=()):
-    """One report row; text from the CSV or messages is made safe for spreadsheets and terminals (:func:`cell`)."""
+def report_row(line, name, status, message, requested=None, measured=None, paths=(), references=""):
+    """One report row; text from the CSV or messages is made safe for spreadsheets and terminals (:func:`cell`).
+    ``references``: the reference set the row was synthesized from (its name)."""
     row = {"line": line, "name": cell(name), "status": status, "message": cell(message or ""),
-           "files": cell(" ".join(paths))}
+           "files": cell(" ".join(paths)), "references": cell(references)}
     error = relative_error(measured, requested) if measured is not None else None
     for i, key in enumerate(MEASUREMENTS):
         row[key] = f"{requested[i]:g}" if requested is not None else ""

@@ -18,6 +18,9 @@ def add_parser(commands):
     measure.add_argument("--json", action="store_true",
                          help='print exactly {"He": …, "Sh": …, "Br": …, "Wa": …, "Hi": …}')
     measure.add_argument("--collection", help="the mannequin collection to measure in a .blend holding several")
+    common.add_references(measure, "measure at the section heights of this reference set instead of those the "
+                                   "mannequin records (its own set's; female for files that record none)",
+                          shipped="female or male")
     common.add_verbose(measure)
     measure.set_defaults(run=run, blender=needs_blender)
 
@@ -38,6 +41,9 @@ def run(args):
         mannequin = load_blend_mannequin(path, args.collection)
     else:
         raise UsageError(f"FILE must be a .json or .blend mannequin, got {path!r}")
+    if args.references:
+        reference = common.references(args)
+        mannequin = mannequin.copy(reference_set=reference.name, section_fractions=reference.section_fractions)
     values = mannequin.measure()
     if args.json:
         try:

@@ -10,7 +10,7 @@ import sys
 
 from ..core.body_mesh import BodyMeshError, read_obj
 from ..core.clean import asymmetry
-from ..core.constants import ABSURD_LIMITS, MEASUREMENTS, SECTION_FRACTIONS
+from ..core.constants import ABSURD_LIMITS, MEASUREMENTS
 from ..core.reference_build import build_reference_set, cleanliness_problems, relative_errors, validate_inputs
 from ..core.reference_manifest import STEM, Manifest, read_manifest, targets_range, write_reference_set
 from ..core.reference_set import load_reference_set
@@ -31,7 +31,8 @@ def add_parser(commands):
                     "topology), refine each until m_T meets its targets, clean them together and write a "
                     "reference-set folder (the RMs' JSON, the base and reference_set.json).")
     build.add_argument("--base", required=True, metavar="BASE.json", help="the Base Mannequin, with its recorded "
-                       "selections (traced with Fit Ellipsoid)")
+                       "selections (traced with Fit Ellipsoid); the set is measured at the section heights it "
+                       "records (its own set's)")
     build.add_argument("--bodies", required=True, nargs="+", metavar="BODY.obj",
                        help="N >= 3 body meshes; each file's stem names its Reference Mannequin")
     build.add_argument("--targets", required=True, metavar="TARGETS.csv",
@@ -119,10 +120,13 @@ def run_build(args):
 
     rms, report = build_reference_set(base, bodies, targets, progress=progress, reference=args.reference,
                                       workers=args.workers)
+    fractions = dict(base.section_fractions)  # what the build measured at: the base's own set's
+    name = args.name or out.resolve().name
+    rms = {stem: rm.copy(reference_set=name) for stem, rm in rms.items()}
     first = next(iter(base.traces.values()))
     manifest = Manifest(
-        name=args.name or out.resolve().name, mannequins=stems, sex=args.sex, base=base_stem,
-        section_fractions=dict(SECTION_FRACTIONS), ranges_cm=targets_range({s: targets[s] for s in stems}),
+        name=name, mannequins=stems, sex=args.sex, base=base_stem,
+        section_fractions=fractions, ranges_cm=targets_range({s: targets[s] for s in stems}),
         absurd_limits_cm={k: list(v) for k, v in ABSURD_LIMITS.items()},
         targets_cm={s: dict(targets[s]) for s in stems},
         provenance={"built_by": f"{PROG} references build", "base": {"file": pathlib.Path(args.base).name,
@@ -131,7 +135,7 @@ def run_build(args):
                                for b, p in zip(bodies, args.bodies)},
                     "labelled_against": report.reference})
     with common.writing(str(out), folder=True):
-        write_reference_set(out, rms, manifest, base=report.base)
+        write_reference_set(out, rms, manifest, base=report.base.copy(reference_set=name))
     for stem in stems:
         key, error = report.worst(stem)
         fill = report.fill.get(stem, {}).get("ellipsoids")

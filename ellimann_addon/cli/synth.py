@@ -17,7 +17,7 @@ def add_parser(commands):
     for key in MEASUREMENTS:
         low, high = RANGES[key]
         synth.add_argument(f"--{key.lower()}", dest=key, type=common.number, required=True, metavar="CM",
-                           help=f"{MEASUREMENT_LABELS[key]} (reference range {low:g}-{high:g})")
+                           help=f"{MEASUREMENT_LABELS[key]} (the female set's reference range {low:g}-{high:g})")
     synth.add_argument("-o", "--output", required=True, metavar="OUT",
                        help="output file: .blend, .glb, .obj, .json (ElliMann's mannequin JSON) or .xml (MJCF, "
                             "for MuJoCo)")
@@ -45,7 +45,7 @@ def run(args):
     kind = common.output_kind(args.output)
     request = [getattr(args, key) for key in MEASUREMENTS]
     reference = common.references(args)
-    warnings = validate_request(request, reference.ranges)
+    warnings = validate_request(request, reference.ranges, reference.absurd_limits)
     options = common.synthesis_options(args, args.name)
     result = synthesize_batch(reference, [request], options)
     mannequin, measured = result.mannequin(0, options.name), as_dict(result.measured[0])

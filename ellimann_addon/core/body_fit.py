@@ -75,7 +75,7 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
     (a mannequin of the same topology, and the ``kept`` axis of each of its parts, or None) each part
     keeps the axis closest to the reference part's kept axis and the reference's roll about it.
     ``cancel``: called between parts, raises BuildCancelledError when it returns True. ``fields``: name, role,
-    measurements of the mannequin.
+    measurements of the mannequin. The mannequin is measured (m_T) at ``constants.section_fractions``.
     """
     constants = constants or FitConstants()
     spacing = constants.fill_spacing
@@ -138,5 +138,7 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
                 rotation[twins[i]], center[twins[i]] = mirror_frame(rotation[i], center[i])
                 semi_axes[twins[i]] = semi_axes[i]
             covers[i], covers[twins[i]] = cover(i), cover(twins[i])
-    return Mannequin(topology, rotation, center, semi_axes, **fields).check(), [
+    # measured where it was fitted: at the set's section heights
+    return Mannequin(topology, rotation, center, semi_axes, section_fractions=constants.section_fractions,
+                     **fields).check(), [
         kept_out[twins[i]] if part.side == "R" else kept_out[i] for i, part in enumerate(topology)]

@@ -15,7 +15,9 @@ MEASUREMENT_LABELS = {
 
 # Section heights as fractions of He above the lowest point of the feet (the paper's Section 2.3.5; the
 # sections and the parts they cut: docs/topology.md); the tools in ../shared/refmodels use the same numbers.
+# These are the female reference set's; another set carries its own in its manifest (core.reference_set).
 SECTION_FRACTIONS = {"Sh": 0.790, "Br": 0.720, "Wa": 0.645, "Hi": 0.500}
+FEMALE_SET = "female"  # the name of the shipped default reference set, whose landmarks are the constants here
 GIRTHS = ("Br", "Wa", "Hi")
 
 CM_PER_M = 100.0
@@ -59,9 +61,10 @@ SEMI_AXIS_LIMITS = (1e-5, 3.0)
 CENTER_LIMIT = 100.0  # largest |x|, |y| or |z| of a piece's centre
 
 
-def quartile_points(key):
-    """The three inner quartile points of L for one measurement (the paper's 243 grid)."""
-    low, high = RANGES[key]
+def quartile_points(key, ranges=None):
+    """The three inner quartile points of L (``ranges``, default RANGES) for one measurement (the paper's 243
+    grid)."""
+    low, high = (ranges or RANGES)[key]
     return tuple(low + (high - low) * q for q in (0.25, 0.5, 0.75))
 
 

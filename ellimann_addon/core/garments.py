@@ -28,7 +28,7 @@ between their two ellipsoids, or a dense body mesh) may reach through that initi
 
 import numpy as np
 
-from .constants import CM_PER_M, SECTION_FRACTIONS
+from .constants import CM_PER_M
 from .ellipsoid import axis_extent
 from .errors import ElliMannError
 from .garment_base import (
@@ -144,10 +144,10 @@ def estimate_vertices(mannequin, kind, edge=DEFAULT_EDGE):
         rows = max(2, int(np.ceil((z_top - z_hem) / edge)) + 1)
         return rows * max(12, int(np.ceil(width / edge)))
     # T-shirt: body tube and yokes from the hem to below the shoulders, then two sleeves.
-    z_hem, z_sh = bottom + options["hem"] * height, bottom + SECTION_FRACTIONS["Sh"] * height
+    z_hem, z_sh = bottom + options["hem"] * height, bottom + mannequin.section_fractions["Sh"] * height
     z = np.linspace(z_hem, z_sh, 16)
     perimeter, _ = _girth_perimeters(mannequin, girth, z)
-    pattern = _pattern_girth(sizes, z, bottom, height) * (1.0 + options["ease"])
+    pattern = _pattern_girth(sizes, z, bottom, height, mannequin.section_fractions) * (1.0 + options["ease"])
     width = float(np.max(np.maximum(pattern, perimeter + 2.0 * np.pi * MIN_CLEARANCE)))
     columns = 2 * max(6, int(np.ceil(width / (2.0 * edge))))
     clearance = options["clearance"]
@@ -157,7 +157,7 @@ def estimate_vertices(mannequin, kind, edge=DEFAULT_EDGE):
     neck = max((float(half_x[i]) for i in neck_parts), default=0.05 * height) + clearance
     z_top = max(float(_silhouette_top(mannequin, np.array([neck]))[0]) - clearance, z_sh)
     rows = int(np.ceil((z_top - z_hem) / edge)) + 4  # + the three girth lines
-    z_armpit = bottom + SECTION_FRACTIONS["Br"] * height  # about where the arms end the body tube
+    z_armpit = bottom + mannequin.section_fractions["Br"] * height  # about where the arms end the body tube
     loop = 1 + 2 * max(1, int(np.ceil((z_top - z_armpit) / edge)))  # armhole nodes: armpit, front, back
     sleeve_rows = max(2, int(np.ceil(options["sleeve_length"] * height / edge)) + 1)
     return rows * (columns + 2) + 2 * sleeve_rows * loop

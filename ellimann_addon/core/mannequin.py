@@ -8,19 +8,21 @@ and semi_axes (n, 3), in metres.
 """
 
 import json
-import math
 import re
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .constants import ABSURD_LIMITS, CENTER_LIMIT, MEASUREMENTS, SEMI_AXIS_LIMITS
+from .constants import CENTER_LIMIT, FEMALE_SET, MEASUREMENTS, SECTION_FRACTIONS, SEMI_AXIS_LIMITS
 from .errors import MannequinError, Problem
 from .files import atomic_write_text
+from .problems import json_type as _json_type
+from .problems import measurement_problems, section_fraction_problems
+from .problems import short as _short
 from .trace import traces_from_dict, traces_to_dict
 
 FORMAT = "ellimann.mannequin"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: "measured_with" (the reference set and section heights); a version 1 file is female
 SIDES = ("L", "R", "C")
 ROLES = ("base", "reference", "synthesized")
 NAME_PATTERN = re.compile(r"^(?P<number>\d+)\.(?P<letter>[a-z]) (?P<label>[^.]+?)(?:\.(?P<side>[LR]))?$")
@@ -211,7 +213,11 @@ def _letter(name):
 
 @dataclass
 class Mannequin:
-    """A topology with geometry. ``measurements`` are the requested/target tailor measurements in cm."""
+    """A topology with geometry. ``measurements`` are the requested/target tailor measurements in cm.
+
+    ``reference_set`` and ``section_fractions``: the reference set the mannequin belongs to (synthesized from,
+    or part of) and the section heights m_T measures it at (fractions of He); the female set's by default.
+    """
 
     topology: Topology
     rotation: np.ndarray
@@ -221,8 +227,13 @@ class Mannequin:
     role: str = "synthesized"
     measurements: dict = field(default=None)
     traces: dict = field(default=None)  # {part name: core.trace.PartTrace}: what each part was traced from
+    reference_set: str = FEMALE_SET
+    section_fractions: dict = field(default=None)
 
     def __post_init__(self):
+        # a copy (mannequins never share one); anything but a dict is left for problems() to name
+        fractions = SECTION_FRACTIONS if self.section_fractions is None else self.section_fractions
+        self.section_fractions = dict(fractions) if isinstance(fractions, dict) else fractions
         self.rotation = np.asarray(self.rotation, dtype=float)
         self.center = np.asarray(self.center, dtype=float)
         self.semi_axes = np.asarray(self.semi_axes, dtype=float)
@@ -234,7 +245,8 @@ class Mannequin:
         values = dict(topology=self.topology, rotation=self.rotation.copy(), center=self.center.copy(),
                       semi_axes=self.semi_axes.copy(), name=self.name, role=self.role,
                       measurements=dict(self.measurements) if self.measurements else None,
-                      traces=dict(self.traces) if self.traces else None)
+                      traces=dict(self.traces) if self.traces else None,
+                      reference_set=self.reference_set, section_fractions=self.section_fractions)
         values.update(changes)
         return Mannequin(**values)
 
@@ -280,6 +292,9 @@ class Mannequin:
                 elif det[i] < 0.0:
                     out.append(Problem(part.name, "rotation", "is a left-handed frame (det -1)"))
         out += measurement_problems(self.measurements)
+        if not isinstance(self.reference_set, str) or not self.reference_set:
+            out.append(Problem("", "reference_set", f"must be a non-empty name, got {_short(self.reference_set)}"))
+        out += section_fraction_problems(self.section_fractions)
         return out
 
     def check(self):
@@ -293,7 +308,8 @@ class Mannequin:
         """m_T in cm as a dict (closed form)."""
         from .measure import as_dict, tailor_measurements
 
-        return as_dict(tailor_measurements(self.rotation, self.center, self.semi_axes, self.topology.girth_mask))
+        return as_dict(tailor_measurements(self.rotation, self.center, self.semi_axes, self.topology.girth_mask,
+                                           self.section_fractions))
 
     def reordered(self, topology):
         """The same mannequin with its parts in ``topology``'s order (which must have the same parts)."""
@@ -313,6 +329,7 @@ class Mannequin:
             "role": self.role,
             "units": "m",
             "measurements_cm": self.measurements,
+            "measured_with": {"reference_set": self.reference_set, "section_fractions": self.section_fractions},
             "ellipsoids": [
                 dict(part.to_dict(), center=self.center[i].tolist(),
                      axes=self.rotation[i].T.tolist(), semi_axes=self.semi_axes[i].tolist())
@@ -346,6 +363,16 @@ class Mannequin:
         if measurements is not None and not isinstance(measurements, dict):
             problems.append(Problem("", "measurements_cm", "must be an object of He, Sh, Br, Wa, Hi in cm (or null), "
                                                            f"got {_json_type(measurements)}"))
+        measured_with = data.get("measured_with") or {}  # absent (version 1): the female set
+        if not isinstance(measured_with, dict):
+            problems.append(Problem("", "measured_with", "must be an object (reference_set, section_fractions), got "
+                                                         f"{_json_type(measured_with)}"))
+            measured_with = {}
+        landmarks = {"reference_set": measured_with.get("reference_set", FEMALE_SET),
+                     "section_fractions": measured_with.get("section_fractions", SECTION_FRACTIONS)}
+        if not isinstance(landmarks["section_fractions"], dict):
+            problems.append(Problem("", "measured_with.section_fractions", "must be an object of Sh, Br, Wa, Hi, got "
+                                                                           f"{_json_type(landmarks['section_fractions'])}"))
         items = data.get("ellipsoids")
         if not isinstance(items, list) or not items:
             got = "it is missing" if items is None else "it is empty" if items == [] else f"got {_json_type(items)}"
@@ -373,7 +400,7 @@ class Mannequin:
             raise MannequinError(problems)
         mannequin = cls(topology, np.swapaxes(np.array(arrays["axes"]), 1, 2), np.array(arrays["center"]),
                         np.array(arrays["semi_axes"]), name=name, role=role, measurements=measurements,
-                        traces=traces_from_dict(data.get("traces"), topology.names))
+                        traces=traces_from_dict(data.get("traces"), topology.names), **landmarks)
         return mannequin.check() if check else mannequin
 
     def to_json(self):
@@ -405,38 +432,6 @@ class Mannequin:
         return cls.from_dict(data, check=check)
 
 
-def measurement_problems(measurements):
-    """Problems of target measurements: None, or a dict of some of He, Sh, Br, Wa, Hi in cm, each a number
-    within ``ABSURD_LIMITS`` (the limits a synthesis request must meet)."""
-    if measurements is None:
-        return []
-    if not isinstance(measurements, dict):
-        return [Problem("", "measurements", f"must be a dict of He, Sh, Br, Wa, Hi in cm (or None), got "
-                                            f"{_json_type(measurements)}")]
-    out = []
-    for key, value in measurements.items():
-        if key not in MEASUREMENTS:
-            out.append(Problem("", "measurements", f"{_short(key)} is not a measurement; expected some of "
-                                                   f"{', '.join(MEASUREMENTS)}"))
-            continue
-        low, high = ABSURD_LIMITS[key]
-        accepted = f"accepted range {low:g}-{high:g} cm"
-        if not _positive_number(value):
-            out.append(Problem("", "measurements", f"{key}={_short(value)} is not a positive measurement ({accepted})"))
-        elif not low <= value <= high:
-            out.append(Problem("", "measurements", f"{key}={value:g} cm is not a plausible value ({accepted})"))
-    return out
-
-
-def _positive_number(value):
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return False
-    try:
-        return math.isfinite(value) and value > 0
-    except OverflowError:  # an int beyond float's range
-        return False
-
-
 def _bom_encoding(raw):
     """'UTF-16' or 'UTF-32' if ``raw`` starts with that byte-order mark or looks like that encoding, else ''."""
     if raw[:4] in (b"\xff\xfe\x00\x00", b"\x00\x00\xfe\xff"):
@@ -444,32 +439,6 @@ def _bom_encoding(raw):
     if raw[:2] in (b"\xff\xfe", b"\xfe\xff") or (len(raw) >= 2 and b"\x00" in raw[:2]):
         return "UTF-16"
     return ""
-
-
-def _json_type(value):
-    """What a JSON value is, for messages: 'a list', 'a string', 'null', ..."""
-    if value is None:
-        return "null"
-    if isinstance(value, bool):
-        return "a boolean"
-    if isinstance(value, (int, float)):
-        return "a number"
-    if isinstance(value, str):
-        return "a string"
-    if isinstance(value, (list, tuple)):
-        return "a list"
-    if isinstance(value, dict):
-        return "an object"
-    return f"a {type(value).__name__}"
-
-
-def _short(value, limit=60):
-    """repr of ``value`` cut to ``limit`` characters (a hostile file's values may be huge or deeply nested)."""
-    try:
-        text = repr(value)
-    except (RecursionError, ValueError):  # ValueError: an int too long to print
-        text = f"a {type(value).__name__}"
-    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def stack(mannequins):

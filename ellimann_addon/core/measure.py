@@ -1,7 +1,8 @@
 """m_T, the tailor measuring of Section 2.3.5, in closed form and batched.
 
 - He: top of the highest ellipsoid minus bottom of the lowest (support function along +-Z).
-- Br, Wa, Hi: the horizontal section at SECTION_FRACTIONS[key] * He above the lowest point,
+- Br, Wa, Hi: the horizontal section at fractions[key] * He above the lowest point (the section heights of
+  the mannequin's reference set; SECTION_FRACTIONS, the female ones, by default),
   through the ellipsoids flagged ``girth``; each ellipsoid's section is an ellipse in closed form
   (:func:`ellipsoid.section_at_height`); the perimeter of the convex hull of those ellipses is
   Cauchy's formula  P = integral_0^2pi max_i h_i(theta) dtheta  with h_i their support functions.
@@ -282,20 +283,24 @@ def hull_boundary(centre, k, active, samples=256):
     return np.stack([value * c - slope * s, value * s + slope * c], axis=-1)
 
 
-def section_heights(rotation, center, semi_axes):
-    """Lowest point, He (m) and the world z of each section, for arrays (..., n, 3[, 3])."""
+def section_heights(rotation, center, semi_axes, fractions=None):
+    """Lowest point, He (m) and the world z of each section, for arrays (..., n, 3[, 3]).
+
+    ``fractions``: the section heights {Sh, Br, Wa, Hi} as fractions of He (default SECTION_FRACTIONS)."""
     z_half = axis_extent(rotation, semi_axes, 2)
     top = np.max(center[..., 2] + z_half, axis=-1)
     bottom = np.min(center[..., 2] - z_half, axis=-1)
     height = top - bottom
-    z = {key: bottom + fraction * height for key, fraction in SECTION_FRACTIONS.items()}
+    fractions = fractions or SECTION_FRACTIONS
+    z = {key: bottom + fractions[key] * height for key in SECTION_FRACTIONS}
     return bottom, height, z
 
 
-def tailor_measurements(rotation, center, semi_axes, girth):
+def tailor_measurements(rotation, center, semi_axes, girth, fractions=None):
     """m_T for one mannequin (n, ...) or a batch (B, n, ...): array (..., 5) in cm, order MEASUREMENTS.
 
-    ``girth`` (n,) bool marks the ellipsoids that take part in the Br/Wa/Hi sections.
+    ``girth`` (n,) bool marks the ellipsoids that take part in the Br/Wa/Hi sections; ``fractions`` the
+    section heights (default SECTION_FRACTIONS, the female set's).
     """
     rotation = np.asarray(rotation, dtype=float)
     center = np.asarray(center, dtype=float)
@@ -305,15 +310,15 @@ def tailor_measurements(rotation, center, semi_axes, girth):
     if single:
         rotation, center, semi_axes = rotation[None], center[None], semi_axes[None]
     out = np.concatenate([
-        _measure_chunk(rotation[i:i + _CHUNK], center[i:i + _CHUNK], semi_axes[i:i + _CHUNK], girth)
+        _measure_chunk(rotation[i:i + _CHUNK], center[i:i + _CHUNK], semi_axes[i:i + _CHUNK], girth, fractions)
         for i in range(0, rotation.shape[0], _CHUNK)
     ]) if rotation.shape[0] else np.zeros((0, len(MEASUREMENTS)))
     return out[0] if single else out
 
 
-def _measure_chunk(rotation, center, semi_axes, girth):
+def _measure_chunk(rotation, center, semi_axes, girth, fractions):
     batch = rotation.shape[0]
-    _, height, z = section_heights(rotation, center, semi_axes)
+    _, height, z = section_heights(rotation, center, semi_axes, fractions)
     result = {"He": height}
 
     centre, k, hit = section_at_height(rotation, center, semi_axes, z["Sh"][:, None])
@@ -346,7 +351,7 @@ def measurement_line(values):
     return ", ".join(f"{key} {value:.2f}" for key, value in zip(MEASUREMENTS, values))
 
 
-def section_hulls(rotation, center, semi_axes, girth, samples=256):
+def section_hulls(rotation, center, semi_axes, girth, samples=256, fractions=None):
     """The sections m_T measures, for drawing: {key: (z, hull points (k, 2))} for Sh, Br, Wa, Hi.
 
     Sh's section runs through every ellipsoid, the girths' only through those flagged ``girth``;
@@ -356,9 +361,9 @@ def section_hulls(rotation, center, semi_axes, girth, samples=256):
     center = np.asarray(center, dtype=float)
     semi_axes = np.asarray(semi_axes, dtype=float)
     girth = np.asarray(girth, dtype=bool)
-    _, _, z = section_heights(rotation, center, semi_axes)
+    _, _, z = section_heights(rotation, center, semi_axes, fractions)
     out = {}
-    for key in SECTION_FRACTIONS:
+    for key in z:
         centre, k, hit = section_at_height(rotation, center, semi_axes, z[key])
         active = hit if key == "Sh" else hit & girth
         out[key] = (float(z[key]), hull_boundary(centre, k, active, samples))
@@ -374,13 +379,14 @@ def _concatenate(meshes):
     return np.concatenate(vertices), np.concatenate(faces)
 
 
-def measure_meshes(meshes, girth):
+def measure_meshes(meshes, girth, fractions=None):
     """m_T of a body made of closed triangle meshes in world space (e.g. a cushion mannequin).
 
     ``meshes`` is a sequence of (vertices (V, 3), faces (F, 3)); ``girth`` one bool per mesh.
     He is the z extent of all vertices; the section heights are the same fractions of He as for
     ellipsoids. Br, Wa, Hi: perimeter of the 2D convex hull of the points where the girth meshes'
     edges cross the section plane. Sh: x extent of the section of all meshes at the shoulder height.
+    ``fractions``: the section heights (default SECTION_FRACTIONS).
     Returns (values (5,) in cm in MEASUREMENTS order, {key: (z, hull polygon (h, 2))}).
     """
     girth = np.asarray(girth, dtype=bool)
@@ -393,8 +399,9 @@ def measure_meshes(meshes, girth):
     height = top - bottom
     values = {"He": height}
     sections = {}
-    for key, fraction in SECTION_FRACTIONS.items():
-        z = bottom + fraction * height
+    fractions = fractions or SECTION_FRACTIONS
+    for key in SECTION_FRACTIONS:
+        z = bottom + fractions[key] * height
         points = plane_section_points(*(everything if key == "Sh" else girth_only), z)
         hull = convex_hull_2d(points) if len(points) else np.zeros((0, 2))
         sections[key] = (float(z), hull)

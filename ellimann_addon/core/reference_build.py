@@ -154,7 +154,8 @@ def adjust(mannequin, targets, settings):
     ReferenceBuildError naming the measurement and how far it stays when a factor limit stops it."""
     wanted = np.array([[targets[key] for key in MEASUREMENTS]])
     result = refine(mannequin.topology, mannequin.rotation[None], mannequin.center[None], mannequin.semi_axes[None],
-                    wanted, tolerance=settings.adjust_tolerance, max_iterations=settings.adjust_iterations)
+                    wanted, tolerance=settings.adjust_tolerance, max_iterations=settings.adjust_iterations,
+                    fractions=mannequin.section_fractions)
     factors = as_dict(result.factors[0])
     if not result.converged[0]:
         errors = result.measured[0] / wanted[0] - 1.0
@@ -218,7 +219,9 @@ def build_reference_set(base, bodies, targets, progress=None, cancel=None, setti
     bodies). Returns ({body name: RM}, BuildReport). Raises ReferenceBuildError (one line) before any work
     for bad input, or when an RM cannot meet its targets.
     """
-    settings = settings or BuildSettings()
+    # by default measured at the base's section heights (its own set's): the fit keeps clear of them and
+    # the refinement meets the targets at them
+    settings = settings or BuildSettings(fit=FitConstants(section_fractions=dict(base.section_fractions)))
     validate_inputs(base, bodies, targets)
     names = [body.name for body in bodies]
     reference = reference or central_body(names, targets)

@@ -16,7 +16,7 @@ import pathlib
 import re
 from dataclasses import dataclass, field
 
-from .constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
+from .constants import ABSURD_LIMITS, FEMALE_SET, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 from .errors import ReferenceSetError
 from .files import atomic_write_text
 
@@ -82,6 +82,9 @@ class Manifest:
         if not isinstance(fractions, dict) or set(fractions) != set(SECTIONS) or not all(
                 _number(v) and 0.0 < v < 1.0 for v in fractions.values()):
             raise bad("section_fractions", f"must give {', '.join(SECTIONS)}, each a fraction of He between 0 and 1")
+        if not fractions["Hi"] < fractions["Wa"] < fractions["Br"]:  # exact mode's girth blend needs this order
+            raise bad("section_fractions", f"must have Hi < Wa < Br, got Hi {fractions['Hi']:g}, Wa "
+                                           f"{fractions['Wa']:g}, Br {fractions['Br']:g}")
         absurd = _limits(data.get("absurd_limits_cm", _pairs(ABSURD_LIMITS)), "absurd_limits_cm", bad)
         ranges = _limits(data.get("ranges_cm", _pairs(RANGES)), "ranges_cm", bad)
         for key in MEASUREMENTS:
@@ -116,7 +119,7 @@ def _limits(value, key, bad):
 
 def legacy_manifest():
     """What a folder without a manifest holds: the five female RMs of Table 2.3, today's constants."""
-    return Manifest("ElliMann female (Table 2.3)", list(REFERENCE_MEASUREMENTS), sex="female",
+    return Manifest(FEMALE_SET, list(REFERENCE_MEASUREMENTS), sex="female",
                     targets_cm={stem: dict(row) for stem, row in REFERENCE_MEASUREMENTS.items()})
 
 

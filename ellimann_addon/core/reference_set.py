@@ -144,8 +144,9 @@ class ReferenceSet:
         """
         if self._jacobian is None:
             girth = self.topology.girth_mask
-            measured = tailor_measurements(self.rotation, self.center, self.semi_axes, girth)
-            basis = _deform_basis(self.topology, self.rotation, self.center, self.semi_axes, measured)
+            fractions = self.section_fractions
+            measured = tailor_measurements(self.rotation, self.center, self.semi_axes, girth, fractions)
+            basis = _deform_basis(self.topology, self.rotation, self.center, self.semi_axes, measured, fractions)
             each = _fd_jacobian(basis, np.arange(len(self)), self.rotation, self.center, self.semi_axes,
                                 np.zeros((len(self), len(MEASUREMENTS))), np.log(measured), girth)
             self._jacobian = each.mean(axis=0)

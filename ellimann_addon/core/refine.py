@@ -24,16 +24,6 @@ _FD_STEP = 1e-4  # log-factor step of the finite-difference Jacobian
 _TIKHONOV = 1e-10  # keeps the Newton system solvable when a measurement does not respond
 _TAPER = 1.0  # how strongly a section's factor lengthens the parts it cuts off their middle
 _DAMPING = 1e-3  # initial Levenberg-Marquardt damping (relative to each factor's own curvature)
-# Hat functions of the girth blend, in fractions of He: full effect at a section, none beyond the
-# neighbouring knots. Below the hip section the blend fades over the thighs, above the breast over
-# the upper chest (as far above Br as Wa is below it).
-_KNOTS = (
-    SECTION_FRACTIONS["Hi"] - (SECTION_FRACTIONS["Wa"] - SECTION_FRACTIONS["Hi"]),
-    SECTION_FRACTIONS["Hi"],
-    SECTION_FRACTIONS["Wa"],
-    SECTION_FRACTIONS["Br"],
-    SECTION_FRACTIONS["Br"] + (SECTION_FRACTIONS["Br"] - SECTION_FRACTIONS["Wa"]),
-)
 _GIRTH_KNOT = {"Hi": 1, "Wa": 2, "Br": 3}
 _INDEX = {key: i for i, key in enumerate(MEASUREMENTS)}
 
@@ -52,8 +42,9 @@ class _DeformBasis:
     anchor: np.ndarray  # (B, n, 3) z of the end of the part farther from each section
     shoulder_scaled: np.ndarray  # (n,) parts that widen with Sh
     shoulder_carried: np.ndarray  # (n,) parts moved sideways with Sh (arms)
+    fractions: dict  # the section heights m_T measures at (the reference set's)
 
-    _SHARED = ("shoulder_scaled", "shoulder_carried")  # per part, not per mannequin
+    _SHARED = ("shoulder_scaled", "shoulder_carried", "fractions")  # per part or set, not per mannequin
 
     def take(self, rows):
         return _DeformBasis(**{f.name: getattr(self, f.name) if f.name in self._SHARED else getattr(self, f.name)[rows]
@@ -67,9 +58,17 @@ class _DeformBasis:
                                for f in fields(self)})
 
 
-def _hat(fraction, knot):
-    """Piecewise-linear hat over _KNOTS, 1 at _KNOTS[knot], 0 at its neighbours and beyond."""
-    return np.interp(fraction, _KNOTS, np.eye(len(_KNOTS))[knot])
+def _knots(fractions):
+    """Knots of the girth blend's hat functions, in fractions of He: full effect at a section, none beyond the
+    neighbouring knots. Below the hip section the blend fades over the thighs, above the breast over the upper
+    chest (as far above Br as Wa is below it)."""
+    hi, wa, br = fractions["Hi"], fractions["Wa"], fractions["Br"]
+    return (hi - (wa - hi), hi, wa, br, br + (br - wa))
+
+
+def _hat(fraction, knot, knots):
+    """Piecewise-linear hat over ``knots``, 1 at knots[knot], 0 at its neighbours and beyond."""
+    return np.interp(fraction, knots, np.eye(len(knots))[knot])
 
 
 # Points across an ellipsoid's height (in half-extents) and their weights, proportional to the area
@@ -78,12 +77,14 @@ _SPAN = np.linspace(-1.0, 1.0, 9)[1:-1]
 _SPAN_WEIGHT = (1.0 - _SPAN**2) / np.sum(1.0 - _SPAN**2)
 
 
-def _deform_basis(topology, rotation, center, semi_axes, measured):
-    bottom, height, z = section_heights(rotation, center, semi_axes)
+def _deform_basis(topology, rotation, center, semi_axes, measured, fractions=None):
+    fractions = fractions or SECTION_FRACTIONS
+    knots = _knots(fractions)
+    bottom, height, z = section_heights(rotation, center, semi_axes, fractions)
     span = center[..., 2, None] + axis_extent(rotation, semi_axes, 2)[..., None] * _SPAN  # (B, n, q)
     fraction = (span - bottom[:, None, None]) / height[:, None, None]
     girth = topology.girth_mask
-    weight = np.stack([_dot(_hat(fraction, _GIRTH_KNOT[key]), _SPAN_WEIGHT) for key in GIRTHS], axis=-1)
+    weight = np.stack([_dot(_hat(fraction, _GIRTH_KNOT[key], knots), _SPAN_WEIGHT) for key in GIRTHS], axis=-1)
     weight = weight * girth[:, None]
     fraction = (center[..., 2] - bottom[:, None]) / height[:, None]
     # Each girth section's own centre in y (middle of its extent), interpolated between sections.
@@ -97,8 +98,8 @@ def _deform_basis(topology, rotation, center, semi_axes, measured):
         centre_y.append(np.where(np.isfinite(top), 0.5 * (top + low), 0.0))
     centre_y = np.stack(centre_y, axis=-1)  # (B, 3) in GIRTHS order: Br, Wa, Hi
     order = [GIRTHS.index(key) for key in ("Hi", "Wa", "Br")]
-    fractions = [SECTION_FRACTIONS[key] for key in ("Hi", "Wa", "Br")]
-    origin_y = _interp_rows(fraction, fractions, centre_y[:, order])
+    heights = [fractions[key] for key in ("Hi", "Wa", "Br")]
+    origin_y = _interp_rows(fraction, heights, centre_y[:, order])
     # Where each section cuts each girth part, relative to the part's middle (-1 bottom .. 1 top).
     half_z = axis_extent(rotation, semi_axes, 2)  # (B, n)
     cut = np.stack([(z[key][:, None] - center[..., 2]) / half_z for key in GIRTHS], axis=-1)  # (B, n, 3)
@@ -109,7 +110,8 @@ def _deform_basis(topology, rotation, center, semi_axes, measured):
     return _DeformBasis(
         bottom=bottom, shoulder_half=0.5 * measured[:, _INDEX["Sh"]] / CM_PER_M, girth_weight=weight,
         origin_y=origin_y, vertical=rotation[..., 2, :] ** 2, lateral=rotation[..., 0, :] ** 2,
-        taper=taper, anchor=anchor, shoulder_scaled=depends_sh & girth, shoulder_carried=depends_sh & ~girth)
+        taper=taper, anchor=anchor, shoulder_scaled=depends_sh & girth, shoulder_carried=depends_sh & ~girth,
+        fractions=fractions)
 
 
 def _interp_rows(x, knots, values):
@@ -171,7 +173,7 @@ class Refinement:
 
 
 def refine(topology, rotation, center, semi_axes, targets, measured=None, tolerance=EXACT_TOLERANCE,
-           max_iterations=EXACT_MAX_ITERATIONS, jacobian=None):
+           max_iterations=EXACT_MAX_ITERATIONS, jacobian=None, fractions=None):
     """Deform mannequins (B, n, ...) so that m_T matches ``targets`` (B, 5) cm (exact mode).
 
     Solves r(x) = log m_T(deform(exp x)) - log target = 0 for the log factors x, Levenberg-Marquardt
@@ -180,13 +182,14 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
     every step (one m_T each), a step kept only if it lowers |r| (else more damping), a
     forward-difference Jacobian if a mannequin is slow to converge. The result is never further from
     the request than the IDW mannequin it starts from. All batched; mannequins already within
-    ``tolerance`` are returned unchanged.
+    ``tolerance`` are returned unchanged. ``fractions``: the section heights m_T measures at (the reference
+    set's; default SECTION_FRACTIONS).
     """
     girth = topology.girth_mask
     targets = np.atleast_2d(np.asarray(targets, dtype=float))
     if measured is None:
-        measured = tailor_measurements(rotation, center, semi_axes, girth)
-    basis = _deform_basis(topology, rotation, center, semi_axes, measured)
+        measured = tailor_measurements(rotation, center, semi_axes, girth, fractions)
+    basis = _deform_basis(topology, rotation, center, semi_axes, measured, fractions)
     count = len(MEASUREMENTS)
     x = np.zeros((len(targets), count))
     current = measured.copy()
@@ -226,7 +229,7 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
         wanted = x[todo] + np.clip(step, -_MAX_STEP, _MAX_STEP)
         new_x = np.clip(wanted, lo, hi)
         c, d = deform(basis.take(todo), center[todo], semi_axes[todo], np.exp(new_x))
-        m = tailor_measurements(rotation[todo], c, d, girth)
+        m = tailor_measurements(rotation[todo], c, d, girth, basis.fractions)
         new_residual = np.log(np.maximum(m, 1e-12) / targets[todo])
         # Broyden: the secant of this step corrects the Jacobian along the step, kept or not.
         dx = new_x - x[todo]
@@ -280,6 +283,6 @@ def _fd_jacobian(basis, rows, rotation, center, semi_axes, x, base, girth):
     probes = np.concatenate([x[rows] + _FD_STEP * np.eye(count)[j] for j in range(count)])
     c, d = deform(basis.take(rows).tile(count), np.tile(center[rows], (count, 1, 1)),
                   np.tile(semi_axes[rows], (count, 1, 1)), np.exp(probes))
-    m = tailor_measurements(np.tile(rotation[rows], (count, 1, 1, 1)), c, d, girth)
+    m = tailor_measurements(np.tile(rotation[rows], (count, 1, 1, 1)), c, d, girth, basis.fractions)
     m = np.log(np.maximum(m, 1e-12)).reshape(count, len(rows), count)
     return np.moveaxis((m - base[None]) / _FD_STEP, 0, -1)

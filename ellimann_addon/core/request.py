@@ -16,18 +16,20 @@ from .options import (
 )
 
 
-def validate_request(me, ranges=RANGES):
+def validate_request(me, ranges=None, limits=None):
     """Check a request {He, Sh, Br, Wa, Hi} in cm (a dict, or a sequence in that order).
 
     Raises MeasurementError naming the field for a missing key, a non-number, NaN/inf, a value
-    <= 0 or outside ``ABSURD_LIMITS``. Returns a list of warnings for values outside the
-    reference range L (``ranges``: a reference set's, default Table 2.3's; allowed: exact mode reaches them,
-    IDW cannot leave the RMs' hull).
+    <= 0 or outside ``limits``. Returns a list of warnings for values outside the reference range L
+    (``ranges``; allowed: exact mode reaches them, IDW cannot leave the RMs' hull). ``ranges`` and ``limits``
+    are the reference set's (``ReferenceSet.ranges``, ``.absurd_limits``); by default the female set's
+    RANGES and ABSURD_LIMITS.
     """
     values = _request_values(me)
+    ranges, limits = ranges or RANGES, limits or ABSURD_LIMITS
     warnings = []
     for key, value in zip(MEASUREMENTS, values):
-        low, high = ABSURD_LIMITS[key]
+        low, high = limits[key]
         accepted = f"accepted range {low:g}-{high:g} cm"
         if not _number(value):
             raise MeasurementError(key, f"must be a number in cm, got {value!r} ({accepted})")
@@ -68,9 +70,9 @@ def _request_values(me):
     return values
 
 
-def request_array(me):
+def request_array(me, ranges=None, limits=None):
     """Validated request as a (5,) float array (warnings dropped; use validate_request to see them)."""
-    validate_request(me)
+    validate_request(me, ranges, limits)
     return np.array(_request_values(me), dtype=float)
 
 
@@ -93,8 +95,9 @@ def relative_error(measured, requested, signed=False):
     return error if signed else np.abs(error)
 
 
-def validate_requests(requests):
-    """(B, 5) array check for batches; raises MeasurementError naming the row and field."""
+def validate_requests(requests, ranges=None, limits=None):
+    """(B, 5) array check for batches (against ``limits``, as :func:`validate_request`); raises MeasurementError
+    naming the row and field."""
     try:
         requests = np.atleast_2d(np.asarray(requests, dtype=float))
     except (TypeError, ValueError):
@@ -103,7 +106,7 @@ def validate_requests(requests):
         raise MeasurementError("requests", f"must have shape (B, 5) (He, Sh, Br, Wa, Hi), got {requests.shape}")
     for row, values in enumerate(requests):
         try:
-            validate_request([float(v) for v in values])
+            validate_request([float(v) for v in values], ranges, limits)
         except MeasurementError as error:
             raise MeasurementError(error.field, f"row {row}: {str(error).partition(': ')[2]}") from None
     return requests

@@ -51,7 +51,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .constants import CENTER_LIMIT, MEASUREMENTS, SEMI_AXIS_LIMITS
+from .constants import CENTER_LIMIT, FEMALE_SET, MEASUREMENTS, SEMI_AXIS_LIMITS
 from .errors import ElliMannError, MannequinError
 from .idw import idw_weights, interpolate
 from .mannequin import Mannequin
@@ -83,7 +83,7 @@ __all__ = [
 
 @dataclass
 class Synthesis:
-    """A batch of synthesized mannequins sharing the reference set's topology."""
+    """A batch of synthesized mannequins sharing the reference set's topology (and its section heights)."""
 
     topology: object
     requests: np.ndarray  # (B, 5) cm
@@ -94,6 +94,8 @@ class Synthesis:
     factors: np.ndarray  # (B, 5) exact-mode deformation factors (ones for IDW)
     converged: np.ndarray  # (B,) exact mode reached its tolerance (True for IDW)
     mode: str
+    reference_set: str = FEMALE_SET  # the name of the set they come from
+    section_fractions: dict = None  # the set's section heights (None: SECTION_FRACTIONS)
 
     def __len__(self):
         return len(self.requests)
@@ -101,7 +103,8 @@ class Synthesis:
     def mannequin(self, i, name=None):
         me = as_dict(self.requests[i])
         return Mannequin(self.topology, self.rotation[i], self.center[i], self.semi_axes[i],
-                         name=name or mannequin_name(me), role="synthesized", measurements=me)
+                         name=name or mannequin_name(me), role="synthesized", measurements=me,
+                         reference_set=self.reference_set, section_fractions=self.section_fractions)
 
     def relative_error(self):
         """(B, 5) |m_T - request| / request in % (:func:`relative_error`)."""
@@ -147,27 +150,30 @@ def synthesize_batch(reference, requests, options=None, *, measure=True, toleran
     """
     options = options_of(options, **fields).checked()
     mode = options.mode
-    requests = validate_requests(requests)
+    requests = validate_requests(requests, reference.ranges, reference.absurd_limits)
     rotation, center, semi_axes = interpolate(reference, requests, options.metric, options.power, options.normalize)
     girth = reference.topology.girth_mask
-    measured = tailor_measurements(rotation, center, semi_axes, girth) if (measure or mode == "exact") else None
+    fractions = reference.section_fractions
+    measured = (tailor_measurements(rotation, center, semi_axes, girth, fractions) if (measure or mode == "exact")
+                else None)
     factors = np.ones_like(requests)
     converged = np.ones(len(requests), dtype=bool)
     if mode == "exact":
         result = refine(reference.topology, rotation, center, semi_axes, requests, measured, tolerance,
-                        jacobian=reference.refine_jacobian())
+                        jacobian=reference.refine_jacobian(), fractions=fractions)
         center, semi_axes, measured = result.center, result.semi_axes, result.measured
         factors, converged = result.factors, result.converged
     check_plausible(reference.topology, requests, rotation, center, semi_axes)
-    return Synthesis(reference.topology, requests, rotation, center, semi_axes, measured, factors, converged, mode)
+    return Synthesis(reference.topology, requests, rotation, center, semi_axes, measured, factors, converged, mode,
+                     reference.name, fractions)
 
 
 def synthesize(reference, request, options=None, **fields):
     """One mannequin from a request (dict or 5 numbers, cm), named ``options.name`` (default: from the request).
     ``options`` and keywords as :func:`synthesize_batch`'s. Returns (Mannequin, measured dict, warnings)."""
     options = options_of(options, **fields)
-    warnings = validate_request(request, reference.ranges)
-    batch = synthesize_batch(reference, [request_array(request)], options)
+    warnings = validate_request(request, reference.ranges, reference.absurd_limits)
+    batch = synthesize_batch(reference, [request_array(request, reference.ranges, reference.absurd_limits)], options)
     if not batch.converged[0]:
         worst = MEASUREMENTS[int(np.argmax(batch.relative_error()[0]))]
         warnings.append(f"exact mode did not fully converge: {worst} is off by {batch.relative_error()[0].max():.2f}%")

@@ -3,7 +3,7 @@ at the shoulders, and two sleeves sewn to the armholes. See ``core.garments`` fo
 
 import numpy as np
 
-from .constants import CM_PER_M, SECTION_FRACTIONS
+from .constants import CM_PER_M
 from .ellipsoid import axis_extent, section_at_height
 from .errors import ElliMannError
 from .garment_base import (
@@ -31,10 +31,11 @@ from .mesh import face_normals
 # T-shirt
 
 
-def _pattern_girth(sizes, heights, bottom, height):
-    """Pattern girth (m) at each height: Hi below the hip line, Br above the bust line, linear between."""
+def _pattern_girth(sizes, heights, bottom, height, fractions):
+    """Pattern girth (m) at each height: Hi below the hip line, Br above the bust line, linear between (the lines
+    at ``fractions``, the mannequin's section heights)."""
     keys = ("Hi", "Wa", "Br")
-    at = [bottom + SECTION_FRACTIONS[key] * height for key in keys]
+    at = [bottom + fractions[key] * height for key in keys]
     values = [sizes[key] / CM_PER_M for key in keys]
     return np.interp(heights, at, values)
 
@@ -89,7 +90,8 @@ def t_shirt(mannequin, ease=0.08, sleeve_ease=0.3, edge=DEFAULT_EDGE, measuremen
     ease = _check("ease", ease, 0.0, 1.0)
     sleeve_ease = _check("sleeve_ease", sleeve_ease, 0.0, 2.0)
     edge = _check("edge", edge, *EDGE_RANGE)
-    hem = _check("hem", hem, 0.2, SECTION_FRACTIONS["Hi"])
+    fractions = mannequin.section_fractions  # the garment's lines sit where m_T measures the mannequin
+    hem = _check("hem", hem, 0.2, fractions["Hi"])
     sleeve_length = _check("sleeve_length", sleeve_length, 0.02, 0.3)
     clearance = _check("clearance", clearance, MIN_CLEARANCE, 0.1)
     sizes = pattern_measurements(mannequin, measurements)
@@ -99,17 +101,17 @@ def t_shirt(mannequin, ease=0.08, sleeve_ease=0.3, edge=DEFAULT_EDGE, measuremen
         raise ElliMannError("mannequin: a T-shirt needs a left and a right part whose region names an arm")
     bottom, height = _body(mannequin)
     girth = topology.girth_mask
-    z_sh = bottom + SECTION_FRACTIONS["Sh"] * height
+    z_sh = bottom + fractions["Sh"] * height
 
     # 1. Body tube, from the hem up to the armpit: the highest height below which every ring stays
     #    clear of every part (the arms included) by half the minimum clearance.
     z_hem = bottom + hem * height
     # Rings every edge length, plus one exactly on each girth line so the pattern girths are exact there.
-    lines = [bottom + SECTION_FRACTIONS[key] * height for key in ("Hi", "Wa", "Br")]
+    lines = [bottom + fractions[key] * height for key in ("Hi", "Wa", "Br")]
     z = np.arange(z_hem, z_sh, edge)
     z = np.sort(np.concatenate([z[np.min(np.abs(z[:, None] - np.array(lines)), axis=1) > edge / 3], lines]))
     perimeter, (centre, k, active) = _girth_perimeters(mannequin, girth, z)
-    pattern = _pattern_girth(sizes, z, bottom, height) * (1.0 + ease)
+    pattern = _pattern_girth(sizes, z, bottom, height, fractions) * (1.0 + ease)
     width = np.maximum(pattern, perimeter + 2.0 * np.pi * MIN_CLEARANCE)
     columns = 2 * max(6, int(np.ceil(width.max() / (2.0 * edge))))  # even: front and back halves
     polygons = _hull_rings(centre, k, active, (width - perimeter) / (2.0 * np.pi))
@@ -217,8 +219,8 @@ def t_shirt(mannequin, ease=0.08, sleeve_ease=0.3, edge=DEFAULT_EDGE, measuremen
         seams=np.concatenate(seams),
         panel=np.concatenate(panel + sleeve_panels),
         panel_names=("body", "front yoke", "back yoke", "left sleeve", "right sleeve"),
-        pattern={"girth_cm": {key: float(np.interp(bottom + SECTION_FRACTIONS[key] * height, z, width) * CM_PER_M)
-                              for key in ("Br", "Wa", "Hi") if z_hem <= bottom + SECTION_FRACTIONS[key] * height
+        pattern={"girth_cm": {key: float(np.interp(bottom + fractions[key] * height, z, width) * CM_PER_M)
+                              for key in ("Br", "Wa", "Hi") if z_hem <= bottom + fractions[key] * height
                               <= z_armpit},
                  "armpit_height_cm": z_armpit * CM_PER_M, "hem_height_cm": z_hem * CM_PER_M,
                  "shoulder_width_cm": 2 * shoulder * CM_PER_M, "neck_width_cm": 2 * neck * CM_PER_M,

@@ -27,6 +27,8 @@ from ellimann_addon.core.constants import (
 )
 from ellimann_addon.core.cushion import cushion_vertices
 from ellimann_addon.core.mesh import convexity_defect, is_closed_manifold
+from ellimann_addon.core.reference_set import load_reference_set
+from ellimann_addon.core.shipped_sets import SHIPPED_SETS
 from ellimann_addon.core.synthesis import synthesize as core_synthesize
 
 
@@ -46,7 +48,7 @@ def no_settle_timer_left():
 @pytest.fixture
 def props(folder):
     props = bpy.context.scene.ellimann_synthesis
-    props.references = folder
+    props.reference_set, props.references = "FOLDER", folder
     for key, value in zip(MEASUREMENTS, (159.0, 43.0, 117.0, 104.0, 117.0)):
         setattr(props, key.lower(), value)
     return props
@@ -357,14 +359,22 @@ def shipped_presets():
     return sorted(presets.SHIPPED_PRESETS.glob("*.py"))
 
 
-def test_shipped_presets_hold_the_reference_and_table_2_5_measurements(props):
-    expected = {f"RM {k.replace('_', ' ').title()}": [v[m] for m in MEASUREMENTS]
+def test_shipped_presets_hold_the_reference_and_table_2_5_measurements_and_choose_their_set(props):
+    """Female presets leave a folder chosen (the user's own set) but leave the male set; male ones choose it."""
+    expected = {f"RM {k.replace('_', ' ').title()}": ([v[m] for m in MEASUREMENTS], "FEMALE")
                 for k, v in REFERENCE_MEASUREMENTS.items()}
-    expected.update({f"Table 2.5 ({i})": list(row) for i, row in enumerate(TABLE_2_5, 1)})
+    expected.update({f"Table 2.5 ({i})": (list(row), "FEMALE") for i, row in enumerate(TABLE_2_5, 1)})
+    male = load_reference_set(SHIPPED_SETS["male"])
+    expected.update({f"Male RM {k.replace('_', ' ').title()}": (list(v), "MALE")
+                     for k, v in zip(male.names, male.measurements)})
     assert {p.stem for p in shipped_presets()} == set(expected)
     for path in shipped_presets():
-        bpy.ops.script.execute_preset(filepath=str(path), menu_idname="ELLIMANN_MT_measurement_presets")
-        assert [getattr(props, m.lower()) for m in MEASUREMENTS] == pytest.approx(expected[path.stem])
+        values, chosen = expected[path.stem]
+        for before, after in (("FOLDER", "FOLDER" if chosen == "FEMALE" else chosen), ("MALE", chosen)):
+            props.reference_set = before
+            bpy.ops.script.execute_preset(filepath=str(path), menu_idname="ELLIMANN_MT_measurement_presets")
+            assert [getattr(props, m.lower()) for m in MEASUREMENTS] == pytest.approx(values)
+            assert props.reference_set == after, (path.stem, before)
 
 
 def test_users_can_save_and_remove_their_own_presets(props):
@@ -389,8 +399,11 @@ def test_users_can_save_and_remove_their_own_presets(props):
 def test_the_panel_draws_request_options_and_measured_values(props):
     recorder = draw_panel(panel.ELLIMANN_PT_synthesize)
     assert [p for p in recorder.props() if p in ("he", "sh", "br", "wa", "hi")] == ["he", "sh", "br", "wa", "hi"]
-    for name in ("mode", "output", "normalize", "metric", "power", "live", "references"):
+    for name in ("mode", "output", "normalize", "metric", "power", "live", "reference_set", "references"):
         assert name in recorder.props()
+    props.reference_set = "MALE"
+    assert "references" not in draw_panel(panel.ELLIMANN_PT_synthesize).props()  # the folder only for Folder
+    props.reference_set = "FOLDER"
     assert "ellimann.synthesize_mannequin" in recorder.operators()
     assert "ellimann.add_measurement_preset" in recorder.operators()
     label = presets.ELLIMANN_MT_measurement_presets.bl_label  # the last preset chosen

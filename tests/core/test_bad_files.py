@@ -16,7 +16,7 @@ from devkit.toy import make_toy_mannequin
 from ellimann_addon.core import garments, synthesis
 from ellimann_addon.core.constants import ABSURD_LIMITS, CENTER_LIMIT, SEMI_AXIS_LIMITS
 from ellimann_addon.core.errors import ElliMannError, MannequinError, ReferenceSetError
-from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.mannequin import FORMAT_VERSION, Mannequin
 from ellimann_addon.core.reference_manifest import MANIFEST_FILE
 
 TOY = make_toy_mannequin()
@@ -129,7 +129,7 @@ def test_a_file_that_is_not_a_mannequin_object(tmp_path, text, words):
 
 
 @pytest.mark.parametrize("change, words", [
-    (lambda d: d.update(version=True), ["version", "reads versions 1 to 1"]),
+    (lambda d: d.update(version=True), ["version", f"reads versions 1 to {FORMAT_VERSION}"]),
     (lambda d: d.update(version=0), ["version"]),
     (lambda d: d.update(version="1"), ["version"]),
     (lambda d: d.update(units="cm"), ["units", "metres"]),

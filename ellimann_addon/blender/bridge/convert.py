@@ -12,7 +12,7 @@ import bpy
 import numpy as np
 from mathutils import Matrix
 
-from ...core.constants import MEASUREMENTS, UNIT_SPHERE_LEVEL
+from ...core.constants import FEMALE_SET, MEASUREMENTS, UNIT_SPHERE_LEVEL
 from ...core.ellipsoid import decompose_matrices_world, decompose_matrix_world, matrix_world
 from ...core.errors import FrameError, MannequinError, Problem
 from ...core.mannequin import NAME_PATTERN, Mannequin, Part, Topology
@@ -179,6 +179,17 @@ def write_collection_props(collection, mannequin):
     props.has_target = all(m in target for m in MEASUREMENTS)
     if props.has_target:
         props.target = [float(target[m]) for m in MEASUREMENTS]
+    props.reference_set = mannequin.reference_set
+    props.section_fractions = json.dumps(mannequin.section_fractions)
+
+
+def read_landmarks(props):
+    """{reference_set, section_fractions} of a mannequin collection (empty fields: the female set's)."""
+    try:
+        fractions = json.loads(props.section_fractions) if props.section_fractions else None
+    except ValueError:
+        fractions = props.section_fractions  # not JSON: Mannequin.check names the field
+    return {"reference_set": props.reference_set or FEMALE_SET, "section_fractions": fractions}
 
 
 def new_ellipsoid_object(part, rotation, center, semi_axes, collection, mesh=None):
@@ -232,7 +243,7 @@ def collection_to_mannequin(collection, check=True):
     measurements = dict(zip(MEASUREMENTS, map(float, props.target))) if props.has_target else None
     traces = {obj.ellimann.part_name: trace for obj in objects if (trace := read_trace(obj)) is not None}
     mannequin = Mannequin(topology, rotation, center, semi_axes, name=collection.name, role=props.role,
-                          measurements=measurements, traces=traces or None)
+                          measurements=measurements, traces=traces or None, **read_landmarks(props))
     return mannequin.check() if check else mannequin
 
 

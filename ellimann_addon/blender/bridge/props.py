@@ -73,6 +73,13 @@ class ELLIMANN_PG_mannequin(bpy.types.PropertyGroup):
                                description="Measured holds m_T of the mannequin (set by Measure and Synthesize)")
     measured: FloatVectorProperty(name="Measured (cm)", size=len(MEASUREMENTS), min=0.0,
                                   description="m_T of the mannequin: He, Sh, Br, Wa, Hi in cm")
+    # Text, not float properties: Blender's floats are single precision and would move the sections.
+    reference_set: StringProperty(name="Reference Set",
+                                  description="The reference set the mannequin belongs to or was synthesized from "
+                                              "(empty: female, as in files from before sets had names)")
+    section_fractions: StringProperty(name="Section Heights",
+                                      description="Where m_T cuts the mannequin, as JSON fractions of He "
+                                                  "{Sh, Br, Wa, Hi} (its reference set's; empty: the female ones)")
 
 
 classes = (ELLIMANN_PG_part, ELLIMANN_PG_mannequin)

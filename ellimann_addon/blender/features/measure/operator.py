@@ -70,11 +70,12 @@ class ELLIMANN_OT_measure_mannequin(MannequinOperator, bpy.types.Operator):
             if missing:
                 raise OperatorError(f"Cushions missing or out of date for {', '.join(missing)}: build cushions "
                                     "again, or measure on the ellipsoids")
-            values, sections = measure_meshes(meshes, girth)
+            values, sections = measure_meshes(meshes, girth, mannequin.section_fractions)
         else:
             r, c, d, g = mannequin.rotation, mannequin.center, mannequin.semi_axes, mannequin.topology.girth_mask
-            values = tailor_measurements(r, c, d, g)
-            sections = section_hulls(r, c, d, g) if self.draw_sections else {}
+            fractions = mannequin.section_fractions  # its reference set's section heights
+            values = tailor_measurements(r, c, d, g, fractions)
+            sections = section_hulls(r, c, d, g, fractions=fractions) if self.draw_sections else {}
         measured = as_dict(values)
         write_measured(collection, measured)
         if self.draw_sections:

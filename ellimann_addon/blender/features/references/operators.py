@@ -13,7 +13,7 @@ import threading
 import bpy
 from bpy.props import IntProperty
 
-from ....core.constants import ABSURD_LIMITS, MEASUREMENTS, SECTION_FRACTIONS
+from ....core.constants import ABSURD_LIMITS, MEASUREMENTS
 from ....core.errors import ElliMannError, MannequinError
 from ....core.reference_build import BuildCancelledError, build_reference_set, validate_inputs
 from ....core.reference_manifest import MANIFEST_FILE, Manifest, targets_range, write_reference_set
@@ -66,7 +66,7 @@ class Request:
         stems = [body.name for body in self.bodies]
         first = next(iter(self.base.traces.values()))
         return Manifest(name=self.name, mannequins=stems, sex=self.sex, base=BASE_STEM,
-                        section_fractions=dict(SECTION_FRACTIONS), ranges_cm=targets_range(self.targets),
+                        section_fractions=dict(self.base.section_fractions), ranges_cm=targets_range(self.targets),
                         absurd_limits_cm={k: list(v) for k, v in ABSURD_LIMITS.items()}, targets_cm=self.targets,
                         provenance={"built_by": "Blender: ElliMann > Build Reference Set",
                                     "base": {"collection": self.base.name, "traced_mesh": first.mesh,
@@ -81,8 +81,9 @@ class Request:
 def finish(operator, context, request, rms, report):
     """Write the set and load it into a new collection (one child collection per RM); report the outcome."""
     manifest = request.manifest(report)
+    rms = {stem: rm.copy(reference_set=manifest.name) for stem, rm in rms.items()}  # they are the set's now
     try:
-        write_reference_set(request.folder, rms, manifest, base=report.base)
+        write_reference_set(request.folder, rms, manifest, base=report.base.copy(reference_set=manifest.name))
     except OSError as error:
         return cancel(operator, f"Cannot write the reference set to {request.folder}: {error}")
     parent = new_collection(f"{manifest.name} (reference set)")
@@ -94,7 +95,8 @@ def finish(operator, context, request, rms, report):
     props.status = (f"{len(rms)} RMs in {request.folder}; worst m_T error {worst[0]:.3%} ({worst[1]})"
                     + (f"; each fills at least {filled:.0%} of its body" if filled is not None else ""))
     props.progress = 1.0
-    operator.report({"INFO"}, f"Built '{manifest.name}': {props.status}; use it in Synthesize > References")
+    operator.report({"INFO"}, f"Built '{manifest.name}': {props.status}; use it in Synthesize > Reference Set > "
+                              "Folder")
     return {"FINISHED"}
 
 

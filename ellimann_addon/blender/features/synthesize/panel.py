@@ -46,7 +46,9 @@ class ELLIMANN_PT_synthesize(SubPanel, bpy.types.Panel):
         options.prop(props, "normalize")
         options.prop(props, "metric")
         options.prop(props, "power")
-        options.prop(props, "references")
+        layout.row().prop(props, "reference_set", expand=True)
+        if props.reference_set == "FOLDER":
+            layout.prop(props, "references")
 
         layout.operator(ids.SYNTHESIZE_MANNEQUIN, icon="OUTLINER_OB_ARMATURE")
         row = layout.row()

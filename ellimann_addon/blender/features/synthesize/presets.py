@@ -1,6 +1,7 @@
 """Measurement presets of the Synthesize feature (Blender's preset system).
 
-The five RMs, the ten mannequins of the paper's Table 2.5 and the user's own: the shipped ones are
+The five female RMs, the ten mannequins of the paper's Table 2.5, the five male RMs and the user's own (each
+also sets the reference set it belongs to): the shipped ones are
 read from ``preset_files/`` beside this module, the user's are saved in Blender's user preset
 folder. A preset sets five fields but makes one live update (the menu's ``reset_cb`` / ``post_cb``
 hold it back), and the menu runs it through ``ELLIMANN_OT_apply_measurement_preset``, so that fields
@@ -23,7 +24,7 @@ SHIPPED_PRESETS = pathlib.Path(__file__).resolve().parent / "preset_files"
 
 
 class ELLIMANN_MT_measurement_presets(bpy.types.Menu):
-    """Measurements of the Reference Mannequins, the paper's Table 2.5 and your own presets"""
+    """Measurements of the female and male Reference Mannequins, the paper's Table 2.5 and your own presets"""
 
     bl_idname = ids.MENU_MEASUREMENT_PRESETS
     bl_label = "Measurement Presets"  # Blender shows the last preset chosen here
@@ -72,14 +73,14 @@ class ELLIMANN_OT_apply_measurement_preset(bpy.types.Operator):
 
 
 class ELLIMANN_OT_add_measurement_preset(AddPresetBase, bpy.types.Operator):
-    """Save the five measurements as a preset (or remove the selected one of your own)"""
+    """Save the five measurements and the reference set as a preset (or remove the selected one of your own)"""
 
     bl_idname = ids.ADD_MEASUREMENT_PRESET
     bl_label = "Add Measurement Preset"
     preset_menu = ids.MENU_MEASUREMENT_PRESETS
     preset_subdir = PRESET_SUBDIR
     preset_defines = ["props = bpy.context.scene.ellimann_synthesis"]
-    preset_values = [f"props.{attr}" for attr in FIELDS.values()]
+    preset_values = [f"props.{attr}" for attr in FIELDS.values()] + ["props.reference_set"]
 
     @classmethod
     def poll(cls, context):

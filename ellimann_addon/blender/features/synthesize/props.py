@@ -7,6 +7,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, PointerProperty
 from ....core.constants import ABSURD_LIMITS, MEASUREMENT_LABELS, RANGES, REFERENCE_MEASUREMENTS
 from ....core.options import SYNTHESIS
 from .live import on_request_change
+from .request import REFERENCE_SET_ITEMS
 
 
 def _measurement(key):
@@ -15,8 +16,8 @@ def _measurement(key):
     return FloatProperty(
         name=key, default=REFERENCE_MEASUREMENTS["average"][key], min=low, max=high, soft_min=soft_low,
         soft_max=soft_high, step=25, precision=2, update=on_request_change,
-        description=f"{MEASUREMENT_LABELS[key]} in cm. Reference range {soft_low:g}-{soft_high:g} cm (outside it "
-                    f"the result is extrapolated); accepted {low:g}-{high:g} cm")
+        description=f"{MEASUREMENT_LABELS[key]} in cm. The female set's reference range {soft_low:g}-{soft_high:g} "
+                    f"cm (outside its set's range the result is extrapolated); accepted {low:g}-{high:g} cm")
 
 
 def _option(name):
@@ -53,10 +54,14 @@ class ELLIMANN_PG_synthesis(bpy.types.PropertyGroup):
     target: PointerProperty(name="Last Synthesized", type=bpy.types.Collection,
                             poll=lambda _self, collection: collection.ellimann.is_mannequin,
                             description="The mannequin that Live updates")
-    references: StringProperty(name="References", subtype="DIR_PATH", default="",
-                               description="A reference-set folder: reference_set.json and the Reference "
-                                           "Mannequins' .json files it lists (Build Reference Set writes one), or "
-                                           "the five files of Table 2.3 (empty: the shipped reference_blends/)")
+    reference_set: EnumProperty(name="Reference Set", items=REFERENCE_SET_ITEMS, default="FEMALE",
+                                update=on_request_change,
+                                description="The Reference Mannequins to synthesize from: the shipped female or "
+                                            "male set, or a folder of your own")
+    references: StringProperty(name="References", subtype="DIR_PATH", default="", update=on_request_change,
+                               description="With Reference Set Folder: a reference-set folder, reference_set.json "
+                                           "and the Reference Mannequins' .json files it lists (Build Reference Set "
+                                           "writes one), or the five files of Table 2.3")
     status: StringProperty(name="Status", description="Outcome of the last live update")
     live_ms: FloatProperty(name="Live Update Time", description="Duration of the last live update (ms)")
 

@@ -3,21 +3,37 @@ core synthesis it asks for (segmented IDW over the Reference Mannequins, :func:`
 
 import bpy
 
-from ....core.constants import MEASUREMENTS
+from ....core.constants import FEMALE_SET, MEASUREMENTS
+from ....core.errors import ReferenceSetError
 from ....core.options import SynthesisOptions
-from ....core.synthesis import cached_reference_set, synthesize
+from ....core.reference_set import cached_reference_set
+from ....core.shipped_sets import MALE_SET, SHIPPED_SETS
+from ....core.synthesis import synthesize
 
 FIELDS = {key: key.lower() for key in MEASUREMENTS}  # He -> props.he
+REFERENCE_SET_ITEMS = (
+    ("FEMALE", "Female", "The shipped female Reference Mannequins (the paper's Table 2.3)"),
+    ("MALE", "Male", "The shipped male Reference Mannequins"),
+    ("FOLDER", "Folder", "Reference Mannequins of your own, in a folder"),
+)
+_SHIPPED = {"FEMALE": FEMALE_SET, "MALE": MALE_SET}
 
 
 def request_of(props):
     return {key: float(getattr(props, attr)) for key, attr in FIELDS.items()}
 
 
+def reference_of(props):
+    """The ReferenceSet the panel chooses (cached): a shipped set, or the folder in ``props.references``."""
+    if props.reference_set != "FOLDER":
+        return cached_reference_set(SHIPPED_SETS[_SHIPPED[props.reference_set]])
+    if not props.references:
+        raise ReferenceSetError("", "References", "is empty: choose the folder of your Reference Mannequins")
+    return cached_reference_set(bpy.path.abspath(props.references))
+
+
 def synthesize_request(props):
-    folder = bpy.path.abspath(props.references) if props.references else None
-    reference = cached_reference_set(folder)
-    return synthesize(reference, request_of(props), options_of(props))
+    return synthesize(reference_of(props), request_of(props), options_of(props))
 
 
 def options_of(props):
