@@ -21,6 +21,10 @@ ADD_MEASUREMENT_PRESET = "ellimann.add_measurement_preset"
 APPLY_MEASUREMENT_PRESET = "ellimann.apply_measurement_preset"
 DRAPE_GARMENT = "ellimann.drape_garment"
 EXPORT_MANNEQUIN = "ellimann.export_mannequin"
+ADD_ARMATURE = "ellimann.add_armature"
+APPLY_POSE = "ellimann.apply_pose"
+REST_POSE = "ellimann.rest_pose"
+IMPORT_BVH = "ellimann.import_bvh"
 
 PANEL_MAIN = "ELLIMANN_PT_main"
 PANEL_TRACE = "ELLIMANN_PT_trace"
@@ -30,11 +34,13 @@ PANEL_CUSHIONS = "ELLIMANN_PT_cushions"
 PANEL_MEASURE = "ELLIMANN_PT_measure"
 PANEL_SYNTHESIZE = "ELLIMANN_PT_synthesize"
 PANEL_DRAPE = "ELLIMANN_PT_drape"
+PANEL_POSE = "ELLIMANN_PT_pose"
 
-# Sub-panels of PANEL_MAIN sort by bl_order. Room is left after Measure for the Synthesize (60)
-# and Drape (70) panels that other parts of the add-on add.
+# Sub-panels of PANEL_MAIN sort by bl_order. Room is left after Measure for the Synthesize (60),
+# Pose (65) and Drape (70) panels that other parts of the add-on add.
 PANEL_ORDER = {PANEL_TRACE: 10, PANEL_PART: 20, PANEL_CLEAN: 30, PANEL_CUSHIONS: 40, PANEL_MEASURE: 50}
 SYNTHESIZE_ORDER = 60
+POSE_ORDER = 65
 DRAPE_ORDER = 70
 
 MENU_OBJECT = "ELLIMANN_MT_object"

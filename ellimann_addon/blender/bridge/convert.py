@@ -2,7 +2,8 @@
 
 An ellipsoid is an object using one shared unit-sphere mesh with ``matrix_world = S @ diag(D, 1)``;
 its topology fields live in ``Object.ellimann``. A mannequin is a collection holding those objects,
-with ``Collection.ellimann`` (role, target and measured values).
+with ``Collection.ellimann`` (role, target and measured values) and, when it has a skeleton, its rest
+joints in the ID property ``ellimann_joints`` (72 numbers: a property group's vectors hold at most 32).
 """
 
 import bpy
@@ -17,6 +18,8 @@ from ...core.mesh import icosphere
 
 UNIT_SPHERE_NAME = "ElliMann Unit Sphere"
 UNIT_SPHERE_TOLERANCE = 1e-4  # single-precision vertices of the icosphere are within 1e-7
+JOINTS_KEY = "ellimann_joints"
+RIG_KEY = "ellimann_rig"  # ID property on a mannequin's armature object (services.rig builds it)
 SIDE_COLORS = {"L": (0.85, 0.55, 0.45, 1.0), "R": (0.45, 0.6, 0.85, 1.0), "C": (0.8, 0.78, 0.72, 1.0)}
 
 
@@ -190,6 +193,7 @@ def mannequin_to_collection(mannequin, name=None, parent=None):
     """Build a new collection with one ellipsoid object per part. Nothing existing is touched."""
     collection = new_collection(name or mannequin.name or "Mannequin", parent)
     write_collection_props(collection, mannequin)
+    write_joints(collection, mannequin.joints)
     mesh = unit_sphere_mesh()
     for i, part in enumerate(mannequin.topology):
         new_ellipsoid_object(part, mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i], collection,
@@ -207,8 +211,31 @@ def collection_to_mannequin(collection, check=True):
     props = collection.ellimann
     measurements = dict(zip(MEASUREMENTS, map(float, props.target))) if props.has_target else None
     mannequin = Mannequin(topology, rotation, center, semi_axes, name=collection.name, role=props.role,
-                          measurements=measurements)
+                          measurements=measurements, joints=read_joints(collection))
     return mannequin.check() if check else mannequin
+
+
+def rig_object(collection):
+    """The armature ElliMann built for a mannequin collection, or None."""
+    if collection is None:
+        return None
+    return next((o for o in collection.objects if o.type == "ARMATURE" and o.get(RIG_KEY)), None)
+
+
+def write_joints(collection, joints):
+    """Keep rest joints (24, 3) on the collection (None removes them)."""
+    if joints is None:
+        collection.pop(JOINTS_KEY, None)
+    else:
+        collection[JOINTS_KEY] = [float(v) for v in np.asarray(joints, dtype=float).ravel()]
+
+
+def read_joints(collection):
+    """The collection's rest joints (24, 3), world space, or None if it has none."""
+    stored = collection.get(JOINTS_KEY)
+    if stored is None or len(stored) % 3:
+        return None
+    return np.array(stored, dtype=float).reshape(-1, 3)
 
 
 def update_collection_geometry(collection, mannequin):
