@@ -56,7 +56,8 @@ def write_bvh(path, names, parents, heads, rotations, root_positions, frame_time
         for child in children[i]:
             joint(child, depth + 1)
         if not children[i]:
-            lines.extend([f"{pad}  End Site", f"{pad}  {{", f"{pad}    OFFSET 0.000000 5.000000 0.000000", f"{pad}  }}"])
+            end = [f"{pad}  End Site", f"{pad}  {{", f"{pad}    OFFSET 0.000000 5.000000 0.000000", f"{pad}  }}"]
+            lines.extend(end)
         lines.append(f"{pad}}}")
 
     order = []

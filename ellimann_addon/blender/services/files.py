@@ -29,6 +29,11 @@ What a three.js / game-engine user finds in the .glb:
   semi_axes_m;
 - ``scene.extras.ellimann`` = {format, version, name, role, units, up, target_cm, measured_cm}
   (target_cm only when the mannequin has a target; measured_cm is m_T of the ellipsoids).
+
+A mannequin with an armature (``services.rig``) is a skinned glTF: one joint node per bone (SMPL names),
+every piece a skinned mesh weighted fully to its bone (the exporter writes each piece's vertices at rest
+in the armature's space, so such a node carries no transform of its own; ``extras.ellimann`` still
+gives its rest frame), the armature in its current pose, and its action (the walk) as an animation.
 """
 
 import json
@@ -42,10 +47,12 @@ from ...core.constants import MEASUREMENTS
 from ...core.errors import ElliMannError
 from ...core.files import atomic_output
 from ...core.formats import BLENDER_FORMATS, extension_of
+from ...core.poses import check_pose_name
 from ..bridge.built import built_objects, is_stale
 from ..bridge.convert import collection_to_mannequin, objects_recursive
 from ..bridge.selection import part_lookup
 from .chatter import blender_output
+from .rig import build_rig, check_rig, pose_standard
 from .scene import add_mannequin, empty_scene, shown_objects
 
 # ------------------------------------------------------------------------------------------------ glTF
@@ -106,8 +113,11 @@ def export_gltf(collection, path):
     objects = [o for o in objects_recursive(collection) if o.ellimann.is_part]
     node_extras = {o.name: part_extras(o) for o in objects}
     with atomic_output(path) as temp:
+        # Skins and animations are the exporter's defaults; the armature's node transforms are its current
+        # pose rather than its rest (a posed mannequin shows posed; an action plays the same either way).
         result = bpy.ops.export_scene.gltf(filepath=temp, export_format="GLB", export_extras=True,
-                                           collection=collection.name, export_yup=True, use_renderable=True)
+                                           collection=collection.name, export_yup=True, use_renderable=True,
+                                           export_rest_position_armature=False)
         if result != {"FINISHED"}:
             raise ElliMannError(f"path: Blender's glTF exporter did not finish ({result})")
         _set_extras(temp, node_extras, scene_extras(mannequin))
@@ -152,21 +162,30 @@ def read_glb_json(path):
 # ------------------------------------------------------------------------------------------------ mannequin files
 
 
-def write_mannequin(mannequin, paths, measured=None, cushions=False):
+def write_mannequin(mannequin, paths, measured=None, cushions=False, pose=None):
     """Write one mannequin to every .blend, .glb and .obj in ``paths`` (format from the extension), all
     from one empty scene. Returns the paths. (.json and MJCF need no Blender: ``core.writers``.)
 
-    ``cushions``: the files show the cushions instead of the ellipsoids they replace. A path of another
-    kind raises ElliMannError before anything is written; an OSError names the file that failed
-    (``filename``, as given in ``paths``).
+    ``cushions``: the files show the cushions instead of the ellipsoids they replace. ``pose``: a standard
+    pose name (``core.poses.POSE_NAMES``): the files hold the mannequin's armature, every piece bound to its
+    bone, in that pose (.obj: the posed pieces); ``walk`` is an action (.blend) and an animation (.glb)
+    looping over the scene's frames. A path of another kind, an unknown pose or a mannequin without joints
+    raises ElliMannError before anything is written; an OSError names the file that failed (``filename``,
+    as given in ``paths``).
     """
     paths = [os.fspath(p) for p in paths]
     other = [p for p in paths if extension_of(p) not in BLENDER_FORMATS]
     if other:
         raise ElliMannError(f"path: {other[0]!r} is not a .blend, .glb or .obj file")
+    if pose is not None:
+        check_pose_name(pose)
+        check_rig(mannequin)
     if paths:
         empty_scene()
         collection = add_mannequin(mannequin, measured, cushions)
+        if pose is not None:
+            rig = build_rig(collection, mannequin)
+            pose_standard(rig, mannequin.joints, pose, bpy.context.scene, f"{mannequin.name or 'Mannequin'} {pose}")
         for path in paths:
             _write_blender_file(path, collection)
     return paths

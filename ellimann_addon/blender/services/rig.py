@@ -19,8 +19,9 @@ from mathutils import Matrix, Vector
 
 from ...core import bones as core_bones
 from ...core.errors import ElliMannError
-from ...core.pose import require_joints
+from ...core.pose import clamp_pose, require_joints
 from ...core.posed import clip_convex_mesh
+from ...core.poses import MOTIONS, WALK_FPS, standard_motion
 from ...core.skeleton import JOINT_INDEX, JOINT_NAMES, PARENTS, cross_joint_pairs, joint_frames, limits, part_bones
 from ..bridge.built import built_objects
 from ..bridge.convert import RIG_KEY, ellipsoid_objects, mesh_from_arrays, rig_object, unit_sphere_mesh, world_triangles
@@ -341,6 +342,24 @@ def apply_motion(rig, poses, name, start=1, loop=False):
         if len(poses) > 1:
             closing[1] = 2.0 * translations[-1, 1] - translations[-2, 1]
     return bake_action(rig, JOINT_NAMES, rotations, translations, name, start, closing)
+
+
+def pose_standard(rig, joints, name, scene, action_name=None):
+    """Put ``rig`` (of a mannequin with rest ``joints``) in the standard pose ``name``; a motion (walk) becomes
+    a looping action with the scene's frames 1..F at its frame rate, from frame 1. Joint angles beyond their
+    limits are clamped. Returns (the poses, the clamp reports, the action or None). ElliMannError for an
+    unknown name, before anything changes."""
+    poses = standard_motion(name, joints)
+    clamped = [clamp_pose(p, joints, frame=i if name in MOTIONS else None) for i, p in enumerate(poses)]
+    poses, reports = [p for p, _ in clamped], [r for _, found in clamped for r in found]
+    if name not in MOTIONS:
+        apply_pose(rig, poses[0])
+        return poses, reports, None
+    action = apply_motion(rig, poses, action_name or f"{rig.name} {name}", start=1, loop=True)
+    scene.render.fps, scene.render.fps_base = WALK_FPS, 1.0
+    scene.frame_start, scene.frame_end = 1, len(poses)
+    scene.frame_set(1)
+    return poses, reports, action
 
 
 def action_fcurves(action, rig):

@@ -4,12 +4,11 @@ import bpy
 from bpy.props import EnumProperty
 
 from ....core.errors import ElliMannError, MannequinError
-from ....core.pose import clamp_pose
-from ....core.poses import MOTIONS, POSE_NAMES, WALK_FPS, standard_motion
+from ....core.poses import POSE_NAMES, WALK_FPS
 from ... import ids
 from ...bridge.convert import read_joints, rig_object
 from ...bridge.selection import active_mannequin
-from ...services.rig import apply_motion, apply_pose, build_rig, rest_pose
+from ...services.rig import build_rig, pose_standard, rest_pose
 from ..base import MannequinOperator, OperatorError, mannequin_or_cancel, plural
 
 POSE_LABELS = {"a_pose": "A-Pose", "t_pose": "T-Pose", "attention": "Attention", "sit": "Sit", "walk": "Walk"}
@@ -80,24 +79,16 @@ class ELLIMANN_OT_apply_pose(MannequinOperator, bpy.types.Operator):
         joints = read_joints(collection)
         if joints is None:
             raise OperatorError(f"Cannot pose '{collection.name}': it has no joints (rig it again: Add Armature)")
+        label = POSE_LABELS.get(self.pose, self.pose)
         try:
-            poses = standard_motion(self.pose, joints)
+            poses, reports, action = pose_standard(rig, joints, self.pose, context.scene,
+                                                   f"{collection.name} {label}")
         except ElliMannError as error:
             raise OperatorError(f"Cannot pose '{collection.name}': {error}") from error
-        clamped = [clamp_pose(p, joints, frame=i if self.pose in MOTIONS else None) for i, p in enumerate(poses)]
-        reports = [r for _, found in clamped for r in found]
-        poses = [p for p, _ in clamped]
-        label = POSE_LABELS.get(self.pose, self.pose)
-        if self.pose in MOTIONS:
-            scene = context.scene
-            action = apply_motion(rig, poses, f"{collection.name} {label}", start=1, loop=True)
-            scene.render.fps, scene.render.fps_base = WALK_FPS, 1.0
-            scene.frame_start, scene.frame_end = 1, len(poses)
-            scene.frame_set(1)
+        if action is not None:
             text = (f"'{collection.name}' walks: action '{action.name}', frames 1-{len(poses)} at {WALK_FPS} fps, "
                     "looping (play the timeline)")
         else:
-            apply_pose(rig, poses[0])
             text = f"'{collection.name}' in {label}"
         for report in reports:
             self.report({"WARNING"}, f"clamped: {report}")
