@@ -19,7 +19,7 @@ VERSION = "2.0.0-dev.3.10"
 SCRIPT = pathlib.Path(__file__).with_name("gltf_validate.js")
 
 
-class ValidatorUnavailable(RuntimeError):
+class ValidatorUnavailableError(RuntimeError):
     """node or npm is missing, or npm could not install the validator."""
 
 
@@ -30,7 +30,8 @@ def module_dir():
         return target
     npm = shutil.which("npm")
     if npm is None:
-        raise ValidatorUnavailable("npm is not on PATH: install Node.js 18+ (the glTF tests run the Khronos validator)")
+        raise ValidatorUnavailableError("npm is not on PATH: install Node.js 18+ (the glTF tests run the Khronos "
+                                        "validator)")
     PREFIX.mkdir(parents=True, exist_ok=True)
     with open(PREFIX / ".install.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
@@ -38,7 +39,8 @@ def module_dir():
             done = subprocess.run([npm, "install", "--prefix", str(PREFIX), "--no-audit", "--no-fund",
                                    "--loglevel=error", f"{PACKAGE}@{VERSION}"], capture_output=True, text=True)
             if done.returncode != 0 or _installed_version(target) != VERSION:
-                raise ValidatorUnavailable(f"npm could not install {PACKAGE}@{VERSION}: {done.stderr.strip()[-400:]}")
+                raise ValidatorUnavailableError(f"npm could not install {PACKAGE}@{VERSION}: "
+                                                f"{done.stderr.strip()[-400:]}")
     return target
 
 
@@ -53,10 +55,11 @@ def validate(path):
     """The validator's issues for a .glb / .gltf file (see the module docstring)."""
     node = shutil.which("node")
     if node is None:
-        raise ValidatorUnavailable("node is not on PATH: install Node.js 18+ (the glTF tests run the Khronos validator)")
+        raise ValidatorUnavailableError("node is not on PATH: install Node.js 18+ (the glTF tests run the Khronos "
+                                        "validator)")
     done = subprocess.run([node, str(SCRIPT), str(module_dir()), str(path)], capture_output=True, text=True)
     if done.returncode != 0:
-        raise ValidatorUnavailable(f"the glTF validator failed on {path}: {done.stderr.strip()[-400:]}")
+        raise ValidatorUnavailableError(f"the glTF validator failed on {path}: {done.stderr.strip()[-400:]}")
     return json.loads(done.stdout)
 
 

@@ -14,8 +14,8 @@ from ellimann_addon.core.errors import ElliMannError
 from ellimann_addon.core.mannequin import Mannequin
 from ellimann_addon.core.pose import Pose, axis_angle, clamp_pose, forward_kinematics
 from ellimann_addon.core.poses import WALK_FPS, standard_motion, standard_pose
-from ellimann_addon.core.skeleton import JOINT_INDEX, JOINT_NAMES, bone_name, joint_frames
 from ellimann_addon.core.reference_set import REFERENCE_FOLDER
+from ellimann_addon.core.skeleton import JOINT_INDEX, JOINT_NAMES, bone_name, joint_frames
 
 TOLERANCE = 2e-5  # m: Blender evaluates in single precision
 

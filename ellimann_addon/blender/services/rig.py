@@ -19,6 +19,7 @@ from mathutils import Matrix, Vector
 
 from ...core import bones as core_bones
 from ...core.errors import ElliMannError
+from ...core.motion import loop_drift
 from ...core.pose import clamp_pose, require_joints
 from ...core.posed import clip_convex_mesh
 from ...core.poses import MOTIONS, WALK_FPS, standard_motion
@@ -63,7 +64,7 @@ def build_rig(collection, mannequin):
     Raises ElliMannError before anything changes if the mannequin has no joints or a part has no bone.
     """
     joints, bones = check_rig(mannequin)
-    layout = core_bones.layout_bones(JOINT_NAMES, joints, PARENTS, joint_frames(joints), PREFERRED_CHILD)
+    layout = skeleton_layout(joints)
     frames, ranges = joint_frames(joints), limits(joints)
     constraint_limits = {}
     for index, bone in enumerate(layout):
@@ -84,6 +85,37 @@ def build_rig(collection, mannequin):
         bind_rigid(obj, rig, bone_of[obj.ellimann.part_name])
     bind_cushions(collection, mannequin, rig)
     return rig
+
+
+def skeleton_layout(joints):
+    """The bones (``core.bones.Bone``) of SMPL joints at ``joints`` (24, 3)."""
+    return core_bones.layout_bones(JOINT_NAMES, joints, PARENTS, joint_frames(joints), PREFERRED_CHILD)
+
+
+def bare_armature(name, joints, collection):
+    """An armature object at ``joints`` in ``collection``, without limits or bound pieces (what a drape's
+    colliders ride on: its motion is clamped already)."""
+    return _armature_object(name, skeleton_layout(joints), collection)
+
+
+def bind_piece(obj, rig, bone_name):
+    """Bind any mesh object rigidly to one bone of ``rig`` (its mesh made its own first if it is shared)."""
+    if obj.data.users > 1:
+        obj.data = obj.data.copy()
+    _set_weights(obj, {bone_name: np.ones(len(obj.data.vertices))})
+    _armature_modifier(obj, rig)
+
+
+def bind_weights(obj, rig, weights):
+    """Bind a mesh object to ``rig`` with per-vertex weights {bone name: (V,)} (its own mesh, not shared)."""
+    _set_weights(obj, weights)
+    _armature_modifier(obj, rig)
+
+
+def bind_across(obj, rig, point, toward, first_bone, second_bone):
+    """Bind a convex mesh object to two bones, cut at the plane through ``point`` normal to ``toward``."""
+    _split_at_joint(obj, point, toward, first_bone, second_bone)
+    _armature_modifier(obj, rig)
 
 
 def _armature_object(name, layout, collection):
@@ -333,14 +365,10 @@ def apply_pose(rig, pose):
 
 def apply_motion(rig, poses, name, start=1, loop=False):
     """Bake core poses (one per frame) as an action; ``loop``: a cycle whose next start is the first pose
-    moved on by the clip's drift along the walking direction (-Y, extrapolated from the last two frames)."""
+    moved on by the clip's drift (``core.motion.loop_drift``: along the walking direction, -Y)."""
     rotations = np.stack([p.rotations for p in poses])
     translations = np.stack([p.translation for p in poses])
-    closing = None
-    if loop:
-        closing = translations[0].copy()
-        if len(poses) > 1:
-            closing[1] = 2.0 * translations[-1, 1] - translations[-2, 1]
+    closing = translations[0] + loop_drift(poses) if loop else None
     return bake_action(rig, JOINT_NAMES, rotations, translations, name, start, closing)
 
 
