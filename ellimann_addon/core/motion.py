@@ -9,7 +9,8 @@ starting where the last one ended, shifted by the loop's drift, e.g. the walk's 
 
 import numpy as np
 
-from .pose import Pose, axis_angle
+from .pose import Pose, axis_angle, clamp_pose
+from .poses import MOTIONS, standard_motion
 
 
 def rotation_fraction(rotation, fraction):
@@ -57,3 +58,11 @@ def loop_drift(poses):
         return np.zeros(3)
     last, before = poses[-1].translation, poses[-2].translation
     return np.array([0.0, 2.0 * last[1] - before[1] - poses[0].translation[1], 0.0])
+
+
+def clamped_motion(name, joints):
+    """(poses, clamp reports, whether it loops) of the standard pose or motion ``name`` on a mannequin with
+    rest ``joints``, every joint angle clamped into its range (ElliMannError for an unknown name)."""
+    poses = standard_motion(name, joints)
+    clamped = [clamp_pose(p, joints, frame=i + 1 if name in MOTIONS else None) for i, p in enumerate(poses)]
+    return [p for p, _ in clamped], [r for _, found in clamped for r in found], name in MOTIONS

@@ -64,6 +64,7 @@ class DrapeResult:
     cpu_seconds: np.ndarray  # CPU seconds of this process per simulated frame
     vertices: np.ndarray  # final garment vertices, world (V, 3)
     fit: dict = field(default_factory=dict)  # fit_statistics against the exact pieces
+    body: object = None  # the core mannequin as the cloth last saw it (posed at the last frame of a motion)
 
     @property
     def frames(self):
@@ -315,9 +316,11 @@ def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None,
     try:
         with removed_on_failure():
             collection, obj, colliders = setup(garment, pieces, settings, name, scene.collection)
+            body = mannequin
             if motion:
                 last = animate_drape(collection, colliders, obj, mannequin, motion, loop, settings.frames)
-                exact = BodyPieces(pose_mannequin(mannequin, last), cushions, FIT_CUSHION_LEVEL)
+                body = pose_mannequin(mannequin, last)
+                exact = BodyPieces(body, cushions, FIT_CUSHION_LEVEL)
             stage = "simulating"
             collection[DRAPE_KEY] = garment.name
             wall, cpu = bake(scene, obj, settings.frames, progress)
@@ -330,7 +333,7 @@ def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None,
         if isinstance(error, RuntimeError):
             raise ElliMannError(f"Blender failed while {stage} the drape: {error}") from error
         raise
-    return DrapeResult(collection, obj, garment, pieces, wall, cpu, vertices, fit)
+    return DrapeResult(collection, obj, garment, pieces, wall, cpu, vertices, fit, body)
 
 
 def mesh_piece(name, vertices, faces):

@@ -3,9 +3,10 @@ that moves from the rest pose into a pose or a motion (``core.motion.drape_motio
 carried by the torso, so the cloth follows a walking body.
 
 The armature lives in the drape's collection (hidden), so the mannequin and its own armature are left as
-they are; each collider is bound rigidly to its piece's bone (a cushion across a joint cut there into two
-halves, as ``services.rig`` does for the mannequin), by an Armature modifier before its Collision modifier,
-which therefore sees the moving mesh. The garment gets an Armature modifier before its Cloth modifier:
+they are; the colliders, which are the moving body, are shown (solid, in renders too). Each collider is
+bound rigidly to its piece's bone (a cushion across a joint cut there into two halves, as ``services.rig``
+does for the mannequin), by an Armature modifier before its Collision modifier, which therefore sees the
+moving mesh. The garment gets an Armature modifier before its Cloth modifier:
 Blender's cloth pulls pinned vertices to that deformed mesh, so the pins (a dress's straps) go where the
 torso goes; the other vertices are the simulation's.
 """
@@ -19,6 +20,7 @@ from .rig import bake_action, bare_armature, bind_across, bind_piece, bind_weigh
 
 PIECE_KEY = "ellimann_piece"  # on a collider: the name of the piece it stands for (a part or a cushion)
 SETTLE_FRAMES = 12  # frames from rest into the first pose, at most a third of the drape
+BODY_COLOR = (0.8, 0.78, 0.72, 1.0)
 TORSO_JOINTS = ("Pelvis", "Spine1", "Spine2", "Spine3", "Neck", "L_Collar", "R_Collar")  # what carries the pins
 
 
@@ -36,7 +38,9 @@ def animate_drape(collection, colliders, garment_object, mannequin, poses, loop,
     names = topology.names
     crossing = {cushion_name(names[i], names[j]): (i, j, joint) for i, j, joint in cross_joint_pairs(topology)}
     pairs = {cushion_name(names[i], names[j]): i for i, j in topology.cushion_pairs}
-    for obj in colliders:
+    for obj in colliders:  # the moving body is what the drape shows: its colliders, solid
+        obj.display_type, obj.hide_render, obj.color = "SOLID", False, BODY_COLOR
+        obj.hide_set(False)
         piece = obj.get(PIECE_KEY, "")
         if piece in crossing:
             i, j, joint = crossing[piece]

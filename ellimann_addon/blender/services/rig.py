@@ -19,10 +19,10 @@ from mathutils import Matrix, Vector
 
 from ...core import bones as core_bones
 from ...core.errors import ElliMannError
-from ...core.motion import loop_drift
-from ...core.pose import clamp_pose, require_joints
+from ...core.motion import clamped_motion, loop_drift
+from ...core.pose import require_joints
 from ...core.posed import clip_convex_mesh
-from ...core.poses import MOTIONS, WALK_FPS, standard_motion
+from ...core.poses import WALK_FPS
 from ...core.skeleton import JOINT_INDEX, JOINT_NAMES, PARENTS, cross_joint_pairs, joint_frames, limits, part_bones
 from ..bridge.built import built_objects
 from ..bridge.convert import RIG_KEY, ellipsoid_objects, mesh_from_arrays, rig_object, unit_sphere_mesh, world_triangles
@@ -377,10 +377,8 @@ def pose_standard(rig, joints, name, scene, action_name=None):
     a looping action with the scene's frames 1..F at its frame rate, from frame 1. Joint angles beyond their
     limits are clamped. Returns (the poses, the clamp reports, the action or None). ElliMannError for an
     unknown name, before anything changes."""
-    poses = standard_motion(name, joints)
-    clamped = [clamp_pose(p, joints, frame=i if name in MOTIONS else None) for i, p in enumerate(poses)]
-    poses, reports = [p for p, _ in clamped], [r for _, found in clamped for r in found]
-    if name not in MOTIONS:
+    poses, reports, loops = clamped_motion(name, joints)
+    if not loops:
         apply_pose(rig, poses[0])
         return poses, reports, None
     action = apply_motion(rig, poses, action_name or f"{rig.name} {name}", start=1, loop=True)
