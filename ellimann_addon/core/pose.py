@@ -149,6 +149,14 @@ def forward_kinematics(joints, rotations, translation=None):
     return world, offset, posed
 
 
+def bone_matrices(joints, pose):
+    """(24, 4, 4): each bone's rigid motion from rest to ``pose`` (the matrix of :func:`forward_kinematics`)."""
+    world, offset, _ = forward_kinematics(joints, pose.rotations, pose.translation)
+    out = np.zeros((JOINT_COUNT, 4, 4))
+    out[:, :3, :3], out[:, :3, 3], out[:, 3, 3] = world, offset, 1.0
+    return out
+
+
 def pose_arrays(joints, bones, rotation, center, pose):
     """Pieces (rotation (n, 3, 3), center (n, 3)) moved with their bones (n,) by ``pose``: (rotation, center,
     posed joints). Semi-axes do not change."""

@@ -157,6 +157,11 @@ def part_bones(topology):
     return np.array([JOINT_INDEX[bone_name(part)] for part in topology], dtype=int)
 
 
+def bone_names(topology):
+    """{part name: SMPL joint name of its bone} (MannequinError if a part has none)."""
+    return {name: JOINT_NAMES[b] for name, b in zip(topology.names, part_bones(topology))}
+
+
 def cross_joint_pairs(topology):
     """The cushion pairs (first, second, joint) whose parts ride on different bones; ``joint`` is the index of
     the joint between them (the child bone's), or -1 if neither bone is the other's parent."""
