@@ -132,3 +132,35 @@ def follow_pieces(joints, anchors, before, after):
     (r0, c0, d0), (r1, c1, d1) = take(*before), take(*after)
     local = np.einsum("...ji,...j->...i", r0, np.asarray(joints, dtype=float) - c0) / d0
     return c1 + np.einsum("...ij,...j->...i", r1, local * d1)
+
+
+def interpolate_joints(reference, requests, metric, power, normalize):
+    """(B, 24, 3) joints of synthesized mannequins, or None if some Reference Mannequin has none: each left and
+    central joint with its anchor part's IDW weights and proportional scales (as that part's centre), the right
+    joints their mirror images. At an RM's measurements, that RM's joints."""
+    if reference.joints is None:
+        return None
+    from .idw import _center_scale, idw_weights
+
+    topology = reference.topology
+    anchors = anchor_indices(topology)
+    source = {int(part): s for s, part in enumerate(reference._source)}
+    own = [j for j, n in enumerate(JOINT_NAMES) if joint_side(n) != "R"]
+    missing = [JOINT_NAMES[j] for j in own if int(anchors[j]) not in source]
+    if missing:
+        raise MannequinError([Problem(JOINT_ANCHORS[missing[0]], "joints", "anchor of a left or central joint "
+                                      "must be a left or central part")])
+    slots = np.array([source[int(anchors[j])] for j in own])
+    weights = idw_weights(reference, requests, metric, power)[:, slots]  # (B, J, k)
+    rm_joints = reference.joints[:, own]  # (k, J, 3)
+    if normalize == "none":
+        mean = np.einsum("bjk,kji->bji", weights, rm_joints)
+    else:
+        horizontal, vertical = reference.size_scales(reference.measurements, normalize)  # (k, s)
+        normalized = rm_joints / _center_scale(horizontal[:, slots], vertical[:, slots])
+        horizontal, vertical = reference.size_scales(np.atleast_2d(requests), normalize)
+        mean = np.einsum("bjk,kji->bji", weights, normalized) * _center_scale(horizontal[:, slots],
+                                                                                vertical[:, slots])
+    out = np.empty((len(mean), JOINT_COUNT, 3))
+    out[:, own] = mean
+    return mirror_joints(out, "L")

@@ -175,6 +175,9 @@ def write_collection_props(collection, mannequin):
     props.has_target = all(m in target for m in MEASUREMENTS)
     if props.has_target:
         props.target = [float(target[m]) for m in MEASUREMENTS]
+    props.has_joints = mannequin.joints is not None
+    if props.has_joints:
+        props.joints = np.asarray(mannequin.joints, dtype=float).tolist()
 
 
 def new_ellipsoid_object(part, rotation, center, semi_axes, collection, mesh=None):
@@ -206,8 +209,9 @@ def collection_to_mannequin(collection, check=True):
     topology = Topology([read_part(obj) for obj in objects])
     props = collection.ellimann
     measurements = dict(zip(MEASUREMENTS, map(float, props.target))) if props.has_target else None
+    joints = np.array(props.joints, dtype=float).reshape(-1, 3) if props.has_joints else None
     mannequin = Mannequin(topology, rotation, center, semi_axes, name=collection.name, role=props.role,
-                          measurements=measurements)
+                          measurements=measurements, joints=joints)
     return mannequin.check() if check else mannequin
 
 
