@@ -11,8 +11,18 @@ import numpy as np
 
 from .constants import CENTER_LIMIT
 from .errors import MannequinError, Problem
-from .skeleton import CHILDREN, JOINT_ANCHORS, JOINT_COUNT, JOINT_INDEX, JOINT_NAMES, JOINT_TWINS, PARENTS, \
-    MAKEHUMAN_JOINTS, bone_problems, joint_side, part_bones
+from .skeleton import (
+    CHILDREN,
+    JOINT_ANCHORS,
+    JOINT_COUNT,
+    JOINT_NAMES,
+    JOINT_TWINS,
+    MAKEHUMAN_JOINTS,
+    PARENTS,
+    bone_problems,
+    joint_side,
+    part_bones,
+)
 
 SECTION_VERSION = 1
 SKELETON = "smpl24"

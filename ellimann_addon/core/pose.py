@@ -52,8 +52,9 @@ class Pose:
         angles = data.get("euler_xyz_degrees") or {}
         unknown = [k for k in angles if k not in JOINT_NAMES] if isinstance(angles, dict) else None
         if unknown is None or unknown:
-            raise ElliMannError(f"pose.euler_xyz_degrees: {'unknown joint ' + repr(unknown[0]) if unknown else 'must be an object'}"
-                                f"; joints are SMPL's ({', '.join(JOINT_NAMES[:4])}, ...)")
+            what = f"unknown joint {unknown[0]!r}" if unknown else "must be an object"
+            raise ElliMannError(f"pose.euler_xyz_degrees: {what}; joints are SMPL's "
+                                f"({', '.join(JOINT_NAMES[:4])}, ...)")
         rotations = np.repeat(np.eye(3)[None], JOINT_COUNT, axis=0)
         for i, name in enumerate(JOINT_NAMES):
             if name in angles:
@@ -244,7 +245,8 @@ def check_limits(pose, joints, frame=None):
     reports = limit_reports(pose, joints, frame)
     if reports:
         more = f" (and {len(reports) - 1} more)" if len(reports) > 1 else ""
-        raise ElliMannError(f"pose {pose.name!r}: {reports[0]}{more}" if pose.name else f"pose: {reports[0]}{more}")
+        named = f" {pose.name!r}" if pose.name and frame is None else ""
+        raise ElliMannError(f"pose{named}: {reports[0]}{more}")
 
 
 def clamp_pose(pose, joints, frame=None):

@@ -18,7 +18,6 @@ turns b, c into -b, -c.
 
 import numpy as np
 
-from .constants import CENTER_LIMIT
 from .errors import Problem
 
 JOINT_NAMES = (
