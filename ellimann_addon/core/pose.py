@@ -222,10 +222,31 @@ class LimitReport:
                 f"its range {self.low:.0f} to {self.high:.0f}")
 
 
+def _wrapped(angles, ranges):
+    """Each angle turned by whole turns to lie nearest its range's middle."""
+    middle = ranges.mean(axis=-1)
+    return middle + np.mod(angles - middle + np.pi, 2.0 * np.pi) - np.pi
+
+
+def _violation(angles, ranges):
+    return np.sum(np.maximum(0.0, np.maximum(ranges[..., 0] - angles, angles - ranges[..., 1])), axis=-1)
+
+
 def joint_angles(pose, joints):
-    """(24, 3) radians: each joint's Euler angles in its joint frame (the quantities the limits bound)."""
+    """(24, 3) radians: each joint's Euler angles in its joint frame (the quantities the limits bound).
+
+    A rotation has two XYZ Euler triples, (a, b, c) and (a + pi, pi - b, c + pi); of the two, each joint takes
+    the one within its limits (or nearer them), so ranges wider than 90 degrees about y (a shoulder's
+    abduction) work, and each angle is taken nearest its range.
+    """
     frames = joint_frames(joints)
-    return euler_xyz(np.swapaxes(frames, -1, -2) @ pose.rotations @ frames)
+    ranges = limits(joints)
+    principal = euler_xyz(np.swapaxes(frames, -1, -2) @ pose.rotations @ frames)
+    other = principal + np.array([np.pi, 0.0, np.pi])
+    other[..., 1] = np.pi - principal[..., 1]
+    principal, other = _wrapped(principal, ranges), _wrapped(other, ranges)
+    better = _violation(other, ranges) < _violation(principal, ranges) - LIMIT_TOLERANCE
+    return np.where(better[..., None], other, principal)
 
 
 def limit_reports(pose, joints, frame=None):
@@ -256,5 +277,7 @@ def clamp_pose(pose, joints, frame=None):
         return pose, []
     frames, ranges = joint_frames(joints), limits(joints)
     angles = np.clip(joint_angles(pose, joints), ranges[..., 0], ranges[..., 1])
-    rotations = frames @ from_euler_xyz(angles) @ np.swapaxes(frames, -1, -2)
+    beyond = sorted({JOINT_NAMES.index(r.joint) for r in reports})  # the others keep their rotation exactly
+    rotations = pose.rotations.copy()
+    rotations[beyond] = frames[beyond] @ from_euler_xyz(angles[beyond]) @ np.swapaxes(frames[beyond], -1, -2)
     return pose.copy(rotations=rotations), reports
