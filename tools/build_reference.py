@@ -27,10 +27,14 @@ Steps (paper, Sections 2.3.2-2.3.4):
    Table 2.3 within ADJUST_TOLERANCE; then the five are cleaned together (core.clean: registration,
    symmetry, axis relabelling against the Average RM) and checked against Table 2.3 within
    ACCEPT_TOLERANCE again.
+4. Joints: each body's SMPL joints from its own rig (skeleton.json, core.joints.joints_from_makehuman) go through
+   every step the pieces go through: mirrored with them, registered with them, and moved by the adjustment as
+   points fixed in their anchor parts (core.joints.follow_pieces).
 Deterministic: no randomness, fixed iteration counts and orders.
 """
 
 import argparse
+import json
 import pathlib
 import re
 import sys
@@ -53,6 +57,7 @@ from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS, 
 from ellimann_addon.core.ellipsoid import section_at_height
 from ellimann_addon.core.files import atomic_write_text
 from ellimann_addon.core.frames import axis_agreement, is_rotation, mirror_frame
+from ellimann_addon.core.joints import anchor_indices, follow_pieces, joints_from_makehuman
 from ellimann_addon.core.mannequin import Mannequin, Topology
 from ellimann_addon.core.measure import as_dict, section_heights
 from ellimann_addon.core.synthesis import refine
@@ -75,6 +80,7 @@ from .fitting import cell_share, hull_surface, inscribed_ellipsoid
 REPO = pathlib.Path(__file__).resolve().parents[1]
 DEFAULT_REFMODELS = REPO.parent / "shared" / "refmodels"
 BASE_FILE = "base_mannequin"
+SKELETON_FILE = "skeleton.json"  # the bodies' joints (refmodels/README.md, "Skeleton")
 REFERENCE_RM = "average"  # the RM whose axes the others are relabelled against
 # Relative m_T error the adjustment aims at: where Newton has converged, so where it stops (an
 # iteration more or less) moves no part by more than rounding; at 1e-5 that was ~0.4 um.
@@ -195,6 +201,12 @@ def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
         kept_out[twins[i]] if part.side == "R" else kept_out[i] for i, part in enumerate(topology)]
 
 
+def load_skeletons(refmodels):
+    """{body: (24, 3) SMPL joints} of the reference bodies, from the body model's own rig (skeleton.json)."""
+    data = json.loads((pathlib.Path(refmodels) / SKELETON_FILE).read_text(encoding="utf-8"))
+    return {name: joints_from_makehuman(bones) for name, bones in data["bodies"].items()}
+
+
 def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
     """Build BM and the five RMs. Returns (base, {name: rm}, report dict).
 
@@ -212,9 +224,11 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
         return Body(body.name, body.vertices + rng.uniform(-jitter, jitter, body.vertices.shape), body.faces)
 
     reference_body = load_body(refmodels, REFERENCE_BODY)
+    skeletons = load_skeletons(refmodels)
     tracing = Tracing.on(reference_body, labels)
 
     base, kept = fit_mannequin(reference_body, tracing, name=DISPLAY_NAMES[BASE_FILE], role="base")
+    base = base.copy(joints=skeletons[REFERENCE_BODY])  # joints go through every step the pieces go through
     log(f"base mannequin fitted ({len(base)} parts)")
     base = symmetrize(base)  # symmetric first: mirroring may move the lowest point
     shifts = {BASE_FILE: registration_offset(base)}  # body -> mannequin translation, to compare them
@@ -226,7 +240,7 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
         targets = REFERENCE_MEASUREMENTS[name]
         fitted, _ = fit_mannequin(bodies[name], tracing, base, kept, name=DISPLAY_NAMES[name], role="reference",
                                   measurements=dict(targets))
-        fitted = symmetrize(fitted)
+        fitted = symmetrize(fitted.copy(joints=skeletons[name]))
         shifts[name] = registration_offset(fitted)
         raw[name] = register_to_world(fitted)
         adjusted.append(adjust(raw[name], targets))
@@ -286,7 +300,10 @@ def adjust(mannequin, targets):
     if not result.converged[0]:
         raise RuntimeError(f"{mannequin.name}: the adjustment did not reach {targets} (m_T "
                            f"{as_dict(result.measured[0])}, factors {result.factors[0].round(4).tolist()})")
-    adjusted = mannequin.copy(center=result.center[0], semi_axes=result.semi_axes[0])
+    joints = follow_pieces(mannequin.joints, anchor_indices(mannequin.topology),
+                           (mannequin.rotation, mannequin.center, mannequin.semi_axes),
+                           (mannequin.rotation, result.center[0], result.semi_axes[0]))
+    adjusted = mannequin.copy(center=result.center[0], semi_axes=result.semi_axes[0], joints=joints)
     return Adjusted(adjusted, as_dict(result.factors[0]))
 
 
@@ -380,7 +397,10 @@ def check_shipped(base, rms, folder, atol=CHECK_TOLERANCE):
         if shipped.topology != fresh.topology:
             problems.append(f"{stem}: topology differs")
             continue
-        for attr in ("rotation", "center", "semi_axes"):
+        if (shipped.joints is None) != (fresh.joints is None):
+            problems.append(f"{stem}: joints {'missing' if shipped.joints is None else 'unexpected'}")
+            continue
+        for attr in ("rotation", "center", "semi_axes") + (("joints",) if fresh.joints is not None else ()):
             diff = float(np.abs(getattr(shipped, attr) - getattr(fresh, attr)).max())
             if diff > atol:
                 problems.append(f"{stem}: {attr} differs by up to {diff:.3g}")

@@ -42,6 +42,7 @@ def add_parser(commands):
                        help="skip rows whose files (every --format) are already in DIR and whole, e.g. after an "
                             "interrupted run with the same CSV and options; without it every row is written again")
     common.add_synthesis_options(batch)
+    common.add_pose_option(batch)
     batch.set_defaults(run=run, blender=needs_blender)
 
 
@@ -51,7 +52,7 @@ def needs_blender(args):
         formats = parse_formats(args.format)
     except UsageError:
         return None
-    blender = [f for f in formats if FORMATS[f].needs_blender]
+    blender = [f for f in formats if FORMATS[f].needs_blender_for(args.pose is not None)]
     return f"--format {blender[0]}" if blender else None
 
 
@@ -140,6 +141,7 @@ def run(args):
     from ..core.synthesis import synthesize_batch
 
     formats = parse_formats(args.format)
+    pose_file = common.check_pose_argument(args, formats)
     shard, shards = parse_shard(args.shard)
     rows = read_rows(args.csv)
     if not rows:
@@ -166,7 +168,7 @@ def run(args):
             chunk = jobs[start:start + CHUNK]
             result = synthesize_batch(reference, [values for _, _, values, _ in chunk], options)
             for i, (line, name, values, warnings) in enumerate(chunk):
-                report.add(_row(args, formats, result, i, line, name, values, warnings))
+                report.add(_row(args, formats, result, i, line, name, values, warnings, pose_file))
                 progress.step(name)
     except KeyboardInterrupt:
         progress.done()
@@ -194,7 +196,7 @@ def run(args):
     return 0
 
 
-def _row(args, formats, result, i, line, name, values, warnings):
+def _row(args, formats, result, i, line, name, values, warnings, pose_file=None):
     """Write (or, with --resume, keep) the files of one synthesized row; its report row. A failure is
     that row's: one line on stderr and status "error", and the batch goes on."""
     paths = [os.path.join(args.output, f"{name}.{common.extension(kind)}") for kind in formats]
@@ -210,7 +212,9 @@ def _row(args, formats, result, i, line, name, values, warnings):
         row["kept"] = True
         return row
     try:
-        common.write(result.mannequin(i, name), paths, as_dict(result.measured[i]), args.cushions)
+        mannequin = result.mannequin(i, name)
+        frames = common.pose_frames(args, mannequin, pose_file)
+        common.write(mannequin, paths, as_dict(result.measured[i]), args.cushions, frames, args.fps)
     except (ElliMannError, OSError, RuntimeError) as error:
         common.say(f"{PROG} batch: line {line}: failed: {common.one_line(error)}")
         return common.report_row(line, name, "error", common.one_line(error), values)

@@ -17,6 +17,7 @@ import numpy as np
 from .constants import ABSURD_LIMITS, CENTER_LIMIT, MEASUREMENTS, SEMI_AXIS_LIMITS
 from .errors import MannequinError, Problem
 from .files import atomic_write_text
+from .joints import joint_problems, joints_from_dict, joints_to_dict
 
 FORMAT = "ellimann.mannequin"
 FORMAT_VERSION = 1
@@ -210,7 +211,8 @@ def _letter(name):
 
 @dataclass
 class Mannequin:
-    """A topology with geometry. ``measurements`` are the requested/target tailor measurements in cm."""
+    """A topology with geometry. ``measurements`` are the requested/target tailor measurements in cm; ``joints``
+    None or the (24, 3) rest joint centres in SMPL order (core.skeleton, core.joints)."""
 
     topology: Topology
     rotation: np.ndarray
@@ -219,11 +221,13 @@ class Mannequin:
     name: str = ""
     role: str = "synthesized"
     measurements: dict = field(default=None)
+    joints: np.ndarray = None
 
     def __post_init__(self):
         self.rotation = np.asarray(self.rotation, dtype=float)
         self.center = np.asarray(self.center, dtype=float)
         self.semi_axes = np.asarray(self.semi_axes, dtype=float)
+        self.joints = None if self.joints is None else np.asarray(self.joints, dtype=float)
 
     def __len__(self):
         return len(self.topology)
@@ -231,9 +235,15 @@ class Mannequin:
     def copy(self, **changes):
         values = dict(topology=self.topology, rotation=self.rotation.copy(), center=self.center.copy(),
                       semi_axes=self.semi_axes.copy(), name=self.name, role=self.role,
-                      measurements=dict(self.measurements) if self.measurements else None)
+                      measurements=dict(self.measurements) if self.measurements else None,
+                      joints=None if self.joints is None else self.joints.copy())
         values.update(changes)
         return Mannequin(**values)
+
+    def translated(self, offset):
+        """The mannequin moved by ``offset`` (3,) m, its joints with it."""
+        offset = np.asarray(offset, dtype=float)
+        return self.copy(center=self.center + offset, joints=None if self.joints is None else self.joints + offset)
 
     def problems(self):
         """Geometry problems, each naming the ellipsoid and field (the topology validated itself)."""
@@ -277,7 +287,7 @@ class Mannequin:
                 elif det[i] < 0.0:
                     out.append(Problem(part.name, "rotation", "is a left-handed frame (det -1)"))
         out += measurement_problems(self.measurements)
-        return out
+        return out + joint_problems(self)
 
     def check(self):
         """Raise MannequinError listing every problem; return self when valid."""
@@ -302,6 +312,7 @@ class Mannequin:
                          semi_axes=self.semi_axes[order])
 
     def to_dict(self):
+        joints = {} if self.joints is None else {"joints": joints_to_dict(self.joints)}
         return {
             "format": FORMAT,
             "version": FORMAT_VERSION,
@@ -314,6 +325,7 @@ class Mannequin:
                      axes=self.rotation[i].T.tolist(), semi_axes=self.semi_axes[i].tolist())
                 for i, part in enumerate(self.topology)
             ],
+            **joints,
         }
 
     @classmethod
@@ -367,7 +379,8 @@ class Mannequin:
         if problems:
             raise MannequinError(problems)
         mannequin = cls(topology, np.swapaxes(np.array(arrays["axes"]), 1, 2), np.array(arrays["center"]),
-                        np.array(arrays["semi_axes"]), name=name, role=role, measurements=measurements)
+                        np.array(arrays["semi_axes"]), name=name, role=role, measurements=measurements,
+                        joints=joints_from_dict(data.get("joints")))
         return mannequin.check() if check else mannequin
 
     def to_json(self):

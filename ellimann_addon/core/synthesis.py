@@ -54,6 +54,7 @@ import numpy as np
 from .constants import CENTER_LIMIT, MEASUREMENTS, SEMI_AXIS_LIMITS
 from .errors import ElliMannError, MannequinError
 from .idw import idw_weights, interpolate
+from .joints import anchor_indices, follow_pieces, interpolate_joints
 from .mannequin import Mannequin
 from .measure import as_dict, tailor_measurements
 from .options import (
@@ -94,6 +95,7 @@ class Synthesis:
     factors: np.ndarray  # (B, 5) exact-mode deformation factors (ones for IDW)
     converged: np.ndarray  # (B,) exact mode reached its tolerance (True for IDW)
     mode: str
+    joints: np.ndarray = None  # (B, 24, 3) rest joints (core.joints), None if the RMs have none
 
     def __len__(self):
         return len(self.requests)
@@ -101,7 +103,8 @@ class Synthesis:
     def mannequin(self, i, name=None):
         me = as_dict(self.requests[i])
         return Mannequin(self.topology, self.rotation[i], self.center[i], self.semi_axes[i],
-                         name=name or mannequin_name(me), role="synthesized", measurements=me)
+                         name=name or mannequin_name(me), role="synthesized", measurements=me,
+                         joints=None if self.joints is None else self.joints[i])
 
     def relative_error(self):
         """(B, 5) |m_T - request| / request in % (:func:`relative_error`)."""
@@ -149,6 +152,7 @@ def synthesize_batch(reference, requests, options=None, *, measure=True, toleran
     mode = options.mode
     requests = validate_requests(requests)
     rotation, center, semi_axes = interpolate(reference, requests, options.metric, options.power, options.normalize)
+    joints = interpolate_joints(reference, requests, options.metric, options.power, options.normalize)
     girth = reference.topology.girth_mask
     measured = tailor_measurements(rotation, center, semi_axes, girth) if (measure or mode == "exact") else None
     factors = np.ones_like(requests)
@@ -156,10 +160,14 @@ def synthesize_batch(reference, requests, options=None, *, measure=True, toleran
     if mode == "exact":
         result = refine(reference.topology, rotation, center, semi_axes, requests, measured, tolerance,
                         jacobian=reference.refine_jacobian())
+        if joints is not None:  # the joints move with their anchor pieces
+            joints = follow_pieces(joints, anchor_indices(reference.topology), (rotation, center, semi_axes),
+                                   (rotation, result.center, result.semi_axes))
         center, semi_axes, measured = result.center, result.semi_axes, result.measured
         factors, converged = result.factors, result.converged
     check_plausible(reference.topology, requests, rotation, center, semi_axes)
-    return Synthesis(reference.topology, requests, rotation, center, semi_axes, measured, factors, converged, mode)
+    return Synthesis(reference.topology, requests, rotation, center, semi_axes, measured, factors, converged, mode,
+                     joints)
 
 
 def synthesize(reference, request, options=None, **fields):

@@ -2,8 +2,7 @@
 
 An ellipsoid is an object using one shared unit-sphere mesh with ``matrix_world = S @ diag(D, 1)``;
 its topology fields live in ``Object.ellimann``. A mannequin is a collection holding those objects,
-with ``Collection.ellimann`` (role, target and measured values) and, when it has a skeleton, its rest
-joints in the ID property ``ellimann_joints`` (72 numbers: a property group's vectors hold at most 32).
+with ``Collection.ellimann`` (role, target and measured values, rest joints when it has a skeleton).
 """
 
 import bpy
@@ -18,7 +17,6 @@ from ...core.mesh import icosphere
 
 UNIT_SPHERE_NAME = "ElliMann Unit Sphere"
 UNIT_SPHERE_TOLERANCE = 1e-4  # single-precision vertices of the icosphere are within 1e-7
-JOINTS_KEY = "ellimann_joints"
 RIG_KEY = "ellimann_rig"  # ID property on a mannequin's armature object (services.rig builds it)
 SIDE_COLORS = {"L": (0.85, 0.55, 0.45, 1.0), "R": (0.45, 0.6, 0.85, 1.0), "C": (0.8, 0.78, 0.72, 1.0)}
 
@@ -178,6 +176,9 @@ def write_collection_props(collection, mannequin):
     props.has_target = all(m in target for m in MEASUREMENTS)
     if props.has_target:
         props.target = [float(target[m]) for m in MEASUREMENTS]
+    props.has_joints = mannequin.joints is not None
+    if props.has_joints:
+        props.joints = np.asarray(mannequin.joints, dtype=float).tolist()
 
 
 def new_ellipsoid_object(part, rotation, center, semi_axes, collection, mesh=None):
@@ -193,7 +194,6 @@ def mannequin_to_collection(mannequin, name=None, parent=None):
     """Build a new collection with one ellipsoid object per part. Nothing existing is touched."""
     collection = new_collection(name or mannequin.name or "Mannequin", parent)
     write_collection_props(collection, mannequin)
-    write_joints(collection, mannequin.joints)
     mesh = unit_sphere_mesh()
     for i, part in enumerate(mannequin.topology):
         new_ellipsoid_object(part, mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i], collection,
@@ -222,20 +222,10 @@ def rig_object(collection):
     return next((o for o in collection.objects if o.type == "ARMATURE" and o.get(RIG_KEY)), None)
 
 
-def write_joints(collection, joints):
-    """Keep rest joints (24, 3) on the collection (None removes them)."""
-    if joints is None:
-        collection.pop(JOINTS_KEY, None)
-    else:
-        collection[JOINTS_KEY] = [float(v) for v in np.asarray(joints, dtype=float).ravel()]
-
-
 def read_joints(collection):
     """The collection's rest joints (24, 3), world space, or None if it has none."""
-    stored = collection.get(JOINTS_KEY)
-    if stored is None or len(stored) % 3:
-        return None
-    return np.array(stored, dtype=float).reshape(-1, 3)
+    props = collection.ellimann
+    return np.array(props.joints, dtype=float).reshape(-1, 3) if props.has_joints else None
 
 
 def update_collection_geometry(collection, mannequin):

@@ -9,6 +9,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatVectorProperty, PointerProperty, StringProperty
 
 from ...core.constants import MEASUREMENT_LABELS, MEASUREMENTS
+from ...core.skeleton import JOINT_COUNT
 
 SIDE_ITEMS = (
     ("L", "Left", "Left side of the body (+X, Blender's .L)"),
@@ -70,6 +71,11 @@ class ELLIMANN_PG_mannequin(bpy.types.PropertyGroup):
     measured: FloatVectorProperty(name="Measured (cm)", size=len(MEASUREMENTS), min=0.0,
                                   description="m_T of the mannequin: He, Sh, Br, Wa, Hi in cm")
 
+    has_joints: BoolProperty(name="Has Joints", default=False,
+                             description="Joints holds the mannequin's rest joint centres (its skeleton, for posing)")
+    joints: FloatVectorProperty(name="Joints (m)", size=(JOINT_COUNT, 3), subtype="NONE",
+                                description="Rest joint centres in SMPL order (Pelvis, L_Hip, R_Hip, ...), x, y, z "
+                                            "each, in metres")
 
 classes = (ELLIMANN_PG_part, ELLIMANN_PG_mannequin)
 
