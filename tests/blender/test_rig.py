@@ -72,7 +72,7 @@ def test_bones_are_the_smpl_joints_and_every_piece_is_bound(rigged, average):
         else:  # a cushion: its pieces' bones, every vertex on exactly one of them, fully
             assert groups == {bones[obj.ellimann.part_name], bones[obj.ellimann.partner]}
             assert all(len(v.groups) == 1 and v.groups[0].weight == 1.0 for v in obj.data.vertices)
-    assert np.abs(read_joints(rigged) - average.joints).max() < 1e-12
+    assert np.abs(read_joints(rigged) - average.joints).max() < 1e-6  # kept in single precision
 
 
 def test_a_piece_follows_its_rotated_bone(rigged, average):

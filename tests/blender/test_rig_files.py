@@ -8,10 +8,11 @@ import pytest
 
 from devkit import gltf_skin, gltf_validator
 from ellimann_addon.blender.bridge.convert import objects_recursive, rig_object
-from ellimann_addon.blender.services.files import write_mannequin
+from ellimann_addon.blender.services.posing import write_posed
 from ellimann_addon.blender.services.rig import action_fcurves
 from ellimann_addon.core.errors import ElliMannError
 from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.motion import clamped_motion
 from ellimann_addon.core.poses import standard_motion
 from ellimann_addon.core.reference_set import REFERENCE_FOLDER
 from ellimann_addon.core.skeleton import JOINT_NAMES, bone_name
@@ -22,6 +23,12 @@ Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  #
 @pytest.fixture(scope="module")
 def average():
     return Mannequin.load(REFERENCE_FOLDER / "average.json")
+
+
+def write_mannequin(mannequin, paths, cushions=False, pose="a_pose"):
+    """What ``ellimann synth ... --pose NAME -o x.glb`` does for the Blender formats."""
+    frames = clamped_motion(pose, mannequin.joints)[0] if mannequin.joints is not None else [None]
+    return write_posed(mannequin, frames, paths, cushions)
 
 
 def evaluated_world(obj):
@@ -106,10 +113,11 @@ def test_a_posed_obj_holds_the_posed_pieces(average, tmp_path):
 
 
 @pytest.mark.parametrize("change, message", [({"pose": "dance"}, "unknown pose 'dance'"),
-                                             ({"joints": None}, "has no joints")])
+                                             ({"joints": None}, "has no joints"),
+                                             ({"path": "x.fbx"}, "is not a .blend, .glb or .obj file")])
 def test_refused_before_anything_is_written(average, tmp_path, change, message):
     pose = change.get("pose", "sit")
     mannequin = average.copy(joints=None) if "joints" in change else average
     with pytest.raises(ElliMannError, match=message):
-        write_mannequin(mannequin, [tmp_path / "x.glb", tmp_path / "x.blend"], pose=pose)
+        write_mannequin(mannequin, [tmp_path / "x.glb", tmp_path / change.get("path", "x.blend")], pose=pose)
     assert not list(tmp_path.iterdir())

@@ -47,12 +47,10 @@ from ...core.constants import MEASUREMENTS
 from ...core.errors import ElliMannError
 from ...core.files import atomic_output
 from ...core.formats import BLENDER_FORMATS, extension_of
-from ...core.poses import check_pose_name
 from ..bridge.built import built_objects, is_stale
 from ..bridge.convert import collection_to_mannequin, objects_recursive
 from ..bridge.selection import part_lookup
 from .chatter import blender_output
-from .rig import build_rig, check_rig, pose_standard
 from .scene import add_mannequin, empty_scene, shown_objects
 
 # ------------------------------------------------------------------------------------------------ glTF
@@ -162,36 +160,35 @@ def read_glb_json(path):
 # ------------------------------------------------------------------------------------------------ mannequin files
 
 
-def write_mannequin(mannequin, paths, measured=None, cushions=False, pose=None):
+def write_mannequin(mannequin, paths, measured=None, cushions=False):
     """Write one mannequin to every .blend, .glb and .obj in ``paths`` (format from the extension), all
-    from one empty scene. Returns the paths. (.json and MJCF need no Blender: ``core.writers``.)
+    from one empty scene. Returns the paths. (.json and MJCF need no Blender: ``core.writers``; a posed
+    mannequin: ``services.posing``.)
 
-    ``cushions``: the files show the cushions instead of the ellipsoids they replace. ``pose``: a standard
-    pose name (``core.poses.POSE_NAMES``): the files hold the mannequin's armature, every piece bound to its
-    bone, in that pose (.obj: the posed pieces); ``walk`` is an action (.blend) and an animation (.glb)
-    looping over the scene's frames. A path of another kind, an unknown pose or a mannequin without joints
-    raises ElliMannError before anything is written; an OSError names the file that failed (``filename``,
-    as given in ``paths``).
+    ``cushions``: the files show the cushions instead of the ellipsoids they replace. A path of another
+    kind raises ElliMannError before anything is written; an OSError names the file that failed
+    (``filename``, as given in ``paths``).
     """
+    paths = checked_paths(paths)
+    if paths:
+        empty_scene()
+        collection = add_mannequin(mannequin, measured, cushions)
+        for path in paths:
+            write_blender_file(path, collection)
+    return paths
+
+
+def checked_paths(paths):
+    """``paths`` as strings; ElliMannError naming the first that is not a .blend, .glb or .obj file."""
     paths = [os.fspath(p) for p in paths]
     other = [p for p in paths if extension_of(p) not in BLENDER_FORMATS]
     if other:
         raise ElliMannError(f"path: {other[0]!r} is not a .blend, .glb or .obj file")
-    if pose is not None:
-        check_pose_name(pose)
-        check_rig(mannequin)
-    if paths:
-        empty_scene()
-        collection = add_mannequin(mannequin, measured, cushions)
-        if pose is not None:
-            rig = build_rig(collection, mannequin)
-            pose_standard(rig, mannequin.joints, pose, bpy.context.scene, f"{mannequin.name or 'Mannequin'} {pose}")
-        for path in paths:
-            _write_blender_file(path, collection)
     return paths
 
 
-def _write_blender_file(path, collection):
+def write_blender_file(path, collection):
+    """Write the scene holding ``collection`` to ``path`` (.blend, .glb or .obj by its extension), atomically."""
     kind = extension_of(path)
     if kind == "glb":  # atomic itself; leaves out what renders do not show (ellipsoids a cushion replaces)
         with blender_output():
