@@ -66,3 +66,7 @@ def validate(path):
 def errors(issues):
     """The messages of severity 0 (errors)."""
     return [m for m in issues["messages"] if m["severity"] == 0]
+
+
+if __name__ == "__main__":  # python3 -m devkit.gltf_validator: install it now (CI does, before the tests)
+    print(f"glTF validator {VERSION} in {module_dir()}")

@@ -55,8 +55,7 @@ def motion_onto(collection, path, rig="AUTO"):
 
 
 class ELLIMANN_OT_import_bvh(MannequinOperator, ImportHelper, bpy.types.Operator):
-    """Import a BVH motion clip onto the active mannequin's armature (bones mapped by name: MakeHuman/CMU or
-    Mixamo); joint angles beyond their limits are clamped, each reported with its joint and frame"""
+    """Import a BVH clip onto the active mannequin's armature by bone names, clamping and reporting passed limits"""
 
     bl_idname = ids.IMPORT_BVH
     bl_label = "Import BVH Motion"

@@ -34,8 +34,7 @@ def has_rig(context):
 
 
 class ELLIMANN_OT_add_armature(MannequinOperator, bpy.types.Operator):
-    """Build an armature at the active mannequin's joints (SMPL names), its pieces bound to their bones, its
-    joints' limits as Limit Rotation constraints (replaces an armature ElliMann built before)"""
+    """Build an armature at the active mannequin's joints (SMPL names), each piece bound to its bone, limits enforced"""
 
     bl_idname = ids.ADD_ARMATURE
     bl_label = "Add Armature"
@@ -60,8 +59,7 @@ class ELLIMANN_OT_add_armature(MannequinOperator, bpy.types.Operator):
 
 
 class ELLIMANN_OT_apply_pose(MannequinOperator, bpy.types.Operator):
-    """Put the active mannequin's armature in a standard pose (walk: the cycle as a looping action on the
-    timeline). Measurements stay the rest pose's"""
+    """Put the active mannequin's armature in a standard pose (walk: a looping action); m_T stays the rest pose's"""
 
     bl_idname = ids.APPLY_POSE
     bl_label = "Apply Pose"

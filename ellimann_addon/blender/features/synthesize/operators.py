@@ -14,8 +14,7 @@ from .request import request_of, synthesize_request
 
 
 class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
-    """Build a new mannequin from the five measurements (segmented IDW over the Reference Mannequins), with an
-    armature at its joints when the references have them"""
+    """Build a new mannequin from the five measurements (segmented IDW over the RMs), rigged if they have joints"""
 
     bl_idname = ids.SYNTHESIZE_MANNEQUIN
     bl_label = "Synthesize"
