@@ -185,7 +185,10 @@ def bind_rigid(obj, rig, bone_name):
 
 
 def _set_weights(obj, weights):
-    obj.vertex_groups.clear()
+    """Replace the object's bone groups (those named after joints) by ``weights``; other groups (a cloth's pins)
+    stay."""
+    for group in [g for g in obj.vertex_groups if g.name in JOINT_INDEX]:
+        obj.vertex_groups.remove(group)
     for bone_name, values in weights.items():
         group = obj.vertex_groups.new(name=bone_name)
         for value in np.unique(values[values > 0]):
@@ -268,7 +271,8 @@ def remove_rig(collection):
         if obj.ellimann.kind == "ELLIPSOID" and obj.data.get(UNIT_SPHERE_BONE_KEY):
             obj.data = shared
         elif obj.type == "MESH":
-            obj.vertex_groups.clear()
+            for group in [g for g in obj.vertex_groups if g.name in JOINT_INDEX]:
+                obj.vertex_groups.remove(group)
         obj.parent = None
         obj.matrix_world = world
     armature = rig.data
