@@ -162,6 +162,27 @@ def _inside_mesh(points, vertices, faces):
     return out
 
 
+def pieces_contain(ellipsoids, meshes, points):
+    """(P,) bool: which points lie in the union of ellipsoids (rotation, center, semi_axes arrays, or None)
+    and convex meshes (a list of (vertices, faces))."""
+    points = np.asarray(points, dtype=float)
+    inside = np.zeros(len(points), dtype=bool)
+    if ellipsoids is not None and len(ellipsoids[0]):
+        inside |= _inside_ellipsoids(points, *ellipsoids)
+    for vertices, faces in meshes:
+        rest = ~inside
+        inside[rest] |= _inside_mesh(points[rest], vertices, faces)
+    return inside
+
+
+def body_pieces(body):
+    """The pieces of a :class:`PosedBody` as (ellipsoids, meshes) for :func:`pieces_contain`: the ellipsoids in
+    no cushion (all of them if it has no cushions) and the cushion meshes."""
+    m = body.mannequin
+    single = m.topology.single_parts(cushions=bool(body.cushions))
+    return (m.rotation[single], m.center[single], m.semi_axes[single]), [(c.vertices, c.faces) for c in body.cushions]
+
+
 def union_volume(ellipsoids, meshes, samples=400_000, seed=0, chunk=50_000):
     """Monte Carlo volume (m^3) of the union of ellipsoids (rotation, center, semi_axes arrays, or None) and
     convex meshes (a list of (vertices, faces)), with its standard error: (volume, error). Uniform samples in
@@ -178,13 +199,7 @@ def union_volume(ellipsoids, meshes, samples=400_000, seed=0, chunk=50_000):
     hits = 0
     for start in range(0, samples, chunk):
         points = low + rng.random((min(chunk, samples - start), 3)) * (high - low)
-        inside = np.zeros(len(points), dtype=bool)
-        if ellipsoids is not None and len(ellipsoids[0]):
-            inside |= _inside_ellipsoids(points, *ellipsoids)
-        for vertices, faces in meshes:
-            rest = ~inside
-            inside[rest] |= _inside_mesh(points[rest], vertices, faces)
-        hits += int(inside.sum())
+        hits += int(pieces_contain(ellipsoids, meshes, points).sum())
     box = float(np.prod(high - low))
     share = hits / samples
     return box * share, box * np.sqrt(share * (1.0 - share) / samples)
@@ -192,7 +207,4 @@ def union_volume(ellipsoids, meshes, samples=400_000, seed=0, chunk=50_000):
 
 def body_volume(body, samples=400_000, seed=0):
     """:func:`union_volume` of a :class:`PosedBody` (its pieces that are not in cushions, and its cushions)."""
-    m = body.mannequin
-    single = m.topology.single_parts(cushions=bool(body.cushions))
-    return union_volume((m.rotation[single], m.center[single], m.semi_axes[single]),
-                        [(c.vertices, c.faces) for c in body.cushions], samples, seed)
+    return union_volume(*body_pieces(body), samples, seed)

@@ -5,7 +5,7 @@ that are exactly the cushion at rest."""
 import numpy as np
 import pytest
 
-from ellimann_addon.core import pose as P
+from ellimann_addon.core import pose as kinematics
 from ellimann_addon.core import poses
 from ellimann_addon.core.cushion import cushion_meshes
 from ellimann_addon.core.mannequin import Mannequin
@@ -34,7 +34,8 @@ def elbows_bent(joints, degrees=90.0):
     pose = poses.t_pose(joints)
     for side in "LR":
         j = JOINT_INDEX[f"{side}_Elbow"]
-        pose.rotations[j] = P.axis_angle(joint_frames(joints)[j][:, 0], np.radians(degrees)) @ pose.rotations[j]
+        flex = kinematics.axis_angle(joint_frames(joints)[j][:, 0], np.radians(degrees))
+        pose.rotations[j] = flex @ pose.rotations[j]
     return pose
 
 
@@ -57,7 +58,7 @@ def test_the_rig_splits_exactly_the_cushions_across_joints(average, rig):
     for whole, halves in split.items():
         assert whole not in names and set(halves) <= names
     assert len(rig.meshes) == len(average.topology.cushion_pairs) + len(split)
-    rest = rig.pose(P.rest_pose())
+    rest = rig.pose(kinematics.rest_pose())
     for mesh, posed in zip(rig.meshes, rest.cushions):
         assert np.allclose(mesh.vertices, posed.vertices, atol=1e-15)  # the rest pose moves nothing
 
@@ -101,9 +102,9 @@ def test_the_hull_of_a_bent_elbow_webs_where_the_split_cushion_does_not(average,
 def test_posing_with_the_rig_is_posing_every_piece_rigidly(average, rig):
     pose = poses.sit(average.joints)
     body = rig.pose(pose)
-    same = P.pose_mannequin(average, pose)
+    same = kinematics.pose_mannequin(average, pose)
     assert np.array_equal(body.mannequin.center, same.center) and np.array_equal(body.mannequin.rotation,
                                                                                   same.rotation)
-    world, offset, _ = P.forward_kinematics(average.joints, pose.rotations, pose.translation)
+    world, offset, _ = kinematics.forward_kinematics(average.joints, pose.rotations, pose.translation)
     for mesh, posed in zip(rig.meshes, body.cushions):
         assert np.allclose(posed.vertices, mesh.vertices @ world[mesh.bone].T + offset[mesh.bone], atol=1e-12)
