@@ -10,9 +10,9 @@ from ...core.cushion import mannequin_cushions
 from ...core.errors import MannequinError, Problem
 from ...core.frames import rigid_matrix
 from ..bridge.built import built_collection, new_cushion_object, remove_built
-from ..bridge.convert import collection_to_mannequin
+from ..bridge.convert import collection_to_mannequin, rig_object
 from ..bridge.selection import part_lookup
-from .rig import bind_cushions, rig_of
+from .rig import bind_cushions
 
 
 def rigid_frame(rotation, center):
@@ -46,6 +46,6 @@ def build_cushions(collection, subdivisions=CUSHION_LEVEL, mannequin=None):
         objects.append(new_cushion_object(hull.name, parts[first], parts[second], hull.vertices, hull.faces,
                                           rigid_frame(mannequin.rotation[hull.first], mannequin.center[hull.first]),
                                           target))
-    if rig_of(collection) is not None and mannequin.joints is not None:  # a rigged mannequin: bind them too
+    if rig_object(collection) is not None and mannequin.joints is not None:  # a rigged mannequin: bind them too
         bind_cushions(collection, mannequin)
     return objects, removed

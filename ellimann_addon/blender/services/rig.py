@@ -38,11 +38,6 @@ UNIT_SPHERE_BONE_KEY = "ellimann_unit_sphere_bone"  # on a per-bone copy of the 
 # ------------------------------------------------------------------------------------------------ lookups
 
 
-def rig_of(collection):
-    """The armature ElliMann built for a mannequin collection, or None."""
-    return rig_object(collection)
-
-
 def bone_frames(rig):
     """(n, 3, 3) rest frames of the rig's bones in bone order (columns = the bone's axes, armature space)."""
     return np.array([np.array(b.matrix_local)[:3, :3] for b in rig.data.bones])
@@ -259,7 +254,7 @@ def _split_at_joint(cushion, point, toward, first_bone, second_bone):
 
 def remove_rig(collection):
     """Remove a mannequin's armature and unbind its pieces (shared unit sphere back, world matrices kept)."""
-    rig = rig_of(collection)
+    rig = rig_object(collection)
     if rig is None:
         return False
     shared = unit_sphere_mesh()
@@ -401,15 +396,3 @@ def action_fcurves(action, rig):
 
     channelbag = anim_utils.action_get_channelbag_for_slot(action, rig.animation_data.action_slot)
     return channelbag.fcurves if channelbag is not None else []
-
-
-def world_rigid(rig, names):
-    """(n, 4, 4) rigid motion of each joint of ``names`` from rest to its evaluated pose, world space."""
-    rig_world = np.array(rig.matrix_world)
-    inverse = np.linalg.inv(rig_world)
-    motions = []
-    for name in names:
-        pose_bone = rig.pose.bones[name]
-        posed = np.array(pose_bone.matrix) @ np.linalg.inv(np.array(pose_bone.bone.matrix_local))
-        motions.append(rig_world @ posed @ inverse)
-    return np.array(motions)
