@@ -23,7 +23,7 @@ from ellimann_addon.core import garments
 from ellimann_addon.core.collision import collision_pieces, triangle_count
 from ellimann_addon.core.garment_fit import BodyPieces, fit_statistics, mesh_distance
 from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.motion import clamped_motion, drape_motion, loop_drift
+from ellimann_addon.core.motion import clamped_motion
 from ellimann_addon.core.skeleton import JOINT_NAMES, RIG_NAME_MAPS
 from ellimann_addon.core.synthesis import REFERENCE_FOLDER
 from tools.bodies import load_obj
@@ -74,12 +74,12 @@ def compare(mannequin, body_vertices, body_faces, bones, frames):
 
     from ellimann_addon.blender.services import drape
     from ellimann_addon.blender.services.chatter import blender_output
-    from ellimann_addon.blender.services.drape_motion import animate_drape, settle_frames
+    from ellimann_addon.blender.services.drape_motion import animate_drape, body_motion, settle_frames
     from ellimann_addon.blender.services.rig import bake_action, bare_armature, bind_weights
     from ellimann_addon.blender.services.scene import empty_scene
 
     walk, _, _ = clamped_motion("walk", mannequin.joints)
-    motion = drape_motion(walk, frames, settle_frames(frames), True, loop_drift(walk))
+    motion = body_motion(walk, frames, True)
     settings = drape.DrapeSettings(frames=frames, edge=EDGE)
     exact = BodyPieces(mannequin, cushions=True, subdivisions=4)
     garment = garments.make_garment(mannequin, "tube_dress", edge=EDGE)

@@ -11,6 +11,7 @@ import numpy as np
 
 from .pose import Pose, axis_angle, clamp_pose
 from .poses import MOTIONS, standard_motion
+from .skeleton import JOINT_INDEX
 
 
 def rotation_fraction(rotation, fraction):
@@ -48,6 +49,21 @@ def drape_motion(poses, frames, settle, loop=False, drift=None):
         pose = poses[position]
         out.append(pose.copy(translation=pose.translation + cycle * shift))
         index += 1
+    return out
+
+
+def arms_out(poses, degrees):
+    """``poses`` with both arms turned ``degrees`` further out from the body at the shoulder (abduction, in the
+    collar's axes, mirrored: the left arm about -Y, the right about +Y), everything else as it was."""
+    left, right = JOINT_INDEX["L_Shoulder"], JOINT_INDEX["R_Shoulder"]
+    turn = {left: axis_angle(np.array([0.0, -1.0, 0.0]), np.radians(degrees)),
+            right: axis_angle(np.array([0.0, 1.0, 0.0]), np.radians(degrees))}
+    out = []
+    for pose in poses:
+        rotations = pose.rotations.copy()
+        for joint, rotation in turn.items():
+            rotations[joint] = rotation @ rotations[joint]
+        out.append(pose.copy(rotations=rotations))
     return out
 
 

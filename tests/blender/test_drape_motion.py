@@ -7,11 +7,11 @@ import pytest
 
 from devkit.blender_scene import state
 from ellimann_addon.blender.services.drape import CLOTH_NAME, PIN_GROUP, DrapeSettings, drape, evaluated_vertices
-from ellimann_addon.blender.services.drape_motion import PIECE_KEY, TORSO_JOINTS, settle_frames
+from ellimann_addon.blender.services.drape_motion import PIECE_KEY, TORSO_JOINTS, body_motion
 from ellimann_addon.blender.services.scene import add_mannequin
 from ellimann_addon.core.errors import ElliMannError
 from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.motion import clamped_motion, drape_motion, loop_drift
+from ellimann_addon.core.motion import clamped_motion
 from ellimann_addon.core.pose import forward_kinematics
 from ellimann_addon.core.reference_set import REFERENCE_FOLDER
 from ellimann_addon.core.skeleton import JOINT_INDEX, part_bones
@@ -31,7 +31,7 @@ def test_the_dress_walks_with_the_body(average):
     walk, _, loop = clamped_motion("walk", average.joints)
     result = drape(average, "tube_dress", DrapeSettings(frames=FRAMES, edge=0.05), motion=walk, loop=loop)
     assert {k: v for k, v in state()["objects"].items() if k in before} == before  # the mannequin is untouched
-    motion = drape_motion(walk, FRAMES, settle_frames(FRAMES), loop, loop_drift(walk))
+    motion = body_motion(walk, FRAMES, loop)
     world, offset, posed = forward_kinematics(average.joints, motion[-1].rotations, motion[-1].translation)
     bones = part_bones(average.topology)
     scene = bpy.context.scene

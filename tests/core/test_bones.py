@@ -112,3 +112,22 @@ def test_no_known_bone_is_refused_naming_the_clips_bones():
     motion = SourceMotion(["Wurzel"], joints[:1], np.eye(3)[None, None], joints[:1], 24.0)
     with pytest.raises(ElliMannError, match=r"none of the clip's 1 bones \(Wurzel\)"):
         retarget(motion, names, joints, parents, {"r": "Root"})
+
+
+def test_a_drape_motion_starts_at_rest_reaches_the_pose_and_loops_with_the_drift():
+    from ellimann_addon.core.motion import arms_out, drape_motion, rotation_fraction
+    from ellimann_addon.core.pose import Pose
+
+    rng = np.random.default_rng(3)
+    poses = [Pose(np.stack([random_rotation(rng) for _ in range(24)]), rng.normal(size=3)) for _ in range(3)]
+    motion = drape_motion(poses, 10, 4, loop=True, drift=(0.0, -1.0, 0.0))
+    assert np.allclose(motion[0].rotations, np.eye(3)) and np.allclose(motion[0].translation, 0.0)
+    assert np.allclose(motion[4].rotations, poses[0].rotations)
+    assert np.allclose(motion[7].rotations, poses[0].rotations)  # frame 8: the second cycle's first
+    assert np.allclose(motion[7].translation, poses[0].translation + (0.0, -1.0, 0.0))
+    half = rotation_fraction(poses[0].rotations[5], 0.5)
+    assert np.allclose(half @ half, poses[0].rotations[5])  # halfway along the arc
+    out = arms_out(poses, 15.0)[0]
+    assert np.allclose(np.delete(out.rotations, [16, 17], axis=0), np.delete(poses[0].rotations, [16, 17], axis=0))
+    turn = out.rotations[16] @ poses[0].rotations[16].T
+    assert np.isclose(np.degrees(np.arccos((np.trace(turn) - 1) / 2)), 15.0)

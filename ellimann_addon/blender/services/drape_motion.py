@@ -14,12 +14,15 @@ torso goes; the other vertices are the simulation's.
 import numpy as np
 
 from ...core.cushion import cushion_name
-from ...core.motion import drape_motion, loop_drift
+from ...core.motion import arms_out, drape_motion, loop_drift
 from ...core.skeleton import JOINT_INDEX, JOINT_NAMES, cross_joint_pairs
 from .rig import bake_action, bare_armature, bind_across, bind_piece, bind_weights, check_rig
 
 PIECE_KEY = "ellimann_piece"  # on a collider: the name of the piece it stands for (a part or a cushion)
-SETTLE_FRAMES = 12  # frames from rest into the first pose, at most a third of the drape
+SETTLE_FRAMES = 20  # frames from rest into the first pose (at most a third of the drape): slow enough for the cloth
+# Arms hanging 5 degrees from vertical (attention, the walk) brush the dress's flanks, whose ease puts
+# the cloth beyond the hips: held this much further out, they swing clear of it.
+ARMS_OUT_DEGREES = 15.0
 BODY_COLOR = (0.8, 0.78, 0.72, 1.0)
 TORSO_JOINTS = ("Pelvis", "Spine1", "Spine2", "Spine3", "Neck", "L_Collar", "R_Collar")  # what carries the pins
 
@@ -49,10 +52,17 @@ def animate_drape(collection, colliders, garment_object, mannequin, poses, loop,
         else:
             bind_piece(obj, rig, JOINT_NAMES[bones[topology.index[piece] if piece in topology.index else pairs[piece]]])
     bind_weights(garment_object, rig, nearest_joint_weights(garment_object, joints))
-    motion = drape_motion(poses, frames, settle_frames(frames), loop, loop_drift(poses) if loop else None)
+    motion = body_motion(poses, frames, loop)
     bake_action(rig, JOINT_NAMES, np.stack([p.rotations for p in motion]), np.stack([p.translation for p in motion]),
                 f"{collection.name} motion")
     return motion[-1]
+
+
+def body_motion(poses, frames, loop):
+    """The drape's body, frame by frame: ``poses`` with the arms ARMS_OUT_DEGREES further out, reached from
+    rest over ``settle_frames(frames)`` frames, then held or looped (``core.motion.drape_motion``)."""
+    poses = arms_out(poses, ARMS_OUT_DEGREES)
+    return drape_motion(poses, frames, settle_frames(frames), loop, loop_drift(poses) if loop else None)
 
 
 def nearest_joint_weights(obj, joints):
