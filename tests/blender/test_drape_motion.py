@@ -63,3 +63,15 @@ def test_a_motion_needs_joints_and_nothing_is_built_without(average):
         drape(average.copy(joints=None), "tube_dress", DrapeSettings(frames=4, edge=0.05),
               motion=clamped_motion("sit", average.joints)[0])
     assert state() == before
+
+
+def test_the_command_line_refuses_a_motion_without_joints_in_one_line(tmp_path, capsys, toy):
+    from devkit.cli_runs import assert_one_line_error, run
+
+    toy.save(tmp_path / "toy.json")
+    out = tmp_path / "x.blend"
+    code, _, err = run(["drape", str(tmp_path / "toy.json"), "--pose", "walk", "-o", str(out)], capsys)
+    assert_one_line_error(code, err, "joints", "has no joints")
+    assert not out.exists()
+    code, _, err = run(["drape", str(tmp_path / "toy.json"), "--pose", "dance", "-o", str(out)], capsys)
+    assert code == 2 and "invalid choice: 'dance'" in err and not out.exists()  # argparse's usage error

@@ -15,7 +15,7 @@ from ellimann_addon.core.mannequin import Mannequin
 from ellimann_addon.core.pose import Pose, axis_angle, clamp_pose, forward_kinematics
 from ellimann_addon.core.poses import WALK_FPS, standard_motion, standard_pose
 from ellimann_addon.core.reference_set import REFERENCE_FOLDER
-from ellimann_addon.core.skeleton import JOINT_INDEX, JOINT_NAMES, bone_name, joint_frames
+from ellimann_addon.core.skeleton import JOINT_INDEX, JOINT_NAMES, bone_name, joint_frames, limits
 
 TOLERANCE = 2e-5  # m: Blender evaluates in single precision
 
@@ -210,3 +210,21 @@ def test_rebuilt_cushions_are_bound_again(rigged, average):
     cushions = [o for o in objects_recursive(rigged) if o.ellimann.kind == "CUSHION"]
     assert len(cushions) == len(average.topology.cushion_pairs)
     assert all(c.modifiers[0].object == rig and c.parent == rig and len(c.vertex_groups) for c in cushions)
+
+
+def test_the_pose_panel_shows_the_poses_and_the_active_bones_limits(rigged, average):
+    from types import SimpleNamespace
+
+    from devkit.ui_recorder import draw_panel
+    from ellimann_addon.blender import ids
+    from ellimann_addon.blender.features.pose.panel import ELLIMANN_PT_pose
+
+    rig = rig_object(rigged)
+    context = SimpleNamespace(scene=bpy.context.scene, active_object=rig, collection=rigged, mode="POSE",
+                              active_pose_bone=rig.pose.bones["L_Knee"])
+    recorder = draw_panel(ELLIMANN_PT_pose, context)
+    assert {ids.APPLY_POSE, ids.REST_POSE, ids.IMPORT_BVH, ids.ADD_ARMATURE} <= set(recorder.operators())
+    labels = recorder.labels()
+    assert "Measurements are the rest pose's" in labels and any(t.startswith("L_Knee limits") for t in labels)
+    low, high = np.degrees(limits(average.joints)[JOINT_INDEX["L_Knee"], 0])
+    assert f"X: {low:.0f} to {high:.0f}" in labels and labels.count("Y: locked") + labels.count("Z: locked") == 2

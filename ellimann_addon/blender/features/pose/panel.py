@@ -1,10 +1,13 @@
 """The Pose sub-panel of the ElliMann sidebar tab: the armature, the standard poses, the walk, BVH motion."""
 
+import math
+
 import bpy
 
 from ... import ids
 from ...bridge.convert import read_joints, rig_object
 from ...bridge.selection import active_mannequin
+from ...services.rig import CONSTRAINT_NAME
 from ..base import SubPanel
 from .operators import POSE_ITEMS
 
@@ -36,6 +39,7 @@ class ELLIMANN_PT_pose(SubPanel, bpy.types.Panel):
         for value, label, _ in POSE_ITEMS:
             grid.operator(ids.APPLY_POSE, text=label).pose = value
         layout.operator(ids.REST_POSE, icon="LOOP_BACK")
+        draw_limits(layout, context, rig)
         props = context.scene.ellimann_pose
         row = layout.row(align=True)
         row.prop(props, "rig", text="")
@@ -43,6 +47,26 @@ class ELLIMANN_PT_pose(SubPanel, bpy.types.Panel):
         if props.status:
             layout.label(text=props.status, icon="INFO")
         layout.label(text="Measurements are the rest pose's", icon="INFO")
+
+
+def draw_limits(layout, context, rig):
+    """The active bone's rotation limits (its Limit Rotation constraint), in degrees about the bone's own axes."""
+    bone = getattr(context, "active_pose_bone", None)
+    if bone is None or bone.id_data != rig:
+        return
+    constraint = bone.constraints.get(CONSTRAINT_NAME)
+    box = layout.box()
+    if constraint is None:
+        box.label(text=f"{bone.name}: free (no limits)")
+        return
+    box.label(text=f"{bone.name} limits (degrees, bone axes, {constraint.euler_order})")
+    for axis in "xyz":
+        if not getattr(constraint, f"use_limit_{axis}"):
+            box.label(text=f"{axis.upper()}: free")
+            continue
+        low, high = (math.degrees(getattr(constraint, f"{end}_{axis}")) for end in ("min", "max"))
+        span = "locked" if abs(high - low) < 1e-6 else f"{low:.0f} to {high:.0f}"
+        box.label(text=f"{axis.upper()}: {span}")
 
 
 classes = (ELLIMANN_PT_pose,)
