@@ -1,5 +1,6 @@
-"""The Khronos glTF validator (npm ``gltf-validator``) for tests: installed on first use into ``out/node`` with
-npm (pinned; one install at a time, so the matrix's parallel lanes share it), run with node.
+"""The Khronos glTF validator (npm ``gltf-validator``) for tests: installed into ``out/node`` with npm (pinned),
+by ``tools.matrix`` before its lanes start (``make test``, CI) or else on first use (one install at a time), run
+with node. No node or npm, or a failed install: ValidatorUnavailableError, so the tests fail (never skip).
 
 ``validate(path)`` returns the validator's issues: ``{"numErrors", "numWarnings", "numInfos", "numHints",
 "messages": [{"code", "message", "severity", "pointer"}, ...]}``. Needs ``node`` and ``npm`` on PATH (CI
@@ -68,5 +69,5 @@ def errors(issues):
     return [m for m in issues["messages"] if m["severity"] == 0]
 
 
-if __name__ == "__main__":  # python3 -m devkit.gltf_validator: install it now (CI does, before the tests)
+if __name__ == "__main__":  # python3 -m devkit.gltf_validator: install it now (tools.matrix does, before the lanes)
     print(f"glTF validator {VERSION} in {module_dir()}")

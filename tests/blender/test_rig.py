@@ -228,3 +228,14 @@ def test_the_pose_panel_shows_the_poses_and_the_active_bones_limits(rigged, aver
     assert "Measurements are the rest pose's" in labels and any(t.startswith("L_Knee limits") for t in labels)
     low, high = np.degrees(limits(average.joints)[JOINT_INDEX["L_Knee"], 0])
     assert f"X: {low:.0f} to {high:.0f}" in labels and labels.count("Y: locked") + labels.count("Z: locked") == 2
+
+
+def test_a_mannequin_outside_the_view_layer_is_refused_unchanged(rigged, average):
+    from ellimann_addon.blender.services.rig import build_rig
+
+    layer = next(lc for lc in bpy.context.view_layer.layer_collection.children if lc.collection == rigged)
+    layer.exclude = True
+    before = state()
+    with pytest.raises(ElliMannError, match="is not in view layer"):
+        build_rig(rigged, average)
+    assert state() == before

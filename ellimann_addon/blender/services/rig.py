@@ -71,6 +71,10 @@ def build_rig(collection, mannequin):
     missing = [o.ellimann.part_name for o in objects if o.ellimann.part_name not in bone_of]
     if missing:
         raise ElliMannError(f"bones: '{collection.name}' holds part '{missing[0]}', which its mannequin lacks")
+    view_layer = bpy.context.view_layer
+    if any(view_layer.objects.get(o.name) != o for o in objects[:1]):  # Edit Mode needs the armature there
+        raise ElliMannError(f"collection: '{collection.name}' is not in view layer '{view_layer.name}' (include it "
+                            "there to rig it)")
     remove_rig(collection)
     rig = _armature_object(f"{collection.name} Rig", layout, collection)
     rig[RIG_KEY] = collection.name
