@@ -239,3 +239,16 @@ def test_a_mannequin_outside_the_view_layer_is_refused_unchanged(rigged, average
     with pytest.raises(ElliMannError, match="is not in view layer"):
         build_rig(rigged, average)
     assert state() == before
+
+
+def test_synthesize_rigs_a_mannequin_of_references_with_joints():
+    props = bpy.context.scene.ellimann_synthesis
+    props.references = str(REFERENCE_FOLDER)  # the shipped RMs carry joints
+    props.output = "CUSHIONS"
+    assert bpy.ops.ellimann.synthesize_mannequin() == {"FINISHED"}
+    collection = props.target
+    rig = rig_object(collection)
+    assert rig is not None and sorted(b.name for b in rig.data.bones) == sorted(JOINT_NAMES)
+    assert all(o.modifiers[0].object == rig for o in objects_recursive(collection) if o.ellimann.is_part)
+    bpy.context.view_layer.objects.active = rig
+    assert bpy.ops.ellimann.apply_pose(pose="sit") == {"FINISHED"}

@@ -72,6 +72,7 @@ def build_rig(collection, mannequin):
     if missing:
         raise ElliMannError(f"bones: '{collection.name}' holds part '{missing[0]}', which its mannequin lacks")
     view_layer = bpy.context.view_layer
+    view_layer.update()  # objects just linked get their view-layer bases
     if any(view_layer.objects.get(o.name) != o for o in objects[:1]):  # Edit Mode needs the armature there
         raise ElliMannError(f"collection: '{collection.name}' is not in view layer '{view_layer.name}' (include it "
                             "there to rig it)")
