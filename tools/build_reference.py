@@ -34,7 +34,6 @@ Deterministic: no randomness, fixed iteration counts and orders.
 """
 
 import argparse
-import json
 import pathlib
 import re
 import sys
@@ -57,7 +56,7 @@ from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS, 
 from ellimann_addon.core.ellipsoid import section_at_height
 from ellimann_addon.core.files import atomic_write_text
 from ellimann_addon.core.frames import axis_agreement, is_rotation, mirror_frame
-from ellimann_addon.core.joints import anchor_indices, follow_pieces, joints_from_makehuman
+from ellimann_addon.core.joints import anchor_indices, follow_pieces
 from ellimann_addon.core.mannequin import Mannequin, Topology
 from ellimann_addon.core.measure import as_dict, section_heights
 from ellimann_addon.core.synthesis import refine
@@ -71,6 +70,7 @@ from .bodies import (
     body_measurements,
     hidden_vertices,
     load_labels,
+    load_skeletons,
     vertex_areas,
     vertex_normals,
 )
@@ -80,7 +80,6 @@ from .fitting import cell_share, hull_surface, inscribed_ellipsoid
 REPO = pathlib.Path(__file__).resolve().parents[1]
 DEFAULT_REFMODELS = REPO.parent / "shared" / "refmodels"
 BASE_FILE = "base_mannequin"
-SKELETON_FILE = "skeleton.json"  # the bodies' joints (refmodels/README.md, "Skeleton")
 REFERENCE_RM = "average"  # the RM whose axes the others are relabelled against
 # Relative m_T error the adjustment aims at: where Newton has converged, so where it stops (an
 # iteration more or less) moves no part by more than rounding; at 1e-5 that was ~0.4 um.
@@ -199,12 +198,6 @@ def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
             covers[i], covers[twins[i]] = cover(i), cover(twins[i])
     return Mannequin(topology, rotation, center, semi_axes, **fields).check(), [
         kept_out[twins[i]] if part.side == "R" else kept_out[i] for i, part in enumerate(topology)]
-
-
-def load_skeletons(refmodels):
-    """{body: (24, 3) SMPL joints} of the reference bodies, from the body model's own rig (skeleton.json)."""
-    data = json.loads((pathlib.Path(refmodels) / SKELETON_FILE).read_text(encoding="utf-8"))
-    return {name: joints_from_makehuman(bones) for name, bones in data["bodies"].items()}
 
 
 def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
