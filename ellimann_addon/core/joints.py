@@ -140,8 +140,13 @@ def follow_pieces(joints, anchors, before, after):
                 np.take(np.asarray(semi_axes, dtype=float), anchors, axis=-2))
 
     (r0, c0, d0), (r1, c1, d1) = take(*before), take(*after)
-    local = np.einsum("...ji,...j->...i", r0, np.asarray(joints, dtype=float) - c0) / d0
-    return c1 + np.einsum("...ij,...j->...i", r1, local * d1)
+    # Sums over three terms written out, in a fixed order: a row gets the same bits in any batch.
+    offset = np.asarray(joints, dtype=float) - c0
+    local = (r0[..., 0, :] * offset[..., 0, None] + r0[..., 1, :] * offset[..., 1, None]
+             + r0[..., 2, :] * offset[..., 2, None]) / d0
+    scaled = local * d1
+    return (c1 + r1[..., 0] * scaled[..., 0, None] + r1[..., 1] * scaled[..., 1, None]
+            + r1[..., 2] * scaled[..., 2, None])
 
 
 def interpolate_joints(reference, requests, metric, power, normalize):
@@ -163,14 +168,15 @@ def interpolate_joints(reference, requests, metric, power, normalize):
     slots = np.array([source[int(anchors[j])] for j in own])
     weights = idw_weights(reference, requests, metric, power)[:, slots]  # (B, J, k)
     rm_joints = reference.joints[:, own]  # (k, J, 3)
-    if normalize == "none":
-        mean = np.einsum("bjk,kji->bji", weights, rm_joints)
-    else:
+    if normalize != "none":
         horizontal, vertical = reference.size_scales(reference.measurements, normalize)  # (k, s)
-        normalized = rm_joints / _center_scale(horizontal[:, slots], vertical[:, slots])
+        rm_joints = rm_joints / _center_scale(horizontal[:, slots], vertical[:, slots])
+    mean = np.zeros((len(weights), len(own), 3))
+    for k in range(len(rm_joints)):  # the weighted sum in a fixed order: a row gets the same bits in any batch
+        mean += weights[:, :, k, None] * rm_joints[k]
+    if normalize != "none":
         horizontal, vertical = reference.size_scales(np.atleast_2d(requests), normalize)
-        mean = np.einsum("bjk,kji->bji", weights, normalized) * _center_scale(horizontal[:, slots],
-                                                                                vertical[:, slots])
+        mean *= _center_scale(horizontal[:, slots], vertical[:, slots])
     out = np.empty((len(mean), JOINT_COUNT, 3))
     out[:, own] = mean
     return mirror_joints(out, "L")

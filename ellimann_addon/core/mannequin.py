@@ -18,6 +18,7 @@ from .constants import ABSURD_LIMITS, CENTER_LIMIT, MEASUREMENTS, SEMI_AXIS_LIMI
 from .errors import MannequinError, Problem
 from .files import atomic_write_text
 from .joints import joint_problems, joints_from_dict, joints_to_dict
+from .trace import traces_from_dict, traces_to_dict
 
 FORMAT = "ellimann.mannequin"
 FORMAT_VERSION = 1
@@ -221,6 +222,7 @@ class Mannequin:
     name: str = ""
     role: str = "synthesized"
     measurements: dict = field(default=None)
+    traces: dict = field(default=None)  # {part name: core.trace.PartTrace}: what each part was traced from
     joints: np.ndarray = None
 
     def __post_init__(self):
@@ -236,6 +238,7 @@ class Mannequin:
         values = dict(topology=self.topology, rotation=self.rotation.copy(), center=self.center.copy(),
                       semi_axes=self.semi_axes.copy(), name=self.name, role=self.role,
                       measurements=dict(self.measurements) if self.measurements else None,
+                      traces=dict(self.traces) if self.traces else None,
                       joints=None if self.joints is None else self.joints.copy())
         values.update(changes)
         return Mannequin(**values)
@@ -312,6 +315,7 @@ class Mannequin:
                          semi_axes=self.semi_axes[order])
 
     def to_dict(self):
+        traces = {"traces": traces_to_dict(self.traces)} if self.traces else {}
         joints = {} if self.joints is None else {"joints": joints_to_dict(self.joints)}
         return {
             "format": FORMAT,
@@ -325,6 +329,7 @@ class Mannequin:
                      axes=self.rotation[i].T.tolist(), semi_axes=self.semi_axes[i].tolist())
                 for i, part in enumerate(self.topology)
             ],
+            **traces,
             **joints,
         }
 
@@ -380,6 +385,7 @@ class Mannequin:
             raise MannequinError(problems)
         mannequin = cls(topology, np.swapaxes(np.array(arrays["axes"]), 1, 2), np.array(arrays["center"]),
                         np.array(arrays["semi_axes"]), name=name, role=role, measurements=measurements,
+                        traces=traces_from_dict(data.get("traces"), topology.names),
                         joints=joints_from_dict(data.get("joints")))
         return mannequin.check() if check else mannequin
 

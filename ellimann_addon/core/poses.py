@@ -3,9 +3,9 @@
 ``a_pose`` is the rest pose (the traced A-pose); ``t_pose``: upper arms and forearms horizontal in the coronal
 plane, elbows straight, nothing else moves; ``attention``: arms hanging 5 degrees from vertical, clear of the
 torso; ``sit``: hips and knees flexed 90 degrees (thighs horizontal, shins vertical), feet flat on the floor
-where they were, the body lowered; ``walk``: a looping cycle, one stride (two steps) per second at ``fps``
-frames per second, arms swinging against the legs, the body carried forward. Every standard pose is within the
-joint limits (tests check it on every Reference Mannequin).
+(their rest orientation and height), the body lowered; ``walk``: a looping cycle, one stride (two steps) per
+second at ``fps`` frames per second, arms swinging against the legs, the body carried forward. Every standard
+pose is within the joint limits (tests check it on every Reference Mannequin).
 """
 
 import numpy as np

@@ -16,12 +16,13 @@ from .options import (
 )
 
 
-def validate_request(me):
+def validate_request(me, ranges=RANGES):
     """Check a request {He, Sh, Br, Wa, Hi} in cm (a dict, or a sequence in that order).
 
     Raises MeasurementError naming the field for a missing key, a non-number, NaN/inf, a value
     <= 0 or outside ``ABSURD_LIMITS``. Returns a list of warnings for values outside the
-    reference range L (allowed: exact mode reaches them, IDW cannot leave the RMs' hull).
+    reference range L (``ranges``: a reference set's, default Table 2.3's; allowed: exact mode reaches them,
+    IDW cannot leave the RMs' hull).
     """
     values = _request_values(me)
     warnings = []
@@ -36,7 +37,7 @@ def validate_request(me):
             raise MeasurementError(key, f"must be > 0, got {value:g} ({accepted})")
         if not low <= value <= high:
             raise MeasurementError(key, f"{value:g} cm is not a plausible value ({accepted})")
-        lo, hi = RANGES[key]
+        lo, hi = ranges[key]
         if value < lo or value > hi:
             bound = lo if value < lo else hi
             by = abs(value - bound)

@@ -68,6 +68,10 @@ def _sided(central, sided):
     return out
 
 
+# The limbs as the CMU motion-capture BVH conversions and Mixamo both name them (LeftUpLeg, RightForeArm, ...).
+_MOTION_CAPTURE_LIMBS = {"{Side}UpLeg": "Hip", "{Side}Leg": "Knee", "{Side}Foot": "Ankle", "{Side}ToeBase": "Foot",
+                         "{Side}Shoulder": "Collar", "{Side}Arm": "Shoulder", "{Side}ForeArm": "Elbow",
+                         "{Side}Hand": "Wrist"}
 # Other rigs' bone names -> SMPL joints (BVH and FBX motion onto a mannequin). A bone not listed is ignored.
 RIG_NAME_MAPS = {
     "makehuman": _sided(
@@ -76,19 +80,12 @@ RIG_NAME_MAPS = {
         {"upperleg01.{S}": "Hip", "lowerleg01.{S}": "Knee", "foot.{S}": "Ankle", "toe3-1.{S}": "Foot",
          "clavicle.{S}": "Collar", "upperarm01.{S}": "Shoulder", "lowerarm01.{S}": "Elbow", "wrist.{S}": "Wrist",
          "finger3-1.{S}": "Hand"}),
-    # The CMU motion-capture database's BVH conversions (Hips, LeftUpLeg, ..., LowerBack, Spine, Spine1).
-    "cmu": _sided(
-        {"Hips": "Pelvis", "LowerBack": "Spine1", "Spine": "Spine2", "Spine1": "Spine3", "Neck": "Neck",
-         "Head": "Head"},
-        {"{Side}UpLeg": "Hip", "{Side}Leg": "Knee", "{Side}Foot": "Ankle", "{Side}ToeBase": "Foot",
-         "{Side}Shoulder": "Collar", "{Side}Arm": "Shoulder", "{Side}ForeArm": "Elbow", "{Side}Hand": "Wrist",
-         "{Side}FingerBase": "Hand"}),
+    # The CMU database's BVH conversions (Hips, LeftUpLeg, ..., LowerBack, Spine, Spine1).
+    "cmu": _sided({"Hips": "Pelvis", "LowerBack": "Spine1", "Spine": "Spine2", "Spine1": "Spine3", "Neck": "Neck",
+                   "Head": "Head"}, {**_MOTION_CAPTURE_LIMBS, "{Side}FingerBase": "Hand"}),
     # Mixamo, without its "mixamorig:" prefix (see joint_of_bone).
-    "mixamo": _sided(
-        {"Hips": "Pelvis", "Spine": "Spine1", "Spine1": "Spine2", "Spine2": "Spine3", "Neck": "Neck", "Head": "Head"},
-        {"{Side}UpLeg": "Hip", "{Side}Leg": "Knee", "{Side}Foot": "Ankle", "{Side}ToeBase": "Foot",
-         "{Side}Shoulder": "Collar", "{Side}Arm": "Shoulder", "{Side}ForeArm": "Elbow", "{Side}Hand": "Wrist",
-         "{Side}HandMiddle1": "Hand"}),
+    "mixamo": _sided({"Hips": "Pelvis", "Spine": "Spine1", "Spine1": "Spine2", "Spine2": "Spine3", "Neck": "Neck",
+                      "Head": "Head"}, {**_MOTION_CAPTURE_LIMBS, "{Side}HandMiddle1": "Hand"}),
 }
 
 

@@ -174,7 +174,7 @@ def synthesize(reference, request, options=None, **fields):
     """One mannequin from a request (dict or 5 numbers, cm), named ``options.name`` (default: from the request).
     ``options`` and keywords as :func:`synthesize_batch`'s. Returns (Mannequin, measured dict, warnings)."""
     options = options_of(options, **fields)
-    warnings = validate_request(request)
+    warnings = validate_request(request, reference.ranges)
     batch = synthesize_batch(reference, [request_array(request)], options)
     if not batch.converged[0]:
         worst = MEASUREMENTS[int(np.argmax(batch.relative_error()[0]))]

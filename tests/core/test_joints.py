@@ -130,6 +130,13 @@ def test_synthesized_joints_are_symmetric_valid_and_between_the_references(refer
     assert np.all(mannequin.joints[:, 2] < heights.max(axis=0) * 165 / 171 + 0.05)
 
 
+def test_a_request_alone_gets_the_joints_it_gets_in_a_batch(reference):
+    requests = np.array([[165, 41.5, 101.25, 82.75, 117.5], [150, 35, 90, 70, 95], [170, 50, 140, 130, 140]])
+    batch = synthesize_batch(reference, requests)
+    for i, request in enumerate(requests):
+        assert np.array_equal(synthesize_batch(reference, [request]).joints[0], batch.joints[i])
+
+
 def test_a_deformation_carries_each_joint_with_its_anchor_piece(average):
     anchors = anchor_indices(average.topology)
     before = (average.rotation, average.center, average.semi_axes)

@@ -54,8 +54,9 @@ class ELLIMANN_PG_synthesis(bpy.types.PropertyGroup):
                             poll=lambda _self, collection: collection.ellimann.is_mannequin,
                             description="The mannequin that Live updates")
     references: StringProperty(name="References", subtype="DIR_PATH", default="",
-                               description="Folder with the five Reference Mannequin .json files "
-                                           "(empty: the shipped reference_blends/)")
+                               description="A reference-set folder: reference_set.json and the Reference "
+                                           "Mannequins' .json files it lists (Build Reference Set writes one), or "
+                                           "the five files of Table 2.3 (empty: the shipped reference_blends/)")
     status: StringProperty(name="Status", description="Outcome of the last live update")
     live_ms: FloatProperty(name="Live Update Time", description="Duration of the last live update (ms)")
 
