@@ -17,6 +17,7 @@ from ..core.formats import FORMATS
 from ..core.measure import as_dict
 from ..core.refine import EXACT_TOLERANCE
 from ..core.request import validate_request
+from ..core.skeleton import JOINT_NAMES
 from . import common, distributed
 from .common import PROG, UsageError
 
@@ -52,6 +53,7 @@ def add_parser(commands):
                        help="skip rows whose files (every --format) are already in DIR and whole, e.g. after an "
                             "interrupted run with the same CSV and options; without it every row is written again")
     common.add_synthesis_options(batch)
+    common.add_pose_option(batch)
     batch.set_defaults(run=run, blender=needs_blender)
 
 
@@ -61,7 +63,7 @@ def needs_blender(args):
         formats = parse_formats(args.format)
     except UsageError:
         return None
-    blender = [f for f in formats if f in FORMATS and FORMATS[f].needs_blender]
+    blender = [f for f in formats if f in FORMATS and FORMATS[f].needs_blender_for(args.pose is not None)]
     return f"--format {blender[0]}" if blender else None
 
 
@@ -157,6 +159,7 @@ def name_rows(rows):
 
 def run(args):
     formats = parse_formats(args.format)
+    pose_file = common.check_pose_argument(args, formats)
     shard, shards = parse_shard(args.shard)
     sets = {"": common.references(args)}  # the command's set, read once, and each other set a row names
 
@@ -173,13 +176,13 @@ def run(args):
     mine = [row for index, row in enumerate(rows) if index % shards == shard - 1]
     cluster = distributed.connect(args.dask) if args.dask else None  # before anything is written
     try:
-        return _run(args, formats, shard, shards, rows, mine, options, cluster)
+        return _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file)
     finally:
         if cluster is not None:
             cluster.close()
 
 
-def _run(args, formats, shard, shards, rows, mine, options, cluster):
+def _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file):
     common.output_folder(args.output, "batch")
     suffix = "" if shards == 1 else f"-{shard}-of-{shards}"
     report = Report(os.path.join(args.output, f"report{suffix}.csv"))
@@ -217,7 +220,7 @@ def _run(args, formats, shard, shards, rows, mine, options, cluster):
         for index, result in results:
             for i, (line, name, values, warnings, reference) in enumerate(chunks[index]):
                 report.add(_row(args, formats, result, i, line, name, values, warnings, reference.name,
-                                bundles.get(id(reference)), index))
+                                bundles.get(id(reference)), index, pose_file))
                 progress.step(name)
         for bundle in bundles.values():
             bundle.write()
@@ -268,20 +271,28 @@ def synthesize_chunk(reference, requests, options):
     return ChunkResult.joined(parts, errors)
 
 
+def _landmarks(synthesis):
+    """What each mannequin of a Synthesis records of its reference set (Mannequin keywords)."""
+    return {"reference_set": synthesis.reference_set, "section_fractions": synthesis.section_fractions}
+
+
 class ChunkResult:
     """A chunk's synthesis as plain arrays (what a Dask worker sends back): ``errors[i]`` is None or why row i
     failed (its arrays are then NaN)."""
 
     FIELDS = ("rotation", "center", "semi_axes", "measured", "factors", "converged")
 
-    def __init__(self, topology, errors, **arrays):
+    def __init__(self, topology, errors, joints=None, landmarks=None, **arrays):
         self.topology, self.errors = topology, errors
+        self.joints = joints  # (B, 24, 3) or None: the reference set has no joints
+        self.landmarks = landmarks or {}  # the set's name and section heights, which each mannequin records
         for key in self.FIELDS:
             setattr(self, key, arrays[key])
 
     @classmethod
     def of(cls, synthesis, errors):
-        return cls(synthesis.topology, errors, **{key: getattr(synthesis, key) for key in cls.FIELDS})
+        return cls(synthesis.topology, errors, synthesis.joints, _landmarks(synthesis),
+                   **{key: getattr(synthesis, key) for key in cls.FIELDS})
 
     @classmethod
     def joined(cls, parts, errors):
@@ -290,21 +301,26 @@ class ChunkResult:
             return cls(None, errors, **{key: [None] * len(parts) for key in cls.FIELDS})
         arrays = {key: np.concatenate([getattr(p if p is not None else good, key) for p in parts])
                   for key in cls.FIELDS}
+        joints = (None if good.joints is None
+                  else np.concatenate([(p if p is not None else good).joints for p in parts]))
         for i, part in enumerate(parts):
             if part is None:
                 for key in cls.FIELDS[:-1]:
                     arrays[key][i] = np.nan
                 arrays["converged"][i] = False
-        return cls(good.topology, errors, **arrays)
+                if joints is not None:
+                    joints[i] = np.nan
+        return cls(good.topology, errors, joints, _landmarks(good), **arrays)
 
     def mannequin(self, i, name, request):
         from ..core.mannequin import Mannequin
 
         return Mannequin(self.topology, self.rotation[i], self.center[i], self.semi_axes[i], name=name,
-                         role="synthesized", measurements=as_dict(request))
+                         role="synthesized", measurements=as_dict(request),
+                         joints=None if self.joints is None else self.joints[i], **self.landmarks)
 
 
-def _row(args, formats, result, i, line, name, values, warnings, references, bundle=None, chunk=0):
+def _row(args, formats, result, i, line, name, values, warnings, references, bundle=None, chunk=0, pose_file=None):
     """Write (or, with --resume, keep) the files of one synthesized row, and add it to the batch file; its report
     row. A failure is that row's: one line on stderr and status "error", and the batch goes on."""
     if result.errors[i] is not None:
@@ -327,7 +343,9 @@ def _row(args, formats, result, i, line, name, values, warnings, references, bun
         return row
     try:
         if paths:
-            common.write(result.mannequin(i, name, values), paths, as_dict(result.measured[i]), args.cushions)
+            mannequin = result.mannequin(i, name, values)
+            frames = common.pose_frames(args, mannequin, pose_file)
+            common.write(mannequin, paths, as_dict(result.measured[i]), args.cushions, frames, args.fps)
     except (ElliMannError, OSError, RuntimeError) as error:
         common.say(f"{PROG} batch: line {line}: failed: {common.one_line(error)}")
         if bundle is not None:
@@ -360,9 +378,13 @@ class Bundle:
         arrays = {key: np.array([getattr(result, key)[i] for _, _, result, i in rows]).reshape((len(rows),) + shape)
                   for key, shape in shapes.items()}
         requests = np.array([values for _, values, _, _ in rows], dtype=float).reshape(len(rows), 5)
+        joints = None
+        if rows and all(result.joints is not None for _, _, result, _ in rows):
+            joints = np.array([result.joints[i] for _, _, result, i in rows]).reshape(len(rows), len(JOINT_NAMES), 3)
         with common.writing(self.path):
             write_batch_file(self.path, batch_arrays(self.topology, [row[0] for row in rows], requests,
-                                                     mode=self.mode, **arrays))
+                                                     mode=self.mode, joints=joints, joint_names=JOINT_NAMES,
+                                                     **arrays))
 
 
 class Report:

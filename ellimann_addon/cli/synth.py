@@ -23,13 +23,14 @@ def add_parser(commands):
                             "for MuJoCo)")
     synth.add_argument("--name", help="mannequin name (default: 'ElliMann He-Sh-Br-Wa-Hi')")
     common.add_synthesis_options(synth)
+    common.add_pose_option(synth)
     synth.set_defaults(run=run, blender=needs_blender)
 
 
 def needs_blender(args):
     """What needs Blender in this command (None: nothing)."""
     kind = FORMATS.get(_kind_or_none(args.output))
-    return f"writing {args.output}" if kind is not None and kind.needs_blender else None
+    return f"writing {args.output}" if kind is not None and kind.needs_blender_for(args.pose is not None) else None
 
 
 def _kind_or_none(path):
@@ -43,6 +44,7 @@ def run(args):
     from ..core.synthesis import synthesize_batch
 
     kind = common.output_kind(args.output)
+    pose_file = common.check_pose_argument(args, [kind])
     request = [getattr(args, key) for key in MEASUREMENTS]
     reference = common.references(args)
     warnings = validate_request(request, reference.ranges, reference.absurd_limits)
@@ -52,8 +54,10 @@ def run(args):
     misses = common.misses(result.measured[0], request) if args.mode == "exact" else []
     for warning in warnings + ([common.missed_text(misses)] if misses else []):
         common.say(f"{PROG} synth: warning: {warning}")
-    common.write(mannequin, [args.output], measured, args.cushions and kind != "json")
+    frames = common.pose_frames(args, mannequin, pose_file)
+    common.write(mannequin, [args.output], measured, args.cushions and kind != "json", frames, args.fps)
     error = relative_error(result.measured[0], request).max()
-    common.say(f"wrote {args.output}: '{mannequin.name}' ({args.mode}), m_T {common.format_me(measured.values())} "
-               f"cm, max error {error:.3f}%", file=sys.stdout)
+    posed = f" in pose {args.pose}" if args.pose else ""
+    common.say(f"wrote {args.output}: '{mannequin.name}'{posed} ({args.mode}), m_T "
+               f"{common.format_me(measured.values())} cm, max error {error:.3f}%", file=sys.stdout)
     return common.MISSED if misses else 0
