@@ -5,8 +5,9 @@
 
 Subcommands, a module each: ``synth`` (one mannequin), ``batch`` (a CSV of measurements), ``pose`` (a mannequin
 in a pose), ``measure`` (m_T of a file), ``demo`` (the paper's Table 2.5 mannequins with a report and a line-up
-picture), ``drape`` (a garment on a mannequin with Blender's cloth simulation) and ``references`` (build or check
-a reference set); ``common`` holds what they share. This package needs numpy only: Blender (the bpy module and
+picture), ``drape`` (a garment on a mannequin with Blender's cloth simulation), ``population`` (rows sampled from
+a survey's statistics, for ``batch``) and ``references`` (build or check a reference set); ``distributed`` runs
+``batch --dask``; ``common`` holds what they share. This package needs numpy only: Blender (the bpy module and
 ``ellimann_addon.blender``) is imported only when a .blend/.glb/.obj file, a drape or a picture is involved, and
 a command that needs it without it is refused in one line. What Blender prints is captured (``chatter``) and
 shown only with ``--verbose``. User mistakes end with a one-line reason and a non-zero exit code: 1 for bad input
@@ -19,11 +20,11 @@ import contextlib
 import sys
 
 from ..core.errors import ElliMannError
-from . import batch, demo, drape, measure, pose, references, synth
+from . import batch, demo, drape, measure, population, pose, references, synth
 from .common import INTERRUPTED, MISSED, PROG, UsageError, blender_available, no_blender, one_line, say
 
 __all__ = ["INTERRUPTED", "MISSED", "PROG", "UsageError", "build_parser", "main", "main_exit"]
-SUBCOMMANDS = (synth, batch, pose, measure, demo, drape, references)
+SUBCOMMANDS = (synth, batch, pose, measure, demo, drape, population, references)
 
 
 def build_parser():

@@ -8,6 +8,8 @@ import os
 import re
 import sys
 
+import numpy as np
+
 from ..core.constants import MEASUREMENTS
 from ..core.errors import ElliMannError, MeasurementError
 from ..core.files import atomic_write_text, incomplete
@@ -15,11 +17,13 @@ from ..core.formats import FORMATS
 from ..core.measure import as_dict
 from ..core.refine import EXACT_TOLERANCE
 from ..core.request import validate_request
-from . import common
+from . import common, distributed
 from .common import PROG, UsageError
 
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,99}$")
-CHUNK = 256  # rows synthesized per core batch
+CHUNK = 256  # rows synthesized per core batch (and per Dask task)
+MAX_WARNING_LINES = 20  # range warnings printed before the rest go to the report only (a population has thousands)
+NPZ = "npz"  # the batch's one-file format (core.batch_file), written once at the end
 
 
 def add_parser(commands):
@@ -33,8 +37,12 @@ def add_parser(commands):
     batch.add_argument("csv", metavar="MEASUREMENTS.csv")
     batch.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
     batch.add_argument("--format", default="json",
-                       help=f"comma-separated output formats among {','.join(FORMATS)} (default json; mjcf "
-                            "writes NAME.xml)")
+                       help=f"comma-separated output formats among {','.join(FORMATS)},npz (default json; mjcf "
+                            "writes NAME.xml; npz writes every mannequin of the batch into one compressed file "
+                            "DIR/mannequins.npz, docs/batch_file.md)")
+    batch.add_argument("--dask", metavar="ADDRESS",
+                       help="synthesize on a Dask cluster: a scheduler's tcp://HOST:PORT, or local:N for N local "
+                            "worker processes (pip install ellimann[dask]); results identical to a serial run")
     batch.add_argument("--shard", metavar="I/N",
                        help="process only rows I, I+N, I+2N… (I from 1 to N), for a render farm; the report "
                             "is DIR/report-I-of-N.csv")
@@ -52,7 +60,7 @@ def needs_blender(args):
         formats = parse_formats(args.format)
     except UsageError:
         return None
-    blender = [f for f in formats if FORMATS[f].needs_blender_for(args.pose is not None)]
+    blender = [f for f in formats if f in FORMATS and FORMATS[f].needs_blender_for(args.pose is not None)]
     return f"--format {blender[0]}" if blender else None
 
 
@@ -67,9 +75,9 @@ def parse_shard(text):
 
 def parse_formats(text):
     formats = [f.strip().lower().lstrip(".") for f in text.split(",") if f.strip()]
-    unknown = [f for f in formats if f not in FORMATS]
+    unknown = [f for f in formats if f not in FORMATS and f != NPZ]
     if unknown or not formats:
-        raise UsageError(f"--format takes a comma-separated list of {', '.join(FORMATS)}, got {text!r}")
+        raise UsageError(f"--format takes a comma-separated list of {', '.join(FORMATS)}, {NPZ}, got {text!r}")
     return list(dict.fromkeys(formats))
 
 
@@ -138,8 +146,6 @@ def name_rows(rows):
 
 
 def run(args):
-    from ..core.synthesis import synthesize_batch
-
     formats = parse_formats(args.format)
     pose_file = common.check_pose_argument(args, formats)
     shard, shards = parse_shard(args.shard)
@@ -150,26 +156,47 @@ def run(args):
     options = common.synthesis_options(args)
     rows = name_rows(rows)  # over the whole CSV, so every shard agrees on which rows are bad
     mine = [row for index, row in enumerate(rows) if index % shards == shard - 1]
+    cluster = distributed.connect(args.dask) if args.dask else None  # before anything is written
+    try:
+        return _run(args, formats, shard, shards, rows, mine, reference, options, cluster, pose_file)
+    finally:
+        if cluster is not None:
+            cluster.close()
+
+
+def _run(args, formats, shard, shards, rows, mine, reference, options, cluster, pose_file=None):
     common.output_folder(args.output, "batch")
-    report_name = "report.csv" if shards == 1 else f"report-{shard}-of-{shards}.csv"
-    report = Report(os.path.join(args.output, report_name))
-    jobs = []
+    suffix = "" if shards == 1 else f"-{shard}-of-{shards}"
+    report = Report(os.path.join(args.output, f"report{suffix}.csv"))
+    bundle = Bundle(os.path.join(args.output, f"mannequins{suffix}.npz"), reference.topology,
+                    args.mode) if NPZ in formats else None
+    jobs, shown = [], 0
     for line, name, values, error, warnings in mine:
         if error is not None:
             common.say(f"{PROG} batch: line {line}: skipped: {error}")
             report.add(common.report_row(line, name, "error", error, values))
             continue
         for warning in warnings:
-            common.say(f"{PROG} batch: line {line}: warning: {warning}")
+            shown += 1
+            if shown <= MAX_WARNING_LINES:
+                common.say(f"{PROG} batch: line {line}: warning: {warning}")
         jobs.append((line, name, values, warnings))
-    progress = common.Progress(len(jobs), "batch")
+    if shown > MAX_WARNING_LINES:
+        common.say(f"{PROG} batch: {shown - MAX_WARNING_LINES} more warning(s) of requests outside the reference "
+                   f"range; every row's are in {report.path}")
+    progress = common.Progress(len(jobs), "batch", quiet=args.quiet)
+    chunks = [jobs[start:start + CHUNK] for start in range(0, len(jobs), CHUNK)]
+    requests = [[values for _, _, values, _ in chunk] for chunk in chunks]
+    results = (cluster.map([reference] * len(requests), requests, options) if cluster is not None
+               else ((index, synthesize_chunk(reference, chunk, options)) for index, chunk in enumerate(requests)))
     try:
-        for start in range(0, len(jobs), CHUNK):
-            chunk = jobs[start:start + CHUNK]
-            result = synthesize_batch(reference, [values for _, _, values, _ in chunk], options)
-            for i, (line, name, values, warnings) in enumerate(chunk):
-                report.add(_row(args, formats, result, i, line, name, values, warnings, pose_file))
+        for index, result in results:
+            for i, (line, name, values, warnings) in enumerate(chunks[index]):
+                report.add(_row(args, formats, result, i, line, name, values, warnings, bundle, index,
+                                pose_file))
                 progress.step(name)
+        if bundle is not None:
+            bundle.write()
     except KeyboardInterrupt:
         progress.done()
         report.finish()
@@ -196,29 +223,127 @@ def run(args):
     return 0
 
 
-def _row(args, formats, result, i, line, name, values, warnings, pose_file=None):
-    """Write (or, with --resume, keep) the files of one synthesized row; its report row. A failure is
-    that row's: one line on stderr and status "error", and the batch goes on."""
-    paths = [os.path.join(args.output, f"{name}.{common.extension(kind)}") for kind in formats]
+def synthesize_chunk(reference, requests, options):
+    """A chunk of requests synthesized in one core batch (what a Dask task runs). If the batch refuses a row
+    (an implausible body), every row is synthesized alone, so only that row fails: batched and one-at-a-time
+    results are the same bits. Returns a ChunkResult."""
+    from ..core.synthesis import synthesize_batch
+
+    try:
+        return ChunkResult.of(synthesize_batch(reference, requests, options), [None] * len(requests))
+    except ElliMannError:
+        pass
+    parts, errors = [], []
+    for values in requests:
+        try:
+            parts.append(synthesize_batch(reference, [values], options))
+            errors.append(None)
+        except ElliMannError as error:
+            parts.append(None)
+            errors.append(common.one_line(error))
+    return ChunkResult.joined(parts, errors)
+
+
+class ChunkResult:
+    """A chunk's synthesis as plain arrays (what a Dask worker sends back): ``errors[i]`` is None or why row i
+    failed (its arrays are then NaN)."""
+
+    FIELDS = ("rotation", "center", "semi_axes", "measured", "factors", "converged")
+
+    def __init__(self, topology, errors, joints=None, **arrays):
+        self.topology, self.errors = topology, errors
+        self.joints = joints  # (B, 24, 3) rest joints, or None when the reference set has none
+        for key in self.FIELDS:
+            setattr(self, key, arrays[key])
+
+    @classmethod
+    def of(cls, synthesis, errors):
+        return cls(synthesis.topology, errors, synthesis.joints, **{key: getattr(synthesis, key) for key in cls.FIELDS})
+
+    @classmethod
+    def joined(cls, parts, errors):
+        good = next((p for p in parts if p is not None), None)
+        if good is None:
+            return cls(None, errors, **{key: [None] * len(parts) for key in cls.FIELDS})
+        fields = cls.FIELDS + (("joints",) if good.joints is not None else ())
+        arrays = {key: np.concatenate([getattr(p if p is not None else good, key) for p in parts]) for key in fields}
+        for i, part in enumerate(parts):
+            if part is None:
+                for key in fields:
+                    if key != "converged":
+                        arrays[key][i] = np.nan
+                arrays["converged"][i] = False
+        return cls(good.topology, errors, **arrays)
+
+    def mannequin(self, i, name, request):
+        from ..core.mannequin import Mannequin
+
+        return Mannequin(self.topology, self.rotation[i], self.center[i], self.semi_axes[i], name=name,
+                         role="synthesized", measurements=as_dict(request),
+                         joints=None if self.joints is None else self.joints[i])
+
+
+def _row(args, formats, result, i, line, name, values, warnings, bundle=None, chunk=0, pose_file=None):
+    """Write (or, with --resume, keep) the files of one synthesized row, and add it to the batch file; its report
+    row. A failure is that row's: one line on stderr and status "error", and the batch goes on."""
+    if result.errors[i] is not None:
+        common.say(f"{PROG} batch: line {line}: failed: {result.errors[i]}")
+        return common.report_row(line, name, "error", result.errors[i], values)
+    paths = [os.path.join(args.output, f"{name}.{common.extension(kind)}") for kind in formats if kind != NPZ]
     notes = list(warnings)
     misses = common.misses(result.measured[i], values) if args.mode == "exact" else []  # = not result.converged[i]
     if misses:
         notes.append(common.missed_text(misses))
         common.say(f"{PROG} batch: line {line}: warning: {common.missed_text(misses)}")
     status = "missed" if misses else "ok"
-    if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths):
+    listed = paths + ([bundle.path] if bundle is not None else [])
+    if bundle is not None:
+        bundle.add(chunk, name, values, result, i)
+    if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths) and paths:
         row = common.report_row(line, name, status, "; ".join(notes + ["kept (--resume)"]), values, result.measured[i],
-                          paths)
+                                listed)
         row["kept"] = True
         return row
     try:
-        mannequin = result.mannequin(i, name)
-        frames = common.pose_frames(args, mannequin, pose_file)
-        common.write(mannequin, paths, as_dict(result.measured[i]), args.cushions, frames, args.fps)
+        if paths:
+            mannequin = result.mannequin(i, name, values)
+            frames = common.pose_frames(args, mannequin, pose_file)
+            common.write(mannequin, paths, as_dict(result.measured[i]), args.cushions, frames, args.fps)
     except (ElliMannError, OSError, RuntimeError) as error:
         common.say(f"{PROG} batch: line {line}: failed: {common.one_line(error)}")
+        if bundle is not None:
+            bundle.drop(chunk, name)
         return common.report_row(line, name, "error", common.one_line(error), values)
-    return common.report_row(line, name, status, "; ".join(notes), values, result.measured[i], paths)
+    return common.report_row(line, name, status, "; ".join(notes), values, result.measured[i], listed)
+
+
+class Bundle:
+    """The rows of ``--format npz``, gathered by chunk (a Dask run finishes chunks in any order) and written
+    once, in the CSV's order, when the batch ends (``core.batch_file``)."""
+
+    def __init__(self, path, topology, mode):
+        self.path, self.topology, self.mode = path, topology, mode
+        self.rows = {}  # chunk -> [(name, request, result, i)]
+
+    def add(self, chunk, name, values, result, i):
+        self.rows.setdefault(chunk, []).append((name, values, result, i))
+
+    def drop(self, chunk, name):
+        self.rows[chunk] = [row for row in self.rows.get(chunk, []) if row[0] != name]
+
+    def write(self):
+        from ..core.batch_file import batch_arrays, write_batch_file
+
+        rows = [row for chunk in sorted(self.rows) for row in self.rows[chunk]]
+        parts = len(self.topology)
+        shapes = {"rotation": (parts, 3, 3), "center": (parts, 3), "semi_axes": (parts, 3), "measured": (5,),
+                  "factors": (5,), "converged": ()}
+        arrays = {key: np.array([getattr(result, key)[i] for _, _, result, i in rows]).reshape((len(rows),) + shape)
+                  for key, shape in shapes.items()}
+        requests = np.array([values for _, values, _, _ in rows], dtype=float).reshape(len(rows), 5)
+        with common.writing(self.path):
+            write_batch_file(self.path, batch_arrays(self.topology, [row[0] for row in rows], requests,
+                                                     mode=self.mode, **arrays))
 
 
 class Report:

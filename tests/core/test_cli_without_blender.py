@@ -95,7 +95,7 @@ def test_posed_core_formats_run_without_blender(tmp_path):
 
 
 @pytest.mark.parametrize("argv", [["--help"], ["synth", "--help"], ["batch", "--help"], ["measure", "--help"],
-                                  ["demo", "--help"], ["drape", "--help"],
+                                  ["demo", "--help"], ["drape", "--help"], ["population", "--help"],
                                   ["pose", "--help"]])
 def test_help_runs_without_blender(argv):
     code, stdout, _ = without_blender(*argv)
