@@ -7,10 +7,11 @@ depends only on its own body: fitted, refined and cleaned alone; only its axis l
 reference RM, here the Average). Then, leaving each body out in turn, mannequins are synthesized
 (exact mode, default options) at the held-out body's measurements from every set of 3, 4 and 5 of
 the other bodies, and compared with the held-out body's mesh: volumetric IoU (intersection over
-union of the voxels, 5 mm grid) of the mannequin's cushions (its convex pieces) and of its ellipsoids,
-the body moved by the registration its own RM got (so both stand in the same frame). The held-out
-body's own RM (traced on it) is the ceiling. With the reference body held out, the set of five is the
-shipped set. Prints a markdown table (and writes it with --out). Takes a few minutes.
+union of the voxels, 5 mm grid: core.volume.voxel_iou) of the mannequin's cushions (its convex
+pieces) and of its ellipsoids, the body moved by the registration its own RM got (so both stand in
+the same frame). The held-out body's own RM (traced on it) is the ceiling. With the reference body
+held out, the set of five is the shipped set. Prints a markdown table (and writes it with --out).
+Takes a few minutes.
 """
 
 import argparse
@@ -27,21 +28,12 @@ from ellimann_addon.core.reference_build import display_name
 from ellimann_addon.core.reference_manifest import Manifest, targets_range
 from ellimann_addon.core.reference_set import REFERENCE_FOLDER, ReferenceSet
 from ellimann_addon.core.synthesis import synthesize_batch
-from ellimann_addon.core.volume import BodyVolume, cushion_hulls, occupancy
+from ellimann_addon.core.volume import IOU_MARGIN, IOU_SPACING, BodyVolume, voxel_iou
 
 from .bodies import REFERENCE_BODY, body_measurements, load_labels
 from .build_reference import DEFAULT_REFMODELS, REFERENCE_RM
 
-SPACING = 0.005  # m: the voxels
-MARGIN = 0.15  # m: around the body, so a mannequin reaching outside it is counted whole
 SIZES = (3, 4, 5)
-
-
-def iou(grid, mannequin, cushions):
-    """Intersection over union of the grid's inside cells (the body) and the mannequin's pieces."""
-    hulls = cushion_hulls(mannequin) if cushions else None
-    occupied = occupancy(grid, mannequin, cushions, hulls)
-    return np.count_nonzero(occupied & grid.inside) / np.count_nonzero(occupied | grid.inside)
 
 
 def six_rms(refmodels, workers):
@@ -64,8 +56,8 @@ def held_out_table(rms, targets, shifts, bodies):
     rows = {}
     for held in bodies:
         body = bodies[held]
-        grid = BodyVolume(body.vertices + shifts[held], body.faces).grid(SPACING, margin=MARGIN)
-        row = {"own": (iou(grid, rms[held], True), iou(grid, rms[held], False))}
+        grid = BodyVolume(body.vertices + shifts[held], body.faces).grid(IOU_SPACING, margin=IOU_MARGIN)
+        row = {"own": (voxel_iou(rms[held], grid=grid), voxel_iou(rms[held], cushions=False, grid=grid))}
         others = [name for name in bodies if name != held]
         request = np.array([[targets[held][k] for k in MEASUREMENTS]])
         for size in SIZES:
@@ -75,7 +67,7 @@ def held_out_table(rms, targets, shifts, bodies):
                 manifest = Manifest("held out", list(subset), ranges_cm=targets_range(chosen), targets_cm=chosen)
                 reference = ReferenceSet([rms[name] for name in subset], names=list(subset), manifest=manifest)
                 mannequin = synthesize_batch(reference, request, mode="exact").mannequin(0)
-                row[size].append((iou(grid, mannequin, True), iou(grid, mannequin, False)))
+                row[size].append((voxel_iou(mannequin, grid=grid), voxel_iou(mannequin, cushions=False, grid=grid)))
         rows[held] = row
         print(f"  {held}: own RM {row['own'][0]:.3f}, " + ", ".join(
             f"N={size} {np.mean([v[0] for v in row[size]]):.3f}" for size in SIZES), file=sys.stderr)
@@ -91,7 +83,7 @@ def markdown(rows):
 
     lines = []
     for which, label in ((0, "cushions"), (1, "ellipsoids")):
-        lines += [f"Volumetric IoU of the {label} with the held-out body ({SPACING * 1e3:g} mm voxels); "
+        lines += [f"Volumetric IoU of the {label} with the held-out body ({IOU_SPACING * 1e3:g} mm voxels); "
                   "N = 3, 4: mean (min-max) over every set of that many of the other five bodies.", "",
                   "| held-out body | own RM (ceiling) | N = 5 | N = 4 | N = 3 |", "|---|---|---|---|---|"]
         for held, row in rows.items():
