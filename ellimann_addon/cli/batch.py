@@ -305,8 +305,9 @@ class ChunkResult:
                   else np.concatenate([(p if p is not None else good).joints for p in parts]))
         for i, part in enumerate(parts):
             if part is None:
-                for key in cls.FIELDS[:-1]:
-                    arrays[key][i] = np.nan
+                for key in fields:
+                    if key != "converged":
+                        arrays[key][i] = np.nan
                 arrays["converged"][i] = False
                 if joints is not None:
                     joints[i] = np.nan

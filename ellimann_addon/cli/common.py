@@ -125,7 +125,7 @@ def check_pose_argument(args, kinds):
         frames = read_pose(args.pose)
     else:
         check_pose_name(args.pose)
-    still = [FORMATS[k] for k in kinds if not FORMATS[k].animated]
+    still = [FORMATS[k] for k in kinds if k in FORMATS and not FORMATS[k].animated]  # (npz: batch's own bundle)
     if still and (args.pose in MOTIONS or (frames is not None and len(frames) > 1)):
         raise UsageError(f"--pose {args.pose} is an animation and a .{still[0].extension} file holds none; write "
                          f"{', '.join('.' + f.extension for f in FORMATS.values() if f.animated)}")
