@@ -104,7 +104,7 @@ def trace_base(reference_body, traces, constants=None, joints=None):
     Returns (base, body -> base translation)."""
     topology = rt.topology()
     base, kept = fit_mannequin(reference_body, topology, traces, constants=constants, name=DISPLAY_NAMES[BASE_FILE],
-                               role=base)
+                               role="base")
     base = symmetrize(base.copy(joints=joints))  # symmetric first: mirroring may move the lowest point
     shift = registration_offset(base)
     traces = {name: dataclasses.replace(trace, fit=dataclasses.replace(trace.fit, kept=kept[topology.index[name]]))

@@ -305,7 +305,7 @@ class ChunkResult:
                   else np.concatenate([(p if p is not None else good).joints for p in parts]))
         for i, part in enumerate(parts):
             if part is None:
-                for key in fields:
+                for key in cls.FIELDS:
                     if key != "converged":
                         arrays[key][i] = np.nan
                 arrays["converged"][i] = False

@@ -16,10 +16,10 @@ import numpy as np
 from .constants import CENTER_LIMIT, FEMALE_SET, MEASUREMENTS, SECTION_FRACTIONS, SEMI_AXIS_LIMITS
 from .errors import MannequinError, Problem
 from .files import atomic_write_text
+from .joints import joint_problems, joints_from_dict, joints_to_dict
 from .problems import json_type as _json_type
 from .problems import measurement_problems, section_fraction_problems
 from .problems import short as _short
-from .joints import joint_problems, joints_from_dict, joints_to_dict
 from .trace import traces_from_dict, traces_to_dict
 
 FORMAT = "ellimann.mannequin"
