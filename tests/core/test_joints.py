@@ -47,7 +47,7 @@ def test_joints_json_round_trip_and_old_files_load(tmp_path, average):
     path = tmp_path / "a.json"
     average.save(path)
     data = json.loads(path.read_text())
-    assert data["joints"]["names"] == list(skeleton.JOINT_NAMES) and data["version"] == 1
+    assert data["joints"]["names"] == list(skeleton.JOINT_NAMES) and data["joints"]["version"] == 1
     assert np.array_equal(Mannequin.load(path).joints, average.joints)
     del data["joints"]
     path.write_text(json.dumps(data))
