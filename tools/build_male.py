@@ -15,6 +15,7 @@
 """
 
 import argparse
+import dataclasses
 import pathlib
 import sys
 import time
@@ -31,7 +32,7 @@ from ellimann_addon.core.reference_manifest import Manifest, targets_range, writ
 
 from . import build_reference as br
 from . import coverage
-from .bodies import RM_BODIES, body_measurements, load_labels
+from .bodies import RM_BODIES, body_measurements, load_labels, load_skeletons
 from .reference_sets import FEMALE, MALE, TRACING_FOLDER
 
 DOCS_NAME = MALE.docs_name
@@ -45,10 +46,12 @@ def build(log=print):
     traced = Mannequin.load(FEMALE.out / f"{br.BASE_FILE}.json")  # its traces: the selections
     constants = FitConstants(section_fractions=dict(MALE.fractions))
     reference_body = read_obj(MALE.refmodels / f"{MALE.reference_body}.obj")
-    base, base_shift = br.trace_base(reference_body, traced.traces, constants)
+    skeletons = load_skeletons(MALE.refmodels)  # the male bodies' own joints, as the female set's
+    base, base_shift = br.trace_base(reference_body, traced.traces, constants, joints=skeletons[MALE.reference_body])
     base = base.copy(**LANDMARKS)
     log(f"male base mannequin fitted ({len(base)} parts)")
-    bodies = [read_obj(MALE.refmodels / f"{name}.obj") for name in RM_BODIES]
+    bodies = [dataclasses.replace(read_obj(MALE.refmodels / f"{name}.obj"), joints=skeletons[name])
+              for name in RM_BODIES]
     rms, built = build_reference_set(base, bodies, MALE.targets, reference=br.REFERENCE_RM,
                                      settings=BuildSettings(fit=constants, check_spacing=None),
                                      progress=lambda fraction, text: log(f"{fraction:4.0%} {text}"))

@@ -120,3 +120,33 @@ def test_exact_mode_converges_on_the_male_grid(male):
     result = synthesize_batch(male, grid, mode="exact")
     assert result.converged.all()
     assert result.relative_error().max() <= 100.0 * EXACT_TOLERANCE
+
+
+def test_a_male_mannequin_has_its_bodys_joints_poses_rigidly_and_simulates(male):
+    """The male RMs carry the male bodies' joints (../shared/refmodels_male/skeleton.json), so a male mannequin
+    is synthesized with joints, poses like a female one, and loads and falls in MuJoCo as an articulated body."""
+    from ellimann_addon.core import poses
+    from ellimann_addon.core.export_mjcf_articulated import articulated_mjcf
+    from ellimann_addon.core.pose import pose_mannequin
+    from ellimann_addon.core.skeleton import JOINT_INDEX
+
+    mujoco = pytest.importorskip("mujoco")  # requirements-dev.txt: CI has it
+    for rm in male.mannequins:
+        assert rm.joints is not None and rm.joints.shape == (24, 3)
+    request = {key: float(np.mean(male.ranges[key])) for key in MEASUREMENTS}
+    mannequin, measured, _ = synthesize(male, request)
+    assert mannequin.joints is not None and mannequin.reference_set == "male"
+    he = measured["He"] / 100.0
+    hip = mannequin.joints[JOINT_INDEX["L_Hip"], 2] / he  # the male hip joint is higher than the female 0.515 He
+    assert 0.48 < hip < 0.56
+    frames = [poses.standard_pose("t_pose", mannequin.joints)]
+    posed = pose_mannequin(mannequin, frames[0])
+    assert np.array_equal(posed.semi_axes, mannequin.semi_axes)
+    wrist = posed.joints[JOINT_INDEX["L_Wrist"]]
+    shoulder = posed.joints[JOINT_INDEX["L_Shoulder"]]
+    assert abs(wrist[2] - shoulder[2]) < 0.02 and wrist[0] > shoulder[0] + 0.3  # the arm out level, to the left
+    model = mujoco.MjModel.from_xml_string(articulated_mjcf(mannequin, frames, cushions=True))
+    data = mujoco.MjData(model)
+    for _ in range(200):
+        mujoco.mj_step(model, data)
+    assert np.isfinite(data.qpos).all()
