@@ -31,6 +31,7 @@ from .mesh import convex_hull_2d, polygon_perimeter
 ARM_SCAN_STEP = 0.005  # He between the sections that find the arms
 ARM_MARGIN = 0.01  # m beyond the body's run before a vertex counts as an arm's
 HEIGHT_RANGE_M = (0.5, 2.5)  # a standing adult or child in metres
+NECK_SAMPLES = 96  # the neck's band (0.12 He) every 2 mm or so: a mannequin's pieces may pinch between them
 ALL_MEASUREMENTS = MEASUREMENTS + EXTRA_MEASUREMENTS
 
 
@@ -285,9 +286,9 @@ def measure_body_mesh(vertices, faces, fractions=None):
                                "calf cannot be taken")
 
     def neck(heights):
-        return np.array([hull_girth(body.body_section(z).reshape(-1, 2))[0] for z in heights])
+        return np.array([hull_girth(body.section(z)[0].reshape(-1, 2))[0] for z in heights])
 
-    values["neck"] = extreme_over_band(neck, *(body.at(f) for f in NECK_BAND), False)
+    values["neck"] = extreme_over_band(neck, *(body.at(f) for f in NECK_BAND), False, samples=NECK_SAMPLES)
 
     if arms_found:
         lengths, girths = [], []

@@ -11,7 +11,7 @@ Measurements (cm):
 - crotch_height: the crotch's height (the inside leg);
 - thigh: one leg's girth at ``THIGH_DROP`` He below the crotch (the gluteal fold);
 - calf: the largest girth of one leg between ``CALF_BAND`` of the crotch height;
-- neck: the smallest girth of the body between ``NECK_BAND`` He (the neck, wherever the jaw and shoulders are);
+- neck: the smallest girth of the whole section between ``NECK_BAND`` He (the neck, wherever jaw and shoulders are);
 - arm_length: shoulder point to fingertip (straight, the arm as it hangs in the A-pose);
 - upper_arm: the arm's girth across its axis (shoulder point to fingertip) at ``UPPER_ARM_FRACTION`` of it.
 A girth is the perimeter of the convex hull of a section (a tape measure), as m_T's; both legs or arms are
@@ -21,7 +21,7 @@ measured and their mean reported.
 import numpy as np
 
 from .constants import CM_PER_M
-from .ellipsoid import section_at_height
+from .ellipsoid import axis_extent, section_at_height
 from .measure import hull_perimeter, section_heights
 
 EXTRA_MEASUREMENTS = ("neck", "upper_arm", "thigh", "calf", "crotch_height", "arm_length")
@@ -52,27 +52,34 @@ GOLDEN_STEPS = 40  # golden-section steps: the band's grid cell shrinks below a 
 SIDES = ("L", "R")
 
 
-def extreme_over_band(function, low, high, largest):
-    """Largest (or smallest) value of a 1-D ``function`` (vectorised over an array of heights) on [low, high]:
-    the best of a grid, refined by golden-section search in the cells beside it."""
-    grid = np.linspace(low, high, BAND_SAMPLES)
-    values = function(grid)
+def extreme_over_band(function, low, high, largest, breaks=(), samples=BAND_SAMPLES):
+    """Largest (or smallest) value of a 1-D ``function`` (vectorised over an array of heights) on [low, high].
+
+    The band is cut at ``breaks`` (where the function may have a kink or a narrow dip: the ends of the pieces
+    a mannequin's section meets) and each piece sampled on a grid; golden-section search then refines every
+    grid cell beside a piece's best sample, all pieces at once, and the best of everything is returned."""
+    cuts = np.unique(np.clip(np.concatenate([[low, high], np.asarray(breaks, float)]), low, high))
+    per_piece = max(4, samples // max(len(cuts) - 1, 1))
+    t = np.linspace(0.0, 1.0, per_piece)
+    grid = cuts[:-1, None] + (cuts[1:] - cuts[:-1])[:, None] * t  # (P, per_piece)
     sign = -1.0 if largest else 1.0
-    best = int(np.argmin(sign * values))
-    a, b = grid[max(best - 1, 0)], grid[min(best + 1, BAND_SAMPLES - 1)]
+    values = sign * function(grid.ravel()).reshape(grid.shape)
+    best = np.argmin(values, axis=1)
+    rows = np.arange(len(grid))
+    a = grid[rows, np.maximum(best - 1, 0)]
+    b = grid[rows, np.minimum(best + 1, per_piece - 1)]
     ratio = (np.sqrt(5.0) - 1.0) / 2.0
     c, d = b - ratio * (b - a), a + ratio * (b - a)
-    fc, fd = sign * function(np.array([c]))[0], sign * function(np.array([d]))[0]
+    fc, fd = sign * function(c), sign * function(d)
     for _ in range(GOLDEN_STEPS):
-        if fc < fd:
-            b, d, fd = d, c, fc
-            c = b - ratio * (b - a)
-            fc = sign * function(np.array([c]))[0]
-        else:
-            a, c, fc = c, d, fd
-            d = a + ratio * (b - a)
-            fd = sign * function(np.array([d]))[0]
-    return float(max(sign * values[best], min(fc, fd)) * sign) if largest else float(min(values[best], fc, fd))
+        left = fc < fd  # the minimum of sign * f lies in [a, d]
+        a, b = np.where(left, a, c), np.where(left, d, b)
+        c_new, d_new = np.where(left, b - ratio * (b - a), d), np.where(left, c, a + ratio * (b - a))
+        probe = np.where(left, c_new, d_new)
+        fp = sign * function(probe)
+        fc, fd = np.where(left, fp, fd), np.where(left, fc, fp)
+        c, d = c_new, d_new
+    return float(sign * min(values.min(), fc.min(), fd.min()))
 
 
 def _permuted(rotation, center, order):
@@ -116,6 +123,11 @@ class MannequinLandmarks:
 
     def at(self, fraction):
         return self.bottom + fraction * self.height
+
+    def piece_ends(self, mask):
+        """Lowest and highest z of the ellipsoids ``mask``: where a section gains or loses a piece."""
+        half = axis_extent(self.rotation[mask], self.semi[mask], 2)
+        return np.concatenate([self.center[mask, 2] - half, self.center[mask, 2] + half])
 
     def girths_at(self, heights, mask):
         """Hull perimeter (m) of the sections of the ellipsoids ``mask`` at each height (array)."""
@@ -189,12 +201,13 @@ def mannequin_extra_measurements(mannequin):
         z_thigh = marks.bottom + crotch - THIGH_DROP * he
         out["thigh"] = float(np.mean([marks.girths_at([z_thigh], mask)[0] for mask in legs]))
         low, high = (marks.bottom + f * crotch for f in CALF_BAND)
-        out["calf"] = float(np.mean([extreme_over_band(lambda z, m=mask: marks.girths_at(z, m), low, high, True)
-                                     for mask in legs]))
+        out["calf"] = float(np.mean([extreme_over_band(lambda z, m=mask: marks.girths_at(z, m), low, high, True,
+                                                       marks.piece_ends(mask)) for mask in legs]))
     else:
         out["thigh"] = out["calf"] = np.nan
-    neck_mask = marks.girth & ~marks.arm
-    out["neck"] = extreme_over_band(lambda z: marks.girths_at(z, neck_mask), *(marks.at(f) for f in NECK_BAND), False)
+    neck_mask = np.ones(len(marks.girth), bool)  # the whole section: no arm reaches the neck's band apart
+    out["neck"] = extreme_over_band(lambda z: marks.girths_at(z, neck_mask), *(marks.at(f) for f in NECK_BAND), False,
+                                    marks.piece_ends(neck_mask))
     if marks.arm.any() and all((marks.arm & (marks.side == side)).any() for side in SIDES):
         out["arm_length"] = float(np.mean([marks.arm_axis(side)[2] for side in SIDES]))
         out["upper_arm"] = float(np.mean([marks.arm_girth(side) for side in SIDES]))
