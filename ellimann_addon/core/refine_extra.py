@@ -1,0 +1,159 @@
+"""Exact mode for the extra measurements: degrees of freedom of their own (a neck, the upper arms, the thighs,
+the calves, the leg and arm lengths), alternated with the five's refinement (``core.refine``) until every given
+measurement is met.
+
+Each extra measurement moves only its own pieces: its girth scales the pieces its section cuts across their
+horizontal (or, for the upper arm, across the arm's) axes; the crotch height stretches the legs against the
+trunk; the arm length stretches the arm along itself about the shoulder point. One log-factor per given
+measurement, solved by secant steps per factor (each measurement responds almost only to its own factor),
+with the five re-met by ``core.refine.refine`` after every round (the extra factors nudge He and the girths).
+"""
+
+import numpy as np
+
+from .constants import MEASUREMENTS
+from .errors import ElliMannError
+from .extra_measures import (
+    CALF_BAND,
+    EXTRA_ABSURD_LIMITS,
+    EXTRA_LABELS,
+    EXTRA_MEASUREMENTS,
+    SIDES,
+    THIGH_DROP,
+    MannequinLandmarks,
+    mannequin_extra_measurements,
+)
+from .measure import tailor_measurements
+from .refine import refine
+
+EXTRA_TOLERANCE_CM = 0.01  # every given extra measurement within 0.1 mm
+EXTRA_MAX_ROUNDS = 12
+EXTRA_FACTOR_LIMITS = (0.5, 2.0)  # beyond these a piece would no longer look like itself
+_MAX_LOG_STEP = 0.25
+
+
+class ExtraRequestError(ElliMannError):
+    """A request for extra measurements that no body can meet (one line, with the amount)."""
+
+
+def extra_request_problems(request, extra):
+    """Lines saying which given extra measurements are outside their limits or contradict the others (with the
+    amount), for a request dict of the five (cm) and a dict of extra measurements (cm)."""
+    problems = []
+    for key, value in extra.items():
+        if key not in EXTRA_MEASUREMENTS:
+            problems.append(f"{key}: not a measurement (one of {', '.join(EXTRA_MEASUREMENTS)})")
+            continue
+        low, high = EXTRA_ABSURD_LIMITS[key]
+        if not (np.isfinite(value) and low <= value <= high):
+            problems.append(f"{key} ({EXTRA_LABELS[key]}) must be {low:g}-{high:g} cm, got {value:g}")
+    if problems:
+        return problems
+    he, hi, br = request["He"], request["Hi"], request["Br"]
+    rules = (("thigh", hi, "Hi", "a thigh cannot be larger than the hip"),
+             ("neck", br, "Br", "a neck cannot be larger than the breast"),
+             ("calf", extra.get("thigh", hi), "thigh" if "thigh" in extra else "Hi",
+              "a calf cannot be larger than the thigh"),
+             ("upper_arm", 0.5 * br, "Br/2", "an upper arm cannot be larger than half the breast"),
+             ("crotch_height", 0.6 * he, "0.6 He", "the crotch cannot be above 0.6 He"),
+             ("arm_length", 0.5 * he, "0.5 He", "the arm cannot be longer than half of He"))
+    for key, limit, name, why in rules:
+        if key in extra and extra[key] >= limit:
+            problems.append(f"{key} {extra[key]:g} cm >= {name} {limit:g} cm by {extra[key] - limit:.2f} cm: {why}")
+    if "crotch_height" in extra and extra["crotch_height"] <= 0.3 * he:
+        problems.append(f"crotch_height {extra['crotch_height']:g} cm <= 0.3 He {0.3 * he:g} cm by "
+                        f"{0.3 * he - extra['crotch_height']:.2f} cm: the legs cannot be that short")
+    return problems
+
+
+def _scale_across(rotation, semi, rows, axis, factor):
+    """Scale the semi-axes of pieces ``rows`` across ``axis`` (a unit vector; their shares along it stay)."""
+    along = np.einsum("nik,i->nk", rotation[rows], axis) ** 2  # share of each local axis along ``axis``
+    semi[rows] *= factor ** (1.0 - along)
+
+
+def _apply(key, factor, mannequin, rotation, center, semi):
+    """Deform (in place) the pieces of measurement ``key`` by ``factor``."""
+    marks = MannequinLandmarks(mannequin.copy(center=center, semi_axes=semi))
+    topology = mannequin.topology
+    region = np.array([part.region for part in topology])
+    up = np.array([0.0, 0.0, 1.0])
+    if key == "neck":
+        _scale_across(rotation, semi, np.nonzero(region == "neck")[0], up, factor)
+    elif key in ("thigh", "calf"):
+        legs = region == "legs"
+        crotch = marks.crotch()
+        if key == "thigh":
+            z = marks.bottom + crotch - THIGH_DROP * marks.height
+        else:  # the height of the largest calf girth, on a grid over the band (enough to pick the pieces)
+            heights = marks.bottom + np.linspace(*CALF_BAND, 48) * crotch
+            z = heights[int(np.argmax(marks.girths_at(heights, marks.leg_mask("L"))))]
+        half = np.sqrt(np.einsum("nk,nk->n", rotation[:, 2, :] ** 2, semi**2))
+        rows = np.nonzero(legs & (np.abs(center[:, 2] - z) < half))[0]
+        _scale_across(rotation, semi, rows, up, factor)
+    elif key == "crotch_height":
+        crotch = marks.bottom + marks.crotch()
+        lower = np.isin(region, ("legs", "feet"))
+        center[lower, 2] = marks.bottom + factor * (center[lower, 2] - marks.bottom)
+        center[~lower, 2] += (factor - 1.0) * (crotch - marks.bottom)
+        semi[lower] *= factor ** (rotation[lower, 2, :] ** 2)  # each local axis by its share along z
+    elif key in ("upper_arm", "arm_length"):
+        for side in SIDES:
+            start, axis, _ = marks.arm_axis(side)
+            arm = np.nonzero(marks.arm & (marks.side == side))[0]
+            if key == "upper_arm":
+                upper = arm[np.argmax(center[arm, 2])]
+                _scale_across(rotation, semi, [upper], axis, factor)
+            else:
+                center[arm] = start + factor * (center[arm] - start)
+                along = np.einsum("nik,i->nk", rotation[arm], axis) ** 2
+                semi[arm] *= factor**along
+
+
+def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXTRA_MAX_ROUNDS):
+    """Deform a synthesized mannequin until its m_T meets its request (``mannequin.measurements``) and its
+    extra measurements meet ``extra`` {key: cm}. Returns (mannequin, measured {all keys: cm}, misses [lines])."""
+    targets = np.array([mannequin.measurements[key] for key in MEASUREMENTS])
+    rotation, center, semi = mannequin.rotation.copy(), mannequin.center.copy(), mannequin.semi_axes.copy()
+    keys = [key for key in EXTRA_MEASUREMENTS if key in extra]
+    log_factor = {key: 0.0 for key in keys}
+    slope = {key: 1.0 for key in keys}
+    previous = {}
+    girth = mannequin.topology.girth_mask
+    fractions = mannequin.section_fractions
+
+    def measure():
+        current = mannequin.copy(rotation=rotation, center=center, semi_axes=semi)
+        return current, mannequin_extra_measurements(current)
+
+    current, values = measure()
+    for _ in range(max_rounds):
+        residual = {key: np.log(values[key] / extra[key]) for key in keys}
+        if all(abs(values[key] - extra[key]) <= tolerance_cm for key in keys):
+            break
+        for key in keys:
+            if key in previous and abs(log_factor[key] - previous[key][0]) > 1e-9:
+                secant = (residual[key] - previous[key][1]) / (log_factor[key] - previous[key][0])
+                slope[key] = secant if secant > 0.05 else slope[key]
+            previous[key] = (log_factor[key], residual[key])
+        for key in keys:
+            step = float(np.clip(-residual[key] / slope[key], -_MAX_LOG_STEP, _MAX_LOG_STEP))
+            wanted = float(np.clip(log_factor[key] + step, *np.log(EXTRA_FACTOR_LIMITS)))
+            _apply(key, np.exp(wanted - log_factor[key]), current, rotation, center, semi)
+            log_factor[key] = wanted
+            current = mannequin.copy(rotation=rotation, center=center, semi_axes=semi)
+        result = refine(mannequin.topology, rotation[None], center[None], semi[None], targets[None],
+                        fractions=fractions)
+        center, semi = result.center[0], result.semi_axes[0]
+        current, values = measure()
+    five = tailor_measurements(rotation, center, semi, girth, fractions)
+    measured = dict(zip(MEASUREMENTS, (float(v) for v in five)))
+    measured.update(values)
+    misses = [f"{key} {measured[key]:.2f} cm, asked {extra[key]:.2f} (off by {measured[key] - extra[key]:+.2f} cm)"
+              for key in keys if abs(measured[key] - extra[key]) > 0.1]
+    return current.copy(center=center, semi_axes=semi), measured, misses
+
+
+def extra_of(values):
+    """The extra measurements (cm) in a dict that may hold the five too."""
+    return {key: float(values[key]) for key in EXTRA_MEASUREMENTS if key in values and values[key] is not None}
