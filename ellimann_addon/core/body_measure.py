@@ -220,7 +220,7 @@ def check_mesh(vertices, faces):
         return (f"the body is not upright (Z extent {tall:.3f} m, X {extent[0]:.3f} m, Y {extent[1]:.3f} m): "
                 "lying or on its side (give the up axis); nothing measured")
     if tall < low:
-        return f"the body is {tall:.3f} m tall: He must be {low}-{high} m (in centimetres? give the unit); nothing measured"
+        return f"the body is {tall:.3f} m tall: He must be {low}-{high} m (is the unit right?); nothing measured"
     bottom = vertices[:, 2].min()
     soles = vertices[vertices[:, 2] < bottom + 0.03 * tall]
     crown = vertices[vertices[:, 2] > bottom + 0.97 * tall]

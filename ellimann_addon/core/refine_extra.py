@@ -157,3 +157,23 @@ def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXT
 def extra_of(values):
     """The extra measurements (cm) in a dict that may hold the five too."""
     return {key: float(values[key]) for key in EXTRA_MEASUREMENTS if key in values and values[key] is not None}
+
+
+def synthesize_extra(reference, request, extra, options=None):
+    """One mannequin meeting the five of ``request`` (dict, cm) and the given ``extra`` measurements (exact mode;
+    IDW leaves the extra ones as the reference set gives them). Returns (Mannequin, measured {all: cm},
+    warnings); raises ExtraRequestError for a contradiction."""
+    from .synthesis import synthesize  # synthesis imports nothing of this module: no cycle, kept lazy anyway
+
+    problems = extra_request_problems(request, extra)
+    if problems:
+        raise ExtraRequestError(problems[0])
+    mannequin, measured, warnings = synthesize(reference, request, options)
+    if extra and getattr(options, "mode", "exact") == "exact":
+        mannequin, measured, misses = meet_extra(mannequin, extra)
+        warnings += [f"exact mode missed {line}" for line in misses]
+    else:
+        measured = dict(measured, **mannequin_extra_measurements(mannequin))
+        if extra:
+            warnings.append("the extra measurements are met in exact mode only (IDW gives the reference set's)")
+    return mannequin, measured, warnings
