@@ -113,6 +113,7 @@ class MannequinLandmarks:
         topology = mannequin.topology
         self.girth = topology.girth_mask
         self.side = np.array([part.side for part in topology])
+        self.lateral = self.side != "C"
         self.arm = np.array([part.region in ("arms", "hands") for part in topology])
         bottom, height, z = section_heights(self.rotation, self.center, self.semi, mannequin.section_fractions)
         self.bottom, self.height, self.z_shoulder = float(bottom), float(height), float(z["Sh"])

@@ -89,7 +89,9 @@ def _apply(key, factor, mannequin, rotation, center, semi):
             heights = marks.bottom + np.linspace(*CALF_BAND, 48) * crotch
             z = heights[int(np.argmax(marks.girths_at(heights, marks.leg_mask("L"))))]
         half = np.sqrt(np.einsum("nk,nk->n", rotation[:, 2, :] ** 2, semi**2))
-        rows = np.nonzero(legs & (np.abs(center[:, 2] - z) < half))[0]
+        # a thigh's section also cuts the hip pieces of its side (their lower ends): they widen with it
+        pieces = (legs | ((region == "hips") & marks.lateral)) if key == "thigh" else legs
+        rows = np.nonzero(pieces & (np.abs(center[:, 2] - z) < half))[0]
         _scale_across(rotation, semi, rows, up, factor)
     elif key == "crotch_height":
         crotch = marks.bottom + marks.crotch()
@@ -127,6 +129,7 @@ def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXT
         return current, mannequin_extra_measurements(current)
 
     current, values = measure()
+    best = (max(abs(values[key] - extra[key]) for key in keys), current, values)
     for _ in range(max_rounds):
         residual = {key: np.log(values[key] / extra[key]) for key in keys}
         if all(abs(values[key] - extra[key]) <= tolerance_cm for key in keys):
@@ -146,12 +149,18 @@ def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXT
                         fractions=fractions)
         center, semi = result.center[0], result.semi_axes[0]
         current, values = measure()
+        worst = max(abs(values[key] - extra[key]) for key in keys)
+        if worst < best[0]:
+            best = (worst, current, values)
+    # the round closest to every given measurement (a measurement its pieces cannot reach never makes it worse)
+    _, current, values = best
+    rotation, center, semi = current.rotation, current.center, current.semi_axes
     five = tailor_measurements(rotation, center, semi, girth, fractions)
     measured = dict(zip(MEASUREMENTS, (float(v) for v in five)))
     measured.update(values)
     misses = [f"{key} {measured[key]:.2f} cm, asked {extra[key]:.2f} (off by {measured[key] - extra[key]:+.2f} cm)"
               for key in keys if abs(measured[key] - extra[key]) > 0.1]
-    return current.copy(center=center, semi_axes=semi), measured, misses
+    return current, measured, misses
 
 
 def extra_of(values):

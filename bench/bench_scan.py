@@ -1,0 +1,53 @@
+"""Scan to mannequin: the time to measure a body mesh, and how much the extra measurements make a synthesized
+twin overlap its body (voxel IoU, tools/overlap.py), on the six female reference bodies of ../shared/refmodels.
+
+Per body: measure the mesh (core.body_measure, no labels), synthesize in exact mode with the five it found and
+again with all it found (core.refine_extra), and count the IoU of each twin with the body. Also: the time to
+measure one 27k-triangle body (the median of three runs) and what the five's measurement differs from the
+README's table by.
+"""
+
+import statistics
+import time
+
+from ellimann_addon.core.body_measure import measure_body_mesh
+from ellimann_addon.core.constants import MEASUREMENTS
+from ellimann_addon.core.refine_extra import synthesize_extra
+from ellimann_addon.core.shipped_sets import named_reference_set
+from tools.bodies import load_body, load_labels, body_measurements
+from tools.overlap import voxel_iou
+from tools.reference_sets import TRACING_FOLDER
+
+BODIES = ("reference_female", "small_slim", "tall_slim", "small_chubby", "tall_chubby", "average")
+SPACING = 0.005
+
+
+def run():
+    reference = named_reference_set("female")
+    labels = load_labels(TRACING_FOLDER)
+    print(f"{'body':<17} {'measure s':>9} {'max |five - README| cm':>22} {'IoU five':>9} {'IoU all':>8} "
+          f"{'gain':>6}")
+    gains = []
+    for name in BODIES:
+        body = load_body(TRACING_FOLDER, name)
+        times = []
+        for _ in range(3):
+            start = time.perf_counter()
+            result = measure_body_mesh(body.vertices, body.faces)
+            times.append(time.perf_counter() - start)
+        readme = body_measurements(body, labels)
+        worst = max(abs(result.values[key] - readme[key]) for key in MEASUREMENTS if key in result.values)
+        five = {key: result.values[key] for key in MEASUREMENTS}
+        extra = {key: value for key, value in result.values.items() if key not in MEASUREMENTS}
+        iou = []
+        for given in ({}, extra):
+            mannequin, _, _ = synthesize_extra(reference, five, given)
+            iou.append(voxel_iou(mannequin, body.vertices, body.faces, SPACING)[0])
+        gains.append(iou[1] - iou[0])
+        print(f"{name:<17} {statistics.median(times):9.2f} {worst:22.3f} {iou[0]:9.3f} {iou[1]:8.3f} "
+              f"{iou[1] - iou[0]:+6.3f}  ({len(body.faces)} triangles; not measured: {result.missing or 'none'})")
+    print(f"mean IoU gain with all measurements: {statistics.mean(gains):+.3f}")
+
+
+if __name__ == "__main__":
+    run()
