@@ -159,11 +159,12 @@ class BodyMesh:
         armpit = {}
         masks = {side: np.zeros(len(self.vertices), bool) for side in SIDES}
         for side in SIDES:
-            top = next((i for i, z in enumerate(heights) if z >= start and not lateral[i][side]), None)
-            if top is None or heights[top] <= start + step or not lateral[top - 1][side]:
+            # an arm still apart at the shoulder section's height has its armpit there
+            top = next((i for i, z in enumerate(heights) if z >= start and not lateral[i][side]), len(heights))
+            if top == 0 or heights[top - 1] < start or not lateral[top - 1][side]:
                 armpit[side] = None  # no separate arm at the waist: against the torso
                 continue
-            armpit[side] = heights[top]
+            armpit[side] = heights[top] if top < len(heights) else stop
             hull = max(lateral[top - 1][side], key=len)
             for i in range(top - 1, -1, -1):
                 if i < top - 1:
@@ -247,7 +248,7 @@ def measure_body_mesh(vertices, faces, fractions=None):
     result.sections["Sh"] = (z_sh, convex_hull_2d(segments.reshape(-1, 2)) if len(segments) else np.zeros((0, 2)))
 
     armpit, arm_vertex = body.find_arms()
-    arms_found = all(armpit[side] is not None for side in SIDES)
+    arms_found = all(armpit[side] is not None and arm_vertex[side].any() for side in SIDES)
     if not arms_found:
         result.problems.append("the arms are against the torso (no gap beside the waist section): Br, Wa, Hi, "
                                "thigh, upper_arm and arm_length cannot be taken")
@@ -286,9 +287,13 @@ def measure_body_mesh(vertices, faces, fractions=None):
                                "calf cannot be taken")
 
     def neck(heights):
-        return np.array([hull_girth(body.section(z)[0].reshape(-1, 2))[0] for z in heights])
+        girths = np.array([hull_girth(body.section(z)[0].reshape(-1, 2))[0] for z in heights])
+        return np.where(girths > 0.0, girths, np.inf)  # a height with no section is no neck
 
     values["neck"] = extreme_over_band(neck, *(body.at(f) for f in NECK_BAND), False, samples=NECK_SAMPLES)
+    if not np.isfinite(values["neck"]):
+        del values["neck"]
+        result.problems.append("no neck: the sections between 0.80 and 0.92 He are empty; neck cannot be taken")
 
     if arms_found:
         lengths, girths = [], []

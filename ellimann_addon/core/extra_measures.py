@@ -136,6 +136,11 @@ class MannequinLandmarks:
         centre, k, hit = section_at_height(self.rotation[None], self.center[None], self.semi[None], heights[:, None])
         return hull_perimeter(centre, k, hit & mask[None])
 
+    def nonzero_girths_at(self, heights, mask):
+        """As girths_at, with infinity where the section is empty (a smallest girth never lies there)."""
+        girths = self.girths_at(heights, mask)
+        return np.where(girths > 0.0, girths, np.inf)
+
     def crotch(self):
         """Height (m above the soles) of the lowest point of the body on the plane x = x_c, above CROTCH_FLOOR."""
         rotation, center = _permuted(self.rotation, self.center - [self.mid_x, 0.0, 0.0], (1, 2, 0))
@@ -207,8 +212,9 @@ def mannequin_extra_measurements(mannequin):
     else:
         out["thigh"] = out["calf"] = np.nan
     neck_mask = np.ones(len(marks.girth), bool)  # the whole section: no arm reaches the neck's band apart
-    out["neck"] = extreme_over_band(lambda z: marks.girths_at(z, neck_mask), *(marks.at(f) for f in NECK_BAND), False,
-                                    marks.piece_ends(neck_mask))
+    out["neck"] = extreme_over_band(lambda z: marks.nonzero_girths_at(z, neck_mask), *(marks.at(f) for f in NECK_BAND),
+                                    False, marks.piece_ends(neck_mask))
+    out["neck"] = out["neck"] if np.isfinite(out["neck"]) else np.nan  # no piece in the neck's band: no neck
     if marks.arm.any() and all((marks.arm & (marks.side == side)).any() for side in SIDES):
         out["arm_length"] = float(np.mean([marks.arm_axis(side)[2] for side in SIDES]))
         out["upper_arm"] = float(np.mean([marks.arm_girth(side) for side in SIDES]))
