@@ -37,6 +37,9 @@ EXTRA_GIRTHS = ("neck", "upper_arm", "thigh", "calf")
 # Plausibility limits (cm) of a request, as ABSURD_LIMITS for the five.
 EXTRA_ABSURD_LIMITS = {"neck": (15.0, 80.0), "upper_arm": (10.0, 80.0), "thigh": (20.0, 140.0),
                        "calf": (15.0, 90.0), "crotch_height": (20.0, 130.0), "arm_length": (20.0, 120.0)}
+# What the female Average Reference Mannequin measures (cm): the panel's starting values.
+EXTRA_DEFAULTS = {"neck": 32.4, "upper_arm": 23.6, "thigh": 56.0, "calf": 42.6, "crotch_height": 72.0,
+                  "arm_length": 57.8}
 # ISO 20685 allowances (cm): how far two ways of measuring one body may differ.
 ISO_ALLOWANCE = {"He": 0.4, "Sh": 0.4, "Br": 0.9, "Wa": 0.9, "Hi": 0.9, "neck": 0.9, "upper_arm": 0.9,
                  "thigh": 0.9, "calf": 0.9, "crotch_height": 0.4, "arm_length": 0.4}
@@ -113,7 +116,6 @@ class MannequinLandmarks:
         topology = mannequin.topology
         self.girth = topology.girth_mask
         self.side = np.array([part.side for part in topology])
-        self.lateral = self.side != "C"
         self.arm = np.array([part.region in ("arms", "hands") for part in topology])
         bottom, height, z = section_heights(self.rotation, self.center, self.semi, mannequin.section_fractions)
         self.bottom, self.height, self.z_shoulder = float(bottom), float(height), float(z["Sh"])

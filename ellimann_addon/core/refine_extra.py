@@ -25,10 +25,13 @@ from .extra_measures import (
 )
 from .measure import tailor_measurements
 from .refine import refine
+from .synthesis import synthesize
 
 EXTRA_TOLERANCE_CM = 0.01  # every given extra measurement within 0.1 mm
 EXTRA_MAX_ROUNDS = 12
-EXTRA_FACTOR_LIMITS = (0.5, 2.0)  # beyond these a piece would no longer look like itself
+MISS_CM = 0.1  # a given extra measurement further off than this (1 mm) is a miss
+FIVE_TOLERANCE_CM = 0.01  # a round that moves any of the five further than this is never the result
+EXTRA_FACTOR_LIMIT = 2.0  # a piece is never scaled beyond this, or below its inverse (it would no longer look like itself)
 _MAX_LOG_STEP = 0.25
 
 
@@ -89,9 +92,7 @@ def _apply(key, factor, mannequin, rotation, center, semi):
             heights = marks.bottom + np.linspace(*CALF_BAND, 48) * crotch
             z = heights[int(np.argmax(marks.girths_at(heights, marks.leg_mask("L"))))]
         half = np.sqrt(np.einsum("nk,nk->n", rotation[:, 2, :] ** 2, semi**2))
-        # a thigh's section also cuts the hip pieces of its side (their lower ends): they widen with it
-        pieces = (legs | ((region == "hips") & marks.lateral)) if key == "thigh" else legs
-        rows = np.nonzero(pieces & (np.abs(center[:, 2] - z) < half))[0]
+        rows = np.nonzero(legs & (np.abs(center[:, 2] - z) < half))[0]
         _scale_across(rotation, semi, rows, up, factor)
     elif key == "crotch_height":
         crotch = marks.bottom + marks.crotch()
@@ -114,22 +115,61 @@ def _apply(key, factor, mannequin, rotation, center, semi):
 
 def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXTRA_MAX_ROUNDS):
     """Deform a synthesized mannequin until its m_T meets its request (``mannequin.measurements``) and its
-    extra measurements meet ``extra`` {key: cm}. Returns (mannequin, measured {all keys: cm}, misses [lines])."""
+    extra measurements meet ``extra`` {key: cm}. Returns (mannequin, measured {all keys: cm}, misses [lines]).
+
+    All at once first; if that misses any, one measurement at a time (in EXTRA_MEASUREMENTS order), each kept
+    only if it and those kept before are met with the five: one that the pieces cannot reach (or only by
+    giving up the five) is left where the reference set puts it, and named in the misses."""
+    result = _meet(mannequin, extra, tolerance_cm, max_rounds)
+    if not result[2]:
+        return result
+    kept, current = {}, mannequin
+    for key in (key for key in EXTRA_MEASUREMENTS if key in extra):
+        trial = _meet(current, {**kept, key: extra[key]}, tolerance_cm, max_rounds)
+        if not trial[2]:
+            kept[key] = extra[key]
+            current = trial[0]
+    final, measured, _ = _meet(current, kept, tolerance_cm, max_rounds) if kept else (current, None, [])
+    if measured is None:
+        measured = _all_measured(final)
+    return final, measured, _misses(measured, extra)
+
+
+def _all_measured(mannequin):
+    five = tailor_measurements(mannequin.rotation, mannequin.center, mannequin.semi_axes,
+                               mannequin.topology.girth_mask, mannequin.section_fractions)
+    return {**dict(zip(MEASUREMENTS, (float(v) for v in five))), **mannequin_extra_measurements(mannequin)}
+
+
+def _misses(measured, extra):
+    return [f"{key} {measured[key]:.2f} cm, asked {extra[key]:.2f} (off by {measured[key] - extra[key]:+.2f} cm)"
+            for key in EXTRA_MEASUREMENTS if key in extra and abs(measured[key] - extra[key]) > MISS_CM]
+
+
+def _meet(mannequin, extra, tolerance_cm, max_rounds):
+    """meet_extra for all of ``extra`` at once."""
     targets = np.array([mannequin.measurements[key] for key in MEASUREMENTS])
     rotation, center, semi = mannequin.rotation.copy(), mannequin.center.copy(), mannequin.semi_axes.copy()
     keys = [key for key in EXTRA_MEASUREMENTS if key in extra]
     log_factor = {key: 0.0 for key in keys}
+    limit = np.log(EXTRA_FACTOR_LIMIT)
     slope = {key: 1.0 for key in keys}
     previous = {}
     girth = mannequin.topology.girth_mask
     fractions = mannequin.section_fractions
 
-    def measure():
-        current = mannequin.copy(rotation=rotation, center=center, semi_axes=semi)
+    def measure():  # a snapshot: the arrays go on being deformed in place
+        current = mannequin.copy(rotation=rotation.copy(), center=center.copy(), semi_axes=semi.copy())
         return current, mannequin_extra_measurements(current)
 
+    def worst_miss(current, values):
+        """(whether the five miss, the largest miss of the given extra ones in cm): the five come first."""
+        five = tailor_measurements(current.rotation, current.center, current.semi_axes, girth, fractions)
+        return (bool(np.any(np.abs(five - targets) > FIVE_TOLERANCE_CM)),
+                max(abs(values[key] - extra[key]) for key in keys))
+
     current, values = measure()
-    best = (max(abs(values[key] - extra[key]) for key in keys), current, values)
+    best = (worst_miss(current, values), current, values)
     for _ in range(max_rounds):
         residual = {key: np.log(values[key] / extra[key]) for key in keys}
         if all(abs(values[key] - extra[key]) <= tolerance_cm for key in keys):
@@ -140,8 +180,10 @@ def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXT
                 slope[key] = secant if secant > 0.05 else slope[key]
             previous[key] = (log_factor[key], residual[key])
         for key in keys:
+            if abs(log_factor[key]) >= limit:
+                continue  # at its limit: this measurement is as close as its pieces go
             step = float(np.clip(-residual[key] / slope[key], -_MAX_LOG_STEP, _MAX_LOG_STEP))
-            wanted = float(np.clip(log_factor[key] + step, *np.log(EXTRA_FACTOR_LIMITS)))
+            wanted = float(np.clip(log_factor[key] + step, -limit, limit))
             _apply(key, np.exp(wanted - log_factor[key]), current, rotation, center, semi)
             log_factor[key] = wanted
             current = mannequin.copy(rotation=rotation, center=center, semi_axes=semi)
@@ -149,31 +191,22 @@ def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXT
                         fractions=fractions)
         center, semi = result.center[0], result.semi_axes[0]
         current, values = measure()
-        worst = max(abs(values[key] - extra[key]) for key in keys)
+        worst = worst_miss(current, values)
         if worst < best[0]:
             best = (worst, current, values)
-    # the round closest to every given measurement (a measurement its pieces cannot reach never makes it worse)
+    # the round closest to the given extra ones among those meeting the five (the synthesized one is such a round)
     _, current, values = best
-    rotation, center, semi = current.rotation, current.center, current.semi_axes
-    five = tailor_measurements(rotation, center, semi, girth, fractions)
-    measured = dict(zip(MEASUREMENTS, (float(v) for v in five)))
-    measured.update(values)
-    misses = [f"{key} {measured[key]:.2f} cm, asked {extra[key]:.2f} (off by {measured[key] - extra[key]:+.2f} cm)"
-              for key in keys if abs(measured[key] - extra[key]) > 0.1]
+    measured = _all_measured(current)
+    misses = _misses(measured, extra)
+    if worst_miss(current, values)[0]:
+        misses.append("the five")
     return current, measured, misses
-
-
-def extra_of(values):
-    """The extra measurements (cm) in a dict that may hold the five too."""
-    return {key: float(values[key]) for key in EXTRA_MEASUREMENTS if key in values and values[key] is not None}
 
 
 def synthesize_extra(reference, request, extra, options=None):
     """One mannequin meeting the five of ``request`` (dict, cm) and the given ``extra`` measurements (exact mode;
     IDW leaves the extra ones as the reference set gives them). Returns (Mannequin, measured {all: cm},
     warnings); raises ExtraRequestError for a contradiction."""
-    from .synthesis import synthesize  # synthesis imports nothing of this module: no cycle, kept lazy anyway
-
     problems = extra_request_problems(request, extra)
     if problems:
         raise ExtraRequestError(problems[0])
