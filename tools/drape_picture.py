@@ -16,12 +16,12 @@ import numpy as np
 
 from bench.bench_drape import BODY, EDGE, REFMODELS
 from ellimann_addon.core import garments
+from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.collision import collision_pieces
 from ellimann_addon.core.ellipsoid import bounds
 from ellimann_addon.core.garment_fit import BodyPieces, mesh_distance
 from ellimann_addon.core.mannequin import Mannequin
 from ellimann_addon.core.synthesis import REFERENCE_FOLDER
-from tools.bodies import load_obj
 
 SPACING = 1.05  # m between slots
 BODY_COLOR = (0.8, 0.78, 0.72, 1.0)
@@ -43,7 +43,8 @@ def main(argv=None):
 
     ellimann_addon.register()
     mannequin = Mannequin.load(REFERENCE_FOLDER / f"{BODY}.json")
-    body_vertices, body_faces = load_obj(REFMODELS / f"{BODY}.obj")
+    body = read_obj(REFMODELS / f"{BODY}.obj")
+    body_vertices, body_faces = body.vertices, body.faces
     empty_scene()
     scene = bpy.context.scene
     settings = drape.DrapeSettings(frames=args.frames, edge=EDGE)

@@ -7,7 +7,7 @@ set's section heights), synthesize a mannequin from those five numbers with the 
 Mannequins (exact mode), stand it where the body stands (the floors at z = 0 and the volumes' centroids
 on one vertical line, since a synthesized mannequin is registered on its own landmark) and count, on a
 regular grid, the cells inside the body, inside the mannequin's pieces and inside both:
-IoU = |body ∩ mannequin| / |body ∪ mannequin|. Body volumes as tools/coverage.py counts them.
+IoU = |body ∩ mannequin| / |body ∪ mannequin|. Body volumes as core/volume.py counts them.
 """
 
 import argparse
@@ -15,38 +15,43 @@ import sys
 
 import numpy as np
 
+from ellimann_addon.core import volume
+from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.reference_set import load_reference_set
 from ellimann_addon.core.synthesis import synthesize_batch
 
-from . import coverage
-from .bodies import RM_BODIES, body_measurements, load_body, load_labels
+from .bodies import RM_BODIES, body_measurements, load_labels
 from .reference_sets import BUILD_SETS, TRACING_FOLDER
 
 
-def voxel_iou(mannequin, vertices, faces, spacing=coverage.GRID_SPACING, cushions=False):
+def voxel_iou(mannequin, vertices, faces, spacing=volume.GRID_SPACING, cushions=False):
     """(IoU, coverage, excess) of ``mannequin`` and the closed body mesh on a grid of ``spacing`` (m), after
     moving the mannequin so that its volume's centroid lies above the body's (x, y only)."""
-    body = coverage.BodyVolume(vertices, faces)
+    body = volume.BodyVolume(vertices, faces)
     grid = body.grid(spacing)
     cells = grid.origin + spacing * np.argwhere(grid.inside)
-    occupied = coverage.occupancy(grid, mannequin, cushions)
-    own = grid.origin + spacing * np.argwhere(occupied)
+    # first onto the body's line by the pieces' volume-weighted centres (wherever the mannequin stands),
+    # then by the centroid of the cells it fills, counting overlaps once
+    weights = np.prod(mannequin.semi_axes, axis=1)
     shift = np.zeros(3)
-    shift[:2] = cells[:, :2].mean(axis=0) - own[:, :2].mean(axis=0)
-    occupied = coverage.occupancy(grid, mannequin.copy(center=mannequin.center + shift), cushions)
+    shift[:2] = cells[:, :2].mean(axis=0) - weights @ mannequin.center[:, :2] / weights.sum()
+    occupied = volume.occupancy(grid, mannequin.copy(center=mannequin.center + shift), cushions)
+    own = grid.origin + spacing * np.argwhere(occupied)
+    shift[:2] += cells[:, :2].mean(axis=0) - own[:, :2].mean(axis=0)
+    occupied = volume.occupancy(grid, mannequin.copy(center=mannequin.center + shift), cushions)
     both = np.count_nonzero(occupied & grid.inside)
     union = np.count_nonzero(occupied | grid.inside)
     return both / union, both / np.count_nonzero(grid.inside), 1.0 - both / max(np.count_nonzero(occupied), 1)
 
 
-def set_overlaps(build_set, spacing=coverage.GRID_SPACING):
+def set_overlaps(build_set, spacing=volume.GRID_SPACING):
     """{body: (IoU, coverage, excess)} of the set's six bodies against mannequins synthesized from their
     measurements with the set's shipped Reference Mannequins."""
     labels = load_labels(TRACING_FOLDER)
     reference = load_reference_set(build_set.out)
     out = {}
     for name in (build_set.reference_body, *RM_BODIES):
-        body = load_body(build_set.refmodels, name)
+        body = read_obj(build_set.refmodels / f"{name}.obj")
         measured = body_measurements(body, labels, build_set.fractions)
         request = [[measured[key] for key in ("He", "Sh", "Br", "Wa", "Hi")]]
         mannequin = synthesize_batch(reference, request).mannequin(0)
@@ -57,7 +62,7 @@ def set_overlaps(build_set, spacing=coverage.GRID_SPACING):
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m tools.overlap", description=__doc__.split("\n")[0])
     parser.add_argument("--set", choices=[*sorted(BUILD_SETS), "both"], default="both")
-    parser.add_argument("--spacing", type=float, default=coverage.GRID_SPACING, help="grid spacing (m)")
+    parser.add_argument("--spacing", type=float, default=volume.GRID_SPACING, help="grid spacing (m)")
     args = parser.parse_args(argv)
     names = sorted(BUILD_SETS) if args.set == "both" else [args.set]
     print("| set | body | IoU | coverage | excess |")

@@ -1,5 +1,6 @@
-"""The reference sets tools/build_reference.py builds: which bodies, which reference body, which targets and
-which section heights (the landmarks that travel with a set: core.reference_set).
+"""The reference sets the tools build (tools/build_reference.py the female, tools/build_male.py the male) and
+measure (tools/overlap.py, tools/landmarks.py): which bodies, which reference body, which targets and which
+section heights (the landmarks that travel with a set: core.reference_set).
 
 Every set is traced with the same selections, made once on the neutral female body: all bodies share one mesh
 topology and vertex order (../shared/refmodels_male/README.md), so the same vertices trace the same part on a

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ellimann_addon.core.constants import GIRTHS, SECTION_FRACTIONS
 from ellimann_addon.core.mannequin import Part, Topology
+from ellimann_addon.core.trace import FitSettings
 
 
 @dataclass(frozen=True)
@@ -34,7 +34,7 @@ class Select:
 
 @dataclass(frozen=True)
 class Spec:
-    """One part of the topology and how to fit it (see tools/fitting.py for the fit parameters)."""
+    """One part of the topology, its selection on the reference body and how to fit it (core.trace.FitSettings)."""
 
     number: int
     letter: str
@@ -51,19 +51,14 @@ class Spec:
     inward: tuple = None  # extrude a surface patch by this vector (m) into the body before fitting
     frame: str = "main"  # the axis the frame takes from the points: "limb", "main", "axis" (``axis``) or "fixed"
     mitten: bool = False  # kept inside the convex hull of its own vertices instead of the body surface
-    level: str = None  # the section (Sh, Br, Wa, Hi) the centre is placed at: centres a part on its section
+    level: str = None  # the section (Br, Wa) the part is centred on
     axis: tuple = None  # world direction of a limb, when its longest extent is not along it (a short neck)
-    clear: tuple = ()  # sections it keeps clear of, besides those section_bounds finds (the neck: Sh)
+    clear: tuple = ()  # sections it keeps clear of, besides those core.body_fit.section_bounds finds (the neck: Sh)
     cavities: bool = False  # the walls of the mesh's open eye sockets and mouth are no obstacles: the part
     # may fill them, as a solid head does
 
 
-# A girth part stays this far (fraction of the body's height) above or below every girth section of
-# a measurement it does not depend on, so that each section cuts only parts that follow its
-# measurement in synthesis, with room for the Reference Mannequins' adjustment, which may lengthen
-# parts a little.
-SECTION_CLEARANCE = 0.025
-# The waist's sides are centred on its section (see fitting.inscribed_ellipsoid's ``level``); the
+# The waist's sides are centred on its section (see core.inscribe.inscribed_ellipsoid's ``level``); the
 # front is left to the belly, which on the chubby bodies bulges below a crease at the waist, and the
 # back free to reach down to the hips.
 WAIST_LEVEL = "Wa"
@@ -129,18 +124,11 @@ SPECS = (
 )
 
 
-def section_bounds(spec, centre, fractions=SECTION_FRACTIONS):
-    """(floor, ceiling) heights (fractions of the body's) a part centred at height ``centre`` may reach:
-    clear, by SECTION_CLEARANCE, of the girth sections (at ``fractions``, the set's) of measurements it
-    does not depend on (if it is a girth part) and of the sections in ``spec.clear``."""
-    floor, ceiling = -np.inf, np.inf
-    keys = [key for key in GIRTHS if key not in spec.depends] if spec.girth else []
-    for key in keys + list(spec.clear):
-        if centre > fractions[key]:
-            floor = max(floor, fractions[key] + SECTION_CLEARANCE)
-        else:
-            ceiling = min(ceiling, fractions[key] - SECTION_CLEARANCE)
-    return floor, ceiling
+def fit_settings(spec, kept=None):
+    """The fit settings a traced part records (core.trace.FitSettings) for ``spec``."""
+    return FitSettings(margin=spec.margin, depth=spec.depth, inside=spec.inside, span=spec.span, inward=spec.inward,
+                       frame=spec.frame, mitten=spec.mitten, level=spec.level, axis=spec.axis, clear=spec.clear,
+                       kept=kept)
 
 
 def _partners():
@@ -176,15 +164,6 @@ def topology():
         partner = part_name(mates[0], side) if mates else ""
         parts.append(Part(part_name(spec, side), side, spec.region, spec.girth, spec.depends, partner))
     return Topology(parts)
-
-
-def obstacle_vertices(spec, hidden):
-    """Indices of the body vertices that must stay outside the part: all of them (none for a mitten),
-    and with ``spec.cavities`` all but the ``hidden`` ones (bool per vertex: the walls of the mesh's
-    cavities)."""
-    if spec.mitten:
-        return np.zeros(0, dtype=int)
-    return np.nonzero(~hidden if spec.cavities else np.ones(len(hidden), dtype=bool))[0]
 
 
 def select_vertices(select, side, vertices, labels, height):

@@ -23,6 +23,9 @@ ADD_MEASUREMENT_PRESET = "ellimann.add_measurement_preset"
 APPLY_MEASUREMENT_PRESET = "ellimann.apply_measurement_preset"
 DRAPE_GARMENT = "ellimann.drape_garment"
 EXPORT_MANNEQUIN = "ellimann.export_mannequin"
+BUILD_REFERENCE_SET = "ellimann.build_reference_set"
+ADD_REFERENCE_BODIES = "ellimann.add_reference_bodies"
+REMOVE_REFERENCE_BODY = "ellimann.remove_reference_body"
 
 PANEL_MAIN = "ELLIMANN_PT_main"
 PANEL_TRACE = "ELLIMANN_PT_trace"
@@ -32,10 +35,13 @@ PANEL_CUSHIONS = "ELLIMANN_PT_cushions"
 PANEL_MEASURE = "ELLIMANN_PT_measure"
 PANEL_SYNTHESIZE = "ELLIMANN_PT_synthesize"
 PANEL_DRAPE = "ELLIMANN_PT_drape"
+PANEL_REFERENCES = "ELLIMANN_PT_references"
 
 # Sub-panels of PANEL_MAIN sort by bl_order. Room is left after Measure for the Synthesize (60)
 # and Drape (70) panels that other parts of the add-on add.
-PANEL_ORDER = {PANEL_TRACE: 10, PANEL_PART: 20, PANEL_CLEAN: 30, PANEL_CUSHIONS: 40, PANEL_MEASURE: 50}
+# Building a reference set (55) comes before synthesizing from it.
+PANEL_ORDER = {PANEL_TRACE: 10, PANEL_PART: 20, PANEL_CLEAN: 30, PANEL_CUSHIONS: 40, PANEL_MEASURE: 50,
+               PANEL_REFERENCES: 55}
 SYNTHESIZE_ORDER = 60
 DRAPE_ORDER = 70
 

@@ -12,10 +12,22 @@ import bpy
 
 from . import cli_command
 from .bridge import props
-from .features import clean, cushions, drape, export, main_panel, measure, menus, part, synthesize, trace
+from .features import (
+    clean,
+    cushions,
+    drape,
+    export,
+    main_panel,
+    measure,
+    menus,
+    part,
+    references,
+    synthesize,
+    trace,
+)
 
 # One package per user task, in the sidebar's order.
-FEATURES = (trace, part, clean, cushions, measure, synthesize, drape, export)
+FEATURES = (trace, part, clean, cushions, measure, references, synthesize, drape, export)
 
 # Property groups first (pointers need them), the main panel before its sub-panels.
 CLASSES = (props.classes + main_panel.classes + tuple(c for feature in FEATURES for c in feature.classes)

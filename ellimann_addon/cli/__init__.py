@@ -4,8 +4,9 @@
 - ``blender --background --command ellimann …`` (registered by ``blender/cli_command.py``)
 
 Subcommands, a module each: ``synth`` (one mannequin), ``batch`` (a CSV of measurements), ``measure`` (m_T of
-a file), ``demo`` (the paper's Table 2.5 mannequins with a report and a line-up picture) and ``drape`` (a
-garment on a mannequin with Blender's cloth simulation); ``common`` holds what they share. This package needs
+a file), ``demo`` (the paper's Table 2.5 mannequins with a report and a line-up picture), ``drape`` (a
+garment on a mannequin with Blender's cloth simulation) and ``references`` (build or check a reference set);
+``common`` holds what they share. This package needs
 numpy only: Blender (the bpy module and ``ellimann_addon.blender``) is imported only when a .blend/.glb/.obj
 file, a drape or a picture is involved, and a command that needs it without it is refused in one line.
 What Blender prints is captured (``chatter``) and shown only with ``--verbose``. User mistakes end with a
@@ -18,11 +19,11 @@ import contextlib
 import sys
 
 from ..core.errors import ElliMannError
-from . import batch, demo, drape, measure, synth
+from . import batch, demo, drape, measure, references, synth
 from .common import INTERRUPTED, MISSED, PROG, UsageError, blender_available, no_blender, one_line, say
 
 __all__ = ["INTERRUPTED", "MISSED", "PROG", "UsageError", "build_parser", "main", "main_exit"]
-SUBCOMMANDS = (synth, batch, measure, demo, drape)
+SUBCOMMANDS = (synth, batch, measure, demo, drape, references)
 
 
 def build_parser():

@@ -7,14 +7,14 @@ import sys
 
 from ..core.body_measure import ALL_MEASUREMENTS, measure_body_mesh
 from ..core.body_mesh import MESH_EXTENSIONS, UNITS, UP_AXES, BodyMeshError, read_body_mesh
-from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS
+from ..core.constants import MEASUREMENT_LABELS
 from ..core.errors import MannequinError
 from ..core.extra_measures import EXTRA_LABELS, mannequin_extra_measurements
 from ..core.mannequin import Mannequin
-
-LABELS = {**MEASUREMENT_LABELS, **EXTRA_LABELS}
 from . import common
 from .common import UsageError
+
+LABELS = {**MEASUREMENT_LABELS, **EXTRA_LABELS}
 
 
 def add_parser(commands):

@@ -13,7 +13,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .body_mesh import boundary_edges, connected_labels, in_plane, section_segments
 from .constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
 from .extra_measures import (
     CALF_BAND,
@@ -26,7 +25,7 @@ from .extra_measures import (
     UPPER_ARM_FRACTION,
     extreme_over_band,
 )
-from .mesh import convex_hull_2d, polygon_perimeter
+from .mesh import boundary_edges, connected_labels, convex_hull_2d, in_plane, polygon_perimeter, section_segments
 
 ARM_SCAN_STEP = 0.005  # He between the sections that find the arms
 ARM_MARGIN = 0.01  # m beyond the body's run before a vertex counts as an arm's
@@ -100,10 +99,12 @@ def _body_blobs(segments, blob, mid_x):
     if len(inside):
         return [labels[inside[np.argmax(hi[inside] - lo[inside])]]]
     left, right = np.nonzero(lo > mid_x)[0], np.nonzero(hi < mid_x)[0]
-    return [labels[left[np.argmin(lo[left])]]] * bool(len(left)) + [labels[right[np.argmax(hi[right])]]] * bool(len(right))
+    nearest = [left[np.argmin(lo[left])]] if len(left) else []
+    nearest += [right[np.argmax(hi[right])]] if len(right) else []
+    return [labels[i] for i in nearest]
 
 
-class BodyMesh:
+class StandingBody:
     """A closed triangle mesh of an upright body in metres (Z up), with its landmarks."""
 
     def __init__(self, vertices, faces, fractions=None):
@@ -238,7 +239,7 @@ def measure_body_mesh(vertices, faces, fractions=None):
     if fatal:
         result.problems.append(fatal)
         return result
-    body = BodyMesh(vertices, faces, fractions)
+    body = StandingBody(vertices, faces, fractions)
     open_edges = boundary_edges(faces)
     values = result.values
     values["He"] = body.height

@@ -6,6 +6,7 @@ import numpy as np
 
 from .constants import (
     MEASUREMENTS,
+    RANGES,
 )
 from .frames import SAGITTAL_REFLECTION, rotation_mean, symmetrize_central
 from .options import (
@@ -16,10 +17,12 @@ from .options import (
 ZERO_DISTANCE = 1e-9  # closer than this (cm, or range units) is the RM's own point
 
 
-def _metric_scale(metric, ranges):
+def _metric_scale(metric, ranges=RANGES):
+    """Per measurement, what one unit of IDW distance is: 1 cm ("raw") or the width of the set's range L."""
     if metric == "raw":
         return np.ones(len(MEASUREMENTS))
-    return np.array([ranges[key][1] - ranges[key][0] for key in MEASUREMENTS])
+    # at least 1 cm: a set whose bodies share a measurement has a range of width 0 there
+    return np.array([max(ranges[key][1] - ranges[key][0], 1.0) for key in MEASUREMENTS])
 
 
 def _inverse_distance(distance, power):
@@ -40,7 +43,8 @@ def idw_weights(reference, requests, metric="raw", power=DEFAULT_POWER):
     does not separate some RMs.
     """
     requests = np.atleast_2d(np.asarray(requests, dtype=float))
-    diff = (requests[:, None, :] - reference.measurements[None]) / _metric_scale(metric, reference.ranges)  # (B, k, 5)
+    scale = _metric_scale(metric, reference.ranges)
+    diff = (requests[:, None, :] - reference.measurements[None]) / scale  # (B, k, 5)
     sub = np.sqrt(np.einsum("bkm,sm->bsk", diff * diff, reference._mask))
     full = np.sqrt(np.sum(diff * diff, axis=-1))
     w_sub = _inverse_distance(sub, power)  # (B, s, k)

@@ -17,6 +17,7 @@ import numpy as np
 from .constants import ABSURD_LIMITS, CENTER_LIMIT, FEMALE_SET, MEASUREMENTS, SECTION_FRACTIONS, SEMI_AXIS_LIMITS
 from .errors import MannequinError, Problem
 from .files import atomic_write_text
+from .trace import traces_from_dict, traces_to_dict
 
 FORMAT = "ellimann.mannequin"
 FORMAT_VERSION = 2  # 2: "measured_with" (the reference set and section heights); a version 1 file is female
@@ -223,11 +224,14 @@ class Mannequin:
     name: str = ""
     role: str = "synthesized"
     measurements: dict = field(default=None)
+    traces: dict = field(default=None)  # {part name: core.trace.PartTrace}: what each part was traced from
     reference_set: str = FEMALE_SET
     section_fractions: dict = field(default=None)
 
     def __post_init__(self):
-        self.section_fractions = dict(self.section_fractions or SECTION_FRACTIONS)
+        # a copy (mannequins never share one); anything but a dict is left for problems() to name
+        fractions = SECTION_FRACTIONS if self.section_fractions is None else self.section_fractions
+        self.section_fractions = dict(fractions) if isinstance(fractions, dict) else fractions
         self.rotation = np.asarray(self.rotation, dtype=float)
         self.center = np.asarray(self.center, dtype=float)
         self.semi_axes = np.asarray(self.semi_axes, dtype=float)
@@ -239,7 +243,8 @@ class Mannequin:
         values = dict(topology=self.topology, rotation=self.rotation.copy(), center=self.center.copy(),
                       semi_axes=self.semi_axes.copy(), name=self.name, role=self.role,
                       measurements=dict(self.measurements) if self.measurements else None,
-                      reference_set=self.reference_set, section_fractions=dict(self.section_fractions))
+                      traces=dict(self.traces) if self.traces else None,
+                      reference_set=self.reference_set, section_fractions=self.section_fractions)
         values.update(changes)
         return Mannequin(**values)
 
@@ -314,6 +319,7 @@ class Mannequin:
                          semi_axes=self.semi_axes[order])
 
     def to_dict(self):
+        traces = {"traces": traces_to_dict(self.traces)} if self.traces else {}
         return {
             "format": FORMAT,
             "version": FORMAT_VERSION,
@@ -327,6 +333,7 @@ class Mannequin:
                      axes=self.rotation[i].T.tolist(), semi_axes=self.semi_axes[i].tolist())
                 for i, part in enumerate(self.topology)
             ],
+            **traces,
         }
 
     @classmethod
@@ -390,7 +397,8 @@ class Mannequin:
         if problems:
             raise MannequinError(problems)
         mannequin = cls(topology, np.swapaxes(np.array(arrays["axes"]), 1, 2), np.array(arrays["center"]),
-                        np.array(arrays["semi_axes"]), name=name, role=role, measurements=measurements, **landmarks)
+                        np.array(arrays["semi_axes"]), name=name, role=role, measurements=measurements,
+                        traces=traces_from_dict(data.get("traces"), topology.names), **landmarks)
         return mannequin.check() if check else mannequin
 
     def to_json(self):

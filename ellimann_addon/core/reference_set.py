@@ -9,14 +9,7 @@ import sys
 import numpy as np
 
 from .clean import asymmetry
-from .constants import (
-    ABSURD_LIMITS,
-    FEMALE_SET,
-    MEASUREMENTS,
-    RANGES,
-    REFERENCE_MEASUREMENTS,
-    SECTION_FRACTIONS,
-)
+from .constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 from .errors import MannequinError, ReferenceSetError
 from .frames import SAGITTAL_REFLECTION
 from .idw import ZERO_DISTANCE, _axis_scale, _center_scale
@@ -25,6 +18,7 @@ from .measure import tailor_measurements
 from .options import (
     _number,
 )
+from .reference_manifest import MANIFEST_FILE, legacy_manifest, read_manifest
 from .refine import _deform_basis, _fd_jacobian
 
 REFERENCE_NAMES = tuple(REFERENCE_MEASUREMENTS)  # small_slim, tall_slim, small_chubby, tall_chubby, average
@@ -54,13 +48,12 @@ class ReferenceSet:
     """The Reference Mannequins: one topology, geometry stacks (k, n, ...) and measurements (k, 5) cm.
 
     ``measurements`` are the RMs' nominal measurements (Table 2.3), the points Eq. 2.1 interpolates
-    between. Every RM is reordered to the first one's topology. The set's landmarks travel with it:
-    ``section_fractions`` (where m_T cuts, fractions of He), ``ranges`` (L, cm) and ``absurd_limits`` (cm, what
-    a request must stay within); by default the female set's (core/constants.py), ``name`` "female".
+    between. Every RM is reordered to the first one's topology. ``manifest`` (core.reference_manifest)
+    gives the set's ``name``, ``section_fractions``, ``ranges`` (L, cm) and ``absurd_limits`` (cm); without
+    one they are the female constants of core/constants.py.
     """
 
-    def __init__(self, mannequins, names=None, sources=None, *, name=FEMALE_SET, section_fractions=None,
-                 ranges=None, absurd_limits=None):
+    def __init__(self, mannequins, names=None, sources=None, manifest=None):
         mannequins = list(mannequins)
         names = list(names or [m.name or f"RM {i + 1}" for i, m in enumerate(mannequins)])
         sources = list(sources or names)
@@ -83,12 +76,14 @@ class ReferenceSet:
             if off > SYMMETRY_TOLERANCE:
                 raise ReferenceSetError(source, "geometry", f"is not symmetric about x = 0 (asymmetry "
                                         f"{off * 1e3:.3g} mm); clean it first")
-        self.name = name
-        self.section_fractions = dict(section_fractions or SECTION_FRACTIONS)
-        self.ranges = dict(ranges or RANGES)
-        self.absurd_limits = dict(absurd_limits or ABSURD_LIMITS)
         self.mannequins = ordered
         self.names = names
+        self.manifest = manifest
+        self.name = manifest.name if manifest else legacy_manifest().name
+        self.section_fractions = dict(manifest.section_fractions) if manifest else dict(SECTION_FRACTIONS)
+        self.ranges = {k: tuple(v) for k, v in manifest.ranges_cm.items()} if manifest else dict(RANGES)
+        self.absurd_limits = ({k: tuple(v) for k, v in manifest.absurd_limits_cm.items()} if manifest
+                              else dict(ABSURD_LIMITS))
         self.sources = sources
         self.topology = first.topology
         self.measurements = np.array(measurements)
@@ -205,25 +200,46 @@ def _reference_measurements(mannequin, source):
     return values
 
 
-def load_reference_set(folder=None, names=REFERENCE_NAMES):
-    """The five RMs from ``folder`` (default: the shipped ``reference_blends/``), one JSON file each."""
+def load_reference_set(folder=None, names=None):
+    """The RMs of a reference-set folder (default: the shipped ``reference_blends/``), one JSON file each: those
+    its manifest (``reference_set.json``) lists, or, in a folder without one, ``names`` (default: the five
+    female RMs of Table 2.3)."""
     folder = pathlib.Path(folder) if folder is not None else REFERENCE_FOLDER
     if folder.exists() and not folder.is_dir():
         raise ReferenceSetError(str(folder), "path", f"is a file, not a folder (a reference set is the folder "
-                                f"holding {', '.join(f'{n}.json' for n in names)})")
+                                f"holding {MANIFEST_FILE} and the RMs' .json files)")
     if not folder.is_dir():
         raise ReferenceSetError(str(folder), "folder", "does not exist")
+    manifest = read_manifest(folder)
+    if manifest is not None and names is None:
+        names = manifest.mannequins
+    names = list(names or REFERENCE_NAMES)
     mannequins, sources = [], []
     for name in names:
         path = folder / f"{name}.json"
         if not path.is_file():
-            raise ReferenceSetError(str(path), "file", f"is missing (a reference set needs {', '.join(names)} .json)")
+            wanted = f"{MANIFEST_FILE} lists" if manifest else "a folder without a manifest needs"
+            raise ReferenceSetError(str(path), "file", f"is missing ({wanted} {', '.join(names)} .json)")
         try:
             mannequins.append(Mannequin.load(path))
         except (MannequinError, OSError, UnicodeDecodeError) as error:
             raise ReferenceSetError(str(path), "file", f"cannot be read: {error}") from None
         sources.append(str(path))
-    return ReferenceSet(mannequins, names=list(names), sources=sources)
+    return ReferenceSet(mannequins, names=names, sources=sources, manifest=manifest)
+
+
+def _stamp(folder):
+    """Modification times of the manifest and the RM files it (or the legacy layout) names."""
+    try:
+        manifest = read_manifest(folder)
+    except ReferenceSetError:
+        return None
+    names = manifest.mannequins if manifest else REFERENCE_NAMES
+    files = [folder / f"{n}.json" for n in names] + ([folder / MANIFEST_FILE] if manifest else [])
+    try:
+        return tuple(os.stat(path).st_mtime_ns for path in files)
+    except OSError:
+        return None
 
 
 _CACHE = {}
@@ -232,10 +248,7 @@ _CACHE = {}
 def cached_reference_set(folder=None):
     """load_reference_set, memoised on the files' modification times (for the live panel and batches)."""
     folder = pathlib.Path(folder) if folder else REFERENCE_FOLDER
-    try:
-        stamp = tuple(os.stat(folder / f"{n}.json").st_mtime_ns for n in REFERENCE_NAMES)
-    except OSError:
-        stamp = None
+    stamp = _stamp(folder)
     key = str(folder.resolve())
     hit = _CACHE.get(key)
     if stamp is not None and hit is not None and hit[0] == stamp:
@@ -243,3 +256,4 @@ def cached_reference_set(folder=None):
     reference = load_reference_set(folder)
     _CACHE[key] = (stamp, reference)
     return reference
+

@@ -31,7 +31,7 @@ EXTRA_TOLERANCE_CM = 0.01  # every given extra measurement within 0.1 mm
 EXTRA_MAX_ROUNDS = 12
 MISS_CM = 0.1  # a given extra measurement further off than this (1 mm) is a miss
 FIVE_TOLERANCE_CM = 0.01  # a round that moves any of the five further than this is never the result
-EXTRA_FACTOR_LIMIT = 2.0  # a piece is never scaled beyond this, or below its inverse (it would no longer look like itself)
+EXTRA_FACTOR_LIMIT = 2.0  # no piece scaled beyond this or below its inverse (it would no longer look like itself)
 _MAX_LOG_STEP = 0.25
 
 

@@ -11,6 +11,7 @@ from ellimann_addon.blender.features import menus
 from ellimann_addon.blender.features.cushions.panel import ELLIMANN_PT_cushions
 from ellimann_addon.blender.features.main_panel import ELLIMANN_PT_main
 from ellimann_addon.blender.features.part.panel import ELLIMANN_PT_part
+from ellimann_addon.blender.features.references import panel as references_panel
 from ellimann_addon.blender.features.synthesize import panel as synthesize_panel
 from ellimann_addon.blender.features.synthesize import presets as synthesize_presets
 
@@ -90,7 +91,14 @@ def test_menus_reach_every_operator():
     assert ids.ADD_MEASUREMENT_PRESET in draw_panel(synthesize_panel.ELLIMANN_PT_synthesize).operators()
     presets_menu = synthesize_presets.ELLIMANN_MT_measurement_presets
     assert set(draw_panel(presets_menu).operators()) == {ids.APPLY_MEASUREMENT_PRESET}
-    assert reached == everything - {ids.ADD_MEASUREMENT_PRESET, ids.APPLY_MEASUREMENT_PRESET}
+    # Adding and removing a reference set's bodies belongs in its panel's list of bodies.
+    bodies = bpy.context.scene.ellimann_references.bodies
+    bodies.add()
+    assert {ids.ADD_REFERENCE_BODIES, ids.REMOVE_REFERENCE_BODY} <= set(draw_panel(
+        references_panel.ELLIMANN_PT_references).operators())
+    bodies.clear()
+    assert reached == everything - {ids.ADD_MEASUREMENT_PRESET, ids.APPLY_MEASUREMENT_PRESET, ids.ADD_REFERENCE_BODIES,
+                                    ids.REMOVE_REFERENCE_BODY}
 
 
 def test_recorder_refuses_misspelt_icons():

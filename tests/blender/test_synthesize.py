@@ -26,9 +26,9 @@ from ellimann_addon.core.constants import (
     TABLE_2_5,
 )
 from ellimann_addon.core.cushion import cushion_vertices
+from ellimann_addon.core.mesh import convexity_defect, is_closed_manifold
 from ellimann_addon.core.reference_set import load_reference_set
 from ellimann_addon.core.shipped_sets import SHIPPED_SETS
-from ellimann_addon.core.mesh import convexity_defect, is_closed_manifold
 from ellimann_addon.core.synthesis import synthesize as core_synthesize
 
 
@@ -360,6 +360,7 @@ def shipped_presets():
 
 
 def test_shipped_presets_hold_the_reference_and_table_2_5_measurements_and_choose_their_set(props):
+    """Female presets leave a folder chosen (the user's own set) but leave the male set; male ones choose it."""
     expected = {f"RM {k.replace('_', ' ').title()}": ([v[m] for m in MEASUREMENTS], "FEMALE")
                 for k, v in REFERENCE_MEASUREMENTS.items()}
     expected.update({f"Table 2.5 ({i})": (list(row), "FEMALE") for i, row in enumerate(TABLE_2_5, 1)})
@@ -368,11 +369,12 @@ def test_shipped_presets_hold_the_reference_and_table_2_5_measurements_and_choos
                      for k, v in zip(male.names, male.measurements)})
     assert {p.stem for p in shipped_presets()} == set(expected)
     for path in shipped_presets():
-        props.reference_set = "FOLDER"
-        bpy.ops.script.execute_preset(filepath=str(path), menu_idname="ELLIMANN_MT_measurement_presets")
         values, chosen = expected[path.stem]
-        assert [getattr(props, m.lower()) for m in MEASUREMENTS] == pytest.approx(values)
-        assert props.reference_set == chosen
+        for before, after in (("FOLDER", "FOLDER" if chosen == "FEMALE" else chosen), ("MALE", chosen)):
+            props.reference_set = before
+            bpy.ops.script.execute_preset(filepath=str(path), menu_idname="ELLIMANN_MT_measurement_presets")
+            assert [getattr(props, m.lower()) for m in MEASUREMENTS] == pytest.approx(values)
+            assert props.reference_set == after, (path.stem, before)
 
 
 def test_users_can_save_and_remove_their_own_presets(props):

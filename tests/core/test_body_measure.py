@@ -9,7 +9,7 @@ import pytest
 from devkit.cli_runs import assert_one_line_error, run
 from devkit.toy import make_toy_mannequin
 from ellimann_addon.core.body_measure import ALL_MEASUREMENTS, hull_girth, measure_body_mesh
-from ellimann_addon.core.body_mesh import BodyMeshError, in_plane, read_body_mesh, section_segments
+from ellimann_addon.core.body_mesh import BodyMeshError, read_body_mesh
 from ellimann_addon.core.constants import MEASUREMENTS, SECTION_FRACTIONS
 from ellimann_addon.core.extra_measures import (
     EXTRA_MEASUREMENTS,
@@ -20,7 +20,7 @@ from ellimann_addon.core.extra_measures import (
     mannequin_extra_measurements,
 )
 from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.mesh import icosphere
+from ellimann_addon.core.mesh import icosphere, in_plane, section_segments
 from ellimann_addon.core.refine_extra import ExtraRequestError, extra_request_problems, synthesize_extra
 from ellimann_addon.core.shipped_sets import named_reference_set, reference_folder
 
@@ -164,8 +164,8 @@ def test_readers_agree(tmp_path):
                                     + "".join(f"{x} {y} {z}\n" for x, y, z in v)
                                     + "".join(f"3 {a} {b} {c}\n" for a, b, c in f))
     (tmp_path / "b.stl").write_text("solid b\n" + "".join(
-        "facet normal 0 0 0\nouter loop\n" + "".join(f"vertex {x} {y} {z}\n" for x, y, z in v[t]) + "endloop\nendfacet\n"
-        for t in f) + "endsolid b\n")
+        "facet normal 0 0 0\nouter loop\n" + "".join(f"vertex {x} {y} {z}\n" for x, y, z in v[t])
+        + "endloop\nendfacet\n" for t in f) + "endsolid b\n")
     for kind in ("obj", "ply", "stl"):
         read, faces = read_body_mesh(str(tmp_path / f"b.{kind}"))
         assert np.allclose(np.sort(read, axis=0), np.sort(v, axis=0), atol=1e-6) and len(faces) == len(f), kind

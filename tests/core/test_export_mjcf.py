@@ -15,6 +15,7 @@ from ellimann_addon.core.errors import ElliMannError, MannequinError
 from ellimann_addon.core.export_mjcf import mannequin_to_mjcf, write_mjcf
 from ellimann_addon.core.garment_fit import BodyPieces
 from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.reference_manifest import MANIFEST_FILE
 
 mujoco = pytest.importorskip("mujoco")  # a dev dependency (requirements-dev.txt); CI always has it
 
@@ -26,6 +27,8 @@ def mannequins(only=None):
     """The toy, plus the shipped reference mannequins once reference_blends/ has them (or just ``only``)."""
     out = [pytest.param(make_toy_mannequin, id="toy")]
     for path in sorted(REFERENCE_DIR.glob("*.json")):
+        if path.name == MANIFEST_FILE:  # the set's manifest, not a mannequin
+            continue
         if only is None or path.stem == only:
             out.append(pytest.param(lambda p=path: Mannequin.load(p), id=path.stem))
     return out

@@ -1,11 +1,13 @@
 """Mannequin <-> Blender collection. The only place where objects and core arrays meet.
 
 An ellipsoid is an object using one shared unit-sphere mesh with ``matrix_world = S @ diag(D, 1)``;
-its topology fields live in ``Object.ellimann``. A mannequin is a collection holding those objects,
+its topology fields live in ``Object.ellimann`` (and what it was traced from, ``trace``: core.trace's JSON).
+A mannequin is a collection holding those objects,
 with ``Collection.ellimann`` (role, target and measured values).
 """
 
 import json
+
 import bpy
 import numpy as np
 from mathutils import Matrix
@@ -15,6 +17,7 @@ from ...core.ellipsoid import decompose_matrices_world, decompose_matrix_world, 
 from ...core.errors import FrameError, MannequinError, Problem
 from ...core.mannequin import NAME_PATTERN, Mannequin, Part, Topology
 from ...core.mesh import icosphere
+from ...core.trace import PartTrace
 
 UNIT_SPHERE_NAME = "ElliMann Unit Sphere"
 UNIT_SPHERE_TOLERANCE = 1e-4  # single-precision vertices of the icosphere are within 1e-7
@@ -198,14 +201,34 @@ def new_ellipsoid_object(part, rotation, center, semi_axes, collection, mesh=Non
     return obj
 
 
+def write_trace(obj, trace):
+    """Record on the part what it was traced from (a core.trace.PartTrace, or None to clear it)."""
+    obj.ellimann.trace = "" if trace is None else json.dumps(trace.to_dict())
+
+
+def read_trace(obj):
+    """The part's recorded trace (core.trace.PartTrace) or None; MannequinError naming the part if unreadable."""
+    text = obj.ellimann.trace
+    if not text:
+        return None
+    name = obj.ellimann.part_name or obj.name
+    try:
+        data = json.loads(text)
+    except ValueError:
+        raise MannequinError([Problem(name, "trace", "is not valid JSON; fit the part again")]) from None
+    return PartTrace.from_dict(data, name)
+
+
 def mannequin_to_collection(mannequin, name=None, parent=None):
     """Build a new collection with one ellipsoid object per part. Nothing existing is touched."""
     collection = new_collection(name or mannequin.name or "Mannequin", parent)
     write_collection_props(collection, mannequin)
     mesh = unit_sphere_mesh()
+    traces = mannequin.traces or {}
     for i, part in enumerate(mannequin.topology):
-        new_ellipsoid_object(part, mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i], collection,
-                             mesh)
+        obj = new_ellipsoid_object(part, mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i],
+                                   collection, mesh)
+        write_trace(obj, traces.get(part.name))
     return collection
 
 
@@ -218,8 +241,9 @@ def collection_to_mannequin(collection, check=True):
     topology = Topology([read_part(obj) for obj in objects])
     props = collection.ellimann
     measurements = dict(zip(MEASUREMENTS, map(float, props.target))) if props.has_target else None
+    traces = {obj.ellimann.part_name: trace for obj in objects if (trace := read_trace(obj)) is not None}
     mannequin = Mannequin(topology, rotation, center, semi_axes, name=collection.name, role=props.role,
-                          measurements=measurements, **read_landmarks(props))
+                          measurements=measurements, traces=traces or None, **read_landmarks(props))
     return mannequin.check() if check else mannequin
 
 

@@ -49,6 +49,10 @@ class ELLIMANN_PG_part(bpy.types.PropertyGroup):
                           description="Measurements this ellipsoid is interpolated on (segmented IDW)")
     partner: StringProperty(name="Cushion Partner",
                             description="Part name of the other ellipsoid of its cushion (empty: none)")
+    trace: StringProperty(name="Traced From", options={"HIDDEN"},
+                          description="What Fit Ellipsoid fitted this part to: the mesh, its vertices and the fit's "
+                                      "settings (JSON, core.trace); Build Reference Set fits the part to the same "
+                                      "vertices on every body")
 
 
 class ELLIMANN_PG_mannequin(bpy.types.PropertyGroup):

@@ -26,6 +26,7 @@ class ELLIMANN_MT_object(bpy.types.Menu):
         layout.separator()
         layout.operator(ids.BUILD_CUSHIONS)
         layout.operator(ids.MEASURE_MANNEQUIN)
+        layout.operator(ids.BUILD_REFERENCE_SET)
         layout.operator(ids.SYNTHESIZE_MANNEQUIN)
         layout.operator(ids.DRAPE_GARMENT)
         layout.separator()

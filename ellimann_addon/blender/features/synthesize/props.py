@@ -60,8 +60,9 @@ class ELLIMANN_PG_synthesis(bpy.types.PropertyGroup):
                                 description="The Reference Mannequins to synthesize from: the shipped female or "
                                             "male set, or a folder of your own")
     references: StringProperty(name="References", subtype="DIR_PATH", default="", update=on_request_change,
-                               description="With Reference Set Folder: the folder with the Reference Mannequin "
-                                           ".json files and their reference_set.json manifest")
+                               description="With Reference Set Folder: a reference-set folder, reference_set.json "
+                                           "and the Reference Mannequins' .json files it lists (Build Reference Set "
+                                           "writes one), or the five files of Table 2.3")
     status: StringProperty(name="Status", description="Outcome of the last live update")
     live_ms: FloatProperty(name="Live Update Time", description="Duration of the last live update (ms)")
 

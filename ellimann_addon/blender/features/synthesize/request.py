@@ -8,8 +8,8 @@ from ....core.errors import ReferenceSetError
 from ....core.extra_measures import EXTRA_MEASUREMENTS
 from ....core.options import SynthesisOptions
 from ....core.reference_set import cached_reference_set
-from ....core.shipped_sets import MALE_SET, SHIPPED_SETS
 from ....core.refine_extra import synthesize_extra
+from ....core.shipped_sets import MALE_SET, SHIPPED_SETS
 
 FIELDS = {key: key.lower() for key in MEASUREMENTS}  # He -> props.he
 REFERENCE_SET_ITEMS = (

@@ -8,7 +8,8 @@ from ....core.ellipsoid import axis_extent
 from ....core.fit import fit_ellipsoid
 from ....core.mannequin import NAME_PATTERN, Part, side_of_name
 from ... import ids
-from ...bridge.convert import mesh_vertices, new_ellipsoid_object
+from ...bridge.bodies import selection_trace
+from ...bridge.convert import mesh_vertices, new_ellipsoid_object, write_trace
 from ...bridge.props import ROLE_ITEMS
 from ...bridge.selection import active_mannequin, new_mannequin_collection, part_lookup
 from ..base import ElliMannOperator, OperatorError
@@ -120,8 +121,14 @@ def edit_mesh_world_vertices(context):
     return tuple(np.concatenate(chunks) if chunks else np.zeros((0, 3)) for chunks in (selected_chunks, other_chunks))
 
 
+def selected_traces(context, method):
+    """The recorded selection (core.trace.PartTrace) of every mesh in Edit Mode with selected vertices."""
+    return [trace for obj in context.objects_in_mode if obj.type == "MESH"
+            and (trace := selection_trace(obj, method)) is not None]
+
+
 class ELLIMANN_OT_fit_ellipsoid(ElliMannOperator, bpy.types.Operator):
-    """Fit an ellipsoid to the selected vertices (principal axes) and add it to the active mannequin"""
+    """Fit an ellipsoid to the selected vertices (principal axes) and add it to the active mannequin, recording them"""
 
     bl_idname = ids.FIT_ELLIPSOID
     bl_label = "Fit Ellipsoid to Selection"
@@ -143,11 +150,17 @@ class ELLIMANN_OT_fit_ellipsoid(ElliMannOperator, bpy.types.Operator):
             rotation, center, semi_axes = fit_ellipsoid(points, self.mode, surface=rest)
         except ValueError as error:
             raise OperatorError(f"Cannot fit an ellipsoid: {error}") from error
+        traces = selected_traces(context, self.mode)  # after edit_mesh_world_vertices updated the meshes
         obj, collection, error = add_part(self, context, rotation, center, semi_axes)
         if error:
             raise OperatorError(error)
+        recorded = "recorded"
+        if len(traces) == 1:
+            write_trace(obj, traces[0])
+        else:  # a part traced across meshes cannot be fitted again on other bodies of one mesh
+            recorded = f"not recorded: the selection spans {len(traces)} meshes"
         self.report({"INFO"}, f"Fitted '{obj.ellimann.part_name}' ({self.mode}) to {len(points)} vertices in "
-                              f"'{collection.name}'")
+                              f"'{collection.name}' (selection {recorded})")
         return {"FINISHED"}
 
 

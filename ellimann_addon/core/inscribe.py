@@ -21,9 +21,10 @@ ellipsoids are inscribed" in the reference 3D model. Here that is an optimisatio
 """
 
 import numpy as np
-from scipy.spatial import ConvexHull
 
-from ellimann_addon.core.frames import relabel_to_reference
+from .cushion import convex_hull_3d
+from .frames import relabel_to_reference
+from .mesh import face_normals
 
 DEGENERATE = 0.12  # relative gap below which two principal variances do not fix their axes
 GROWTH = 1.15  # largest growth of a semi-axis per round: keeps the ascent from favouring one axis
@@ -324,15 +325,17 @@ def hull_surface(points, depth=0.0, spacing=0.003):
     As obstacles they keep a part inside the hull of its own vertices: a mitten over spread fingers,
     which no ellipsoid inside the body surface could fill.
     """
-    hull = ConvexHull(points)
+    faces = convex_hull_3d(points)
+    normals = face_normals(points, faces)
     out, areas = [], []
-    for simplex, equation in zip(hull.simplices, hull.equations):
+    for simplex, normal in zip(faces, normals):
         a, b, c = points[simplex]
-        area = 0.5 * np.linalg.norm(np.cross(b - a, c - a))
+        area = 0.5 * np.linalg.norm(normal)
+        normal = normal / np.linalg.norm(normal)
         k = max(1, int(np.ceil(np.sqrt(2.0 * area) / spacing)))
         i, j = np.meshgrid(np.arange(k + 1), np.arange(k + 1), indexing="ij")
         keep = i + j <= k
         u, v = i[keep] / k, j[keep] / k
-        out.append(a + u[:, None] * (b - a) + v[:, None] * (c - a) + depth * equation[:3])
+        out.append(a + u[:, None] * (b - a) + v[:, None] * (c - a) + depth * normal)
         areas.append(np.full(len(u), area / len(u)))
     return np.concatenate(out), np.concatenate(areas)

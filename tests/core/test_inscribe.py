@@ -1,13 +1,14 @@
-"""The build tool's ellipsoid fits and body helpers, on meshes whose answer is known."""
+"""The reference builder's ellipsoid fits (core/inscribe.py) and body helpers (core/body_mesh.py), on meshes
+whose answer is known."""
 
 import numpy as np
 import pytest
 
 from devkit.toy import rotation_from_vector
+from ellimann_addon.core.body_mesh import hidden_vertices, vertex_areas, vertex_normals
 from ellimann_addon.core.frames import is_rotation
+from ellimann_addon.core.inscribe import hull_surface, inscribed_ellipsoid, principal_frame
 from ellimann_addon.core.mesh import icosphere
-from tools.bodies import hidden_vertices, vertex_areas, vertex_normals
-from tools.fitting import hull_surface, inscribed_ellipsoid, principal_frame
 
 ROTATION = rotation_from_vector([0.3, -0.2, 0.5])
 SEMI = np.array([0.05, 0.08, 0.12])

@@ -1,0 +1,191 @@
+"""``ellimann references``: build a reference set from a traced Base Mannequin and N >= 3 body meshes
+(``build``), or check a reference-set folder (``check``). numpy only."""
+
+import csv
+import hashlib
+import math
+import pathlib
+import sys
+
+from ..core.body_mesh import BodyMeshError, read_obj
+from ..core.clean import asymmetry
+from ..core.constants import ABSURD_LIMITS, MEASUREMENTS
+from ..core.reference_build import build_reference_set, cleanliness_problems, relative_errors
+from ..core.reference_manifest import STEM, Manifest, read_manifest, targets_range, write_reference_set
+from ..core.reference_set import load_reference_set
+from . import common
+from .common import PROG, UsageError
+
+ACCEPT = 5e-3  # what ``check`` lets an RM's m_T differ from its targets by (the builder's accept tolerance)
+
+
+def add_parser(commands):
+    references = commands.add_parser("references", help="build or check a reference set",
+                                     description="Reference sets: the Reference Mannequins synthesis interpolates.")
+    actions = references.add_subparsers(dest="action", metavar="ACTION", required=True)
+    build = actions.add_parser(
+        "build", help="Reference Mannequins from a traced Base Mannequin and N >= 3 bodies",
+        description="Fit the Base Mannequin's traced parts in every body (OBJ meshes of the traced mesh's "
+                    "topology), refine each until m_T meets its targets, clean them together and write a "
+                    "reference-set folder (the RMs' JSON, the base and reference_set.json).")
+    build.add_argument("--base", required=True, metavar="BASE.json", help="the Base Mannequin, with its recorded "
+                       "selections (traced with Fit Ellipsoid); the set is measured at the section heights it "
+                       "records (its own set's)")
+    build.add_argument("--bodies", required=True, nargs="+", metavar="BODY.obj",
+                       help="N >= 3 body meshes; each file's stem names its Reference Mannequin")
+    build.add_argument("--targets", required=True, metavar="TARGETS.csv",
+                       help="a 'name' column (the bodies' file stems) and a column per measurement: "
+                            f"{', '.join(MEASUREMENTS)} in cm (or target_He, ...)")
+    build.add_argument("-o", "--out", required=True, metavar="DIR", help="the reference-set folder to write")
+    build.add_argument("--name", help="the set's name (default: the folder's name)")
+    build.add_argument("--sex", choices=("female", "male"), help="the set's sex, if it has one")
+    build.add_argument("--reference", metavar="STEM", help="the body whose RM the others' axes are labelled "
+                       "against (default: the one nearest the targets' mean)")
+    common.add_verbose(build)
+    build.set_defaults(run=run_build, blender=lambda args: None)
+    check = actions.add_parser("check", help="check a reference-set folder",
+                               description="Validity, ranges, symmetry and how each RM meets its targets.")
+    check.add_argument("folder", metavar="DIR")
+    common.add_verbose(check)
+    check.set_defaults(run=run_check, blender=lambda args: None)
+
+
+def read_targets(path):
+    """{name: {He, Sh, Br, Wa, Hi: cm}} from a CSV with a 'name' column and a column per measurement."""
+    try:
+        with open(path, encoding="utf-8-sig", newline="") as stream:
+            rows = list(csv.DictReader(stream))
+    except (OSError, UnicodeDecodeError, csv.Error) as error:
+        raise UsageError(f"{path}: cannot be read ({common.one_line(error)})") from None
+    if not rows or "name" not in rows[0]:
+        raise UsageError(f"{path}: needs a header with a 'name' column and {', '.join(MEASUREMENTS)}")
+    columns = {}
+    for key in MEASUREMENTS:
+        column = next((c for c in (key, f"target_{key}") if c in rows[0]), None)
+        if column is None:
+            raise UsageError(f"{path}: has no {key} column (cm)")
+        columns[key] = column
+    targets = {}
+    for line, row in enumerate(rows, 2):
+        name = (row.get("name") or "").strip()
+        values = {key: (row.get(column) or "").strip() for key, column in columns.items()}
+        if not name or not any(values.values()):
+            continue  # a body without targets (e.g. the traced one) is no RM
+        if name in targets:
+            raise UsageError(f"{path}: line {line}: '{name}' has a second row")
+        try:
+            targets[name] = {key: float(value) for key, value in values.items()}
+        except ValueError:
+            bad = next(key for key, value in values.items() if not _is_number(value))
+            raise UsageError(f"{path}: line {line}: {bad}={values[bad]!r} is not a number (cm)") from None
+    return targets
+
+
+def _is_number(text):
+    try:
+        return math.isfinite(float(text))
+    except ValueError:
+        return False
+
+
+def run_build(args):
+    out = pathlib.Path(args.out)
+    base = common_load_base(args.base)
+    base_stem = pathlib.Path(args.base).stem
+    stems = [pathlib.Path(p).stem for p in args.bodies]
+    if base_stem in stems or not STEM.match(base_stem):
+        base_stem = "base_mannequin"
+    for path in args.bodies:
+        if not STEM.match(pathlib.Path(path).stem):
+            raise UsageError(f"{path}: its stem must be letters, digits, _ . - (it names the RM's file)")
+    targets = read_targets(args.targets)
+    if len(args.bodies) < 3:  # before reading any mesh
+        raise UsageError(f"--bodies: a reference set needs at least 3 bodies, got {len(args.bodies)}")
+    try:
+        bodies = [read_obj(path) for path in args.bodies]
+    except BodyMeshError as error:
+        raise UsageError(str(error)) from None
+    common.output_folder(str(out), "references build")
+
+    def progress(fraction, text):
+        common.say(f"{PROG} references build: {fraction:4.0%} {text}", file=sys.stderr)
+
+    rms, report = build_reference_set(base, bodies, targets, progress=progress, reference=args.reference)
+    fractions = dict(base.section_fractions)  # what the build measured at: the base's own set's
+    name = args.name or out.resolve().name
+    rms = {stem: rm.copy(reference_set=name) for stem, rm in rms.items()}
+    first = next(iter(base.traces.values()))
+    manifest = Manifest(
+        name=name, mannequins=stems, sex=args.sex, base=base_stem,
+        section_fractions=fractions, ranges_cm=targets_range({s: targets[s] for s in stems}),
+        absurd_limits_cm={k: list(v) for k, v in ABSURD_LIMITS.items()},
+        targets_cm={s: dict(targets[s]) for s in stems},
+        provenance={"built_by": f"{PROG} references build", "base": {"file": pathlib.Path(args.base).name,
+                    "traced_mesh": first.mesh, "vertex_count": first.vertex_count},
+                    "bodies": {b.name: {"file": pathlib.Path(p).name, "sha256": _sha256(p)}
+                               for b, p in zip(bodies, args.bodies)},
+                    "labelled_against": report.reference})
+    with common.writing(str(out), folder=True):
+        write_reference_set(out, rms, manifest, base=report.base.copy(reference_set=name))
+    for stem in stems:
+        key, error = report.worst(stem)
+        fill = report.fill.get(stem, {}).get("ellipsoids")
+        filled = f", fills {fill['coverage']:.1%} of its body (excess {fill['excess']:.1%})" if fill else ""
+        print(f"{stem}: worst m_T error {error:+.4%} ({key}){filled}")
+    print(f"wrote {len(stems)} Reference Mannequins, {base_stem}.json and reference_set.json to {out}")
+    return 0
+
+
+def common_load_base(path):
+    from .measure import load_json_mannequin
+
+    if not pathlib.Path(path).is_file():
+        raise UsageError(f"{path}: no such file")
+    return load_json_mannequin(path)
+
+
+def _sha256(path):
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def check_folder(folder):
+    """(lines, problems) of ``references check``: one line per RM, one per problem found."""
+    reference = load_reference_set(folder)  # validity: files, topology, symmetry, distinct measurements
+    manifest = read_manifest(folder)
+    lines, problems = [], []
+    layout = "manifest reference_set.json" if manifest else "legacy layout (no reference_set.json)"
+    lines.append(f"{folder}: '{reference.name}', {len(reference)} RMs, {layout}")
+    for key in MEASUREMENTS:
+        lo, hi = reference.ranges[key]
+        a_lo, a_hi = reference.absurd_limits[key]
+        values = reference.measurements[:, MEASUREMENTS.index(key)]
+        if not a_lo <= lo <= hi <= a_hi:
+            problems.append(f"ranges_cm {key} [{lo:g}, {hi:g}] is not within absurd_limits_cm [{a_lo:g}, {a_hi:g}]")
+        if values.min() < lo - 1e-9 or values.max() > hi + 1e-9:
+            problems.append(f"ranges_cm {key} [{lo:g}, {hi:g}] does not hold the RMs' {key} "
+                            f"({values.min():g} to {values.max():g} cm)")
+    targets = manifest.targets_cm if manifest else {}
+    for name, rm in zip(reference.names, reference.mannequins):
+        wanted = targets.get(name) or rm.measurements
+        errors = relative_errors(rm.measure(), wanted)
+        key = max(errors, key=lambda k: abs(errors[k]))
+        lines.append(f"{name}: worst m_T error {errors[key]:+.4%} ({key}), asymmetry {asymmetry(rm) * 1e3:.2g} mm")
+        if abs(errors[key]) > ACCEPT:
+            problems.append(f"{name}: m_T {key} is off its target by {errors[key]:+.3%} (accepted {ACCEPT:.1%})")
+        problems += [f"{name}: {text}" for text in cleanliness_problems(rm, 1e-6)]
+    return lines, problems
+
+
+def run_check(args):
+    if not pathlib.Path(args.folder).is_dir():
+        raise UsageError(f"{args.folder}: no such folder")
+    lines, problems = check_folder(pathlib.Path(args.folder))
+    for line in lines:
+        print(line)
+    for problem in problems:
+        common.say(f"{PROG} references check: error: {problem}")
+    return 1 if problems else 0
