@@ -11,6 +11,7 @@ import statistics
 import time
 
 from ellimann_addon.core.body_measure import measure_body_mesh
+from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.refine_extra import synthesize_extra
 from ellimann_addon.core.shipped_sets import named_reference_set
@@ -29,7 +30,7 @@ def run():
           f"{'gain':>6}")
     gains = []
     for name in BODIES:
-        body = load_body(TRACING_FOLDER, name)
+        body = read_obj(TRACING_FOLDER / f"{name}.obj")
         times = []
         for _ in range(3):
             start = time.perf_counter()

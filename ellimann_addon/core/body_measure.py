@@ -41,7 +41,7 @@ class BodyMeasurement:
 
     values: dict = field(default_factory=dict)
     problems: list = field(default_factory=list)
-    sections: dict = field(default_factory=dict)  # key: (z or plane, hull points) for drawing
+    sections: dict = field(default_factory=dict)  # key: (k, 3) points where it is taken (loops, a line, a point)
 
     @property
     def missing(self):
@@ -115,6 +115,7 @@ class StandingBody:
         self.height = float(self.vertices[:, 2].max()) - self.bottom
         mid = section_segments(self.vertices, self.faces, self.at(MID_PLANE_HEIGHT))[0]
         self.mid_x = 0.5 * (mid[:, :, 0].min() + mid[:, :, 0].max()) if len(mid) else 0.0
+        self.crotch_y = np.nan  # y of the crotch, once found
 
     def at(self, fraction):
         return self.bottom + fraction * self.height
@@ -181,9 +182,13 @@ class StandingBody:
         """Height above the soles of the lowest point on the plane x = x_c above CROTCH_FLOOR (m), or NaN."""
         turned = np.stack([self.vertices[:, 1], self.vertices[:, 2], self.vertices[:, 0] - self.mid_x], axis=1)
         segments, _ = section_segments(turned, self.faces, 0.0)
-        z = segments[:, :, 1].ravel()
-        z = z[z > self.at(CROTCH_FLOOR)]
-        return float(z.min() - self.bottom) if len(z) else np.nan
+        points = segments.reshape(-1, 2)
+        points = points[points[:, 1] > self.at(CROTCH_FLOOR)]
+        if not len(points):
+            return np.nan
+        lowest = int(np.argmin(points[:, 1]))
+        self.crotch_y = float(points[lowest, 0])  # where it is, for drawing
+        return float(points[lowest, 1] - self.bottom)
 
     def leg_girth(self, z, side, leg_faces):
         """One leg's girth at height z (below the crotch): the body blob on that side, hands left out."""
@@ -246,7 +251,7 @@ def measure_body_mesh(vertices, faces, fractions=None):
     z_sh = body.at(body.fractions["Sh"])
     segments, _ = body.section(z_sh)
     values["Sh"] = float(np.ptp(segments[:, :, 0])) if len(segments) else 0.0
-    result.sections["Sh"] = (z_sh, convex_hull_2d(segments.reshape(-1, 2)) if len(segments) else np.zeros((0, 2)))
+    result.sections["Sh"] = _at_height(convex_hull_2d(segments.reshape(-1, 2)) if len(segments) else [], z_sh)
 
     armpit, arm_vertex = body.find_arms()
     arms_found = all(armpit[side] is not None and arm_vertex[side].any() for side in SIDES)
@@ -266,23 +271,25 @@ def measure_body_mesh(vertices, faces, fractions=None):
             continue
         segments = body.body_section(z)
         values[key], hull = hull_girth(segments.reshape(-1, 2))
-        result.sections[key] = (z, hull)
+        result.sections[key] = _at_height(hull, z)
 
     crotch = body.crotch()
     if np.isfinite(crotch):
         values["crotch_height"] = crotch
+        result.sections["crotch_height"] = np.array([[body.mid_x, body.crotch_y, body.bottom + crotch]])
         if arms_found:
             z = body.bottom + crotch - THIGH_DROP * body.height
             girths = [body.leg_girth(z, side, leg_faces) for side in SIDES]
             values["thigh"] = float(np.mean([g for g, _ in girths]))
-            result.sections["thigh"] = (z, girths[0][1])
+            result.sections["thigh"] = _at_height(girths[0][1], z)
         low, high = (body.bottom + f * crotch for f in CALF_BAND)
 
         def calf(heights, side):
             return np.array([body.leg_girth(z, side, leg_faces)[0] for z in heights])
 
-        values["calf"] = float(np.mean([extreme_over_band(lambda h, s=side: calf(h, s), low, high, True)
-                                        for side in SIDES]))
+        found = [extreme_over_band(lambda h, s=side: calf(h, s), low, high, True, where=True) for side in SIDES]
+        values["calf"] = float(np.mean([value for value, _ in found]))
+        result.sections["calf"] = _at_height(body.leg_girth(found[0][1], "L", leg_faces)[1], found[0][1])
     else:
         result.problems.append("no crotch (the legs are not apart at the mid-plane): crotch_height, thigh and "
                                "calf cannot be taken")
@@ -291,17 +298,22 @@ def measure_body_mesh(vertices, faces, fractions=None):
         girths = np.array([hull_girth(body.section(z)[0].reshape(-1, 2))[0] for z in heights])
         return np.where(girths > 0.0, girths, np.inf)  # a height with no section is no neck
 
-    values["neck"] = extreme_over_band(neck, *(body.at(f) for f in NECK_BAND), False, samples=NECK_SAMPLES)
-    if not np.isfinite(values["neck"]):
+    values["neck"], z_neck = extreme_over_band(neck, *(body.at(f) for f in NECK_BAND), False, samples=NECK_SAMPLES,
+                                               where=True)
+    if np.isfinite(values["neck"]):
+        result.sections["neck"] = _at_height(hull_girth(body.section(z_neck)[0].reshape(-1, 2))[1], z_neck)
+    else:
         del values["neck"]
         result.problems.append("no neck: the sections between 0.80 and 0.92 He are empty; neck cannot be taken")
 
     if arms_found:
         lengths, girths = [], []
         for side in SIDES:
-            tip, length, girth = _arm(body, side, z_sh, arm_vertex[side], arm_faces[side])
+            start, tip, length, girth, loop = _arm(body, side, z_sh, arm_vertex[side], arm_faces[side])
             lengths.append(length)
             girths.append(girth)
+            if side == "L":
+                result.sections["arm_length"], result.sections["upper_arm"] = np.array([start, tip]), loop
         values["arm_length"] = float(np.mean(lengths))
         values["upper_arm"] = float(np.mean(girths))
     if len(open_edges):
@@ -315,6 +327,12 @@ def measure_body_mesh(vertices, faces, fractions=None):
     return result
 
 
+def _at_height(hull, z):
+    """A 2-D hull as 3-D points at height z."""
+    hull = np.asarray(hull, float).reshape(-1, 2)
+    return np.c_[hull, np.full(len(hull), z)]
+
+
 def _shoulder_point(body, z_sh, side):
     segments, _ = body.section(z_sh)
     points = segments.reshape(-1, 2)
@@ -323,31 +341,29 @@ def _shoulder_point(body, z_sh, side):
 
 
 def _arm(body, side, z_sh, arm_vertex, arm_faces):
-    """(fingertip, shoulder-to-fingertip length m, upper-arm girth m) of one arm."""
+    """(shoulder point, fingertip, shoulder-to-fingertip length m, upper-arm girth m, its loop (k, 3)) of an arm."""
     start = _shoulder_point(body, z_sh, side)
     points = body.vertices[arm_vertex]
     distance = np.linalg.norm(points - start, axis=1)
     tip = points[int(np.argmax(distance))]
     length = float(distance.max())
     axis = (tip - start) / length
-    moved, _ = in_plane(body.vertices, start + UPPER_ARM_FRACTION * length * axis, axis)
+    origin = start + UPPER_ARM_FRACTION * length * axis
+    moved, frame = in_plane(body.vertices, origin, axis)
     segments, _, blob = section_blobs(moved, body.faces[arm_faces], 0.0)
     if len(segments) == 0:
-        return tip, length, 0.0
+        return start, tip, length, 0.0, np.zeros((0, 3))
     # the arm's own loop: the blob around the axis (a torso vertex near the armpit may be in the mask)
     around = [b for b in np.unique(blob) if _inside(np.zeros((1, 2)), segments[blob == b])[0]]
     if around:
         segments = segments[blob == around[0]]
-    girth, _ = hull_girth(segments.reshape(-1, 2))
-    return tip, length, girth
+    girth, hull = hull_girth(segments.reshape(-1, 2))
+    return start, tip, length, girth, origin + hull @ frame[:2]
 
 
 def _keys_crossing(body, open_edges, result):
-    """The measurements whose section height lies within the z range of a boundary edge."""
+    """The measurements whose section (its z range) meets the z range of a boundary edge."""
     z = body.vertices[open_edges, 2]
     lo, hi = z.min(axis=1), z.max(axis=1)
-    crossed = []
-    for key, (height, _) in result.sections.items():
-        if np.any((lo <= height) & (hi >= height)):
-            crossed.append(key)
-    return crossed
+    return [key for key, points in result.sections.items() if len(points)
+            and np.any((lo <= points[:, 2].max()) & (hi >= points[:, 2].min()))]

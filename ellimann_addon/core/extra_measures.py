@@ -55,7 +55,7 @@ GOLDEN_STEPS = 40  # golden-section steps: the band's grid cell shrinks below a 
 SIDES = ("L", "R")
 
 
-def extreme_over_band(function, low, high, largest, breaks=(), samples=BAND_SAMPLES):
+def extreme_over_band(function, low, high, largest, breaks=(), samples=BAND_SAMPLES, where=False):
     """Largest (or smallest) value of a 1-D ``function`` (vectorised over an array of heights) on [low, high].
 
     The band is cut at ``breaks`` (where the function may have a kink or a narrow dip: the ends of the pieces
@@ -82,7 +82,11 @@ def extreme_over_band(function, low, high, largest, breaks=(), samples=BAND_SAMP
         fp = sign * function(probe)
         fc, fd = np.where(left, fp, fd), np.where(left, fc, fp)
         c, d = c_new, d_new
-    return float(sign * min(values.min(), fc.min(), fd.min()))
+    heights = np.concatenate([grid.ravel(), c, d])
+    found = np.concatenate([values.ravel(), fc, fd])
+    best_index = int(np.argmin(found))
+    value = float(sign * found[best_index])
+    return (value, float(heights[best_index])) if where else value
 
 
 def _permuted(rotation, center, order):
