@@ -2,12 +2,13 @@
 or of a body mesh (.obj / .ply / .stl, no Blender)."""
 
 import json
+import math
 import os
 import sys
 
 from ..core.body_measure import ALL_MEASUREMENTS, measure_body_mesh
 from ..core.body_mesh import MESH_EXTENSIONS, UNITS, UP_AXES, BodyMeshError, read_body_mesh
-from ..core.constants import MEASUREMENT_LABELS
+from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS
 from ..core.errors import MannequinError
 from ..core.extra_measures import EXTRA_LABELS, mannequin_extra_measurements
 from ..core.mannequin import Mannequin
@@ -82,17 +83,21 @@ def measure_mesh_file(path, args):
 
 
 def _print(values, as_json, path, title):
-    keys = [key for key in ALL_MEASUREMENTS if key in values]
+    """The measurements, as JSON or a table; non-finite ones: the five refuse, an extra one (a mannequin without
+    arm or leg pieces) is left out with a warning."""
+    five = [values[key] for key in MEASUREMENTS if key in values]
+    if not all(math.isfinite(value) for value in five):
+        raise UsageError(f"{path}: m_T is not finite ({common.format_me(five)} cm)")
+    lost = [key for key in ALL_MEASUREMENTS if key in values and not math.isfinite(values[key])]
+    if lost:
+        common.say(f"{common.PROG} measure: warning: {path}: {', '.join(lost)} cannot be taken (no such pieces)")
+    keys = [key for key in ALL_MEASUREMENTS if key in values and key not in lost]
     if as_json:
-        try:
-            text = json.dumps({key: round(values[key], 4) for key in keys}, allow_nan=False)
-        except ValueError:  # NaN or infinity: not JSON, and not a measurement
-            raise UsageError(f"{path}: a measurement is not finite ({common.format_me(values.values())} cm)") from None
-        print(text)
+        print(json.dumps({key: round(values[key], 4) for key in keys}))
     else:
         common.say(title, file=sys.stdout)
         for key in keys:
-            print(f"  {key:<13} {LABELS[key]:<17} {values[key]:9.2f} cm")
+            print(f"  {key} {LABELS[key]:<17} {values[key]:9.2f} cm")
 
 
 def load_json_mannequin(path):

@@ -97,7 +97,8 @@ def run(args):
     common.write(mannequin, [args.output], {key: measured[key] for key in MEASUREMENTS},
                  args.cushions and kind != "json")
     error = relative_error(achieved, request).max()
-    extra_line = "".join(f", {key} {measured[key]:.2f}" for key in EXTRA_MEASUREMENTS)
-    common.say(f"wrote {args.output}: '{mannequin.name}' ({args.mode}), m_T {common.format_me(achieved)}"
-               f"{extra_line} cm, max error of the five {error:.3f}%", file=sys.stdout)
+    extra_line = ("; " + ", ".join(f"{key} {measured[key]:.2f}" for key in EXTRA_MEASUREMENTS) + " cm"
+                  if extra else "")
+    common.say(f"wrote {args.output}: '{mannequin.name}' ({args.mode}), m_T {common.format_me(achieved)} cm, "
+               f"max error {error:.3f}%{extra_line}", file=sys.stdout)
     return common.MISSED if misses or missed_extra else 0

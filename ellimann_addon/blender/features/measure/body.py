@@ -31,8 +31,7 @@ def values_line(values):
 
 
 class ELLIMANN_OT_measure_body(ElliMannOperator, bpy.types.Operator):
-    """Measure the active mesh as a standing A-pose body (the five measurements and neck, upper arm, thigh, calf,
-    crotch height, arm length; arms found by geometry) and store them on it"""
+    """Measure the active mesh as a standing A-pose body (the five and neck, upper arm, thigh, calf, crotch height, arm length) and store them on it"""  # noqa: E501
 
     bl_idname = ids.MEASURE_BODY
     bl_label = "Measure Body Mesh"
