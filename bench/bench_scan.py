@@ -15,7 +15,7 @@ from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.refine_extra import synthesize_extra
 from ellimann_addon.core.shipped_sets import named_reference_set
-from tools.bodies import body_measurements, load_body, load_labels
+from tools.bodies import body_measurements, load_labels
 from tools.overlap import voxel_iou
 from tools.reference_sets import TRACING_FOLDER
 

@@ -80,8 +80,9 @@ def main(argv=None):
     body_object = bpy.data.objects.new(args.body, mesh)
     bpy.context.scene.collection.objects.link(body_object)
     body_marks = marks(measure_body_mesh(body.vertices, body.faces).sections, "body")
-    slots = [Slot(solid=mannequin_marks, ghosts=[collection]), Slot(solid=mannequin_marks, ghosts=[collection], turn=90),
-             Slot(solid=body_marks, ghosts=[body_object]), Slot(solid=body_marks, ghosts=[body_object], turn=90)]
+    slots = [Slot(solid=marks_, ghosts=[ghost], turn=turn) for marks_, ghost in ((mannequin_marks, collection),
+                                                                                  (body_marks, body_object))
+             for turn in (0, 90)]
     render(args.out, slots, resolution=(1800, 1100), spacing=0.25)
     print(f"wrote {args.out}")
 
