@@ -22,6 +22,7 @@ import time
 import numpy as np
 
 from bench.bench_core import best_of
+from devkit.hull_before import hull_perimeter_before
 from devkit.synthetic import shipped_or_synthetic
 from ellimann_addon.core import synthesis
 from ellimann_addon.core.constants import MEASUREMENTS, PAPER_TABLE_2_4, SECTION_FRACTIONS, quartile_points
@@ -198,6 +199,7 @@ def run():
                           ("exact mode, now", t_exact)):
         print(f"  {name:<37}{batch / seconds:10,.0f} mannequins/s  ({seconds * 1e3:7.1f} ms)")
     print(f"  exact mode batched: {t_old / t_exact:.1f}x faster than before")
+    population_scale(reference, requests)
     one = requests[121:122]
     t_one = {}
     for name, fn in (("idw, paper", lambda: synthesis.synthesize_batch(reference, one, mode="idw", normalize="none")),
@@ -216,6 +218,51 @@ def run():
           f"{np.median(singles) * 1e3:.2f} ms, max {np.max(singles) * 1e3:.2f} ms")
 
     blender(reference, exact)
+
+
+def population_scale(reference, requests, repeat=5):
+    """Exact mode against proportional IDW on the same batch, with today's m_T and the one it replaced
+    (``devkit.hull_before``), every variant timed in turn within each round (best of ``repeat`` rounds), in CPU
+    time (on a shared machine wall time mostly measures the other jobs): the ratios are the figures to read."""
+    from ellimann_addon.core import measure
+
+    def previous_m_t(fn):
+        def run():
+            current = measure.hull_perimeter
+            measure.hull_perimeter = hull_perimeter_before
+            try:
+                return fn()
+            finally:
+                measure.hull_perimeter = current
+        return run
+
+    rotation, center, semi_axes = synthesis.interpolate(reference, requests)
+    girth = reference.topology.girth_mask
+    reference.refine_jacobian()
+    variants = {
+        "proportional IDW (interpolation)": lambda: synthesis.interpolate(reference, requests),
+        "IDW + m_T (mode idw)": lambda: synthesis.synthesize_batch(reference, requests, mode="idw"),
+        "m_T, now": lambda: tailor_measurements(rotation, center, semi_axes, girth),
+        "m_T, before": previous_m_t(lambda: tailor_measurements(rotation, center, semi_axes, girth)),
+        "exact, now": lambda: synthesis.synthesize_batch(reference, requests, mode="exact"),
+        "exact, with the m_T before": previous_m_t(lambda: synthesis.synthesize_batch(reference, requests,
+                                                                                         mode="exact")),
+    }
+    best = dict.fromkeys(variants, float("inf"))
+    for _ in range(repeat):
+        for name, fn in variants.items():
+            start = time.process_time()  # CPU time: what the work costs, whatever else the machine runs
+            fn()
+            best[name] = min(best[name], time.process_time() - start)
+    batch = len(requests)
+    print(f"\npopulation scale (batch {batch}; CPU time of this process, variants interleaved, best of {repeat}):")
+    for name, seconds in best.items():
+        print(f"  {name:<37}{batch / seconds:10,.0f} mannequins/s  ({seconds * 1e3:7.1f} ms)")
+    idw, measured = best["proportional IDW (interpolation)"], best["IDW + m_T (mode idw)"]
+    now, before = best["exact, now"], best["exact, with the m_T before"]
+    print(f"  m_T {best['m_T, before'] / best['m_T, now']:.2f}x faster, {best['m_T, now'] / idw:.1f}x the "
+          f"interpolation; exact costs {now / idw:.1f}x the interpolation (before {before / idw:.1f}x) and "
+          f"{now / measured:.2f}x IDW with its m_T (before {before / measured:.2f}x)")
 
 
 def blender(reference, exact):

@@ -5,7 +5,8 @@
 
 Subcommands, a module each: ``synth`` (one mannequin), ``batch`` (a CSV of measurements), ``measure`` (m_T of
 a file), ``demo`` (the paper's Table 2.5 mannequins with a report and a line-up picture), ``drape`` (a
-garment on a mannequin with Blender's cloth simulation) and ``references`` (build or check a reference set);
+garment on a mannequin with Blender's cloth simulation), ``references`` (build or check a reference set) and
+``population`` (rows sampled from a survey's statistics, for ``batch``); ``distributed`` runs ``batch --dask``;
 ``common`` holds what they share. This package needs
 numpy only: Blender (the bpy module and ``ellimann_addon.blender``) is imported only when a .blend/.glb/.obj
 file, a drape or a picture is involved, and a command that needs it without it is refused in one line.
@@ -19,11 +20,11 @@ import contextlib
 import sys
 
 from ..core.errors import ElliMannError
-from . import batch, demo, drape, measure, references, synth
+from . import batch, demo, drape, measure, population, references, synth
 from .common import INTERRUPTED, MISSED, PROG, UsageError, blender_available, no_blender, one_line, say
 
 __all__ = ["INTERRUPTED", "MISSED", "PROG", "UsageError", "build_parser", "main", "main_exit"]
-SUBCOMMANDS = (synth, batch, measure, demo, drape, references)
+SUBCOMMANDS = (synth, batch, measure, demo, drape, references, population)
 
 
 def build_parser():

@@ -19,22 +19,23 @@ from ..core.measure import as_dict
 from ..core.refine import EXACT_TOLERANCE
 from ..core.refine_extra import extra_request_problems, meet_extra
 from ..core.request import validate_request
-from . import common
+from . import common, distributed
 from .common import PROG, UsageError
 
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,99}$")
-CHUNK = 256  # rows synthesized per core batch
+CHUNK = 256  # rows synthesized per core batch (and per Dask task)
+MAX_WARNING_LINES = 20  # range warnings printed before the rest go to the report only (a population has thousands)
+NPZ = "npz"  # the batch's one-file format (core.batch_file), written once at the end
 
 
 def add_parser(commands):
     batch = commands.add_parser("batch", help="synthesize every row of a CSV",
                                 description="One mannequin per CSV row. The header names the columns "
-                                            "He,Sh,Br,Wa,Hi (cm) and optionally name and references (a row's "
+                                            "He,Sh,Br,Wa,Hi (cm) and optionally name, references (a row's "
                                             "reference set: female, male or a folder; empty: --references) "
                                             "and any of the extra measurements (neck, upper_arm, thigh, calf, "
                                             "crotch_height, arm_length: the keys measure --json prints; an empty "
-                                            "cell leaves it to the reference set). "
-                                            "Writes the files and "
+                                            "cell leaves it to the reference set). Writes the files and "
                                             "DIR/report.csv (requested vs measured), row by row into "
                                             "DIR/report.partial.csv while it runs. Bad or failed rows are "
                                             "reported and skipped; the exit code is 1 if any row failed, 3 if "
@@ -42,8 +43,12 @@ def add_parser(commands):
     batch.add_argument("csv", metavar="MEASUREMENTS.csv")
     batch.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
     batch.add_argument("--format", default="json",
-                       help=f"comma-separated output formats among {','.join(FORMATS)} (default json; mjcf "
-                            "writes NAME.xml)")
+                       help=f"comma-separated output formats among {','.join(FORMATS)},npz (default json; mjcf "
+                            "writes NAME.xml; npz writes every mannequin of the batch into one compressed file "
+                            "DIR/mannequins.npz, docs/batch_file.md)")
+    batch.add_argument("--dask", metavar="ADDRESS",
+                       help="synthesize on a Dask cluster: a scheduler's tcp://HOST:PORT, or local:N for N local "
+                            "worker processes (pip install ellimann[dask]); results identical to a serial run")
     batch.add_argument("--shard", metavar="I/N",
                        help="process only rows I, I+N, I+2N… (I from 1 to N), for a render farm; the report "
                             "is DIR/report-I-of-N.csv")
@@ -60,7 +65,7 @@ def needs_blender(args):
         formats = parse_formats(args.format)
     except UsageError:
         return None
-    blender = [f for f in formats if FORMATS[f].needs_blender]
+    blender = [f for f in formats if f in FORMATS and FORMATS[f].needs_blender]
     return f"--format {blender[0]}" if blender else None
 
 
@@ -75,9 +80,9 @@ def parse_shard(text):
 
 def parse_formats(text):
     formats = [f.strip().lower().lstrip(".") for f in text.split(",") if f.strip()]
-    unknown = [f for f in formats if f not in FORMATS]
+    unknown = [f for f in formats if f not in FORMATS and f != NPZ]
     if unknown or not formats:
-        raise UsageError(f"--format takes a comma-separated list of {', '.join(FORMATS)}, got {text!r}")
+        raise UsageError(f"--format takes a comma-separated list of {', '.join(FORMATS)}, {NPZ}, got {text!r}")
     return list(dict.fromkeys(formats))
 
 
@@ -173,8 +178,6 @@ def name_rows(rows):
 
 
 def run(args):
-    from ..core.synthesis import synthesize_batch
-
     formats = parse_formats(args.format)
     shard, shards = parse_shard(args.shard)
     sets = {"": common.references(args)}  # the command's set, read once, and each other set a row names
@@ -190,31 +193,57 @@ def run(args):
     options = common.synthesis_options(args)
     rows = name_rows(rows)  # over the whole CSV, so every shard agrees on which rows are bad
     mine = [row for index, row in enumerate(rows) if index % shards == shard - 1]
+    cluster = distributed.connect(args.dask) if args.dask else None  # before anything is written
+    try:
+        return _run(args, formats, shard, shards, rows, mine, options, cluster)
+    finally:
+        if cluster is not None:
+            cluster.close()
+
+
+def _run(args, formats, shard, shards, rows, mine, options, cluster):
     common.output_folder(args.output, "batch")
-    report_name = "report.csv" if shards == 1 else f"report-{shard}-of-{shards}.csv"
-    report = Report(os.path.join(args.output, report_name))
-    jobs = []
+    suffix = "" if shards == 1 else f"-{shard}-of-{shards}"
+    report = Report(os.path.join(args.output, f"report{suffix}.csv"))
+    jobs, shown = [], 0
     for line, name, values, error, warnings, reference, extra in mine:
         if error is not None:
             common.say(f"{PROG} batch: line {line}: skipped: {error}")
             report.add(common.report_row(line, name, "error", error, values))
             continue
         for warning in warnings:
-            common.say(f"{PROG} batch: line {line}: warning: {warning}")
+            shown += 1
+            if shown <= MAX_WARNING_LINES:
+                common.say(f"{PROG} batch: line {line}: warning: {warning}")
         jobs.append((line, name, values, warnings, extra, reference))
-    progress = common.Progress(len(jobs), "batch")
-    # one core batch per reference set (in the order the sets first appear), in chunks
+    if shown > MAX_WARNING_LINES:
+        common.say(f"{PROG} batch: {shown - MAX_WARNING_LINES} more warning(s) of requests outside the reference "
+                   f"range; every row's are in {report.path}")
+    progress = common.Progress(len(jobs), "batch", quiet=args.quiet)
+    # chunks of one reference set each (the sets in the order they first appear)
     groups = {}
     for job in jobs:
         groups.setdefault(id(job[-1]), []).append(job)
+    chunks = [group[start:start + CHUNK] for group in groups.values() for start in range(0, len(group), CHUNK)]
+    references = [chunk[0][-1] for chunk in chunks]
+    requests = [[job[2] for job in chunk] for chunk in chunks]
+    # one batch file per set (their topologies may differ): mannequins.npz, or mannequins-<set>.npz when mixed
+    named = {id(reference): reference for reference in references}
+    bundles = {key: Bundle(os.path.join(args.output, f"mannequins{'' if len(named) == 1 else '-' + ref.name}"
+                                                     f"{suffix}.npz"), ref.topology, args.mode)
+               for key, ref in named.items()} if NPZ in formats else {}
+    results = (cluster.map(references, requests, options) if cluster is not None
+               else ((index, synthesize_chunk(references[index], chunk, options))
+                     for index, chunk in enumerate(requests)))
     try:
-        for group in groups.values():
-            for start in range(0, len(group), CHUNK):
-                chunk = group[start:start + CHUNK]
-                result = synthesize_batch(chunk[0][-1], [values for _, _, values, _, _, _ in chunk], options)
-                for i, (line, name, values, warnings, extra, reference) in enumerate(chunk):
-                    report.add(_row(args, formats, result, i, line, name, values, warnings, reference.name, extra))
-                    progress.step(name)
+        for index, result in results:
+            bundle = bundles.get(id(references[index]))
+            for i, (line, name, values, warnings, extra, reference) in enumerate(chunks[index]):
+                report.add(_row(args, formats, result, i, line, name, values, warnings, bundle, index, reference,
+                                extra))
+                progress.step(name)
+        for bundle in bundles.values():
+            bundle.write()
     except KeyboardInterrupt:
         progress.done()
         report.finish()
@@ -241,13 +270,78 @@ def run(args):
     return 0
 
 
-def _row(args, formats, result, i, line, name, values, warnings, references, extra=None):
-    """Write (or, with --resume, keep) the files of one synthesized row; its report row. A failure is
-    that row's: one line on stderr and status "error", and the batch goes on. A row with extra measurements is
-    deformed to meet them too (exact mode; the report's message gives what they came to)."""
-    paths = [os.path.join(args.output, f"{name}.{common.extension(kind)}") for kind in formats]
+def synthesize_chunk(reference, requests, options):
+    """A chunk of requests synthesized in one core batch (what a Dask task runs). If the batch refuses a row
+    (an implausible body), every row is synthesized alone, so only that row fails: batched and one-at-a-time
+    results are the same bits. Returns a ChunkResult."""
+    from ..core.synthesis import synthesize_batch
+
+    try:
+        return ChunkResult.of(synthesize_batch(reference, requests, options), [None] * len(requests))
+    except ElliMannError:
+        pass
+    parts, errors = [], []
+    for values in requests:
+        try:
+            parts.append(synthesize_batch(reference, [values], options))
+            errors.append(None)
+        except ElliMannError as error:
+            parts.append(None)
+            errors.append(common.one_line(error))
+    return ChunkResult.joined(parts, errors)
+
+
+class ChunkResult:
+    """A chunk's synthesis as plain arrays (what a Dask worker sends back): ``errors[i]`` is None or why row i
+    failed (its arrays are then NaN)."""
+
+    FIELDS = ("rotation", "center", "semi_axes", "measured", "factors", "converged")
+
+    def __init__(self, topology, errors, **arrays):
+        self.topology, self.errors = topology, errors
+        for key in self.FIELDS:
+            setattr(self, key, arrays[key])
+
+    @classmethod
+    def of(cls, synthesis, errors):
+        return cls(synthesis.topology, errors, **{key: getattr(synthesis, key) for key in cls.FIELDS})
+
+    @classmethod
+    def joined(cls, parts, errors):
+        good = next((p for p in parts if p is not None), None)
+        if good is None:
+            return cls(None, errors, **{key: [None] * len(parts) for key in cls.FIELDS})
+        arrays = {key: np.concatenate([getattr(p if p is not None else good, key) for p in parts])
+                  for key in cls.FIELDS}
+        for i, part in enumerate(parts):
+            if part is None:
+                for key in cls.FIELDS[:-1]:
+                    arrays[key][i] = np.nan
+                arrays["converged"][i] = False
+        return cls(good.topology, errors, **arrays)
+
+    def mannequin(self, i, name, request, reference=None):
+        """Row i as a Mannequin, recording the set (``reference``) it was synthesized from and its section heights."""
+        from ..core.mannequin import Mannequin
+
+        sets = {} if reference is None else {"reference_set": reference.name,
+                                             "section_fractions": reference.section_fractions}
+        return Mannequin(self.topology, self.rotation[i], self.center[i], self.semi_axes[i], name=name,
+                         role="synthesized", measurements=as_dict(request), **sets)
+
+
+def _row(args, formats, result, i, line, name, values, warnings, bundle=None, chunk=0, reference=None, extra=None):
+    """Write (or, with --resume, keep) the files of one synthesized row, and add it to the batch file; its report
+    row. A failure is that row's: one line on stderr and status "error", and the batch goes on. A row with extra
+    measurements is deformed to meet them too (exact mode; the report's message gives what they came to; the
+    batch file holds the five's mannequin)."""
+    sets = reference.name if reference is not None else ""
+    if result.errors[i] is not None:
+        common.say(f"{PROG} batch: line {line}: failed: {result.errors[i]}")
+        return common.report_row(line, name, "error", result.errors[i], values, references=sets)
+    paths = [os.path.join(args.output, f"{name}.{common.extension(kind)}") for kind in formats if kind != NPZ]
     notes = list(warnings)
-    mannequin, measured = result.mannequin(i, name), result.measured[i]
+    mannequin, measured = result.mannequin(i, name, values, reference), result.measured[i]
     if extra and args.mode == "exact":
         mannequin, achieved, missed_extra = meet_extra(mannequin, extra)
         measured = np.array([achieved[key] for key in MEASUREMENTS])
@@ -260,17 +354,52 @@ def _row(args, formats, result, i, line, name, values, warnings, references, ext
         notes.append(common.missed_text(misses))
         common.say(f"{PROG} batch: line {line}: warning: {common.missed_text(misses)}")
     status = "missed" if misses else "ok"
-    if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths):
+    listed = paths + ([bundle.path] if bundle is not None else [])
+    if bundle is not None:
+        bundle.add(chunk, name, values, result, i)
+    if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths) and paths:
         row = common.report_row(line, name, status, "; ".join(notes + ["kept (--resume)"]), values, measured,
-                                paths, references)
+                                listed, sets)
         row["kept"] = True
         return row
     try:
-        common.write(mannequin, paths, as_dict(measured), args.cushions)
+        if paths:
+            common.write(mannequin, paths, as_dict(measured), args.cushions)
     except (ElliMannError, OSError, RuntimeError) as error:
         common.say(f"{PROG} batch: line {line}: failed: {common.one_line(error)}")
-        return common.report_row(line, name, "error", common.one_line(error), values)
-    return common.report_row(line, name, status, "; ".join(notes), values, measured, paths, references)
+        if bundle is not None:
+            bundle.drop(chunk, name)
+        return common.report_row(line, name, "error", common.one_line(error), values, references=sets)
+    return common.report_row(line, name, status, "; ".join(notes), values, measured, listed, sets)
+
+
+class Bundle:
+    """The rows of ``--format npz``, gathered by chunk (a Dask run finishes chunks in any order) and written
+    once, in the CSV's order, when the batch ends (``core.batch_file``)."""
+
+    def __init__(self, path, topology, mode):
+        self.path, self.topology, self.mode = path, topology, mode
+        self.rows = {}  # chunk -> [(name, request, result, i)]
+
+    def add(self, chunk, name, values, result, i):
+        self.rows.setdefault(chunk, []).append((name, values, result, i))
+
+    def drop(self, chunk, name):
+        self.rows[chunk] = [row for row in self.rows.get(chunk, []) if row[0] != name]
+
+    def write(self):
+        from ..core.batch_file import batch_arrays, write_batch_file
+
+        rows = [row for chunk in sorted(self.rows) for row in self.rows[chunk]]
+        parts = len(self.topology)
+        shapes = {"rotation": (parts, 3, 3), "center": (parts, 3), "semi_axes": (parts, 3), "measured": (5,),
+                  "factors": (5,), "converged": ()}
+        arrays = {key: np.array([getattr(result, key)[i] for _, _, result, i in rows]).reshape((len(rows),) + shape)
+                  for key, shape in shapes.items()}
+        requests = np.array([values for _, values, _, _ in rows], dtype=float).reshape(len(rows), 5)
+        with common.writing(self.path):
+            write_batch_file(self.path, batch_arrays(self.topology, [row[0] for row in rows], requests,
+                                                     mode=self.mode, **arrays))
 
 
 class Report:

@@ -75,6 +75,8 @@ def number(text):
 def add_verbose(parser):
     parser.add_argument("-v", "--verbose", action="store_true",
                         help="also show what Blender prints (on stderr); without it only ElliMann's lines show")
+    parser.add_argument("-q", "--quiet", action="store_true",
+                        help="no progress line (errors, warnings and the result still show)")
 
 
 def add_synthesis_options(parser):
@@ -296,26 +298,51 @@ def write_text(path, text):
 
 
 class Progress:
-    """One progress line on stderr: rewritten in place on a terminal, every ~5% in a log."""
+    """One progress line on stderr: count, rate and time left, rewritten in place on a terminal, every ~5% in a
+    log; nothing with ``quiet`` (``-q``)."""
 
-    def __init__(self, total, command, every=None):
+    def __init__(self, total, command, every=None, quiet=False):
         self.total, self.count, self.start = total, 0, time.perf_counter()
-        self.command = command
+        self.command, self.quiet = command, quiet
         self.stream = sys.stderr  # ElliMann's stderr, also from inside blender_output() (where sys.stderr is Blender's)
         self.tty = self.stream.isatty()
         self.every = every or max(1, total // 20)
+        self.shown = 0.0  # when the line was last rewritten (a terminal gets at most ~10 a second)
 
     def step(self, name, count=None):
         """One more done (``name``: what), or ``count`` done so far; repeated counts are ignored."""
         if count is not None and count <= self.count:
             return
+        previous = self.count
         self.count = self.count + 1 if count is None else count
-        if self.tty or self.count % self.every == 0 or self.count == self.total:
-            rate = self.count / max(time.perf_counter() - self.start, 1e-9)
-            text = printable(f"{PROG} {self.command}: {self.count}/{self.total} ({rate:.1f}/s) {name}")
+        if self.quiet:
+            return
+        now = time.perf_counter()
+        due = (now - self.shown >= 0.1 or self.count == self.total) if self.tty else (
+            self.count // self.every > previous // self.every or self.count == self.total)
+        if due:
+            self.shown = now
+            text = printable(f"{PROG} {self.command}: {self.line(now)} {name}")
             print(f"\r{text[:100]:<100}" if self.tty else text, end="" if self.tty else "\n", file=self.stream,
                   flush=True)
 
+    def line(self, now):
+        """"120/2000 (41.5/s, 45 s left)": count, rate and the time left at that rate."""
+        elapsed = max(now - self.start, 1e-9)
+        rate = self.count / elapsed
+        left = (self.total - self.count) / rate if rate > 0 else 0.0
+        return f"{self.count}/{self.total} ({rate:.1f}/s, {duration(left)} left)"
+
     def done(self):
-        if self.tty and self.total:
+        if self.tty and self.total and not self.quiet:
             print(file=self.stream)
+
+
+def duration(seconds):
+    """"45 s", "12 min 5 s", "2 h 3 min": a time left, to the second below a minute."""
+    seconds = int(round(seconds))
+    if seconds < 60:
+        return f"{seconds} s"
+    if seconds < 3600:
+        return f"{seconds // 60} min {seconds % 60} s"
+    return f"{seconds // 3600} h {seconds % 3600 // 60} min"

@@ -76,7 +76,8 @@ def run(args):
              f"{size / 1e9:.1f} GB; it is slow (a larger --edge is faster)")
     common.say(f"{PROG} drape: {args.garment} on '{mannequin.name}', {settings.frames} frames, cloth edge "
          f"{settings.edge * CM_PER_M:g} cm, colliding with {'cushions' if settings.cushions else 'ellipsoids'}")
-    progress = common.Progress(settings.frames, "drape", every=max(10, settings.frames // 20))  # 10 frames, 5% past 200
+    progress = common.Progress(settings.frames, "drape", every=max(10, settings.frames // 20),  # 10 frames, 5% past 200
+                               quiet=args.quiet)
 
     def frame_done(frame):
         progress.step("frames simulated" + ("; baking and measuring the fit" if frame == settings.frames else ""),

@@ -74,7 +74,7 @@ def incomplete(path, kind=None):
     block chain from the header to the ENDB block (Blender 4.x and 5.x layouts; zstd files: the
     frames listed in the seek table Blender appends; gzip: the decompressed blocks); .glb: the
     length in the header is the file's and the chunks fill it; .json/.xml: it parses; .png: it
-    ends with IEND; .obj: it ends with a complete line. Any other kind: it is not empty.
+    ends with IEND; .obj: it ends with a complete line; .npz: its zip directory reads. Any other kind: it is not empty.
     """
     kind = kind_of(path) if kind is None else kind
     try:
@@ -209,7 +209,17 @@ def _obj(stream, size):
     return None if stream.read(1) == b"\n" else "it does not end with a complete line"
 
 
-_CHECKS = {"blend": _blend, "glb": _glb, "json": _json, "xml": _xml, "png": _png, "obj": _obj}
+def _npz(stream, size):
+    import zipfile
+
+    try:
+        zipfile.ZipFile(stream).close()  # reads the central directory at the end of the file
+    except (zipfile.BadZipFile, OSError, EOFError) as error:
+        return f"its zip directory cannot be read ({error})"
+    return None
+
+
+_CHECKS = {"blend": _blend, "glb": _glb, "json": _json, "xml": _xml, "png": _png, "obj": _obj, "npz": _npz}
 
 
 def disk_full(folder):

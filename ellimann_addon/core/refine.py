@@ -84,7 +84,7 @@ def _deform_basis(topology, rotation, center, semi_axes, measured, fractions=Non
     span = center[..., 2, None] + axis_extent(rotation, semi_axes, 2)[..., None] * _SPAN  # (B, n, q)
     fraction = (span - bottom[:, None, None]) / height[:, None, None]
     girth = topology.girth_mask
-    weight = np.stack([_hat(fraction, _GIRTH_KNOT[key], knots) @ _SPAN_WEIGHT for key in GIRTHS], axis=-1)
+    weight = np.stack([_dot(_hat(fraction, _GIRTH_KNOT[key], knots), _SPAN_WEIGHT) for key in GIRTHS], axis=-1)
     weight = weight * girth[:, None]
     fraction = (center[..., 2] - bottom[:, None]) / height[:, None]
     # Each girth section's own centre in y (middle of its extent), interpolated between sections.
@@ -99,7 +99,7 @@ def _deform_basis(topology, rotation, center, semi_axes, measured, fractions=Non
     centre_y = np.stack(centre_y, axis=-1)  # (B, 3) in GIRTHS order: Br, Wa, Hi
     order = [GIRTHS.index(key) for key in ("Hi", "Wa", "Br")]
     heights = [fractions[key] for key in ("Hi", "Wa", "Br")]
-    origin_y = np.stack([np.interp(fraction[b], heights, centre_y[b, order]) for b in range(len(bottom))])
+    origin_y = _interp_rows(fraction, heights, centre_y[:, order])
     # Where each section cuts each girth part, relative to the part's middle (-1 bottom .. 1 top).
     half_z = axis_extent(rotation, semi_axes, 2)  # (B, n)
     cut = np.stack([(z[key][:, None] - center[..., 2]) / half_z for key in GIRTHS], axis=-1)  # (B, n, 3)
@@ -112,6 +112,18 @@ def _deform_basis(topology, rotation, center, semi_axes, measured, fractions=Non
         origin_y=origin_y, vertical=rotation[..., 2, :] ** 2, lateral=rotation[..., 0, :] ** 2,
         taper=taper, anchor=anchor, shoulder_scaled=depends_sh & girth, shoulder_carried=depends_sh & ~girth,
         fractions=fractions)
+
+
+def _interp_rows(x, knots, values):
+    """np.interp(x[b], knots, values[b]) for every row b at once: x (B, n), knots (K,) increasing, values (B, K);
+    constant beyond the first and last knot."""
+    out = np.broadcast_to(values[:, :1], x.shape).copy()
+    for j in range(len(knots) - 1):
+        slope = (values[:, j + 1] - values[:, j]) / (knots[j + 1] - knots[j])
+        inside = x > knots[j]
+        part = values[:, j, None] + slope[:, None] * (np.minimum(x, knots[j + 1]) - knots[j])
+        out = np.where(inside, part, out)
+    return out
 
 
 def deform(basis, center, semi_axes, factors):
@@ -136,7 +148,7 @@ def deform(basis, center, semi_axes, factors):
     center[..., 2] = basis.bottom[:, None] + he * (center[..., 2] - basis.bottom[:, None])
     semi *= 1.0 + (he[..., None] - 1.0) * basis.vertical
     # Br, Wa, Hi: horizontal scaling blended with height.
-    sigma = 1.0 + np.einsum("bng,bg->bn", basis.girth_weight, girth_f - 1.0)
+    sigma = 1.0 + _dot(basis.girth_weight, (girth_f - 1.0)[:, None, :])
     center[..., 0] *= sigma
     center[..., 1] = basis.origin_y + sigma * (center[..., 1] - basis.origin_y)
     semi *= 1.0 + (sigma[..., None] - 1.0) * (1.0 - basis.vertical)
@@ -210,12 +222,10 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
         mask = free[todo]
         reduced = j * mask[:, :, None] * mask[:, None, :]
         rt = np.swapaxes(reduced, -1, -2)
-        normal = rt @ reduced
+        normal = _dot(rt[:, :, None, :], rt[:, None, :, :])  # J^T J
         scale = np.diagonal(normal, axis1=-2, axis2=-1) + _TIKHONOV  # Marquardt: each factor by its own scale
         system = normal + (damping[todo, None] * scale + ~mask)[..., None] * eye
-        # A stacked right-hand side as explicit column vectors: numpy 2 no longer broadcasts (t, f) against (t, f, f).
-        rhs = np.einsum("tfm,tm->tf", rt, residual[todo] * mask)
-        step = -np.linalg.solve(system, rhs[..., None])[..., 0]
+        step = -_solve_positive(system, _dot(rt, (residual[todo] * mask)[:, None, :]))
         wanted = x[todo] + np.clip(step, -_MAX_STEP, _MAX_STEP)
         new_x = np.clip(wanted, lo, hi)
         c, d = deform(basis.take(todo), center[todo], semi_axes[todo], np.exp(new_x))
@@ -223,12 +233,12 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
         new_residual = np.log(np.maximum(m, 1e-12) / targets[todo])
         # Broyden: the secant of this step corrects the Jacobian along the step, kept or not.
         dx = new_x - x[todo]
-        norm = np.einsum("tf,tf->t", dx, dx)
-        miss = new_residual - residual[todo] - np.einsum("tmf,tf->tm", j, dx)
+        norm = _dot(dx, dx)
+        miss = new_residual - residual[todo] - _dot(j, dx[:, None, :])
         jacobian[todo] = j + np.divide(miss[:, :, None] * dx[:, None, :], norm[:, None, None],
                                        out=np.zeros_like(j), where=norm[:, None, None] > 0)
         age[todo] += 1
-        better = np.sum((new_residual * mask) ** 2, axis=1) < np.sum((residual[todo] * mask) ** 2, axis=1)
+        better = _dot(new_residual * mask, new_residual * mask) < _dot(residual[todo] * mask, residual[todo] * mask)
         damping[todo] = np.where(better, damping[todo] / 3.0, damping[todo] * 4.0)
         keep = todo[better]
         x[keep], residual[keep], current[keep] = new_x[better], new_residual[better], m[better]
@@ -236,6 +246,35 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
         free[keep] &= new_x[better] == wanted[better]
     converged = np.abs(residual).max(axis=1) <= tolerance
     return Refinement(out_center, out_semi, current, np.exp(x), iterations, converged)
+
+
+def _dot(a, b):
+    """Sum over the last axis of a * b (broadcast), in a fixed order: unlike a matrix product or einsum, whose
+    order can depend on the array's size and alignment, a mannequin gets the same bits alone as in a batch."""
+    a, b = np.broadcast_arrays(a, b)
+    total = a[..., 0] * b[..., 0]
+    for k in range(1, a.shape[-1]):
+        total += a[..., k] * b[..., k]
+    return total
+
+
+def _solve_positive(system, rhs):
+    """x with system x = rhs for stacks of symmetric positive definite (T, f, f) and (T, f): Cholesky, in a fixed
+    order (LAPACK's pivoting and blocking could differ between a batch and one system alone)."""
+    count = system.shape[-1]
+    factor = np.zeros_like(system)
+    for i in range(count):
+        for j in range(i + 1):
+            total = system[:, i, j] - _dot(factor[:, i, :j], factor[:, j, :j]) if j else system[:, i, j].copy()
+            factor[:, i, j] = np.sqrt(total) if i == j else total / factor[:, j, j]
+    y = np.zeros_like(rhs)
+    for i in range(count):
+        y[:, i] = (rhs[:, i] - (_dot(factor[:, i, :i], y[:, :i]) if i else 0.0)) / factor[:, i, i]
+    x = np.zeros_like(rhs)
+    for i in reversed(range(count)):
+        later = slice(i + 1, count)
+        x[:, i] = (y[:, i] - (_dot(factor[:, later, i], x[:, later]) if i + 1 < count else 0.0)) / factor[:, i, i]
+    return x
 
 
 def _fd_jacobian(basis, rows, rotation, center, semi_axes, x, base, girth):

@@ -85,7 +85,7 @@ def test_batch_to_core_formats_runs_without_blender(tmp_path, references):
 
 
 @pytest.mark.parametrize("argv", [["--help"], ["synth", "--help"], ["batch", "--help"], ["measure", "--help"],
-                                  ["demo", "--help"], ["drape", "--help"]])
+                                  ["demo", "--help"], ["drape", "--help"], ["population", "--help"]])
 def test_help_runs_without_blender(argv):
     code, stdout, _ = without_blender(*argv)
     assert code == 0 and "usage: ellimann" in stdout
