@@ -1,8 +1,9 @@
 """Scan to mannequin: the time to measure a body mesh, and how much the extra measurements make a synthesized
 twin overlap its body (voxel IoU, tools/overlap.py), on the six female reference bodies of ../shared/refmodels.
 
-Per body: measure the mesh (core.body_measure, no labels), synthesize in exact mode with the five it found and
-again with all it found (core.refine_extra), and count the IoU of each twin with the body. Also: the time to
+Per body: measure the mesh (core.body_measure, no labels), synthesize in exact mode with the five it found, with
+the five and each extra measurement alone, and with all it found (core.refine_extra), and count the IoU of each
+twin with the body. Also: the time to
 measure one 27k-triangle body (the median of three runs) and what the five's measurement differs from the
 README's table by.
 """
@@ -46,9 +47,14 @@ def run():
             missed += [line.split()[3] for line in warnings if line.startswith("exact mode missed")]
             iou.append(voxel_iou(mannequin, body.vertices, body.faces, SPACING)[0])
         gains.append(iou[1] - iou[0])
+        alone = []
+        for key, value in extra.items():
+            mannequin, _, _ = synthesize_extra(reference, five, {key: value})
+            alone.append(f"{key} {voxel_iou(mannequin, body.vertices, body.faces, SPACING)[0] - iou[0]:+.3f}")
         print(f"{name:<17} {statistics.median(times):9.2f} {worst:22.3f} {iou[0]:9.3f} {iou[1]:8.3f} "
               f"{iou[1] - iou[0]:+6.3f}  ({len(body.faces)} triangles; not measured: {result.missing or 'none'}; "
               f"missed by the twin: {missed or 'none'})")
+        print(f"{'':<17} IoU change with one extra measurement alone: {', '.join(alone)}")
     print(f"mean IoU gain with all measurements: {statistics.mean(gains):+.3f}")
 
 
