@@ -1,4 +1,5 @@
-"""Synthesize: five measurements in, a mannequin out; presets, and Live updates of the last one."""
+"""Synthesize: five measurements (and any of the extra ones) in, a mannequin out; presets, Live updates of the last
+one, and Synthesize from Mesh (a body mesh's twin)."""
 
 from . import from_mesh, live, operators, panel, presets, props
 
