@@ -7,7 +7,7 @@ shows Blender's output too (on stderr).
 import importlib
 import sys
 
-BENCHES = ("bench_core", "bench_synthesis", "bench_male", "bench_drape", "bench_scan")
+BENCHES = ("bench_core", "bench_synthesis", "bench_male", "bench_drape", "bench_references", "bench_scan")
 
 
 def main(names=None, verbose=False):

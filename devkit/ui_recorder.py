@@ -169,13 +169,14 @@ def draw_menu_function(draw, context=None):
     return recorder
 
 
-def draw_panel(panel_class, context=None):
-    """Run a panel's (or menu's) ``draw`` (and ``draw_header`` if any) against a Recorder; return it.
+def draw_panel(panel_class, context=None, recorder=None):
+    """Run a panel's (or menu's) ``draw`` (and ``draw_header`` if any) against a Recorder (or ``recorder``);
+    return it.
 
     A panel whose ``poll`` fails is not drawn (the recorder stays empty), as in Blender.
     """
     context = context or bpy.context
-    recorder = Recorder()
+    recorder = Recorder() if recorder is None else recorder
     panel = _StandIn(panel_class, recorder)
     if hasattr(panel_class, "poll") and not panel_class.poll(context):
         return recorder

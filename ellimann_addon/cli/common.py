@@ -95,10 +95,10 @@ def add_synthesis_options(parser):
     add_references(parser, "the reference set to synthesize from")
 
 
-def add_references(parser, what):
+def add_references(parser, what, shipped="female (the default) or male"):
     parser.add_argument("--references", metavar="NAME_OR_DIR",
-                        help=f"{what}: a shipped set, female (the default) or male, or a folder of Reference "
-                             "Mannequin .json files (with its reference_set.json manifest)")
+                        help=f"{what}: a shipped set, {shipped}, or a folder of Reference Mannequin .json files "
+                             "(with its reference_set.json manifest)")
 
 
 def synthesis_options(args, name=None):
@@ -118,7 +118,8 @@ def references(args, name_or_dir=None):
     except ReferenceSetError as error:
         if chosen:
             raise
-        raise UsageError(f"{error} (the shipped Reference Mannequins; use --references DIR for others)") from None
+        raise UsageError(f"{error} (the shipped Reference Mannequins; use --references NAME_OR_DIR for "
+                         "others)") from None
 
 
 # ------------------------------------------------------------------------------------------------ Blender

@@ -32,7 +32,8 @@ def add_parser(commands):
     measure.add_argument("--unit", choices=tuple(UNITS), default="m", help="a body mesh's length unit (default m)")
     measure.add_argument("--collection", help="the mannequin collection to measure in a .blend holding several")
     common.add_references(measure, "measure at the section heights of this reference set instead of those the "
-                                   "mannequin records (its own set's; female for files that record none)")
+                                   "mannequin records (its own set's; female for files that record none)",
+                          shipped="female or male")
     common.add_verbose(measure)
     measure.set_defaults(run=run, blender=needs_blender)
 

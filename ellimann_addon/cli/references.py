@@ -4,17 +4,19 @@
 import csv
 import hashlib
 import math
+import os
 import pathlib
 import sys
 
 from ..core.body_mesh import BodyMeshError, read_obj
 from ..core.clean import asymmetry
 from ..core.constants import ABSURD_LIMITS, MEASUREMENTS
-from ..core.reference_build import build_reference_set, cleanliness_problems, relative_errors
+from ..core.reference_build import build_reference_set, cleanliness_problems, relative_errors, validate_inputs
 from ..core.reference_manifest import STEM, Manifest, read_manifest, targets_range, write_reference_set
 from ..core.reference_set import load_reference_set
 from . import common
 from .common import PROG, UsageError
+from .measure import load_json_mannequin
 
 ACCEPT = 5e-3  # what ``check`` lets an RM's m_T differ from its targets by (the builder's accept tolerance)
 
@@ -39,6 +41,9 @@ def add_parser(commands):
     build.add_argument("-o", "--out", required=True, metavar="DIR", help="the reference-set folder to write")
     build.add_argument("--name", help="the set's name (default: the folder's name)")
     build.add_argument("--sex", choices=("female", "male"), help="the set's sex, if it has one")
+    build.add_argument("--workers", type=int, default=os.cpu_count() or 1, metavar="N",
+                       help="processes fitting bodies at once (default: the CPUs, %(default)s here; the result is "
+                            "the same for any N)")
     build.add_argument("--reference", metavar="STEM", help="the body whose RM the others' axes are labelled "
                        "against (default: the one nearest the targets' mean)")
     common.add_verbose(build)
@@ -90,7 +95,7 @@ def _is_number(text):
 
 def run_build(args):
     out = pathlib.Path(args.out)
-    base = common_load_base(args.base)
+    base = load_base(args.base)
     base_stem = pathlib.Path(args.base).stem
     stems = [pathlib.Path(p).stem for p in args.bodies]
     if base_stem in stems or not STEM.match(base_stem):
@@ -99,18 +104,22 @@ def run_build(args):
         if not STEM.match(pathlib.Path(path).stem):
             raise UsageError(f"{path}: its stem must be letters, digits, _ . - (it names the RM's file)")
     targets = read_targets(args.targets)
+    if args.workers < 1:
+        raise UsageError(f"--workers must be 1 or more, got {args.workers}")
     if len(args.bodies) < 3:  # before reading any mesh
         raise UsageError(f"--bodies: a reference set needs at least 3 bodies, got {len(args.bodies)}")
     try:
         bodies = [read_obj(path) for path in args.bodies]
     except BodyMeshError as error:
         raise UsageError(str(error)) from None
+    validate_inputs(base, bodies, targets)  # before the folder is made: bad input writes nothing
     common.output_folder(str(out), "references build")
 
     def progress(fraction, text):
         common.say(f"{PROG} references build: {fraction:4.0%} {text}", file=sys.stderr)
 
-    rms, report = build_reference_set(base, bodies, targets, progress=progress, reference=args.reference)
+    rms, report = build_reference_set(base, bodies, targets, progress=progress, reference=args.reference,
+                                      workers=args.workers)
     fractions = dict(base.section_fractions)  # what the build measured at: the base's own set's
     name = args.name or out.resolve().name
     rms = {stem: rm.copy(reference_set=name) for stem, rm in rms.items()}
@@ -136,9 +145,7 @@ def run_build(args):
     return 0
 
 
-def common_load_base(path):
-    from .measure import load_json_mannequin
-
+def load_base(path):
     if not pathlib.Path(path).is_file():
         raise UsageError(f"{path}: no such file")
     return load_json_mannequin(path)

@@ -8,15 +8,17 @@ and semi_axes (n, 3), in metres.
 """
 
 import json
-import math
 import re
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .constants import ABSURD_LIMITS, CENTER_LIMIT, FEMALE_SET, MEASUREMENTS, SECTION_FRACTIONS, SEMI_AXIS_LIMITS
+from .constants import CENTER_LIMIT, FEMALE_SET, MEASUREMENTS, SECTION_FRACTIONS, SEMI_AXIS_LIMITS
 from .errors import MannequinError, Problem
 from .files import atomic_write_text
+from .problems import json_type as _json_type
+from .problems import measurement_problems, section_fraction_problems
+from .problems import short as _short
 from .trace import traces_from_dict, traces_to_dict
 
 FORMAT = "ellimann.mannequin"
@@ -430,55 +432,6 @@ class Mannequin:
         return cls.from_dict(data, check=check)
 
 
-def measurement_problems(measurements):
-    """Problems of target measurements: None, or a dict of some of He, Sh, Br, Wa, Hi in cm, each a number
-    within ``ABSURD_LIMITS`` (the limits a synthesis request must meet)."""
-    if measurements is None:
-        return []
-    if not isinstance(measurements, dict):
-        return [Problem("", "measurements", f"must be a dict of He, Sh, Br, Wa, Hi in cm (or None), got "
-                                            f"{_json_type(measurements)}")]
-    out = []
-    for key, value in measurements.items():
-        if key not in MEASUREMENTS:
-            out.append(Problem("", "measurements", f"{_short(key)} is not a measurement; expected some of "
-                                                   f"{', '.join(MEASUREMENTS)}"))
-            continue
-        low, high = ABSURD_LIMITS[key]
-        accepted = f"accepted range {low:g}-{high:g} cm"
-        if not _positive_number(value):
-            out.append(Problem("", "measurements", f"{key}={_short(value)} is not a positive measurement ({accepted})"))
-        elif not low <= value <= high:
-            out.append(Problem("", "measurements", f"{key}={value:g} cm is not a plausible value ({accepted})"))
-    return out
-
-
-def section_fraction_problems(fractions):
-    """Problems of section heights: a dict of exactly Sh, Br, Wa, Hi, each a fraction of He, with
-    0 < Hi < Wa < Br < 1 and 0 < Sh < 1 (the girth blend of exact mode needs the girths in that order)."""
-    field_name = "section_fractions"
-    if not isinstance(fractions, dict) or set(fractions) != set(SECTION_FRACTIONS):
-        return [Problem("", field_name, f"must hold exactly {', '.join(SECTION_FRACTIONS)} (fractions of He), got "
-                                        f"{_short(fractions)}")]
-    for key in SECTION_FRACTIONS:
-        value = fractions[key]
-        if not _positive_number(value) or value >= 1.0:
-            return [Problem("", field_name, f"{key}={_short(value)} must be a fraction of He in (0, 1)")]
-    if not fractions["Hi"] < fractions["Wa"] < fractions["Br"]:
-        return [Problem("", field_name, f"must have Hi < Wa < Br, got Hi {fractions['Hi']:g}, Wa {fractions['Wa']:g}, "
-                                        f"Br {fractions['Br']:g}")]
-    return []
-
-
-def _positive_number(value):
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return False
-    try:
-        return math.isfinite(value) and value > 0
-    except OverflowError:  # an int beyond float's range
-        return False
-
-
 def _bom_encoding(raw):
     """'UTF-16' or 'UTF-32' if ``raw`` starts with that byte-order mark or looks like that encoding, else ''."""
     if raw[:4] in (b"\xff\xfe\x00\x00", b"\x00\x00\xfe\xff"):
@@ -486,32 +439,6 @@ def _bom_encoding(raw):
     if raw[:2] in (b"\xff\xfe", b"\xfe\xff") or (len(raw) >= 2 and b"\x00" in raw[:2]):
         return "UTF-16"
     return ""
-
-
-def _json_type(value):
-    """What a JSON value is, for messages: 'a list', 'a string', 'null', ..."""
-    if value is None:
-        return "null"
-    if isinstance(value, bool):
-        return "a boolean"
-    if isinstance(value, (int, float)):
-        return "a number"
-    if isinstance(value, str):
-        return "a string"
-    if isinstance(value, (list, tuple)):
-        return "a list"
-    if isinstance(value, dict):
-        return "an object"
-    return f"a {type(value).__name__}"
-
-
-def _short(value, limit=60):
-    """repr of ``value`` cut to ``limit`` characters (a hostile file's values may be huge or deeply nested)."""
-    try:
-        text = repr(value)
-    except (RecursionError, ValueError):  # ValueError: an int too long to print
-        text = f"a {type(value).__name__}"
-    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def stack(mannequins):

@@ -15,6 +15,7 @@ the RMs belongs to the mannequins' joints (issue 12) and is not done here yet.
 
 import math
 import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -54,11 +55,10 @@ class BuildReport:
     """What the build found, per RM stem: ``shifts`` (body -> RM translation, m), ``fitted`` (m_T before
     the refinement), ``factors`` (of the refinement), ``errors`` (relative m_T error after cleaning),
     ``fill`` (coverage and excess of ellipsoids and cushions), ``seconds`` per stage; ``base`` relabelled
-    against ``reference`` (the RM the others' axes are labelled against), and the base's ``kept`` axes."""
+    against ``reference`` (the RM the others' axes are labelled against)."""
 
     base: object
     reference: str
-    kept: list
     shifts: dict = field(default_factory=dict)
     fitted: dict = field(default_factory=dict)
     factors: dict = field(default_factory=dict)
@@ -191,14 +191,33 @@ def relative_errors(measured, targets):
     return {key: measured[key] / targets[key] - 1.0 for key in MEASUREMENTS}
 
 
-def build_reference_set(base, bodies, targets, progress=None, cancel=None, settings=None, reference=None):
+def _fit_body(base, body, targets, settings, cancel=None):
+    """One body's RM before the set is cleaned: (name, body -> RM shift, m_T as fitted, RM, refinement factors)."""
+    fitted, _ = fit_mannequin(body, base.topology, base.traces, base, _kept(base), settings.fit, cancel,
+                              name=display_name(body.name), role="reference", measurements=dict(targets))
+    fitted = symmetrize(fitted)
+    shift = registration_offset(fitted)
+    fitted = register_to_world(fitted)
+    rm, factors = adjust(fitted, targets, settings)
+    return body.name, shift, fitted.measure(), rm, factors
+
+
+def _kept(base):
+    """Per part, the axis of the base part's frame its fit took from the points (recorded in its trace)."""
+    return [base.traces[part.name].fit.kept if part.name in base.traces else None for part in base.topology]
+
+
+def build_reference_set(base, bodies, targets, progress=None, cancel=None, settings=None, reference=None,
+                        workers=1):
     """N Reference Mannequins from ``base`` (a Mannequin with traces) and ``bodies`` (BodyMesh, N >= 3).
 
     ``targets``: {body name: {He, Sh, Br, Wa, Hi: cm}}; ``progress(fraction, text)`` is called as the
     work goes on; ``cancel()`` is polled between parts and stops the build (BuildCancelledError) when true;
     ``reference``: the body whose RM the others' axes are labelled against (default: the one nearest
-    the targets' mean). Returns ({body name: RM}, BuildReport). Raises ReferenceBuildError (one line)
-    before any work for bad input, or when an RM cannot meet its targets.
+    the targets' mean); ``workers``: processes fitting bodies at once (each body is fitted alike whichever
+    process fits it, so the result does not depend on it; with more than one, ``cancel`` is polled between
+    bodies). Returns ({body name: RM}, BuildReport). Raises ReferenceBuildError (one line) before any work
+    for bad input, or when an RM cannot meet its targets.
     """
     # by default measured at the base's section heights (its own set's): the fit keeps clear of them and
     # the refinement meets the targets at them
@@ -208,25 +227,36 @@ def build_reference_set(base, bodies, targets, progress=None, cancel=None, setti
     reference = reference or central_body(names, targets)
     if reference not in names:
         raise ReferenceBuildError(f"reference: '{reference}' is not one of the bodies ({', '.join(names)})")
-    kept = [base.traces[part.name].fit.kept if part.name in base.traces else None for part in base.topology]
-    report = BuildReport(base=None, reference=reference, kept=kept)
+    report = BuildReport(base=None, reference=reference)
     steps = len(bodies) + (1 if settings.check_spacing else 0)
 
     def tell(done, text):
         if progress is not None:
             progress(done / steps, text)
 
-    adjusted = []
     started = time.perf_counter()
-    for k, body in enumerate(bodies):
-        tell(k, f"fitting {body.name} ({k + 1} of {len(bodies)})")
-        fitted, _ = fit_mannequin(body, base.topology, base.traces, base, kept, settings.fit, cancel,
-                                  name=display_name(body.name), role="reference", measurements=dict(targets[body.name]))
-        fitted = symmetrize(fitted)
-        report.shifts[body.name] = registration_offset(fitted)
-        fitted = register_to_world(fitted)
-        report.fitted[body.name] = fitted.measure()
-        rm, report.factors[body.name] = adjust(fitted, targets[body.name], settings)
+    fitted = {}
+    jobs = [(base, body, targets[body.name], settings) for body in bodies]
+    if workers > 1 and len(bodies) > 1:
+        pool = ProcessPoolExecutor(min(workers, len(bodies)))
+        try:
+            futures = [pool.submit(_fit_body, *job) for job in jobs]
+            for k, future in enumerate(as_completed(futures)):
+                if cancel is not None and cancel():
+                    raise BuildCancelledError()
+                name, *result = future.result()
+                fitted[name] = result
+                tell(k + 1, f"fitted {name} ({k + 1} of {len(bodies)})")
+        finally:  # a failed or cancelled build does not wait for the bodies still being fitted
+            pool.shutdown(wait=False, cancel_futures=True)
+    else:
+        for k, job in enumerate(jobs):
+            tell(k, f"fitting {job[1].name} ({k + 1} of {len(bodies)})")
+            name, *result = _fit_body(*job, cancel=cancel)
+            fitted[name] = result
+    adjusted = []
+    for name in names:
+        report.shifts[name], report.fitted[name], rm, report.factors[name] = fitted[name]
         adjusted.append(rm)
     report.seconds["fit and refine"] = time.perf_counter() - started
 

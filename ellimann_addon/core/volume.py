@@ -211,3 +211,18 @@ def fill_shares(grid, mannequin, hulls=None):
 def cushion_hulls(mannequin):
     """{(i, j): hull mesh} of every cushion pair."""
     return {indices: _hull(mannequin, indices) for _, indices in pieces(mannequin, True) if len(indices) == 2}
+
+
+IOU_SPACING = 0.005  # m: the voxels of voxel_iou
+IOU_MARGIN = 0.15  # m: voxels around the body, so a mannequin reaching out of it is counted whole
+
+
+def voxel_iou(mannequin, vertices=None, faces=None, cushions=True, spacing=IOU_SPACING, grid=None):
+    """Volumetric IoU (intersection over union, voxelized) of a mannequin's pieces (``cushions``: the cushion
+    hulls and single ellipsoids; else the ellipsoids) and a closed body mesh (``vertices``, ``faces``, in the
+    mannequin's frame). ``grid``: the body's grid (``BodyVolume(...).grid(spacing, margin=IOU_MARGIN)``) to
+    reuse instead of the mesh. 1 when they fill the same voxels, 0 when they share none."""
+    if grid is None:
+        grid = BodyVolume(vertices, faces).grid(spacing, margin=IOU_MARGIN)
+    occupied = occupancy(grid, mannequin, cushions, cushion_hulls(mannequin) if cushions else None)
+    return np.count_nonzero(occupied & grid.inside) / max(np.count_nonzero(occupied | grid.inside), 1)

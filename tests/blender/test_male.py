@@ -9,6 +9,7 @@ import bpy
 import numpy as np
 import pytest
 
+from devkit.blender_scene import state
 from devkit.cli_runs import assert_one_line_error, run
 from ellimann_addon.blender.bridge import convert
 from ellimann_addon.blender.services.files import EXTRAS_KEY, read_glb_json
@@ -82,3 +83,12 @@ def test_the_command_line_chooses_the_set_by_name_and_per_batch_row(tmp_path, ca
                                                                                                104))), rel=1e-5)
     code, stdout, _ = run(["measure", str(tmp_path / "out" / "him.json"), "--json", "--references", "female"], capsys)
     assert json.loads(stdout)["Hi"] != pytest.approx(104.0, rel=1e-3)  # cut at the female hip height
+
+
+def test_folder_without_a_folder_is_refused_and_changes_nothing():
+    props = bpy.context.scene.ellimann_synthesis
+    props.reference_set, props.references = "FOLDER", ""
+    before = state()
+    with pytest.raises(RuntimeError, match="References is empty"):
+        bpy.ops.ellimann.synthesize_mannequin()
+    assert state() == before

@@ -1,4 +1,5 @@
-"""The .blend twins in reference_blends/ hold the same mannequins as the JSON files."""
+"""The .blend twins in reference_blends/ (the female set) and reference_blends/male/ hold the same mannequins as
+the JSON files, measured at the same section heights."""
 
 import pathlib
 
@@ -13,14 +14,16 @@ FOLDER = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"
 STEMS = ("base_mannequin", "small_slim", "tall_slim", "small_chubby", "tall_chubby", "average")
 
 
+@pytest.mark.parametrize("folder", [FOLDER, FOLDER / "male"], ids=["female", "male"])
 @pytest.mark.parametrize("stem", STEMS)
-def test_blend_and_json_agree(stem):
-    json_twin = Mannequin.load(FOLDER / f"{stem}.json")
-    bpy.ops.wm.open_mainfile(filepath=str(FOLDER / f"{stem}.blend"))
+def test_blend_and_json_agree(stem, folder):
+    json_twin = Mannequin.load(folder / f"{stem}.json")
+    bpy.ops.wm.open_mainfile(filepath=str(folder / f"{stem}.blend"))
     collections = convert.mannequin_collections()
     assert [c.name for c in collections] == [json_twin.name]
     blend = convert.collection_to_mannequin(collections[0]).reordered(json_twin.topology)
     assert blend.role == json_twin.role
+    assert (blend.reference_set, blend.section_fractions) == (json_twin.reference_set, json_twin.section_fractions)
     assert blend.measurements == (None if json_twin.measurements is None else pytest.approx(json_twin.measurements))
     # Blender keeps matrix_world in single precision
     assert np.allclose(blend.center, json_twin.center, atol=1e-6)

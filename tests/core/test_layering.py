@@ -34,6 +34,20 @@ def test_importing_every_core_module_loads_no_blender_module():
     assert out.stdout.strip() == "[]"
 
 
+def test_importing_every_core_module_loads_no_package_blender_lacks():
+    """Blender bundles numpy, not scipy (nor the dev tools): the core, the reference builder included, needs none."""
+    modules = [p.stem for p in CORE.glob("*.py") if p.stem != "__init__"]
+    code = (
+        "import sys, importlib\n"
+        f"for m in {modules!r}: importlib.import_module('ellimann_addon.core.' + m)\n"
+        "loaded = {name.partition('.')[0] for name in sys.modules}\n"
+        "print(sorted(loaded & {'scipy', 'pytest', 'hypothesis', 'mujoco'}))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         cwd=CORE.parents[1])
+    assert out.stdout.strip() == "[]"
+
+
 def test_core_uses_only_relative_imports_for_project_modules():
     for path in CORE.rglob("*.py"):
         for node in ast.walk(ast.parse(path.read_text())):

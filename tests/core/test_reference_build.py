@@ -148,7 +148,7 @@ def test_the_command_refuses_in_one_line_and_writes_nothing(inputs, tmp_path, ca
     out = tmp_path / "set"
     code, _, err = run([*args, "-o", str(out)], capsys)
     assert_one_line_error(code, err, *words)
-    assert not out.exists() or not any(out.iterdir())
+    assert not out.exists()
 
 
 def test_check_reports_each_rm_of_the_shipped_set(capsys):
@@ -171,3 +171,20 @@ def test_check_flags_an_rm_off_its_targets(tmp_path, capsys):
                         dataclasses.replace(Manifest("x", list(targets)), targets_cm=targets))
     code, _, err = run(["references", "check", str(tmp_path)], capsys)
     assert_one_line_error(code, err, mannequins[0].name, "Hi is off its target")
+
+
+def test_voxel_iou_of_a_ball_in_a_ball_is_their_volume_ratio_and_of_a_ball_with_itself_one():
+    from ellimann_addon.core.mannequin import Mannequin, Part, Topology
+    from ellimann_addon.core.volume import BodyVolume, voxel_iou
+
+    vertices, faces = icosphere(4)
+    topology = Topology([Part("1.a Ball", "C", "body", True, ("He",))])
+
+    def ball(radius, x=0.0):
+        return Mannequin(topology, np.eye(3)[None], np.array([[x, 0.0, 0.0]]), np.full((1, 3), radius))
+
+    grid = BodyVolume(0.1 * vertices, faces).grid(0.003, margin=0.02)
+    assert voxel_iou(ball(0.1), grid=grid) == pytest.approx(1.0, abs=0.05)  # the mesh is a little inside
+    assert voxel_iou(ball(0.05), grid=grid) == pytest.approx(0.125, abs=0.01)
+    assert voxel_iou(ball(0.05, x=0.5), grid=grid) == 0.0
+    assert voxel_iou(ball(0.05), 0.1 * vertices, faces) == pytest.approx(0.125, abs=0.02)  # from the mesh

@@ -25,12 +25,11 @@ class ELLIMANN_PT_references(SubPanel, bpy.types.Panel):
         props = context.scene.ellimann_references
         layout.prop(props, "base")
         header = layout.row()
-        header.label(text=f"Bodies ({len(props.bodies)}, at least 3), targets in cm")
+        header.label(text=f"Bodies: {len(props.bodies)} (at least 3)")
         header.operator(ids.ADD_REFERENCE_BODIES, text="", icon="ADD")
         labels = layout.row(align=True)
-        labels.label(text="")
         for key in MEASUREMENTS:
-            labels.label(text=key)
+            labels.label(text=f"{key} (cm)")
         for index, row in enumerate(props.bodies):
             box = layout.column(align=True)
             line = box.row(align=True)
