@@ -27,7 +27,8 @@ class Matrix4:
 
 def state():
     """Objects (transform, data, collections, parent, ElliMann fields), collections, meshes (with their vertex
-    counts) and curves, and the scene's frame range and current frame."""
+    counts) and curves, armatures (each pose bone's rotation and location, the assigned action) and actions,
+    and the scene's frame range and current frame."""
     objects = {}
     for obj in bpy.data.objects:
         part = obj.ellimann
@@ -42,11 +43,18 @@ def state():
         for c in bpy.data.collections
     }
     scene = bpy.context.scene
+    armatures = {
+        obj.name: (tuple((b.name, Matrix4(b.matrix_basis)) for b in obj.pose.bones),
+                   obj.animation_data.action.name if obj.animation_data and obj.animation_data.action else None)
+        for obj in bpy.data.objects if obj.type == "ARMATURE"
+    }
     return {
         "objects": objects,
         "collections": collections,
         "meshes": sorted((m.name, len(m.vertices)) for m in bpy.data.meshes),
         "curves": sorted(c.name for c in bpy.data.curves),
+        "armatures": armatures,
+        "actions": sorted(a.name for a in bpy.data.actions),
         "active_collection": bpy.context.view_layer.active_layer_collection.name,
         "frames": (scene.frame_start, scene.frame_end, scene.frame_current),
     }

@@ -12,11 +12,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ellimann_addon.core.constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
+from ellimann_addon.core.joints import joints_from_makehuman
 from ellimann_addon.core.mesh import convex_hull_2d, plane_section_points, polygon_perimeter
 
 REFERENCE_BODY = "reference_female"
 RM_BODIES = ("small_slim", "tall_slim", "small_chubby", "tall_chubby", "average")
 LABELS_FILE = "reference_female_regions.json"
+SKELETON_FILE = "skeleton.json"  # the bodies' joints (refmodels/README.md, "Skeleton")
 
 
 @dataclass(frozen=True)
@@ -26,6 +28,12 @@ class Labels:
     region: np.ndarray  # (V,) region name per vertex
     bone: np.ndarray  # (V,) dominant skinning bone name per vertex
     torso: np.ndarray  # (V,) bool: not an arm or hand vertex (the girth sections use these)
+
+
+def load_skeletons(folder):
+    """{body: (24, 3) SMPL joints} of the reference bodies, from the body model's own rig (skeleton.json)."""
+    data = json.loads((pathlib.Path(folder) / SKELETON_FILE).read_text(encoding="utf-8"))
+    return {name: joints_from_makehuman(bones) for name, bones in data["bodies"].items()}
 
 
 def load_labels(folder):

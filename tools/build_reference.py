@@ -23,6 +23,9 @@ Steps (paper, Sections 2.3.2-2.3.4):
 3. Reference Mannequins: the product's builder (core/reference_build.py, ``ellimann references
    build``) on the five bodies and Table 2.3, the Average RM the one the others' axes are labelled
    against.
+4. Joints: each body's SMPL joints from its own rig (skeleton.json, core.joints.joints_from_makehuman) go through
+   every step the pieces go through: mirrored with them, registered with them, and moved by the refinement as
+   points fixed in their anchor parts (core.joints.follow_pieces, in core/reference_build.py).
 Deterministic: no randomness, fixed iteration counts and orders.
 """
 
@@ -59,7 +62,7 @@ from ellimann_addon.core.trace import PartTrace
 
 from . import coverage
 from . import reference_topology as rt
-from .bodies import REFERENCE_BODY, RM_BODIES, body_measurements, load_labels
+from .bodies import REFERENCE_BODY, RM_BODIES, body_measurements, load_labels, load_skeletons
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 DEFAULT_REFMODELS = REPO.parent / "shared" / "refmodels"
@@ -94,14 +97,15 @@ def trace_reference(reference_body, labels):
     return traces, hidden
 
 
-def trace_base(reference_body, traces, constants=None):
+def trace_base(reference_body, traces, constants=None, joints=None):
     """The Base Mannequin fitted over the reference body: symmetric, registered, each part's trace
-    recording the axis its frame took from the points. ``constants``: the fit's (core.body_fit.FitConstants;
-    default the female set's section heights). Returns (base, body -> base translation)."""
+    recording the axis its frame took from the points, ``joints`` (the body's, or None) moved with it.
+    ``constants``: the fit's (core.body_fit.FitConstants; default the female set's section heights).
+    Returns (base, body -> base translation)."""
     topology = rt.topology()
     base, kept = fit_mannequin(reference_body, topology, traces, constants=constants, name=DISPLAY_NAMES[BASE_FILE],
                                role="base")
-    base = symmetrize(base)  # symmetric first: mirroring may move the lowest point
+    base = symmetrize(base.copy(joints=joints))  # symmetric first: mirroring may move the lowest point
     shift = registration_offset(base)
     traces = {name: dataclasses.replace(trace, fit=dataclasses.replace(trace.fit, kept=kept[topology.index[name]]))
               for name, trace in traces.items()}
@@ -125,10 +129,11 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
         return dataclasses.replace(body, vertices=body.vertices + rng.uniform(-jitter, jitter, body.vertices.shape))
 
     reference_body = load_body(REFERENCE_BODY)
+    skeletons = load_skeletons(refmodels)
     traces, cavity = trace_reference(reference_body, labels)
-    base, base_shift = trace_base(reference_body, traces)
+    base, base_shift = trace_base(reference_body, traces, joints=skeletons[REFERENCE_BODY])
     log(f"base mannequin fitted ({len(base)} parts)")
-    bodies = [load_body(name) for name in RM_BODIES]
+    bodies = [dataclasses.replace(load_body(name), joints=skeletons[name]) for name in RM_BODIES]
     rms, built = build_reference_set(base, bodies, REFERENCE_MEASUREMENTS, settings=BuildSettings(check_spacing=None),
                                      reference=REFERENCE_RM,
                                      progress=lambda fraction, text: log(f"{fraction:4.0%} {text}"))
@@ -240,7 +245,10 @@ def check_shipped(base, rms, folder, atol=CHECK_TOLERANCE):
         if shipped.topology != fresh.topology:
             problems.append(f"{stem}: topology differs")
             continue
-        for attr in ("rotation", "center", "semi_axes"):
+        if (shipped.joints is None) != (fresh.joints is None):
+            problems.append(f"{stem}: joints {'missing' if shipped.joints is None else 'unexpected'}")
+            continue
+        for attr in ("rotation", "center", "semi_axes") + (("joints",) if fresh.joints is not None else ()):
             diff = float(np.abs(getattr(shipped, attr) - getattr(fresh, attr)).max())
             if diff > atol:
                 problems.append(f"{stem}: {attr} differs by up to {diff:.3g}")

@@ -68,7 +68,7 @@ def main(argv=None):
                 pieces = [drape.mesh_piece(f"{BODY}.obj", body_vertices + offset, body_faces)]
                 label = f"{garment.name} on {BODY}.obj"
             else:
-                copy = mannequin.copy(center=mannequin.center + offset)
+                copy = mannequin.translated(offset)
                 add_mannequin(copy, cushions=True)
                 pieces = collision_pieces(copy, True, settings.sphere_subdivisions, settings.cushion_subdivisions)
                 label = f"{garment.name} on the mannequin"

@@ -167,6 +167,19 @@ def versions(lane):
     return out.stdout.strip().splitlines()[-1] if out.returncode == 0 and out.stdout.strip() else "?"
 
 
+def ensure_gltf_validator():
+    """Install the Khronos glTF validator the Blender suite runs (``devkit.gltf_validator``: npm, into out/node)
+    once, before the lanes start (they would race for it); False, saying why, if node/npm cannot."""
+    from devkit import gltf_validator
+
+    try:
+        gltf_validator.module_dir()
+    except gltf_validator.ValidatorUnavailableError as error:
+        print(f"matrix: {error}", file=sys.stderr)
+        return False
+    return True
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python3 -m tools.matrix", description=__doc__.split("\n")[0])
     parser.add_argument("--lanes", default=os.environ.get("LANES", ""),
@@ -187,6 +200,8 @@ def main(argv=None):
             pins, suites = " ".join(lane.pins), ", ".join(lane.suites)
             print(f"Blender {lane.blender}: Python {lane.python}, {pins}; suites {suites}")
         return 0
+    if any("blender" in lane.suites for lane in lanes) and not ensure_gltf_validator():
+        return 1
     if args.setup_only:
         LOGS.mkdir(parents=True, exist_ok=True)
         for lane in lanes:

@@ -7,6 +7,7 @@ traced over); several slots stand side by side along X for a line-up.
 
     python -m tools.render mannequins A.json [B.json ...] [--ghost A.obj ...] --out PNG [--view SIDE]
         [--ghost-shift X Y Z] [--side-too]
+    python -m tools.render poses A.json --out PNG [--view THREE_QUARTER] [--pose NAME ...] [--walk-frame K]
 """
 
 import argparse
@@ -19,9 +20,11 @@ import numpy as np
 from mathutils import Matrix
 
 import ellimann_addon
-from ellimann_addon.blender.bridge.convert import mannequin_to_collection
+from ellimann_addon.blender.bridge.convert import SIDE_COLORS, mannequin_to_collection, mesh_from_arrays
 from ellimann_addon.blender.services.render import workbench, write_png
 from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.posed import PosingRig
+from ellimann_addon.core.poses import POSE_NAMES, standard_motion
 
 GHOST_COLOR = (0.55, 0.55, 0.58, 0.22)
 VIEWS = {"FRONT": 0.0, "SIDE": 90.0, "THREE_QUARTER": 35.0}  # camera turn about Z, degrees
@@ -151,6 +154,37 @@ def mannequins(files, ghosts, out, view="FRONT", ghost_shift=(0.0, 0.0, 0.0), si
     return render(out, slots, resolution=(max(800, 420 * len(slots)), 1000), view=view)
 
 
+def posed_objects(rig, pose):
+    """The mannequin of ``rig`` in ``pose`` as objects in a new collection: the ellipsoids no cushion replaces
+    and the posed cushion meshes (those across a joint in their two halves)."""
+    body = rig.pose(pose)
+    collection = mannequin_to_collection(body.mannequin, name=pose.name)
+    topology = body.mannequin.topology
+    keep = {topology.names[i] for i in topology.single_parts(cushions=True)}
+    objects = [o for o in collection.objects if o.ellimann.part_name in keep]
+    for mesh in body.cushions:
+        obj = bpy.data.objects.new(mesh.name, mesh_from_arrays(mesh.name, mesh.vertices, mesh.faces))
+        obj.color = SIDE_COLORS[topology.parts[int(np.flatnonzero(rig.bones == mesh.bone)[0])].side]
+        collection.objects.link(obj)
+        objects.append(obj)
+    return objects
+
+
+def poses(path, out, names=POSE_NAMES, view="FRONT", walk_frame=6):
+    """One mannequin (a JSON with joints) in each pose of ``names`` side by side, cushions split at the joints
+    (``core.posed``); the walk cycle shown at frame ``walk_frame``."""
+    bpy.ops.wm.read_homefile(use_empty=True)
+    mannequin = Mannequin.load(path)
+    rig = PosingRig(mannequin)
+    slots = []
+    for name in names:
+        frames = standard_motion(name, mannequin.joints)
+        pose = frames[walk_frame % len(frames)]
+        pose = pose.copy(translation=pose.translation * [1.0, 0.0, 1.0])  # walk in place: the slots stay apart
+        slots.append(Slot(solid=posed_objects(rig, pose)))
+    return render(out, slots, resolution=(max(800, 420 * len(slots)), 1000), view=view, spacing=0.25)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m tools.render", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -162,10 +196,19 @@ def main(argv=None):
     lineup.add_argument("--side-too", action="store_true", help="each mannequin also seen from the side")
     lineup.add_argument("--out", required=True, type=Path)
     lineup.add_argument("--view", default="FRONT", choices=sorted(VIEWS))
+    posing = sub.add_parser("poses", help="one mannequin in the standard poses side by side")
+    posing.add_argument("file", type=Path)
+    posing.add_argument("--out", required=True, type=Path)
+    posing.add_argument("--view", default="FRONT", choices=sorted(VIEWS))
+    posing.add_argument("--pose", action="append", choices=POSE_NAMES, help="which poses (default: all five)")
+    posing.add_argument("--walk-frame", type=int, default=6, help="the frame of the walk cycle shown (default 6)")
     args = parser.parse_args(argv)
     ellimann_addon.register()  # the mannequin collections need ElliMann's properties
     try:
-        mannequins(args.files, args.ghost, args.out, args.view, args.ghost_shift, args.side_too)
+        if args.command == "poses":
+            poses(args.file, args.out, args.pose or POSE_NAMES, args.view, args.walk_frame)
+        else:
+            mannequins(args.files, args.ghost, args.out, args.view, args.ghost_shift, args.side_too)
     finally:
         ellimann_addon.unregister()
     print(f"wrote {args.out}")

@@ -21,13 +21,14 @@ from .features import (
     measure,
     menus,
     part,
+    pose,
     references,
     synthesize,
     trace,
 )
 
 # One package per user task, in the sidebar's order.
-FEATURES = (trace, part, clean, cushions, measure, references, synthesize, drape, export)
+FEATURES = (trace, part, clean, cushions, measure, references, synthesize, pose, drape, export)
 
 # Property groups first (pointers need them), the main panel before its sub-panels.
 CLASSES = (props.classes + main_panel.classes + tuple(c for feature in FEATURES for c in feature.classes)

@@ -19,6 +19,7 @@ from ..core.measure import as_dict
 from ..core.refine import EXACT_TOLERANCE
 from ..core.refine_extra import extra_request_problems, meet_extra
 from ..core.request import validate_request
+from ..core.skeleton import JOINT_NAMES
 from . import common, distributed
 from .common import PROG, UsageError
 
@@ -31,7 +32,7 @@ NPZ = "npz"  # the batch's one-file format (core.batch_file), written once at th
 def add_parser(commands):
     batch = commands.add_parser("batch", help="synthesize every row of a CSV",
                                 description="One mannequin per CSV row. The header names the columns "
-                                            "He,Sh,Br,Wa,Hi (cm) and optionally name, references (a row's "
+                                            "He,Sh,Br,Wa,Hi (cm) and optionally name and references (a row's "
                                             "reference set: female, male or a folder; empty: --references) "
                                             "and any of the extra measurements (neck, upper_arm, thigh, calf, "
                                             "crotch_height, arm_length: the keys measure --json prints; an empty "
@@ -56,6 +57,7 @@ def add_parser(commands):
                        help="skip rows whose files (every --format) are already in DIR and whole, e.g. after an "
                             "interrupted run with the same CSV and options; without it every row is written again")
     common.add_synthesis_options(batch)
+    common.add_pose_option(batch)
     batch.set_defaults(run=run, blender=needs_blender)
 
 
@@ -65,7 +67,7 @@ def needs_blender(args):
         formats = parse_formats(args.format)
     except UsageError:
         return None
-    blender = [f for f in formats if f in FORMATS and FORMATS[f].needs_blender]
+    blender = [f for f in formats if f in FORMATS and FORMATS[f].needs_blender_for(args.pose is not None)]
     return f"--format {blender[0]}" if blender else None
 
 
@@ -179,6 +181,7 @@ def name_rows(rows):
 
 def run(args):
     formats = parse_formats(args.format)
+    pose_file = common.check_pose_argument(args, formats)
     shard, shards = parse_shard(args.shard)
     sets = {"": common.references(args)}  # the command's set, read once, and each other set a row names
 
@@ -195,13 +198,13 @@ def run(args):
     mine = [row for index, row in enumerate(rows) if index % shards == shard - 1]
     cluster = distributed.connect(args.dask) if args.dask else None  # before anything is written
     try:
-        return _run(args, formats, shard, shards, rows, mine, options, cluster)
+        return _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file)
     finally:
         if cluster is not None:
             cluster.close()
 
 
-def _run(args, formats, shard, shards, rows, mine, options, cluster):
+def _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file):
     common.output_folder(args.output, "batch")
     suffix = "" if shards == 1 else f"-{shard}-of-{shards}"
     report = Report(os.path.join(args.output, f"report{suffix}.csv"))
@@ -220,27 +223,26 @@ def _run(args, formats, shard, shards, rows, mine, options, cluster):
         common.say(f"{PROG} batch: {shown - MAX_WARNING_LINES} more warning(s) of requests outside the reference "
                    f"range; every row's are in {report.path}")
     progress = common.Progress(len(jobs), "batch", quiet=args.quiet)
-    # chunks of one reference set each (the sets in the order they first appear)
+    # one core batch per reference set (in the order the sets first appear), in chunks
     groups = {}
     for job in jobs:
         groups.setdefault(id(job[-1]), []).append(job)
     chunks = [group[start:start + CHUNK] for group in groups.values() for start in range(0, len(group), CHUNK)]
-    references = [chunk[0][-1] for chunk in chunks]
+    sets = [chunk[0][-1] for chunk in chunks]
     requests = [[job[2] for job in chunk] for chunk in chunks]
-    # one batch file per set (their topologies may differ): mannequins.npz, or mannequins-<set>.npz when mixed
-    named = {id(reference): reference for reference in references}
-    bundles = {key: Bundle(os.path.join(args.output, f"mannequins{'' if len(named) == 1 else '-' + ref.name}"
-                                                     f"{suffix}.npz"), ref.topology, args.mode)
-               for key, ref in named.items()} if NPZ in formats else {}
-    results = (cluster.map(references, requests, options) if cluster is not None
-               else ((index, synthesize_chunk(references[index], chunk, options))
-                     for index, chunk in enumerate(requests)))
+    bundles = {}  # one batch file per reference set: mannequins.npz, or mannequins-NAME.npz when a batch uses several
+    if NPZ in formats:
+        for reference in dict.fromkeys(sets):
+            tag = f"-{reference.name}" if len(groups) > 1 else ""
+            bundles[id(reference)] = Bundle(os.path.join(args.output, f"mannequins{tag}{suffix}.npz"),
+                                            reference.topology, args.mode)
+    results = (cluster.map(sets, requests, options) if cluster is not None
+               else ((index, synthesize_chunk(sets[index], chunk, options)) for index, chunk in enumerate(requests)))
     try:
         for index, result in results:
-            bundle = bundles.get(id(references[index]))
             for i, (line, name, values, warnings, extra, reference) in enumerate(chunks[index]):
-                report.add(_row(args, formats, result, i, line, name, values, warnings, bundle, index, reference,
-                                extra))
+                report.add(_row(args, formats, result, i, line, name, values, warnings, reference.name,
+                                bundles.get(id(reference)), index, pose_file, extra))
                 progress.step(name)
         for bundle in bundles.values():
             bundle.write()
@@ -291,20 +293,28 @@ def synthesize_chunk(reference, requests, options):
     return ChunkResult.joined(parts, errors)
 
 
+def _landmarks(synthesis):
+    """What each mannequin of a Synthesis records of its reference set (Mannequin keywords)."""
+    return {"reference_set": synthesis.reference_set, "section_fractions": synthesis.section_fractions}
+
+
 class ChunkResult:
     """A chunk's synthesis as plain arrays (what a Dask worker sends back): ``errors[i]`` is None or why row i
     failed (its arrays are then NaN)."""
 
     FIELDS = ("rotation", "center", "semi_axes", "measured", "factors", "converged")
 
-    def __init__(self, topology, errors, **arrays):
+    def __init__(self, topology, errors, joints=None, landmarks=None, **arrays):
         self.topology, self.errors = topology, errors
+        self.joints = joints  # (B, 24, 3) or None: the reference set has no joints
+        self.landmarks = landmarks or {}  # the set's name and section heights, which each mannequin records
         for key in self.FIELDS:
             setattr(self, key, arrays[key])
 
     @classmethod
     def of(cls, synthesis, errors):
-        return cls(synthesis.topology, errors, **{key: getattr(synthesis, key) for key in cls.FIELDS})
+        return cls(synthesis.topology, errors, synthesis.joints, _landmarks(synthesis),
+                   **{key: getattr(synthesis, key) for key in cls.FIELDS})
 
     @classmethod
     def joined(cls, parts, errors):
@@ -313,35 +323,38 @@ class ChunkResult:
             return cls(None, errors, **{key: [None] * len(parts) for key in cls.FIELDS})
         arrays = {key: np.concatenate([getattr(p if p is not None else good, key) for p in parts])
                   for key in cls.FIELDS}
+        joints = (None if good.joints is None
+                  else np.concatenate([(p if p is not None else good).joints for p in parts]))
         for i, part in enumerate(parts):
             if part is None:
-                for key in cls.FIELDS[:-1]:
-                    arrays[key][i] = np.nan
+                for key in cls.FIELDS:
+                    if key != "converged":
+                        arrays[key][i] = np.nan
                 arrays["converged"][i] = False
-        return cls(good.topology, errors, **arrays)
+                if joints is not None:
+                    joints[i] = np.nan
+        return cls(good.topology, errors, joints, _landmarks(good), **arrays)
 
-    def mannequin(self, i, name, request, reference=None):
-        """Row i as a Mannequin, recording the set (``reference``) it was synthesized from and its section heights."""
+    def mannequin(self, i, name, request):
         from ..core.mannequin import Mannequin
 
-        sets = {} if reference is None else {"reference_set": reference.name,
-                                             "section_fractions": reference.section_fractions}
         return Mannequin(self.topology, self.rotation[i], self.center[i], self.semi_axes[i], name=name,
-                         role="synthesized", measurements=as_dict(request), **sets)
+                         role="synthesized", measurements=as_dict(request),
+                         joints=None if self.joints is None else self.joints[i], **self.landmarks)
 
 
-def _row(args, formats, result, i, line, name, values, warnings, bundle=None, chunk=0, reference=None, extra=None):
+def _row(args, formats, result, i, line, name, values, warnings, references, bundle=None, chunk=0, pose_file=None,
+         extra=None):
     """Write (or, with --resume, keep) the files of one synthesized row, and add it to the batch file; its report
     row. A failure is that row's: one line on stderr and status "error", and the batch goes on. A row with extra
     measurements is deformed to meet them too (exact mode; the report's message gives what they came to; the
     batch file holds the five's mannequin)."""
-    sets = reference.name if reference is not None else ""
     if result.errors[i] is not None:
         common.say(f"{PROG} batch: line {line}: failed: {result.errors[i]}")
-        return common.report_row(line, name, "error", result.errors[i], values, references=sets)
+        return common.report_row(line, name, "error", result.errors[i], values)
     paths = [os.path.join(args.output, f"{name}.{common.extension(kind)}") for kind in formats if kind != NPZ]
     notes = list(warnings)
-    mannequin, measured = result.mannequin(i, name, values, reference), result.measured[i]
+    mannequin, measured = result.mannequin(i, name, values), result.measured[i]
     if extra and args.mode == "exact":
         mannequin, achieved, missed_extra = meet_extra(mannequin, extra)
         measured = np.array([achieved[key] for key in MEASUREMENTS])
@@ -359,18 +372,19 @@ def _row(args, formats, result, i, line, name, values, warnings, bundle=None, ch
         bundle.add(chunk, name, values, result, i)
     if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths) and paths:
         row = common.report_row(line, name, status, "; ".join(notes + ["kept (--resume)"]), values, measured,
-                                listed, sets)
+                                listed, references)
         row["kept"] = True
         return row
     try:
         if paths:
-            common.write(mannequin, paths, as_dict(measured), args.cushions)
+            frames = common.pose_frames(args, mannequin, pose_file)
+            common.write(mannequin, paths, as_dict(measured), args.cushions, frames, args.fps)
     except (ElliMannError, OSError, RuntimeError) as error:
         common.say(f"{PROG} batch: line {line}: failed: {common.one_line(error)}")
         if bundle is not None:
             bundle.drop(chunk, name)
-        return common.report_row(line, name, "error", common.one_line(error), values, references=sets)
-    return common.report_row(line, name, status, "; ".join(notes), values, measured, listed, sets)
+        return common.report_row(line, name, "error", common.one_line(error), values)
+    return common.report_row(line, name, status, "; ".join(notes), values, measured, listed, references)
 
 
 class Bundle:
@@ -397,9 +411,13 @@ class Bundle:
         arrays = {key: np.array([getattr(result, key)[i] for _, _, result, i in rows]).reshape((len(rows),) + shape)
                   for key, shape in shapes.items()}
         requests = np.array([values for _, values, _, _ in rows], dtype=float).reshape(len(rows), 5)
+        joints = None
+        if rows and all(result.joints is not None for _, _, result, _ in rows):
+            joints = np.array([result.joints[i] for _, _, result, i in rows]).reshape(len(rows), len(JOINT_NAMES), 3)
         with common.writing(self.path):
             write_batch_file(self.path, batch_arrays(self.topology, [row[0] for row in rows], requests,
-                                                     mode=self.mode, **arrays))
+                                                     mode=self.mode, joints=joints, joint_names=JOINT_NAMES,
+                                                     **arrays))
 
 
 class Report:

@@ -101,6 +101,52 @@ def add_references(parser, what, shipped="female (the default) or male"):
                              "(with its reference_set.json manifest)")
 
 
+def add_pose_option(parser):
+    """--pose NAME (a standard pose, or a pose .json) and --fps."""
+    from ..core.poses import POSE_NAMES, WALK_FPS
+
+    parser.add_argument("--pose", metavar="NAME", help=f"write the mannequin posed: {', '.join(POSE_NAMES)} (walk: "
+                        "an animation, in .json and .xml as its frames), or a pose .json file; measurements stay "
+                        "the rest pose's")
+    parser.add_argument("--fps", type=number, default=WALK_FPS, help=f"frames per second of walk (default {WALK_FPS})")
+
+
+def check_pose_argument(args, kinds):
+    """Refuse, before any work is done, an unknown pose name, a pose file that cannot be read and an animation
+    for a format of ``kinds`` that holds none. Returns the frames of a pose file (None otherwise)."""
+    from ..core.poses import MOTIONS, check_pose_name
+
+    if args.pose is None:
+        return None
+    frames = None
+    if args.pose.lower().endswith(".json"):
+        from ..core.posed_files import read_pose
+
+        frames = read_pose(args.pose)
+    else:
+        check_pose_name(args.pose)
+    still = [FORMATS[k] for k in kinds if k in FORMATS and not FORMATS[k].animated]  # (npz: batch's own bundle)
+    if still and (args.pose in MOTIONS or (frames is not None and len(frames) > 1)):
+        raise UsageError(f"--pose {args.pose} is an animation and a .{still[0].extension} file holds none; write "
+                         f"{', '.join('.' + f.extension for f in FORMATS.values() if f.animated)}")
+    return frames
+
+
+def pose_frames(args, mannequin, frames=None):
+    """The frames of ``--pose`` for ``mannequin`` (None without --pose): ``frames`` read from a pose file, or the
+    standard pose made on its joints; ElliMannError naming the joint (and frame) of one beyond its limits."""
+    from ..core.pose import check_limits, require_joints
+    from ..core.poses import standard_motion
+
+    if args.pose is None:
+        return None
+    joints = require_joints(mannequin)
+    frames = frames if frames is not None else standard_motion(args.pose, joints, args.fps)
+    for index, frame in enumerate(frames):
+        check_limits(frame, joints, index if len(frames) > 1 else None)
+    return frames
+
+
 def synthesis_options(args, name=None):
     """The SynthesisOptions of the command line (built once per command)."""
     return SynthesisOptions(mode=args.mode, metric=args.metric, power=args.power, normalize=args.normalize,
@@ -171,11 +217,14 @@ def extension(kind):
     return FORMATS[kind].extension
 
 
-def write(mannequin, paths, measured, cushions):
-    """Write every path (format from the extension); Blender is loaded only for .blend/.glb/.obj.
+def write(mannequin, paths, measured, cushions, frames=None, fps=None):
+    """Write every path (format from the extension); Blender is loaded only for .blend/.glb/.obj (posed: .blend
+    and .glb). ``frames``: the pose (a list of core.pose.Pose) to write the mannequin in, if any.
 
     A path that cannot be written raises UsageError naming it (not the temporary file behind it).
     """
+    if frames is not None:
+        return write_posed(mannequin, paths, cushions, frames, fps)
     for path in paths:
         if core_format(path):
             with writing(path):
@@ -191,6 +240,26 @@ def write(mannequin, paths, measured, cushions):
             if error.filename is None:
                 raise
             raise cannot_write(error.filename, error) from None
+    return paths
+
+
+def write_posed(mannequin, paths, cushions, frames, fps):
+    """:func:`write` of a posed mannequin: .json, .xml and .obj by the core (core.posed_files), .blend and .glb by
+    the Blender rig (``blender.services.posing.write_posed``)."""
+    from ..core.posed_files import write_posed as write_core_posed
+
+    blender = [p for p in paths if format_of(p).needs_blender_for(True)]
+    for path in [p for p in paths if p not in blender]:
+        with writing(path):
+            write_core_posed(mannequin, frames, path, cushions, fps)
+    if blender:
+        ensure_registered(f"writing {blender[0]}")
+        try:
+            from ..blender.services.posing import write_posed as write_blender_posed
+        except ImportError:
+            raise UsageError(f"writing a posed {blender[0]} needs ElliMann's Blender rig, which this build lacks; "
+                             "write .json, .xml or .obj") from None
+        write_blender_posed(mannequin, frames, blender, cushions)
     return paths
 
 

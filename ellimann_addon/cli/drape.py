@@ -10,7 +10,10 @@ from ..core.constants import CM_PER_M
 from ..core.ellipsoid import bounds
 from ..core.files import atomic_output
 from ..core.garments import EDGE_RANGE
+from ..core.motion import clamped_motion
 from ..core.options import DRAPE, DrapeSettings, garment_help
+from ..core.pose import require_joints
+from ..core.poses import POSE_NAMES
 from . import common
 from .common import PROG, UsageError
 from .measure import load_blend_mannequin, load_json_mannequin
@@ -33,6 +36,9 @@ def add_parser(commands):
                            default_text="cushions" if defaults.cushions else "every ellipsoid"))
     drape.add_argument("--edge", type=common.number, metavar="CM",
                        help=DRAPE["edge"].help.format(default_cm=defaults.edge * CM_PER_M))
+    drape.add_argument("--pose", choices=POSE_NAMES, metavar="POSE",
+                       help=f"drape on a moving body: from rest into a standard pose (held), or walking (the cloth "
+                            f"follows the stride); one of {', '.join(POSE_NAMES)}; needs a mannequin with joints")
     drape.add_argument("--collection", help="the mannequin collection in a .blend holding several (.blend only)")
     drape.add_argument("-o", "--output", required=True, metavar="OUT.blend")
     drape.add_argument("--render", metavar="OUT.png", help="also a Workbench picture of the last frame")
@@ -66,15 +72,20 @@ def run(args):
 
     settings = settings_of(args)
     if kind == ".json":
+        motion, loop = motion_of(args, mannequin)
         empty_scene()
-        add_mannequin(mannequin, cushions=settings.cushions and bool(mannequin.topology.cushion_pairs))
+        shown = add_mannequin(mannequin, cushions=settings.cushions and bool(mannequin.topology.cushion_pairs))
+        if motion:  # the drape's colliders are the moving body; the standing one would hide it
+            shown.hide_render = shown.hide_viewport = True
     else:
         mannequin = load_blend_mannequin(args.mannequin, args.collection)
+        motion, loop = motion_of(args, mannequin)
     vertices, size = check_cloth_size(mannequin, args.garment, settings)  # refuses a cloth too large to drape
     if vertices > WARN_CLOTH_VERTICES:
         common.say(f"{PROG} drape: warning: the cloth will have about {vertices:,} vertices and need about "
              f"{size / 1e9:.1f} GB; it is slow (a larger --edge is faster)")
-    common.say(f"{PROG} drape: {args.garment} on '{mannequin.name}', {settings.frames} frames, cloth edge "
+    moving = f" ({args.pose})" if motion else ""
+    common.say(f"{PROG} drape: {args.garment} on '{mannequin.name}'{moving}, {settings.frames} frames, cloth edge "
          f"{settings.edge * CM_PER_M:g} cm, colliding with {'cushions' if settings.cushions else 'ellipsoids'}")
     progress = common.Progress(settings.frames, "drape", every=max(10, settings.frames // 20),  # 10 frames, 5% past 200
                                quiet=args.quiet)
@@ -85,7 +96,7 @@ def run(args):
 
     with blender_output():
         try:
-            result = drape(mannequin, args.garment, settings, progress=frame_done)
+            result = drape(mannequin, args.garment, settings, progress=frame_done, motion=motion, loop=loop)
         finally:
             progress.done()
         with common.writing(args.output), atomic_output(args.output) as temp:
@@ -94,11 +105,20 @@ def run(args):
     if args.render:
         from ..blender.services.render import render_view
 
-        low, high = bounds(mannequin.rotation, mannequin.center, mannequin.semi_axes)
+        body = result.body
+        low, high = bounds(body.rotation, body.center, body.semi_axes)
         with common.writing(args.render):
             render_view(args.render, low.min(axis=0), high.max(axis=0))
         common.say(f"wrote {args.render}", file=sys.stdout)
     return 0
+
+
+def motion_of(args, mannequin):
+    """(core poses or None, whether they loop) of --pose on ``mannequin`` (ElliMannError: no joints)."""
+    if args.pose is None or args.pose == "a_pose":
+        return None, False
+    poses, _, loop = clamped_motion(args.pose, require_joints(mannequin))
+    return poses, loop
 
 
 def settings_of(args):

@@ -29,6 +29,7 @@ def add_parser(commands):
                             help="with --synthesize: batch's output formats (default npz, one file for all)")
     population.add_argument("--dask", metavar="ADDRESS", help="with --synthesize: batch's --dask")
     common.add_synthesis_options(population)
+    common.add_pose_option(population)  # with --synthesize: batch's --pose
     population.set_defaults(run=run, blender=needs_blender)
 
 

@@ -37,13 +37,14 @@ def add_parser(commands):
                             "for MuJoCo)")
     synth.add_argument("--name", help="mannequin name (default: 'ElliMann He-Sh-Br-Wa-Hi')")
     common.add_synthesis_options(synth)
+    common.add_pose_option(synth)
     synth.set_defaults(run=run, blender=needs_blender)
 
 
 def needs_blender(args):
     """What needs Blender in this command (None: nothing)."""
     kind = FORMATS.get(_kind_or_none(args.output))
-    return f"writing {args.output}" if kind is not None and kind.needs_blender else None
+    return f"writing {args.output}" if kind is not None and kind.needs_blender_for(args.pose is not None) else None
 
 
 def _kind_or_none(path):
@@ -80,6 +81,7 @@ def run(args):
     from ..core.refine_extra import synthesize_extra
 
     kind = common.output_kind(args.output)
+    pose_file = common.check_pose_argument(args, [kind])
     five, extra = _wanted(args)
     request = [five[key] for key in MEASUREMENTS]
     reference = common.references(args)
@@ -94,11 +96,13 @@ def run(args):
     missed_extra = [line for line in more if line.startswith("exact mode missed")]
     for warning in warnings + more + ([common.missed_text(misses)] if misses else []):
         common.say(f"{PROG} synth: warning: {warning}")
+    frames = common.pose_frames(args, mannequin, pose_file)
     common.write(mannequin, [args.output], {key: measured[key] for key in MEASUREMENTS},
-                 args.cushions and kind != "json")
+                 args.cushions and kind != "json", frames, args.fps)
     error = relative_error(achieved, request).max()
+    posed = f" in pose {args.pose}" if args.pose else ""
     extra_line = ("; " + ", ".join(f"{key} {measured[key]:.2f}" for key in EXTRA_MEASUREMENTS) + " cm"
                   if extra else "")
-    common.say(f"wrote {args.output}: '{mannequin.name}' ({args.mode}), m_T {common.format_me(achieved)} cm, "
+    common.say(f"wrote {args.output}: '{mannequin.name}'{posed} ({args.mode}), m_T {common.format_me(achieved)} cm, "
                f"max error {error:.3f}%{extra_line}", file=sys.stdout)
     return common.MISSED if misses or missed_extra else 0

@@ -120,12 +120,10 @@ def load_batch_file(path):
         raise _problem(path, "part_names", "differ from the topology's")
     keys = [str(k) for k in arrays["measurement_keys"]]
     joints = arrays.get("joints")
-    carries_joints = "joints" in getattr(Mannequin, "__dataclass_fields__", {})
     mannequins = []
     for i, name in enumerate(arrays["names"]):
-        extra = {"joints": joints[i]} if joints is not None and carries_joints else {}
         mannequins.append(Mannequin(topology, arrays["rotation"][i], arrays["center"][i], arrays["semi_axes"][i],
                                     name=str(name), role="synthesized",
                                     measurements={k: float(v) for k, v in zip(keys, arrays["requests_cm"][i])},
-                                    **extra))
+                                    joints=None if joints is None else joints[i]))
     return mannequins

@@ -22,12 +22,14 @@ class BodyMeshError(ElliMannError):
 @dataclass(frozen=True)
 class BodyMesh:
     """A closed triangle mesh (metres, ElliMann axes: +X the body's left, -Y front, Z up), named by its
-    file stem. ``edges_crc``: fingerprint of the polygons' edges (see :func:`connectivity_fingerprint`)."""
+    file stem. ``edges_crc``: fingerprint of the polygons' edges (see :func:`connectivity_fingerprint`);
+    ``joints``: the body's skeleton, which the Reference Mannequin built from it carries."""
 
     name: str
     vertices: np.ndarray  # (V, 3)
     faces: np.ndarray  # (F, 3) int, 0-based triangles
     edges_crc: int = 0
+    joints: np.ndarray = None  # (24, 3) its SMPL joints in the same axes (core.joints), if it has a skeleton
 
 
 def connectivity_fingerprint(polygons):

@@ -5,6 +5,7 @@ import numpy as np
 from .ellipsoid import axis_extent
 from .errors import MannequinError, Problem
 from .frames import mirror_frame, relabel_to_reference, symmetrize_central
+from .joints import mirror_joints
 from .mannequin import NAME_PATTERN
 
 REGISTRATION_LABEL = "Trapezius"
@@ -32,7 +33,7 @@ def registration_offset(mannequin, label=REGISTRATION_LABEL):
 
 
 def register_to_world(mannequin, label=REGISTRATION_LABEL):
-    return mannequin.copy(center=mannequin.center + registration_offset(mannequin, label))
+    return mannequin.translated(registration_offset(mannequin, label))
 
 
 def mirror_side(mannequin, source="L", replace=True):
@@ -44,6 +45,8 @@ def mirror_side(mannequin, source="L", replace=True):
     out = mannequin.copy()
     if replace:
         out.rotation[dst], out.center[dst], out.semi_axes[dst] = rotation, center, mannequin.semi_axes[src]
+        if out.joints is not None:
+            out.joints = mirror_joints(out.joints, source)
     return out
 
 

@@ -12,18 +12,24 @@ class Format:
     extension: str  # the file extension, without the dot
     writer: str  # "core" (numpy only) or "blender" (needs bpy)
     title: str  # what it is, for help texts
+    posed_writer: str  # who writes it posed (``--pose``): "core" (core.posed_files) or "blender"
+    animated: bool  # holds an animation (the walk cycle)
 
     @property
     def needs_blender(self):
         return self.writer == "blender"
 
+    def needs_blender_for(self, posed):
+        """Whether writing it (posed, with ``posed``) needs the bpy module."""
+        return (self.posed_writer if posed else self.writer) == "blender"
+
 
 FORMATS = {f.name: f for f in (
-    Format("blend", "blend", "blender", "Blender file"),
-    Format("glb", "glb", "blender", "binary glTF with ElliMann's extras"),
-    Format("obj", "obj", "blender", "Wavefront OBJ"),
-    Format("json", "json", "core", "ElliMann's mannequin JSON"),
-    Format("mjcf", "xml", "core", "MJCF, for MuJoCo"),
+    Format("blend", "blend", "blender", "Blender file", "blender", True),
+    Format("glb", "glb", "blender", "binary glTF with ElliMann's extras", "blender", True),
+    Format("obj", "obj", "blender", "Wavefront OBJ", "core", False),
+    Format("json", "json", "core", "ElliMann's mannequin JSON", "core", True),
+    Format("mjcf", "xml", "core", "MJCF, for MuJoCo", "core", True),
 )}
 CORE_FORMATS = tuple(name for name, f in FORMATS.items() if not f.needs_blender)  # json, mjcf
 BLENDER_FORMATS = tuple(name for name, f in FORMATS.items() if f.needs_blender)  # blend, glb, obj
@@ -41,6 +47,6 @@ def format_of(path):
     return next((f for f in FORMATS.values() if f.extension == extension), None)
 
 
-def needs_blender(paths):
-    """Whether writing ``paths`` needs the bpy module (one of them is a Blender format)."""
-    return any(f is not None and f.needs_blender for f in map(format_of, paths))
+def needs_blender(paths, posed=False):
+    """Whether writing ``paths`` (posed, with ``posed``) needs the bpy module."""
+    return any(f is not None and f.needs_blender_for(posed) for f in map(format_of, paths))

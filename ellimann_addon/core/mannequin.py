@@ -16,6 +16,7 @@ import numpy as np
 from .constants import CENTER_LIMIT, FEMALE_SET, MEASUREMENTS, SECTION_FRACTIONS, SEMI_AXIS_LIMITS
 from .errors import MannequinError, Problem
 from .files import atomic_write_text
+from .joints import joint_problems, joints_from_dict, joints_to_dict
 from .problems import json_type as _json_type
 from .problems import measurement_problems, section_fraction_problems
 from .problems import short as _short
@@ -217,6 +218,7 @@ class Mannequin:
 
     ``reference_set`` and ``section_fractions``: the reference set the mannequin belongs to (synthesized from,
     or part of) and the section heights m_T measures it at (fractions of He); the female set's by default.
+    ``joints``: None or the (24, 3) rest joint centres in SMPL order (core.skeleton, core.joints).
     """
 
     topology: Topology
@@ -229,6 +231,7 @@ class Mannequin:
     traces: dict = field(default=None)  # {part name: core.trace.PartTrace}: what each part was traced from
     reference_set: str = FEMALE_SET
     section_fractions: dict = field(default=None)
+    joints: np.ndarray = None
 
     def __post_init__(self):
         # a copy (mannequins never share one); anything but a dict is left for problems() to name
@@ -237,6 +240,7 @@ class Mannequin:
         self.rotation = np.asarray(self.rotation, dtype=float)
         self.center = np.asarray(self.center, dtype=float)
         self.semi_axes = np.asarray(self.semi_axes, dtype=float)
+        self.joints = None if self.joints is None else np.asarray(self.joints, dtype=float)
 
     def __len__(self):
         return len(self.topology)
@@ -246,9 +250,15 @@ class Mannequin:
                       semi_axes=self.semi_axes.copy(), name=self.name, role=self.role,
                       measurements=dict(self.measurements) if self.measurements else None,
                       traces=dict(self.traces) if self.traces else None,
-                      reference_set=self.reference_set, section_fractions=self.section_fractions)
+                      reference_set=self.reference_set, section_fractions=self.section_fractions,
+                      joints=None if self.joints is None else self.joints.copy())
         values.update(changes)
         return Mannequin(**values)
+
+    def translated(self, offset):
+        """The mannequin moved by ``offset`` (3,) m, its joints with it."""
+        offset = np.asarray(offset, dtype=float)
+        return self.copy(center=self.center + offset, joints=None if self.joints is None else self.joints + offset)
 
     def problems(self):
         """Geometry problems, each naming the ellipsoid and field (the topology validated itself)."""
@@ -295,7 +305,7 @@ class Mannequin:
         if not isinstance(self.reference_set, str) or not self.reference_set:
             out.append(Problem("", "reference_set", f"must be a non-empty name, got {_short(self.reference_set)}"))
         out += section_fraction_problems(self.section_fractions)
-        return out
+        return out + joint_problems(self)
 
     def check(self):
         """Raise MannequinError listing every problem; return self when valid."""
@@ -322,6 +332,7 @@ class Mannequin:
 
     def to_dict(self):
         traces = {"traces": traces_to_dict(self.traces)} if self.traces else {}
+        joints = {} if self.joints is None else {"joints": joints_to_dict(self.joints)}
         return {
             "format": FORMAT,
             "version": FORMAT_VERSION,
@@ -336,6 +347,7 @@ class Mannequin:
                 for i, part in enumerate(self.topology)
             ],
             **traces,
+            **joints,
         }
 
     @classmethod
@@ -400,7 +412,8 @@ class Mannequin:
             raise MannequinError(problems)
         mannequin = cls(topology, np.swapaxes(np.array(arrays["axes"]), 1, 2), np.array(arrays["center"]),
                         np.array(arrays["semi_axes"]), name=name, role=role, measurements=measurements,
-                        traces=traces_from_dict(data.get("traces"), topology.names), **landmarks)
+                        traces=traces_from_dict(data.get("traces"), topology.names),
+                        joints=joints_from_dict(data.get("joints")), **landmarks)
         return mannequin.check() if check else mannequin
 
     def to_json(self):

@@ -9,8 +9,9 @@ mean) and each is checked: clean, every measurement within ``accept_tolerance`` 
 much of its body it fills (coverage, excess: core/volume.py). Deterministic: no randomness, fixed
 iteration counts and orders. Everything is checked before the first fit, so bad input costs nothing.
 
-Joints: a body may come with a skeleton (``BodyMesh`` is the place to carry it); carrying joints into
-the RMs belongs to the mannequins' joints (issue 12) and is not done here yet.
+Joints: a body with a skeleton (``BodyMesh.joints``) gives its RM joints that go through every step the pieces
+go through: mirrored and registered with them, moved by the refinement as points fixed in their anchor parts
+(core.joints.follow_pieces), translated by the cleaning.
 """
 
 import math
@@ -26,6 +27,7 @@ from .clean import asymmetry, clean, landmark_indices, register_to_world, regist
 from .constants import ABSURD_LIMITS, MEASUREMENTS
 from .errors import ElliMannError
 from .frames import is_rotation
+from .joints import anchor_indices, follow_pieces
 from .measure import as_dict, section_heights
 from .refine import FACTOR_LIMITS, refine
 from .volume import GRID_SPACING, BodyVolume, fill_shares
@@ -168,7 +170,11 @@ def adjust(mannequin, targets, settings):
         raise ReferenceBuildError(
             f"targets: '{mannequin.name}' cannot reach {key}={wanted[0, k]:g} cm: it stays at "
             f"{result.measured[0, k]:.2f} cm ({errors[k]:+.2%}); {why}. Use a body nearer its targets")
-    return mannequin.copy(center=result.center[0], semi_axes=result.semi_axes[0]), factors
+    joints = None if mannequin.joints is None else follow_pieces(
+        mannequin.joints, anchor_indices(mannequin.topology), (mannequin.rotation, mannequin.center,
+                                                               mannequin.semi_axes),
+        (mannequin.rotation, result.center[0], result.semi_axes[0]))
+    return mannequin.copy(center=result.center[0], semi_axes=result.semi_axes[0], joints=joints), factors
 
 
 def cleanliness_problems(mannequin, tol=1e-9):
@@ -195,7 +201,7 @@ def _fit_body(base, body, targets, settings, cancel=None):
     """One body's RM before the set is cleaned: (name, body -> RM shift, m_T as fitted, RM, refinement factors)."""
     fitted, _ = fit_mannequin(body, base.topology, base.traces, base, _kept(base), settings.fit, cancel,
                               name=display_name(body.name), role="reference", measurements=dict(targets))
-    fitted = symmetrize(fitted)
+    fitted = symmetrize(fitted.copy(joints=body.joints))
     shift = registration_offset(fitted)
     fitted = register_to_world(fitted)
     rm, factors = adjust(fitted, targets, settings)

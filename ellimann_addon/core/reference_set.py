@@ -91,6 +91,8 @@ class ReferenceSet:
         self.rotation = np.stack([m.rotation for m in ordered])
         self.center = np.stack([m.center for m in ordered])
         self.semi_axes = np.stack([m.semi_axes for m in ordered])
+        # (k, 24, 3) rest joints when every RM has them (core.joints.interpolate_joints), else None
+        self.joints = np.stack([m.joints for m in ordered]) if all(m.joints is not None for m in ordered) else None
         for j in range(len(ordered)):
             for i in range(j):
                 if np.allclose(self.measurements[i], self.measurements[j]):

@@ -23,6 +23,7 @@ from .extra_measures import (
     MannequinLandmarks,
     mannequin_extra_measurements,
 )
+from .joints import anchor_indices, follow_pieces
 from .measure import tailor_measurements
 from .refine import refine
 from .synthesis import synthesize
@@ -120,6 +121,16 @@ def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXT
     All at once first; if that misses any, one measurement at a time (in EXTRA_MEASUREMENTS order), each kept
     only if it and those kept before are met with the five: one that the pieces cannot reach (or only by
     giving up the five) is left where the reference set puts it, and named in the misses."""
+    final, measured, misses = _extra_pieces(mannequin, extra, tolerance_cm, max_rounds)
+    if final.joints is not None:  # the joints ride on their anchor pieces, as through the five's refinement
+        before = (mannequin.rotation, mannequin.center, mannequin.semi_axes)
+        after = (final.rotation, final.center, final.semi_axes)
+        final = final.copy(joints=follow_pieces(mannequin.joints, anchor_indices(mannequin.topology), before, after))
+    return final, measured, misses
+
+
+def _extra_pieces(mannequin, extra, tolerance_cm, max_rounds):
+    """meet_extra's pieces (the joints left where they were)."""
     result = _meet(mannequin, extra, tolerance_cm, max_rounds)
     if not result[2]:
         return result

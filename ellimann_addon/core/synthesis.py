@@ -54,6 +54,7 @@ import numpy as np
 from .constants import CENTER_LIMIT, FEMALE_SET, MEASUREMENTS, SEMI_AXIS_LIMITS
 from .errors import ElliMannError, MannequinError
 from .idw import idw_weights, interpolate
+from .joints import anchor_indices, follow_pieces, interpolate_joints
 from .mannequin import Mannequin
 from .measure import as_dict, tailor_measurements
 from .options import (
@@ -96,6 +97,7 @@ class Synthesis:
     mode: str
     reference_set: str = FEMALE_SET  # the name of the set they come from
     section_fractions: dict = None  # the set's section heights (None: SECTION_FRACTIONS)
+    joints: np.ndarray = None  # (B, 24, 3) rest joints (core.joints), None if the RMs have none
 
     def __len__(self):
         return len(self.requests)
@@ -104,7 +106,8 @@ class Synthesis:
         me = as_dict(self.requests[i])
         return Mannequin(self.topology, self.rotation[i], self.center[i], self.semi_axes[i],
                          name=name or mannequin_name(me), role="synthesized", measurements=me,
-                         reference_set=self.reference_set, section_fractions=self.section_fractions)
+                         reference_set=self.reference_set, section_fractions=self.section_fractions,
+                         joints=None if self.joints is None else self.joints[i])
 
     def relative_error(self):
         """(B, 5) |m_T - request| / request in % (:func:`relative_error`)."""
@@ -152,6 +155,7 @@ def synthesize_batch(reference, requests, options=None, *, measure=True, toleran
     mode = options.mode
     requests = validate_requests(requests, reference.ranges, reference.absurd_limits)
     rotation, center, semi_axes = interpolate(reference, requests, options.metric, options.power, options.normalize)
+    joints = interpolate_joints(reference, requests, options.metric, options.power, options.normalize)
     girth = reference.topology.girth_mask
     fractions = reference.section_fractions
     measured = (tailor_measurements(rotation, center, semi_axes, girth, fractions) if (measure or mode == "exact")
@@ -161,11 +165,14 @@ def synthesize_batch(reference, requests, options=None, *, measure=True, toleran
     if mode == "exact":
         result = refine(reference.topology, rotation, center, semi_axes, requests, measured, tolerance,
                         jacobian=reference.refine_jacobian(), fractions=fractions)
+        if joints is not None:  # the joints move with their anchor pieces
+            joints = follow_pieces(joints, anchor_indices(reference.topology), (rotation, center, semi_axes),
+                                   (rotation, result.center, result.semi_axes))
         center, semi_axes, measured = result.center, result.semi_axes, result.measured
         factors, converged = result.factors, result.converged
     check_plausible(reference.topology, requests, rotation, center, semi_axes)
     return Synthesis(reference.topology, requests, rotation, center, semi_axes, measured, factors, converged, mode,
-                     reference.name, fractions)
+                     reference.name, fractions, joints)
 
 
 def synthesize(reference, request, options=None, **fields):

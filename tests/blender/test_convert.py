@@ -69,6 +69,17 @@ def test_update_geometry_moves_objects_in_place(toy):
     assert len(bpy.data.objects) == len(toy)
 
 
+def test_joints_go_into_the_collection_and_back():
+    from ellimann_addon.core.mannequin import Mannequin
+    from ellimann_addon.core.reference_set import REFERENCE_FOLDER
+
+    average = Mannequin.load(REFERENCE_FOLDER / "average.json")
+    back = convert.collection_to_mannequin(convert.mannequin_to_collection(average))
+    assert np.abs(back.joints - average.joints).max() < 1e-6  # Blender keeps 32-bit floats
+    without = convert.collection_to_mannequin(convert.mannequin_to_collection(average.copy(joints=None)))
+    assert without.joints is None
+
+
 def test_empty_collection_is_refused():
     collection = convert.new_collection("Nothing")
     with pytest.raises(MannequinError, match="holds no ElliMann ellipsoids"):

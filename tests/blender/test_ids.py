@@ -47,8 +47,9 @@ def test_operators_have_poll_tooltip_and_undo_when_they_change_data(cls):
 def test_sub_panels_hang_under_the_main_panel_in_their_order():
     subs = [cls for cls in PANELS if cls.bl_idname != ids.PANEL_MAIN]
     assert all(cls.bl_parent_id == ids.PANEL_MAIN for cls in subs)
-    assert [cls.bl_order for cls in subs] == sorted(ids.PANEL_ORDER.values()) + [ids.SYNTHESIZE_ORDER, ids.DRAPE_ORDER]
-    assert max(ids.PANEL_ORDER.values()) < ids.SYNTHESIZE_ORDER < ids.DRAPE_ORDER  # Synthesize, Drape come last
+    assert [cls.bl_order for cls in subs] == sorted(ids.PANEL_ORDER.values()) + [ids.SYNTHESIZE_ORDER, ids.POSE_ORDER,
+                                                                                 ids.DRAPE_ORDER]
+    assert max(ids.PANEL_ORDER.values()) < ids.SYNTHESIZE_ORDER < ids.POSE_ORDER < ids.DRAPE_ORDER  # they come last
 
 
 def test_the_other_modules_use_the_ids_of_ids_py():

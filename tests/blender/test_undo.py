@@ -13,6 +13,9 @@ from devkit.blender_scene import edit_with_selection, parts, reference_mesh, sel
 from devkit.poses import make_apose_toy
 from devkit.toy import rotation_from_vector
 from ellimann_addon.blender.bridge.convert import mannequin_to_collection
+from ellimann_addon.blender.services.scene import add_mannequin
+from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.reference_set import REFERENCE_FOLDER
 
 CYCLE = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])  # relabels axes (x, y, z) -> (y, z, x)
 
@@ -125,3 +128,25 @@ def test_drape():
     props.frames, props.edge = 4, 0.05
     after = undo_redo(bpy.ops.ellimann.drape_garment)
     assert after["frames"][2] == 4  # the drape shows its last frame
+
+
+def rm_with_joints():
+    """The Average RM (it has joints) as a collection, one of its pieces active."""
+    collection = add_mannequin(Mannequin.load(REFERENCE_FOLDER / "average.json"))
+    bpy.context.view_layer.objects.active = next(iter(collection.objects))
+    return collection
+
+
+def test_add_armature():
+    rm_with_joints()
+    after = undo_redo(bpy.ops.ellimann.add_armature)
+    assert len(after["armatures"]) == 1
+
+
+def test_apply_pose_and_rest():
+    rm_with_joints()
+    assert bpy.ops.ellimann.add_armature() == {"FINISHED"}
+    undo_redo(bpy.ops.ellimann.apply_pose, pose="t_pose")
+    after = undo_redo(bpy.ops.ellimann.apply_pose, pose="walk")
+    assert len(after["actions"]) == 1
+    undo_redo(bpy.ops.ellimann.rest_pose)

@@ -84,8 +84,22 @@ def test_batch_to_core_formats_runs_without_blender(tmp_path, references):
                                                                     "report.csv"]
 
 
+def test_posed_core_formats_run_without_blender(tmp_path):
+    rest = tmp_path / "rest.json"
+    code, _, stderr = without_blender("synth", *REQUEST, "-o", str(rest))
+    assert code == 0, stderr
+    for pose, out in (("sit", "sit.obj"), ("walk", "walk.xml"), ("t_pose", "t.json")):
+        code, stdout, stderr = without_blender("pose", str(rest), "--pose", pose, "--cushions", "-o",
+                                               str(tmp_path / out))
+        assert code == 0, stderr
+        assert stdout.startswith(f"wrote {tmp_path / out}: 'ElliMann 165-41.5-101.25-82.75-117.5' in pose {pose}")
+    code, _, stderr = without_blender("synth", *REQUEST, "--pose", "attention", "-o", str(tmp_path / "a.obj"))
+    assert code == 0, stderr
+
+
 @pytest.mark.parametrize("argv", [["--help"], ["synth", "--help"], ["batch", "--help"], ["measure", "--help"],
-                                  ["demo", "--help"], ["drape", "--help"], ["population", "--help"]])
+                                  ["demo", "--help"], ["drape", "--help"], ["population", "--help"],
+                                  ["pose", "--help"]])
 def test_help_runs_without_blender(argv):
     code, stdout, _ = without_blender(*argv)
     assert code == 0 and "usage: ellimann" in stdout
@@ -99,6 +113,7 @@ def test_help_runs_without_blender(argv):
     (["synth", *REQUEST, "-o", "{tmp}/w.obj"], "writing {tmp}/w.obj"),
     (["batch", "{tmp}/in.csv", "-o", "{tmp}/out", "--format", "json,blend"], "--format blend"),
     (["measure", "{tmp}/w.blend"], "reading {tmp}/w.blend"),
+    (["synth", *REQUEST, "--pose", "walk", "-o", "{tmp}/w.glb"], "writing {tmp}/w.glb"),
     (["drape", "{tmp}/w.json", "-o", "{tmp}/d.blend"], "the cloth simulation"),
     (["demo", "-o", "{tmp}/demo"], "the demo (.blend files and a line-up picture)"),
 ])

@@ -90,3 +90,14 @@ def test_list_names_every_lanes_pins(capsys):
     assert matrix.main(["--list"]) == 0
     out = capsys.readouterr().out
     assert all(pin in out for lane in matrix.LANES for pin in lane.pins)
+
+
+def test_the_blender_lanes_do_not_start_without_the_gltf_validator(monkeypatch, capsys):
+    from devkit import gltf_validator
+
+    def unavailable():
+        raise gltf_validator.ValidatorUnavailableError("npm is not on PATH")
+
+    monkeypatch.setattr(gltf_validator, "module_dir", unavailable)
+    assert matrix.main(["--setup-only", "--lanes", "4.2"]) == 1
+    assert "matrix: npm is not on PATH" in capsys.readouterr().err

@@ -65,7 +65,7 @@ def test_a_body_with_shuffled_vertex_order_is_refused(tmp_path, capsys):
     order = np.random.default_rng(0).permutation(len(body.vertices))
     inverse = np.argsort(order)
     path = tmp_path / "average.obj"
-    path.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in body.vertices[order])
+    path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in body.vertices[order])
                     + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in inverse[body.faces]))
     bodies = [str(DEFAULT_REFMODELS / "small_slim.obj"), str(DEFAULT_REFMODELS / "tall_chubby.obj"), str(path)]
     out = tmp_path / "set"

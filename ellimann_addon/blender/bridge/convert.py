@@ -2,8 +2,8 @@
 
 An ellipsoid is an object using one shared unit-sphere mesh with ``matrix_world = S @ diag(D, 1)``;
 its topology fields live in ``Object.ellimann`` (and what it was traced from, ``trace``: core.trace's JSON).
-A mannequin is a collection holding those objects,
-with ``Collection.ellimann`` (role, target and measured values).
+A mannequin is a collection holding those objects, with ``Collection.ellimann`` (role, target and measured
+values, rest joints when it has a skeleton).
 """
 
 import json
@@ -21,6 +21,7 @@ from ...core.trace import PartTrace
 
 UNIT_SPHERE_NAME = "ElliMann Unit Sphere"
 UNIT_SPHERE_TOLERANCE = 1e-4  # single-precision vertices of the icosphere are within 1e-7
+RIG_KEY = "ellimann_rig"  # ID property on a mannequin's armature object (services.rig builds it)
 SIDE_COLORS = {"L": (0.85, 0.55, 0.45, 1.0), "R": (0.45, 0.6, 0.85, 1.0), "C": (0.8, 0.78, 0.72, 1.0)}
 
 
@@ -181,6 +182,9 @@ def write_collection_props(collection, mannequin):
         props.target = [float(target[m]) for m in MEASUREMENTS]
     props.reference_set = mannequin.reference_set
     props.section_fractions = json.dumps(mannequin.section_fractions)
+    props.has_joints = mannequin.joints is not None
+    if props.has_joints:
+        props.joints = np.asarray(mannequin.joints, dtype=float).tolist()
 
 
 def read_landmarks(props):
@@ -243,8 +247,22 @@ def collection_to_mannequin(collection, check=True):
     measurements = dict(zip(MEASUREMENTS, map(float, props.target))) if props.has_target else None
     traces = {obj.ellimann.part_name: trace for obj in objects if (trace := read_trace(obj)) is not None}
     mannequin = Mannequin(topology, rotation, center, semi_axes, name=collection.name, role=props.role,
-                          measurements=measurements, traces=traces or None, **read_landmarks(props))
+                          measurements=measurements, traces=traces or None, joints=read_joints(collection),
+                          **read_landmarks(props))
     return mannequin.check() if check else mannequin
+
+
+def rig_object(collection):
+    """The armature ElliMann built for a mannequin collection, or None."""
+    if collection is None:
+        return None
+    return next((o for o in collection.objects if o.type == "ARMATURE" and o.get(RIG_KEY)), None)
+
+
+def read_joints(collection):
+    """The collection's rest joints (24, 3), world space, or None if it has none."""
+    props = collection.ellimann
+    return np.array(props.joints, dtype=float).reshape(-1, 3) if props.has_joints else None
 
 
 def update_collection_geometry(collection, mannequin):

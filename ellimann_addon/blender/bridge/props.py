@@ -9,6 +9,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatVectorProperty, PointerProperty, StringProperty
 
 from ...core.constants import MEASUREMENT_LABELS, MEASUREMENTS
+from ...core.skeleton import JOINT_COUNT
 
 SIDE_ITEMS = (
     ("L", "Left", "Left side of the body (+X, Blender's .L)"),
@@ -81,6 +82,11 @@ class ELLIMANN_PG_mannequin(bpy.types.PropertyGroup):
                                       description="Where m_T cuts the mannequin, as JSON fractions of He "
                                                   "{Sh, Br, Wa, Hi} (its reference set's; empty: the female ones)")
 
+    has_joints: BoolProperty(name="Has Joints", default=False,
+                             description="Joints holds the mannequin's rest joint centres (its skeleton, for posing)")
+    joints: FloatVectorProperty(name="Joints (m)", size=(JOINT_COUNT, 3), subtype="NONE",
+                                description="Rest joint centres in SMPL order (Pelvis, L_Hip, R_Hip, ...), x, y, z "
+                                            "each, in metres")
 
 classes = (ELLIMANN_PG_part, ELLIMANN_PG_mannequin)
 

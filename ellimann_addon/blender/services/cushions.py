@@ -10,8 +10,9 @@ from ...core.cushion import mannequin_cushions
 from ...core.errors import MannequinError, Problem
 from ...core.frames import rigid_matrix
 from ..bridge.built import built_collection, new_cushion_object, remove_built
-from ..bridge.convert import collection_to_mannequin
+from ..bridge.convert import collection_to_mannequin, rig_object
 from ..bridge.selection import part_lookup
+from .rig import bind_cushions
 
 
 def rigid_frame(rotation, center):
@@ -25,7 +26,8 @@ def build_cushions(collection, subdivisions=CUSHION_LEVEL, mannequin=None):
     ``mannequin``: the core mannequin the collection was just made from, when the caller has it (the
     hulls are computed from it instead of the objects read back); None: read from the collection.
     Everything is computed before the scene is touched, so a failure (MannequinError) changes nothing.
-    Rebuilding removes only cushions ElliMann built before.
+    Rebuilding removes only cushions ElliMann built before. On a mannequin with an armature they are bound
+    to its bones (``services.rig.bind_cushions``).
     """
     if mannequin is None:
         mannequin = collection_to_mannequin(collection)
@@ -44,4 +46,6 @@ def build_cushions(collection, subdivisions=CUSHION_LEVEL, mannequin=None):
         objects.append(new_cushion_object(hull.name, parts[first], parts[second], hull.vertices, hull.faces,
                                           rigid_frame(mannequin.rotation[hull.first], mannequin.center[hull.first]),
                                           target))
+    if rig_object(collection) is not None and mannequin.joints is not None:  # a rigged mannequin: bind them too
+        bind_cushions(collection, mannequin)
     return objects, removed

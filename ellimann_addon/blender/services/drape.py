@@ -31,7 +31,10 @@ from ...core.constants import CLEARING_CUSHION_LEVEL, FIT_CUSHION_LEVEL
 from ...core.errors import ElliMannError
 from ...core.garment_fit import BodyPieces, fit_statistics
 from ...core.options import FRAME_RANGE, MAX_CLOTH_VERTICES, DrapeSettings  # noqa: F401  (DrapeSettings: public here)
+from ...core.pose import pose_mannequin
 from ..bridge.convert import mesh_from_arrays, new_collection
+from .drape_motion import PIECE_KEY, animate_drape
+from .rig import check_rig
 
 DRAPE_KEY = "ellimann_drape"  # ID property on a drape collection: the garment's name
 PIN_GROUP = "Pin"
@@ -61,6 +64,7 @@ class DrapeResult:
     cpu_seconds: np.ndarray  # CPU seconds of this process per simulated frame
     vertices: np.ndarray  # final garment vertices, world (V, 3)
     fit: dict = field(default_factory=dict)  # fit_statistics against the exact pieces
+    body: object = None  # the core mannequin as the cloth last saw it (posed at the last frame of a motion)
 
     @property
     def frames(self):
@@ -139,6 +143,7 @@ def collider_objects(pieces, collection):
             if key:
                 shared[key] = mesh
         obj = bpy.data.objects.new(f"Collider {piece.name}", mesh)
+        obj[PIECE_KEY] = piece.name
         obj.matrix_world = Matrix(np.asarray(piece.matrix).tolist())
         obj.display_type = "WIRE"
         obj.hide_render = True
@@ -153,7 +158,8 @@ def collider_objects(pieces, collection):
 
 
 def setup(garment, pieces, settings, name, parent=None):
-    """A new drape collection with the garment and its colliders; returns (collection, garment object).
+    """A new drape collection with the garment and its colliders; returns (collection, garment object,
+    collider objects).
 
     If anything fails on the way, what was built is removed (:func:`removed_on_failure`) before the
     error goes on.
@@ -163,8 +169,8 @@ def setup(garment, pieces, settings, name, parent=None):
         colliders = new_collection("Colliders", collection)
         obj = garment_object(garment, collection, settings)
         obj.modifiers[CLOTH_NAME].collision_settings.collection = colliders
-        collider_objects(pieces, colliders)
-    return collection, obj
+        objects = collider_objects(pieces, colliders)
+    return collection, obj, objects
 
 
 @contextlib.contextmanager
@@ -269,8 +275,13 @@ def _gigabytes(size):
 # ------------------------------------------------------------------------------------------------ drape
 
 
-def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None, progress=None):
+def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None, progress=None, motion=None,
+          loop=False):
     """Drape ``garment`` (a ``core.garments.BUILDERS`` key or a core Garment) on ``mannequin`` (a core Mannequin).
+
+    ``motion``: core poses (one, or a motion's frames; ``loop`` for a cycle such as the walk): the body goes
+    from rest into them and the cloth follows (``services.drape_motion``); the mannequin needs joints. The
+    fit is then measured against the body in the last frame's pose.
 
     A garment named by its key is built from the mannequin's m_T and moved clear of the pieces
     (:func:`garments.clear_of`); a Garment given as such is used as it is.
@@ -288,6 +299,8 @@ def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None,
     settings = (settings or DrapeSettings()).checked()
     scene = scene or bpy.context.scene
     mannequin.check()
+    if motion:
+        check_rig(mannequin)
     check_cloth_size(mannequin, garment, settings)
     cushions = settings.cushions and bool(mannequin.topology.cushion_pairs)
     if isinstance(garment, str):
@@ -296,13 +309,18 @@ def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None,
         clearing = BodyPieces(mannequin, cushions, CLEARING_CUSHION_LEVEL)
         garment = garments.clear_of(garment, lambda points: clearing.signed_distance(points, CLEARING_CUTOFF)[0])
     pieces = collision_pieces(mannequin, cushions, settings.sphere_subdivisions, settings.cushion_subdivisions)
-    exact = BodyPieces(mannequin, cushions, FIT_CUSHION_LEVEL)
+    exact = None if motion else BodyPieces(mannequin, cushions, FIT_CUSHION_LEVEL)
     name = name or f"Drape {garment.name} on {mannequin.name}"
     frame = scene.frame_current
     stage = "building"
     try:
         with removed_on_failure():
-            collection, obj = setup(garment, pieces, settings, name, scene.collection)
+            collection, obj, colliders = setup(garment, pieces, settings, name, scene.collection)
+            body = mannequin
+            if motion:
+                last = animate_drape(collection, colliders, obj, mannequin, motion, loop, settings.frames)
+                body = pose_mannequin(mannequin, last)
+                exact = BodyPieces(body, cushions, FIT_CUSHION_LEVEL)
             stage = "simulating"
             collection[DRAPE_KEY] = garment.name
             wall, cpu = bake(scene, obj, settings.frames, progress)
@@ -315,7 +333,7 @@ def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None,
         if isinstance(error, RuntimeError):
             raise ElliMannError(f"Blender failed while {stage} the drape: {error}") from error
         raise
-    return DrapeResult(collection, obj, garment, pieces, wall, cpu, vertices, fit)
+    return DrapeResult(collection, obj, garment, pieces, wall, cpu, vertices, fit, body)
 
 
 def mesh_piece(name, vertices, faces):

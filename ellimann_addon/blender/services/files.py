@@ -29,6 +29,11 @@ What a three.js / game-engine user finds in the .glb:
   semi_axes_m;
 - ``scene.extras.ellimann`` = {format, version, name, role, units, up, target_cm, measured_cm}
   (target_cm only when the mannequin has a target; measured_cm is m_T of the ellipsoids).
+
+A mannequin with an armature (``services.rig``) is a skinned glTF: one joint node per bone (SMPL names),
+every piece a skinned mesh weighted fully to its bone (the exporter writes each piece's vertices at rest
+in the armature's space, so such a node carries no transform of its own; ``extras.ellimann`` still
+gives its rest frame), the armature in its current pose, and its action (the walk) as an animation.
 """
 
 import json
@@ -106,8 +111,11 @@ def export_gltf(collection, path):
     objects = [o for o in objects_recursive(collection) if o.ellimann.is_part]
     node_extras = {o.name: part_extras(o) for o in objects}
     with atomic_output(path) as temp:
+        # Skins and animations are the exporter's defaults; the armature's node transforms are its current
+        # pose rather than its rest (a posed mannequin shows posed; an action plays the same either way).
         result = bpy.ops.export_scene.gltf(filepath=temp, export_format="GLB", export_extras=True,
-                                           collection=collection.name, export_yup=True, use_renderable=True)
+                                           collection=collection.name, export_yup=True, use_renderable=True,
+                                           export_rest_position_armature=False)
         if result != {"FINISHED"}:
             raise ElliMannError(f"path: Blender's glTF exporter did not finish ({result})")
         _set_extras(temp, node_extras, scene_extras(mannequin))
@@ -154,25 +162,33 @@ def read_glb_json(path):
 
 def write_mannequin(mannequin, paths, measured=None, cushions=False):
     """Write one mannequin to every .blend, .glb and .obj in ``paths`` (format from the extension), all
-    from one empty scene. Returns the paths. (.json and MJCF need no Blender: ``core.writers``.)
+    from one empty scene. Returns the paths. (.json and MJCF need no Blender: ``core.writers``; a posed
+    mannequin: ``services.posing``.)
 
     ``cushions``: the files show the cushions instead of the ellipsoids they replace. A path of another
     kind raises ElliMannError before anything is written; an OSError names the file that failed
     (``filename``, as given in ``paths``).
     """
-    paths = [os.fspath(p) for p in paths]
-    other = [p for p in paths if extension_of(p) not in BLENDER_FORMATS]
-    if other:
-        raise ElliMannError(f"path: {other[0]!r} is not a .blend, .glb or .obj file")
+    paths = checked_paths(paths)
     if paths:
         empty_scene()
         collection = add_mannequin(mannequin, measured, cushions)
         for path in paths:
-            _write_blender_file(path, collection)
+            write_blender_file(path, collection)
     return paths
 
 
-def _write_blender_file(path, collection):
+def checked_paths(paths):
+    """``paths`` as strings; ElliMannError naming the first that is not a .blend, .glb or .obj file."""
+    paths = [os.fspath(p) for p in paths]
+    other = [p for p in paths if extension_of(p) not in BLENDER_FORMATS]
+    if other:
+        raise ElliMannError(f"path: {other[0]!r} is not a .blend, .glb or .obj file")
+    return paths
+
+
+def write_blender_file(path, collection):
+    """Write the scene holding ``collection`` to ``path`` (.blend, .glb or .obj by its extension), atomically."""
     kind = extension_of(path)
     if kind == "glb":  # atomic itself; leaves out what renders do not show (ellipsoids a cushion replaces)
         with blender_output():

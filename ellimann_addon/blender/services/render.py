@@ -32,7 +32,7 @@ def render_lineup(mannequins, filepath, labels=None, cushions=False, width=2000)
         lo, hi = bounds(mannequin.rotation, mannequin.center, mannequin.semi_axes)
         lo, hi = lo.min(axis=0), hi.max(axis=0)
         offset = np.array([x - lo[0], 0.0, 0.0])
-        add_mannequin(mannequin.copy(center=mannequin.center + offset), cushions=cushions)
+        add_mannequin(mannequin.translated(offset), cushions=cushions)
         _add_label(label, (x + 0.5 * (hi[0] - lo[0]), lo[1] - 0.2, -0.05))
         low, high = np.minimum(low, lo + offset), np.maximum(high, hi + offset)
         x += hi[0] - lo[0] + GAP

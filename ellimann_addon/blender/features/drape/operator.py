@@ -5,11 +5,22 @@ import contextlib
 import bpy
 
 from ....core.errors import ElliMannError, MannequinError
+from ....core.motion import clamped_motion
+from ....core.pose import require_joints
 from ... import ids
 from ...services.drape import drape
 from ..base import MannequinOperator, OperatorError, has_mannequin, mannequin_or_cancel
+from .props import REST
 
 PENETRATION_WARNING = 0.01  # fraction of garment vertices inside the body worth a warning
+
+
+def body_motion(mannequin, pose):
+    """(core poses or None, loops) for the Drape panel's Body: None at rest; ElliMannError without joints."""
+    if pose == REST:
+        return None, False
+    poses, _, loops = clamped_motion(pose, require_joints(mannequin))
+    return poses, loops
 
 
 @contextlib.contextmanager
@@ -39,8 +50,10 @@ class ELLIMANN_OT_drape_garment(MannequinOperator, bpy.types.Operator):
         mannequin = mannequin_or_cancel(collection)
         settings = props.settings()
         try:
+            motion, loop = body_motion(mannequin, props.pose)
             with progress_bar(context.window_manager, settings.frames) as update:
-                result = drape(mannequin, props.garment, settings, scene=context.scene, progress=update)
+                result = drape(mannequin, props.garment, settings, scene=context.scene, progress=update,
+                               motion=motion, loop=loop)
         except MannequinError as error:
             raise OperatorError(f"Cannot drape '{collection.name}'", error.problems) from error
         except ElliMannError as error:

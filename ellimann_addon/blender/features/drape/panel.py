@@ -22,6 +22,7 @@ class ELLIMANN_PT_drape(SubPanel, bpy.types.Panel):
         props = context.scene.ellimann_drape
         layout.row().prop(props, "garment", expand=True)
         column = layout.column(align=True)
+        column.prop(props, "pose")
         column.prop(props, "frames")
         column.prop(props, "edge")
         column = layout.column(align=True)

@@ -4,6 +4,12 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
 from ....core.options import DRAPE, DrapeSettings
+from ..pose.operators import POSE_ITEMS
+
+REST = "REST"
+# The body under the cloth: as traced, or moving from rest into a standard pose or the walk.
+BODY_POSE_ITEMS = ((REST, "Rest", "The mannequin at rest (the traced A-pose), standing still"),
+                   *(item for item in POSE_ITEMS if item[0] != "a_pose"))
 
 # Items, defaults and descriptions: core.options.DRAPE (the command line's too).
 GARMENT_ITEMS = tuple((c.value, c.label, c.description) for c in DRAPE["garment"].choices)  # keys as they are
@@ -30,6 +36,9 @@ class ELLIMANN_PG_drape(bpy.types.PropertyGroup):
                            description=DRAPE["cushions"].description)
     sphere_subdivisions: _subdivisions("sphere_subdivisions")
     cushion_subdivisions: _subdivisions("cushion_subdivisions")
+    pose: EnumProperty(name="Body", items=BODY_POSE_ITEMS, default=REST,
+                       description="The body under the cloth: at rest, or turning from rest into a standard pose "
+                                   "(then holding it) or walking, the cloth following (needs joints)")
     status: StringProperty(name="Last Drape", description="Outcome of the last drape")
 
     def settings(self):

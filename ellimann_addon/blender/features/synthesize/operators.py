@@ -9,12 +9,13 @@ from ....core.measure import measurement_line
 from ....core.synthesis import relative_error
 from ... import ids
 from ...bridge.convert import ellipsoid_objects
+from ...services.rig import build_rig, check_rig
 from ...services.scene import add_mannequin
 from .request import extra_of, request_of, synthesize_request
 
 
 class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
-    """Build a new mannequin from the five measurements (segmented IDW over the Reference Mannequins)"""
+    """Build a new mannequin from the five measurements (segmented IDW over the RMs), rigged if they have joints"""
 
     bl_idname = ids.SYNTHESIZE_MANNEQUIN
     bl_label = "Synthesize"
@@ -29,7 +30,10 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
         try:
             mannequin, measured, warnings = synthesize_request(props)
             five = {key: measured[key] for key in MEASUREMENTS}
+            if mannequin.joints is not None:
+                check_rig(mannequin)  # before the scene changes
             collection = add_mannequin(mannequin, five, cushions=props.output == "CUSHIONS")
+            rig = build_rig(collection, mannequin) if mannequin.joints is not None else None
         except ElliMannError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
@@ -40,7 +44,8 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
         worst = relative_error(five, request_of(props)).max()
         values = measurement_line(five) + "".join(f", {key} {measured[key]:.2f}" for key in extra_of(props))
         self.report({"INFO"}, f"Synthesized '{collection.name}' ({len(ellipsoid_objects(collection))} ellipsoids, "
-                              f"{props.mode.lower()}): m_T {values} cm, max error {worst:.2f}%")
+                              f"{props.mode.lower()}{', with an armature' if rig else ''}): m_T {values} cm, "
+                              f"max error {worst:.2f}%")
         return {"FINISHED"}
 
 

@@ -1,0 +1,46 @@
+"""Posed mannequins in Blender files: the armature, every piece bound to its bone, in a pose or moving.
+
+``write_posed`` is what the command line calls for ``--pose`` with .blend and .glb outputs
+(``cli.common.write_posed``; .json, MJCF and .obj come from ``core.posed_files``): from an empty scene,
+the rest mannequin, its armature (``services.rig``), one pose or a looping motion as an action on the
+timeline (the walk), then each file through ``services.files`` (atomically). A .blend opens posed (or
+playing the walk); a .glb is a skinned glTF in that pose with the motion as an animation.
+"""
+
+import bpy
+
+from ...core.errors import ElliMannError
+from ...core.poses import WALK_FPS
+from .files import checked_paths, write_blender_file
+from .rig import apply_motion, apply_pose, build_rig, check_rig
+from .scene import add_mannequin, empty_scene
+
+
+def write_posed(mannequin, frames, paths, cushions=False, fps=WALK_FPS):
+    """Write ``mannequin`` (at rest, with joints) posed by ``frames`` (core Poses, already within the limits:
+    one for a still pose, several for a looping motion at ``fps``) to every .blend, .glb and .obj in ``paths``.
+
+    Raises ElliMannError before anything is written for a path of another kind, no frames, or a mannequin
+    that cannot be rigged (no joints, a part without a bone). Returns the paths.
+    """
+    paths = checked_paths(paths)
+    if not frames:
+        raise ElliMannError("pose: no frames to write")
+    check_rig(mannequin)
+    if not paths:
+        return paths
+    scene = empty_scene()
+    collection = add_mannequin(mannequin, cushions=cushions)
+    rig = build_rig(collection, mannequin)
+    if len(frames) == 1:
+        apply_pose(rig, frames[0])
+    else:
+        name = frames[0].name.split()[0] if frames[0].name else "motion"
+        apply_motion(rig, frames, f"{collection.name} {name}", loop=True)
+        scene.render.fps, scene.render.fps_base = int(round(fps)), 1.0
+        scene.frame_start, scene.frame_end = 1, len(frames)
+        scene.frame_set(1)
+    bpy.context.view_layer.update()
+    for path in paths:
+        write_blender_file(path, collection)
+    return paths

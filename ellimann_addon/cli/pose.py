@@ -1,0 +1,48 @@
+"""``ellimann pose IN.json --pose NAME -o OUT``: an existing mannequin (with joints) written in a pose."""
+
+import sys
+
+from ..core.errors import MannequinError
+from ..core.formats import FORMATS, format_of
+from . import common
+from .common import PROG, UsageError
+
+
+def add_parser(commands):
+    pose = commands.add_parser("pose", help="write a mannequin in a pose",
+                               description="Write a mannequin (a .json with joints) in a standard pose or a pose "
+                                           "file; its measurements stay the rest pose's.")
+    pose.add_argument("input", metavar="IN.json", help="the mannequin (ElliMann's JSON, with joints)")
+    pose.add_argument("-o", "--output", required=True, metavar="OUT",
+                      help="output file: .json (rest mannequin, joints and the pose), .xml (MJCF: an articulated "
+                           "body, the pose as keyframes), .obj (the posed pieces), .glb or .blend (Blender's rig)")
+    pose.add_argument("--cushions", action="store_true",
+                      help="cushions instead of their ellipsoids (split at the joints they cross)")
+    common.add_verbose(pose)
+    common.add_pose_option(pose)
+    pose.set_defaults(run=run, blender=needs_blender)
+
+
+def needs_blender(args):
+    kind = format_of(args.output)
+    return f"writing {args.output}" if kind is not None and kind.needs_blender_for(True) else None
+
+
+def run(args):
+    from ..core.mannequin import Mannequin
+
+    kind = common.output_kind(args.output)
+    if args.pose is None:
+        raise UsageError(f"--pose is required: one of the standard poses or a pose .json (see {PROG} pose --help)")
+    if format_of(args.input) is not FORMATS["json"]:
+        raise UsageError(f"IN must be a mannequin .json file, got {args.input!r}")
+    pose_file = common.check_pose_argument(args, [kind])
+    try:
+        mannequin = Mannequin.load(args.input)
+    except MannequinError as error:
+        raise UsageError(f"{args.input}: {error}") from None
+    frames = common.pose_frames(args, mannequin, pose_file)
+    common.write(mannequin, [args.output], None, args.cushions, frames, args.fps)
+    count = f" ({len(frames)} frames)" if len(frames) > 1 else ""
+    common.say(f"wrote {args.output}: '{mannequin.name}' in pose {args.pose}{count}", file=sys.stdout)
+    return 0

@@ -1,0 +1,110 @@
+"""Dev tool (not shipped): Workbench pictures of posing, for docs/posing.md.
+
+    python -m tools.pose_pictures poses OUT.png [--mannequin RM.json]   # the five standard poses side by side
+    python -m tools.pose_pictures walk-drape OUT.png [--frames N]        # a frame of the tube dress on the walk
+
+Each mannequin is rigged and posed the way the Pose panel does it (``services.rig``; the walk shown at its
+frame 7, mid-stride); the walking drape is ``services.drape`` with the walk as its motion, three of its
+frames side by side, seen from the side.
+"""
+
+import argparse
+import pathlib
+import tempfile
+
+import bpy
+import numpy as np
+
+import ellimann_addon
+from ellimann_addon.blender.bridge.convert import objects_recursive
+from ellimann_addon.blender.services import teardown
+from ellimann_addon.blender.services.chatter import blender_output
+from ellimann_addon.blender.services.drape import DrapeSettings, drape
+from ellimann_addon.blender.services.render import render_view
+from ellimann_addon.blender.services.rig import build_rig, pose_standard
+from ellimann_addon.blender.services.scene import add_mannequin, empty_scene
+from ellimann_addon.core.files import atomic_output
+from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.motion import clamped_motion
+from ellimann_addon.core.poses import POSE_NAMES
+from ellimann_addon.core.reference_set import REFERENCE_FOLDER
+
+SPACING = 1.3  # m between mannequins of the line-up
+WALK_FRAME = 7
+
+
+def poses_picture(mannequin, path, width=2000):
+    """The standard poses of ``mannequin`` side by side, seen from the front and a little to the side."""
+    with blender_output():
+        scene = empty_scene()
+        for index, name in enumerate(POSE_NAMES):
+            placed = mannequin.translated((SPACING * (index - (len(POSE_NAMES) - 1) / 2), 0.0, 0.0))
+            placed.name = name
+            collection = add_mannequin(placed, cushions=True)
+            rig = build_rig(collection, placed)
+            pose_standard(rig, placed.joints, name, scene, name)
+        scene.frame_set(WALK_FRAME)
+        half = SPACING * len(POSE_NAMES) / 2
+        render_view(path, np.array([-half, -0.6, 0.0]), np.array([half, 0.6, 1.75]), width=width, azimuth=20.0)
+    return path
+
+
+def walk_drape_picture(mannequin, path, frames=48, shown=(36, 42, 48), width=700):
+    """A tube dress draped on the walking mannequin: the frames ``shown`` side by side, seen from its left
+    side, each framed on the body where it is then."""
+    poses, _, loop = clamped_motion("walk", mannequin.joints)
+    with blender_output():
+        scene = empty_scene()
+        standing = add_mannequin(mannequin, cushions=True)
+        for obj in objects_recursive(standing):  # the drape's colliders are the moving body
+            obj.hide_render = True
+        result = drape(mannequin, "tube_dress", DrapeSettings(frames=frames, edge=0.02), motion=poses, loop=loop)
+        rig = next(o for o in result.collection.objects if o.type == "ARMATURE")
+        pictures = []
+        with tempfile.TemporaryDirectory() as folder:
+            for frame in shown:
+                scene.frame_set(frame)
+                pelvis = np.array(rig.matrix_world @ rig.pose.bones["Pelvis"].head)
+                low, high = pelvis + (-0.5, -0.5, -pelvis[2]), pelvis + (0.5, 0.5, 1.75 - pelvis[2])
+                pictures.append(render_view(str(pathlib.Path(folder) / f"{frame}.png"), low, high, width, 80.0))
+            side_by_side(pictures, path)
+    print(f"walk drape: {result.summary()}")
+    return path
+
+
+def side_by_side(paths, out):
+    """One PNG of equally sized PNGs in a row (through Blender's image API), written atomically."""
+    images = [bpy.data.images.load(str(p)) for p in paths]
+    width, height = images[0].size
+    row = np.concatenate([np.array(im.pixels[:], dtype=np.float32).reshape(height, width, 4) for im in images],
+                         axis=1)
+    combined = bpy.data.images.new("side by side", width * len(images), height, alpha=True)
+    combined.pixels.foreach_set(row.ravel())
+    with atomic_output(out) as temp:
+        combined.filepath_raw, combined.file_format = temp, "PNG"
+        combined.save()
+    for image in [*images, combined]:
+        bpy.data.images.remove(image)
+    return out
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m tools.pose_pictures", description=__doc__.splitlines()[0])
+    parser.add_argument("what", choices=("poses", "walk-drape"))
+    parser.add_argument("out", metavar="OUT.png")
+    parser.add_argument("--mannequin", default=str(REFERENCE_FOLDER / "average.json"))
+    parser.add_argument("--frames", type=int, default=48)
+    args = parser.parse_args(argv)
+    ellimann_addon.register()
+    mannequin = Mannequin.load(args.mannequin)
+    if args.what == "poses":
+        poses_picture(mannequin, args.out)
+    else:
+        walk_drape_picture(mannequin, args.out, args.frames)
+    print(f"wrote {args.out}")
+    bpy.ops.wm.read_homefile(use_empty=True)
+
+
+if __name__ == "__main__":
+    main()
+    teardown.exit_with(0)
