@@ -95,3 +95,18 @@ def test_a_mannequins_exported_obj_measures_as_the_mannequin(tmp_path, capsys):
     assert set(mesh) == set(closed_form)
     for key, value in closed_form.items():
         assert mesh[key] == pytest.approx(value, abs=ISO_ALLOWANCE[key]), key
+
+
+def test_the_twin_stands_beside_the_body_in_one_piece():
+    """Every piece and the armature move together (children with their parents): the twin keeps its width."""
+    from ellimann_addon.blender.bridge.convert import collection_to_mannequin
+
+    average = read_obj(TRACING_FOLDER / "average.obj")
+    body_object(average.vertices, average.faces, "average")
+    collections = set(bpy.data.collections)
+    bpy.ops.ellimann.synthesize_from_mesh()
+    (twin,) = set(bpy.data.collections) - collections
+    placed = collection_to_mannequin(twin)
+    width = np.ptp(average.vertices[:, 0])
+    assert placed.center[:, 0].min() > average.vertices[:, 0].max()  # beside the body, not inside it
+    assert np.ptp(placed.center[:, 0]) < width  # not pulled apart

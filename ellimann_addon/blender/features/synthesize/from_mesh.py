@@ -2,11 +2,14 @@
 (the panel's options and reference set), in a new collection beside the body; both reported."""
 
 import bpy
+import numpy as np
+from mathutils import Vector
 
 from ....core.constants import MEASUREMENTS
 from ....core.errors import ElliMannError
 from ....core.measure import measurement_line
 from ... import ids
+from ...services.rig import build_rig, check_rig
 from ...services.scene import add_mannequin
 from ..base import ElliMannOperator, OperatorError
 from ..measure.body import is_body_mesh, measure_object, values_line
@@ -49,13 +52,17 @@ class ELLIMANN_OT_synthesize_from_mesh(ElliMannOperator, bpy.types.Operator):
                 mannequin, measured, warnings = synthesize_extra(reference, five, extra, options_of(props))
             except ElliMannError as error:
                 raise OperatorError(str(error)) from None
+            # beside the body (a synthesized mannequin stands at x = 0): moved in the core, joints and all
+            corners = [obj.matrix_world @ Vector(corner) for corner in obj.bound_box]
+            leftmost = float(np.min(mannequin.center[:, 0] - mannequin.semi_axes.max(axis=1)))
+            mannequin = mannequin.translated((max(c.x for c in corners) - leftmost + 0.1, 0.0, 0.0))
+            if mannequin.joints is not None:
+                check_rig(mannequin)  # before the scene changes
             collection = add_mannequin(mannequin, five, cushions=props.output == "CUSHIONS")
+            if mannequin.joints is not None:
+                build_rig(collection, mannequin)  # posable as a synthesized mannequin is
         finally:
             wm.progress_end()
-        # beside the body: the twin's pieces are registered at x = 0
-        width = float(max(v[0] for v in obj.bound_box) - min(v[0] for v in obj.bound_box)) * max(obj.scale)
-        for piece in collection.all_objects:
-            piece.location.x += obj.matrix_world.translation.x + width
         props.target = collection
         for line in problems + warnings:
             self.report({"WARNING"}, line)
