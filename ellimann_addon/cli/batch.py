@@ -12,10 +12,12 @@ import numpy as np
 
 from ..core.constants import MEASUREMENTS
 from ..core.errors import ElliMannError, MeasurementError, ReferenceSetError
+from ..core.extra_measures import EXTRA_MEASUREMENTS
 from ..core.files import atomic_write_text, incomplete
 from ..core.formats import FORMATS
 from ..core.measure import as_dict
 from ..core.refine import EXACT_TOLERANCE
+from ..core.refine_extra import extra_request_problems, meet_extra
 from ..core.request import validate_request
 from ..core.skeleton import JOINT_NAMES
 from . import common, distributed
@@ -31,8 +33,10 @@ def add_parser(commands):
     batch = commands.add_parser("batch", help="synthesize every row of a CSV",
                                 description="One mannequin per CSV row. The header names the columns "
                                             "He,Sh,Br,Wa,Hi (cm) and optionally name and references (a row's "
-                                            "reference set: female, male or a folder; empty: --references). "
-                                            "Writes the files and "
+                                            "reference set: female, male or a folder; empty: --references) "
+                                            "and any of the extra measurements (neck, upper_arm, thigh, calf, "
+                                            "crotch_height, arm_length: the keys measure --json prints; an empty "
+                                            "cell leaves it to the reference set). Writes the files and "
                                             "DIR/report.csv (requested vs measured), row by row into "
                                             "DIR/report.partial.csv while it runs. Bad or failed rows are "
                                             "reported and skipped; the exit code is 1 if any row failed, 3 if "
@@ -101,7 +105,8 @@ def read_rows(path, reference_of):
     columns = {}
     for index, title in enumerate(header):
         key = title.strip()
-        canonical = next((m for m in MEASUREMENTS + ("name", "references") if m.lower() == key.lower()), None)
+        canonical = next((m for m in MEASUREMENTS + EXTRA_MEASUREMENTS + ("name", "references")
+                          if m.lower() == key.lower()), None)
         if canonical in columns:
             raise UsageError(f"{path}: column {canonical} appears twice in the header")
         if canonical:
@@ -131,12 +136,29 @@ def read_rows(path, reference_of):
                 except ValueError:
                     raise MeasurementError(key, f"{cell!r} is not a number (cm)") from None
             warnings = validate_request(values, reference.ranges, reference.absurd_limits)
+            extra = _extra_cells(record, columns)
+            problems = extra_request_problems(dict(zip(MEASUREMENTS, values)), extra)
+            if problems:
+                raise MeasurementError(problems[0].split(" ")[0], problems[0].split(" ", 1)[1])
             if name and not NAME_PATTERN.match(name):
                 raise MeasurementError("name", f"{name!r} must be letters, digits, '.', '_' or '-' (a file name)")
-            rows.append((line, name, values, None, warnings, reference))
+            rows.append((line, name, values, None, warnings, reference, extra))
         except MeasurementError as error:
-            rows.append((line, name, None, str(error), [], reference))
+            rows.append((line, name, None, str(error), [], reference, {}))
     return rows
+
+
+def _extra_cells(record, columns):
+    """The extra measurements a row gives (an empty cell: not given, the reference set's)."""
+    extra = {}
+    for key in EXTRA_MEASUREMENTS:
+        cell = record[columns[key]].strip() if key in columns and columns[key] < len(record) else ""
+        if cell:
+            try:
+                extra[key] = float(cell)
+            except ValueError:
+                raise MeasurementError(key, f"{cell!r} is not a number (cm)") from None
+    return extra
 
 
 def name_rows(rows):
@@ -144,7 +166,7 @@ def name_rows(rows):
     whose name an earlier row already uses (letter case ignored: the files would clash on macOS and
     Windows). Runs over the whole CSV before sharding, so every shard refuses the same rows."""
     seen, named = {}, []
-    for line, name, values, error, warnings, reference in rows:
+    for line, name, values, error, warnings, reference, extra in rows:
         name = name or f"row-{line - 1:05d}"
         key = name.casefold()
         if error is None and key in seen:
@@ -153,7 +175,7 @@ def name_rows(rows):
             error = f"name: {name!r} is already used on line {first_line}{same}"
         if error is None:
             seen[key] = (line, name)
-        named.append((line, name, values, error, warnings, reference))
+        named.append((line, name, values, error, warnings, reference, extra))
     return named
 
 
@@ -187,7 +209,7 @@ def _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file):
     suffix = "" if shards == 1 else f"-{shard}-of-{shards}"
     report = Report(os.path.join(args.output, f"report{suffix}.csv"))
     jobs, shown = [], 0
-    for line, name, values, error, warnings, reference in mine:
+    for line, name, values, error, warnings, reference, extra in mine:
         if error is not None:
             common.say(f"{PROG} batch: line {line}: skipped: {error}")
             report.add(common.report_row(line, name, "error", error, values))
@@ -196,7 +218,7 @@ def _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file):
             shown += 1
             if shown <= MAX_WARNING_LINES:
                 common.say(f"{PROG} batch: line {line}: warning: {warning}")
-        jobs.append((line, name, values, warnings, reference))
+        jobs.append((line, name, values, warnings, extra, reference))
     if shown > MAX_WARNING_LINES:
         common.say(f"{PROG} batch: {shown - MAX_WARNING_LINES} more warning(s) of requests outside the reference "
                    f"range; every row's are in {report.path}")
@@ -207,7 +229,7 @@ def _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file):
         groups.setdefault(id(job[-1]), []).append(job)
     chunks = [group[start:start + CHUNK] for group in groups.values() for start in range(0, len(group), CHUNK)]
     sets = [chunk[0][-1] for chunk in chunks]
-    requests = [[values for _, _, values, _, _ in chunk] for chunk in chunks]
+    requests = [[job[2] for job in chunk] for chunk in chunks]
     bundles = {}  # one batch file per reference set: mannequins.npz, or mannequins-NAME.npz when a batch uses several
     if NPZ in formats:
         for reference in dict.fromkeys(sets):
@@ -218,9 +240,9 @@ def _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file):
                else ((index, synthesize_chunk(sets[index], chunk, options)) for index, chunk in enumerate(requests)))
     try:
         for index, result in results:
-            for i, (line, name, values, warnings, reference) in enumerate(chunks[index]):
+            for i, (line, name, values, warnings, extra, reference) in enumerate(chunks[index]):
                 report.add(_row(args, formats, result, i, line, name, values, warnings, reference.name,
-                                bundles.get(id(reference)), index, pose_file))
+                                bundles.get(id(reference)), index, pose_file, extra))
                 progress.step(name)
         for bundle in bundles.values():
             bundle.write()
@@ -321,15 +343,26 @@ class ChunkResult:
                          joints=None if self.joints is None else self.joints[i], **self.landmarks)
 
 
-def _row(args, formats, result, i, line, name, values, warnings, references, bundle=None, chunk=0, pose_file=None):
+def _row(args, formats, result, i, line, name, values, warnings, references, bundle=None, chunk=0, pose_file=None,
+         extra=None):
     """Write (or, with --resume, keep) the files of one synthesized row, and add it to the batch file; its report
-    row. A failure is that row's: one line on stderr and status "error", and the batch goes on."""
+    row. A failure is that row's: one line on stderr and status "error", and the batch goes on. A row with extra
+    measurements is deformed to meet them too (exact mode; the report's message gives what they came to; the
+    batch file holds the five's mannequin)."""
     if result.errors[i] is not None:
         common.say(f"{PROG} batch: line {line}: failed: {result.errors[i]}")
         return common.report_row(line, name, "error", result.errors[i], values)
     paths = [os.path.join(args.output, f"{name}.{common.extension(kind)}") for kind in formats if kind != NPZ]
     notes = list(warnings)
-    misses = common.misses(result.measured[i], values) if args.mode == "exact" else []  # = not result.converged[i]
+    mannequin, measured = result.mannequin(i, name, values), result.measured[i]
+    if extra and args.mode == "exact":
+        mannequin, achieved, missed_extra = meet_extra(mannequin, extra)
+        measured = np.array([achieved[key] for key in MEASUREMENTS])
+        notes.append("extra: " + ", ".join(f"{key} {achieved[key]:.2f}" for key in extra))
+        notes += [f"exact mode missed {text}" for text in missed_extra]
+    elif extra:
+        notes.append("the extra measurements are met in exact mode only (IDW gives the reference set's)")
+    misses = common.misses(measured, values) if args.mode == "exact" else []  # = not result.converged[i]
     if misses:
         notes.append(common.missed_text(misses))
         common.say(f"{PROG} batch: line {line}: warning: {common.missed_text(misses)}")
@@ -338,21 +371,20 @@ def _row(args, formats, result, i, line, name, values, warnings, references, bun
     if bundle is not None:
         bundle.add(chunk, name, values, result, i)
     if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths) and paths:
-        row = common.report_row(line, name, status, "; ".join(notes + ["kept (--resume)"]), values, result.measured[i],
+        row = common.report_row(line, name, status, "; ".join(notes + ["kept (--resume)"]), values, measured,
                                 listed, references)
         row["kept"] = True
         return row
     try:
         if paths:
-            mannequin = result.mannequin(i, name, values)
             frames = common.pose_frames(args, mannequin, pose_file)
-            common.write(mannequin, paths, as_dict(result.measured[i]), args.cushions, frames, args.fps)
+            common.write(mannequin, paths, as_dict(measured), args.cushions, frames, args.fps)
     except (ElliMannError, OSError, RuntimeError) as error:
         common.say(f"{PROG} batch: line {line}: failed: {common.one_line(error)}")
         if bundle is not None:
             bundle.drop(chunk, name)
         return common.report_row(line, name, "error", common.one_line(error), values)
-    return common.report_row(line, name, status, "; ".join(notes), values, result.measured[i], listed, references)
+    return common.report_row(line, name, status, "; ".join(notes), values, measured, listed, references)
 
 
 class Bundle:

@@ -1,22 +1,35 @@
-"""``ellimann measure``: m_T of a .json mannequin (no Blender) or of a .blend (Blender)."""
+"""``ellimann measure``: m_T and the extra measurements of a .json mannequin (no Blender), of a .blend (Blender),
+or of a body mesh (.obj / .ply / .stl, no Blender)."""
 
 import json
+import math
 import os
 import sys
 
+from ..core.body_measure import ALL_MEASUREMENTS, measure_body_mesh
+from ..core.body_mesh import MESH_EXTENSIONS, UNITS, UP_AXES, BodyMeshError, read_body_mesh
 from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS
 from ..core.errors import MannequinError
+from ..core.extra_measures import EXTRA_LABELS, mannequin_extra_measurements
 from ..core.mannequin import Mannequin
 from . import common
 from .common import UsageError
 
+LABELS = {**MEASUREMENT_LABELS, **EXTRA_LABELS}
+
 
 def add_parser(commands):
-    measure = commands.add_parser("measure", help="m_T of a mannequin file",
-                                  description="Tailor measurements (m_T) of a .json or .blend mannequin, in cm.")
+    measure = commands.add_parser("measure", help="measurements of a mannequin file or a body mesh",
+                                  description="Tailor measurements (m_T and the extra ones, docs/measurements.md) of a "
+                                              ".json or .blend mannequin or of an upright A-pose body mesh "
+                                              "(.obj, .ply, .stl), in cm.")
     measure.add_argument("file", metavar="FILE")
     measure.add_argument("--json", action="store_true",
-                         help='print exactly {"He": …, "Sh": …, "Br": …, "Wa": …, "Hi": …}')
+                         help='print {"He": …, "Sh": …, "Br": …, "Wa": …, "Hi": …, "neck": …, …} (a body mesh: '
+                              'only the measurements that could be taken)')
+    measure.add_argument("--up", choices=UP_AXES, help="a body mesh's up axis (default: y for .obj, as Blender "
+                                                       "imports it; z for .ply and .stl)")
+    measure.add_argument("--unit", choices=tuple(UNITS), default="m", help="a body mesh's length unit (default m)")
     measure.add_argument("--collection", help="the mannequin collection to measure in a .blend holding several")
     common.add_references(measure, "measure at the section heights of this reference set instead of those the "
                                    "mannequin records (its own set's; female for files that record none)",
@@ -35,27 +48,57 @@ def run(args):
     kind = os.path.splitext(path)[1].lower()
     if not os.path.isfile(path):
         raise UsageError(f"{path}: no such file")
+    if kind in MESH_EXTENSIONS:
+        values, problems = measure_mesh_file(path, args)
+        if not values:
+            raise UsageError(f"{path}: {problems[0]}")
+        for problem in problems:
+            common.say(f"{common.PROG} measure: warning: {path}: {problem}")
+        _print(values, args.json, path, f"{path}: body mesh")
+        return 0
     if kind == ".json":
         mannequin = load_json_mannequin(path)
     elif kind == ".blend":
         mannequin = load_blend_mannequin(path, args.collection)
     else:
-        raise UsageError(f"FILE must be a .json or .blend mannequin, got {path!r}")
+        raise UsageError(f"FILE must be a .json or .blend mannequin or a {'/'.join(MESH_EXTENSIONS)} body mesh, "
+                         f"got {path!r}")
     if args.references:
         reference = common.references(args)
         mannequin = mannequin.copy(reference_set=reference.name, section_fractions=reference.section_fractions)
-    values = mannequin.measure()
-    if args.json:
-        try:
-            text = json.dumps({key: round(values[key], 4) for key in MEASUREMENTS}, allow_nan=False)
-        except ValueError:  # NaN or infinity: not JSON, and not a measurement
-            raise UsageError(f"{path}: m_T is not finite ({common.format_me(values.values())} cm)") from None
-        print(text)
-    else:
-        common.say(f"{mannequin.name or path}: m_T", file=sys.stdout)
-        for key in MEASUREMENTS:
-            print(f"  {key} {MEASUREMENT_LABELS[key]:<17} {values[key]:9.2f} cm")
+    values = dict(mannequin.measure())
+    values.update(mannequin_extra_measurements(mannequin))
+    _print(values, args.json, path, f"{mannequin.name or path}: m_T and more")
     return 0
+
+
+def measure_mesh_file(path, args):
+    """({key: cm} of what could be measured, [problem lines]) of a body mesh file."""
+    try:
+        vertices, faces = read_body_mesh(path, args.up, args.unit)
+    except BodyMeshError as error:
+        raise UsageError(common.one_line(error)) from None
+    fractions = common.references(args).section_fractions if args.references else None
+    result = measure_body_mesh(vertices, faces, fractions)
+    return result.values, result.problems
+
+
+def _print(values, as_json, path, title):
+    """The measurements, as JSON or a table; non-finite ones: the five refuse, an extra one (a mannequin without
+    arm or leg pieces) is left out with a warning."""
+    five = [values[key] for key in MEASUREMENTS if key in values]
+    if not all(math.isfinite(value) for value in five):
+        raise UsageError(f"{path}: m_T is not finite ({common.format_me(five)} cm)")
+    lost = [key for key in ALL_MEASUREMENTS if key in values and not math.isfinite(values[key])]
+    if lost:
+        common.say(f"{common.PROG} measure: warning: {path}: {', '.join(lost)} cannot be taken (no such pieces)")
+    keys = [key for key in ALL_MEASUREMENTS if key in values and key not in lost]
+    if as_json:
+        print(json.dumps({key: round(values[key], 4) for key in keys}))
+    else:
+        common.say(title, file=sys.stdout)
+        for key in keys:
+            print(f"  {key} {LABELS[key]:<17} {values[key]:9.2f} cm")
 
 
 def load_json_mannequin(path):

@@ -1,11 +1,13 @@
-"""``ellimann synth``: one mannequin from five measurements, written as .json/.xml (no Blender) or
-.blend/.glb/.obj (Blender)."""
+"""``ellimann synth``: one mannequin from five measurements (and any of the extra ones), or from a body mesh's
+own measurements (``--from body.obj``), written as .json/.xml (no Blender) or .blend/.glb/.obj (Blender)."""
 
 import sys
 
+from ..core.body_mesh import UNITS, UP_AXES
 from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS, RANGES
+from ..core.errors import ElliMannError
+from ..core.extra_measures import EXTRA_ABSURD_LIMITS, EXTRA_LABELS, EXTRA_MEASUREMENTS
 from ..core.formats import FORMATS
-from ..core.measure import as_dict
 from ..core.request import relative_error, validate_request
 from . import common
 from .common import PROG, UsageError
@@ -13,11 +15,23 @@ from .common import PROG, UsageError
 
 def add_parser(commands):
     synth = commands.add_parser("synth", help="synthesize one mannequin",
-                                description="Synthesize one mannequin from five measurements (cm).")
+                                description="Synthesize one mannequin from five measurements (cm), any of the extra "
+                                            "ones (docs/measurements.md), or a body mesh's own (--from).")
     for key in MEASUREMENTS:
         low, high = RANGES[key]
-        synth.add_argument(f"--{key.lower()}", dest=key, type=common.number, required=True, metavar="CM",
-                           help=f"{MEASUREMENT_LABELS[key]} (the female set's reference range {low:g}-{high:g})")
+        synth.add_argument(f"--{key.lower()}", dest=key, type=common.number, metavar="CM",
+                           help=f"{MEASUREMENT_LABELS[key]} (the female set's reference range {low:g}-{high:g}; "
+                                "required unless --from)")
+    for key in EXTRA_MEASUREMENTS:
+        low, high = EXTRA_ABSURD_LIMITS[key]
+        synth.add_argument(f"--{key.replace('_', '-')}", dest=key, type=common.number, metavar="CM",
+                           help=f"{EXTRA_LABELS[key]} ({low:g}-{high:g}; optional: met in exact mode, otherwise the "
+                                "reference set's)")
+    synth.add_argument("--from", dest="from_mesh", metavar="BODY",
+                       help="a body mesh (.obj, .ply, .stl; upright A-pose): measure it and synthesize with every "
+                            "measurement found (a measurement given as an option wins)")
+    synth.add_argument("--up", choices=UP_AXES, help="--from's up axis (default: y for .obj, z for .ply/.stl)")
+    synth.add_argument("--unit", choices=tuple(UNITS), default="m", help="--from's length unit (default m)")
     synth.add_argument("-o", "--output", required=True, metavar="OUT",
                        help="output file: .blend, .glb, .obj, .json (ElliMann's mannequin JSON) or .xml (MJCF, "
                             "for MuJoCo)")
@@ -40,24 +54,55 @@ def _kind_or_none(path):
         return None
 
 
+def _wanted(args):
+    """(the five {key: cm}, the extra ones {key: cm}) from --from's body and the options."""
+    found = {}
+    if args.from_mesh:
+        from .measure import measure_mesh_file
+
+        found, problems = measure_mesh_file(args.from_mesh, args)
+        if not found:
+            raise UsageError(f"{args.from_mesh}: {problems[0]}")
+        for problem in problems:
+            common.say(f"{PROG} synth: warning: {args.from_mesh}: {problem}")
+        common.say(f"{args.from_mesh}: measured " + ", ".join(f"{key} {value:.2f}" for key, value in found.items()),
+                   file=sys.stdout)
+    given = {key: getattr(args, key) for key in MEASUREMENTS + EXTRA_MEASUREMENTS if getattr(args, key) is not None}
+    wanted = {**found, **given}
+    missing = [key for key in MEASUREMENTS if key not in wanted]
+    if missing:
+        where = f" ({args.from_mesh} gave none)" if args.from_mesh else ""
+        raise UsageError(f"missing {', '.join('--' + key.lower() for key in missing)}{where}")
+    return ({key: wanted[key] for key in MEASUREMENTS},
+            {key: wanted[key] for key in EXTRA_MEASUREMENTS if key in wanted})
+
+
 def run(args):
-    from ..core.synthesis import synthesize_batch
+    from ..core.refine_extra import synthesize_extra
 
     kind = common.output_kind(args.output)
     pose_file = common.check_pose_argument(args, [kind])
-    request = [getattr(args, key) for key in MEASUREMENTS]
+    five, extra = _wanted(args)
+    request = [five[key] for key in MEASUREMENTS]
     reference = common.references(args)
     warnings = validate_request(request, reference.ranges, reference.absurd_limits)
     options = common.synthesis_options(args, args.name)
-    result = synthesize_batch(reference, [request], options)
-    mannequin, measured = result.mannequin(0, options.name), as_dict(result.measured[0])
-    misses = common.misses(result.measured[0], request) if args.mode == "exact" else []
-    for warning in warnings + ([common.missed_text(misses)] if misses else []):
+    try:
+        mannequin, measured, more = synthesize_extra(reference, five, extra, options)
+    except ElliMannError as error:
+        raise UsageError(common.one_line(error)) from None
+    achieved = [measured[key] for key in MEASUREMENTS]
+    misses = common.misses(achieved, request) if args.mode == "exact" else []
+    missed_extra = [line for line in more if line.startswith("exact mode missed")]
+    for warning in warnings + more + ([common.missed_text(misses)] if misses else []):
         common.say(f"{PROG} synth: warning: {warning}")
     frames = common.pose_frames(args, mannequin, pose_file)
-    common.write(mannequin, [args.output], measured, args.cushions and kind != "json", frames, args.fps)
-    error = relative_error(result.measured[0], request).max()
+    common.write(mannequin, [args.output], {key: measured[key] for key in MEASUREMENTS},
+                 args.cushions and kind != "json", frames, args.fps)
+    error = relative_error(achieved, request).max()
     posed = f" in pose {args.pose}" if args.pose else ""
-    common.say(f"wrote {args.output}: '{mannequin.name}'{posed} ({args.mode}), m_T "
-               f"{common.format_me(measured.values())} cm, max error {error:.3f}%", file=sys.stdout)
-    return common.MISSED if misses else 0
+    extra_line = ("; " + ", ".join(f"{key} {measured[key]:.2f}" for key in EXTRA_MEASUREMENTS) + " cm"
+                  if extra else "")
+    common.say(f"wrote {args.output}: '{mannequin.name}'{posed} ({args.mode}), m_T {common.format_me(achieved)} cm, "
+               f"max error {error:.3f}%{extra_line}", file=sys.stdout)
+    return common.MISSED if misses or missed_extra else 0

@@ -1,8 +1,11 @@
 """Body meshes a Reference Mannequin is fitted in: reading OBJ files, per-vertex areas and normals, the
 fingerprint of a mesh's connectivity (which bodies share a traced mesh's vertex order), closedness, and
-the walls of a mesh's cavities (open mouth and eye sockets)."""
+the walls of a mesh's cavities (open mouth and eye sockets); reading a scan (.obj / .ply / .stl, its up axis and
+unit) for measuring (``read_body_mesh``)."""
 
+import os
 import pathlib
+import struct
 import zlib
 from dataclasses import dataclass
 
@@ -76,6 +79,15 @@ def read_obj(path):
     """The body mesh of an OBJ file (``v`` and ``f`` lines; polygons fan-triangulated; texture and normal
     indices after '/' ignored; negative indices count from the end), named by the file's stem."""
     path = pathlib.Path(path)
+    vertices, polygons = _obj_polygons(path)
+    try:
+        return from_polygons(path.stem, vertices, polygons)
+    except BodyMeshError as error:
+        raise BodyMeshError(f"{path}: {str(error).partition(': ')[2]}") from None
+
+
+def _obj_polygons(path):
+    """(vertices (V, 3), polygons) of an OBJ file, as written (no check that the surface is closed)."""
     vertices, polygons = [], []
     try:
         with open(path, encoding="utf-8") as stream:
@@ -99,10 +111,7 @@ def read_obj(path):
     bad = [i for p in polygons for i in p if not 0 <= i < len(vertices)]
     if bad:
         raise BodyMeshError(f"{path}: a face uses vertex {bad[0] + 1}, but the file has {len(vertices)} vertices")
-    try:
-        return from_polygons(path.stem, vertices, polygons)
-    except BodyMeshError as error:
-        raise BodyMeshError(f"{path}: {str(error).partition(': ')[2]}") from None
+    return vertices, polygons
 
 
 def mesh_problem(body):
@@ -185,3 +194,125 @@ def hidden_vertices(vertices, faces, normals, candidates, reach=0.1, cell=0.01):
     hit = ((np.abs(det) > 1e-14) & (u >= -edge) & (v >= -edge) & (u + v <= 1 + edge) & (t > 1e-4)
            & (t < reach))
     return np.bincount(ray[hit], minlength=len(candidates)) > 0
+
+
+# Scans and bodies from other tools (core.body_measure): any of OBJ / PLY / STL, their axes and units, open or
+# closed. OBJ files are read as Blender reads them (Y up, -Z forward): a file point (x, y, z) is the scene
+# point (x, -z, y); ``up="z"`` takes files written in the scene's own axes (as ../shared/refmodels' bodies).
+# PLY (ASCII or binary little-endian) and STL (ASCII or binary) are read in their own axes (Z up, as
+# Blender's importers leave them).
+MESH_EXTENSIONS = (".obj", ".ply", ".stl")
+UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
+UP_AXES = ("y", "z")
+
+
+def read_body_mesh(path, up=None, unit="m"):
+    """(vertices (V, 3) in metres, Z up; faces (F, 3) int64) of an .obj / .ply / .stl file.
+
+    ``up``: the file's up axis ("y" or "z"; default "y" for OBJ as Blender imports it, "z" for PLY/STL);
+    ``unit``: the file's length unit (m, cm, mm)."""
+    kind = os.path.splitext(path)[1].lower()
+    if kind not in MESH_EXTENSIONS:
+        raise BodyMeshError(f"{path}: a body mesh must be {', '.join(MESH_EXTENSIONS)}, got {kind or 'no extension'}")
+    if unit not in UNITS:
+        raise BodyMeshError(f"unit must be one of {', '.join(UNITS)}, got {unit!r}")
+    if up not in (None,) + UP_AXES:
+        raise BodyMeshError(f"up must be one of {', '.join(UP_AXES)}, got {up!r}")
+    if kind == ".obj":
+        vertices, polygons = _obj_polygons(path)
+        faces = triangulate(polygons)
+    else:
+        try:
+            with open(path, "rb") as stream:
+                raw = stream.read()
+        except OSError as error:
+            raise BodyMeshError(f"{path}: cannot be read ({error.strerror or error})") from None
+        try:
+            vertices, faces = {".ply": _parse_ply, ".stl": _parse_stl}[kind](raw)
+        except (ValueError, IndexError, struct.error, UnicodeDecodeError) as error:
+            raise BodyMeshError(f"{path}: not a readable {kind[1:].upper()} file ({error})") from None
+    if len(faces) and (faces.min() < 0 or faces.max() >= len(vertices)):
+        raise BodyMeshError(f"{path}: a face refers to a vertex that does not exist")
+    if not np.all(np.isfinite(vertices)):
+        raise BodyMeshError(f"{path}: holds coordinates that are not finite numbers")
+    if (up or ("y" if kind == ".obj" else "z")) == "y":
+        vertices = np.stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]], axis=1)
+    return vertices * UNITS[unit], faces
+
+
+def _parse_ply(raw):
+    end = raw.find(b"end_header")
+    if not raw.startswith(b"ply") or end < 0:
+        raise ValueError("no PLY header")
+    header = raw[:end].decode("ascii").splitlines()
+    body = raw[raw.index(b"\n", end) + 1:]
+    fmt = next(line.split()[1] for line in header if line.startswith("format"))
+    elements, current = [], None
+    for line in header:
+        words = line.split()
+        if words[:1] == ["element"]:
+            current = [words[1], int(words[2]), []]
+            elements.append(current)
+        elif words[:1] == ["property"] and current is not None:
+            current[2].append(words[1:])
+    types = {"char": "b", "int8": "b", "uchar": "B", "uint8": "B", "short": "h", "int16": "h", "ushort": "H",
+             "uint16": "H", "int": "i", "int32": "i", "uint": "I", "uint32": "I", "float": "f", "float32": "f",
+             "double": "d", "float64": "d"}
+    vertices, polygons = None, []
+    if fmt == "ascii":
+        rows = iter(body.decode("ascii").split("\n"))
+        for name, count, props in elements:
+            for _ in range(count):
+                values = next(rows).split()
+                if name == "vertex":
+                    vertices = vertices if vertices is not None else []
+                    vertices.append([float(values[i]) for i in _xyz(props)])
+                elif name == "face":
+                    polygons.append([int(v) for v in values[1:1 + int(values[0])]])
+    elif fmt == "binary_little_endian":
+        offset = 0
+        for name, count, props in elements:
+            if all(p[0] != "list" for p in props):
+                record = "<" + "".join(types[p[0]] for p in props)
+                size = struct.calcsize(record)
+                data = np.frombuffer(body[offset:offset + size * count], dtype=np.dtype(
+                    [(f"p{i}", "<" + types[p[0]]) for i, p in enumerate(props)]), count=count)
+                offset += size * count
+                if name == "vertex":
+                    vertices = [list(row) for row in zip(*(data[f"p{i}"] for i in _xyz(props)))]
+                continue
+            for _ in range(count):
+                row = []
+                for p in props:
+                    if p[0] == "list":
+                        (n,) = struct.unpack_from("<" + types[p[1]], body, offset)
+                        offset += struct.calcsize(types[p[1]])
+                        row = list(struct.unpack_from(f"<{n}{types[p[2]]}", body, offset))
+                        offset += n * struct.calcsize(types[p[2]])
+                    else:
+                        offset += struct.calcsize(types[p[0]])
+                if name == "face":
+                    polygons.append(row)
+    else:
+        raise ValueError(f"PLY format {fmt} is not supported (ascii or binary_little_endian)")
+    return np.array(vertices or [], dtype=float).reshape(-1, 3), triangulate(polygons)
+
+
+def _xyz(props):
+    names = [p[-1] for p in props]
+    return [names.index(axis) for axis in ("x", "y", "z")]
+
+
+def _parse_stl(raw):
+    if raw[:5].lower() == b"solid" and b"facet" in raw[:512]:
+        corners = [[float(v) for v in line.split()[1:4]] for line in raw.decode("ascii").splitlines()
+                   if line.strip().startswith("vertex")]
+        points = np.array(corners, dtype=float).reshape(-1, 3)
+    else:
+        (count,) = struct.unpack_from("<I", raw, 80)
+        records = np.frombuffer(raw[84:84 + 50 * count], dtype=np.dtype(
+            [("normal", "<f4", 3), ("corners", "<f4", (3, 3)), ("attribute", "<u2")]), count=count)
+        points = records["corners"].reshape(-1, 3).astype(float)
+    # STL repeats each corner per triangle: weld identical corners so the mesh's edges are shared
+    vertices, index = np.unique(points, axis=0, return_inverse=True)
+    return vertices, np.asarray(index, dtype=np.int64).reshape(-1, 3)

@@ -152,3 +152,75 @@ def polygon_perimeter(polygon):
     if len(polygon) < 2:
         return 0.0
     return float(np.linalg.norm(polygon - np.roll(polygon, -1, axis=0), axis=1).sum())
+
+
+def boundary_edges(faces):
+    """(k, 2) edges used by exactly one triangle (a closed surface has none)."""
+    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    return unique[counts == 1]
+
+
+def section_segments(vertices, faces, height, with_edges=False):
+    """The segments in which the triangles cross the plane z = height: (k, 2, 2) x-y end points, and the
+    index of each segment's triangle (and, ``with_edges``, the mesh edge (k, 2) each end point lies on, as one
+    integer a * V + b with a < b: segments sharing an end share its edge). A vertex on the plane counts as
+    above it (a fixed tie rule)."""
+    z = vertices[faces, 2] - height  # (F, 3)
+    above = z >= 0.0
+    count = above.sum(axis=1)
+    rows = np.nonzero((count == 1) | (count == 2))[0]
+    if len(rows) == 0:
+        empty = (np.zeros((0, 2, 2)), rows)
+        return empty + (np.zeros((0, 2), np.int64),) if with_edges else empty
+    lone_above = count[rows] == 1
+    # the vertex alone on its side of the plane; the segment joins the crossings of its two edges
+    lone = np.argmax(above[rows] == lone_above[:, None], axis=1)
+    every = np.arange(len(rows))
+    tri = vertices[faces[rows]]  # (k, 3, 3)
+    zr = z[rows]
+    ends, keys = [], []
+    for step in (1, 2):
+        other = (lone + step) % 3
+        a, b = tri[every, lone], tri[every, other]
+        za, zb = zr[every, lone], zr[every, other]
+        t = (za / (za - zb))[:, None]
+        ends.append(a[:, :2] + t * (b[:, :2] - a[:, :2]))
+        ia, ib = faces[rows, lone], faces[rows, other]
+        keys.append(np.minimum(ia, ib) * len(vertices) + np.maximum(ia, ib))
+    if with_edges:
+        return np.stack(ends, axis=1), rows, np.stack(keys, axis=1)
+    return np.stack(ends, axis=1), rows
+
+
+def connected_labels(count, pairs):
+    """Component label (0..c-1) of each of ``count`` nodes joined by ``pairs`` (k, 2): minimum-label
+    propagation with pointer jumping (numpy only)."""
+    label = np.arange(count)
+    pairs = np.asarray(pairs, np.int64).reshape(-1, 2)
+    while True:
+        low = np.minimum(label[pairs[:, 0]], label[pairs[:, 1]])
+        new = label.copy()
+        np.minimum.at(new, pairs[:, 0], low)
+        np.minimum.at(new, pairs[:, 1], low)
+        new = new[new]
+        while True:
+            jumped = new[new]
+            if np.array_equal(jumped, new):
+                break
+            new = jumped
+        if np.array_equal(new, label):
+            break
+        label = new
+    return np.unique(label, return_inverse=True)[1].reshape(-1)
+
+
+def in_plane(vertices, origin, normal):
+    """Vertices in a frame whose z axis is ``normal`` (unit) and whose origin is ``origin``: the plane through
+    ``origin`` across ``normal`` becomes z = 0 (its section is then :func:`section_segments` at 0)."""
+    normal = np.asarray(normal, float) / np.linalg.norm(normal)
+    helper = np.array([0.0, 0.0, 1.0]) if abs(normal[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    first = np.cross(helper, normal)
+    first /= np.linalg.norm(first)
+    frame = np.stack([first, np.cross(normal, first), normal])  # rows: the new axes
+    return (np.asarray(vertices, float) - origin) @ frame.T, frame

@@ -11,6 +11,7 @@ import sys
 import pytest
 
 from devkit import synthetic
+from ellimann_addon.core.extra_measures import EXTRA_MEASUREMENTS
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]
@@ -65,8 +66,10 @@ def test_synth_and_measure_run_without_blender(tmp_path, references, kind):
     if kind == "json":
         code, stdout, stderr = without_blender("measure", str(out), "--json")
         assert code == 0 and stderr == ""
-        assert json.loads(stdout) == pytest.approx(dict(zip(("He", "Sh", "Br", "Wa", "Hi"),
-                                                            (165, 41.5, 101.25, 82.75, 117.5))), rel=1e-4)
+        printed = json.loads(stdout)  # the five, then the extra measurements (docs/measurements.md)
+        assert list(printed) == ["He", "Sh", "Br", "Wa", "Hi", *EXTRA_MEASUREMENTS]
+        assert {key: printed[key] for key in ("He", "Sh", "Br", "Wa", "Hi")} == pytest.approx(
+            dict(zip(("He", "Sh", "Br", "Wa", "Hi"), (165, 41.5, 101.25, 82.75, 117.5))), rel=1e-4)
         code, stdout, _ = without_blender("measure", str(out))
         assert code == 0 and "He Height" in stdout
 

@@ -1,5 +1,6 @@
-"""Measure: m_T (He, Sh, Br, Wa, Hi in cm) of the active mannequin, optionally its section curves."""
+"""Measure: m_T (He, Sh, Br, Wa, Hi in cm) and the extra measurements of the active mannequin, optionally its
+section curves; Measure Body Mesh for a scan or another tool's body."""
 
-from . import operator, panel
+from . import body, operator, panel
 
-classes = operator.classes + panel.classes
+classes = operator.classes + body.classes + panel.classes

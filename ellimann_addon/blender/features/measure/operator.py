@@ -4,6 +4,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty
 
 from ....core.cushion import cushion_name
+from ....core.extra_measures import mannequin_extra_measurements
 from ....core.measure import as_dict, measure_meshes, measurement_line, section_hulls, tailor_measurements
 from ... import ids
 from ...bridge.built import built_collection, built_objects, is_stale, new_section_object, remove_built
@@ -41,10 +42,6 @@ def cushion_mannequin_meshes(collection, mannequin, cushions):
             meshes.append(world_triangles(obj))
             girth.append(obj.ellimann.girth)
     return meshes, girth, missing
-
-
-def format_measurements(values):
-    return measurement_line(values) + " cm"
 
 
 class ELLIMANN_OT_measure_mannequin(MannequinOperator, bpy.types.Operator):
@@ -85,7 +82,10 @@ class ELLIMANN_OT_measure_mannequin(MannequinOperator, bpy.types.Operator):
                 if len(points) >= 3:
                     new_section_object(f"{collection.name} {key}", key, z, points, target)
         where = "cushion hulls" if on_hulls else "ellipsoids"
-        self.report({"INFO"}, f"'{collection.name}' ({where}): {format_measurements(measured)}")
+        more = mannequin_extra_measurements(mannequin)  # closed forms on the ellipsoids, rest pose
+        self.report({"INFO"}, f"'{collection.name}' ({where}): {measurement_line(measured)}, "
+                              + ", ".join(f"{key} {value:.2f}" for key, value in more.items()) + " cm (the extra ones "
+                              "on the ellipsoids)")
         return {"FINISHED"}
 
 

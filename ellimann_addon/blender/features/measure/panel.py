@@ -1,11 +1,17 @@
 """The Measure sub-panel: measure (and draw the sections), the last m_T."""
 
+import json
+
 import bpy
 
 from ....core.constants import MEASUREMENT_LABELS, MEASUREMENTS
+from ....core.extra_measures import EXTRA_LABELS
 from ... import ids
 from ...bridge.selection import active_mannequin
 from ..base import SubPanel
+from .body import RESULT_PROPERTY
+
+LABELS = {**MEASUREMENT_LABELS, **EXTRA_LABELS}
 
 
 class ELLIMANN_PT_measure(SubPanel, bpy.types.Panel):
@@ -20,6 +26,13 @@ class ELLIMANN_PT_measure(SubPanel, bpy.types.Panel):
         col = layout.column(align=True)
         col.operator(ids.MEASURE_MANNEQUIN, icon="DRIVER_DISTANCE")
         col.operator(ids.MEASURE_MANNEQUIN, text="Measure and Draw Sections").draw_sections = True
+        layout.operator(ids.MEASURE_BODY, icon="MESH_DATA")
+        obj = context.active_object
+        if obj is not None and RESULT_PROPERTY in obj:
+            col = layout.column(align=True)
+            col.label(text=f"'{obj.name}' (body mesh):")
+            for key, value in json.loads(obj[RESULT_PROPERTY]).items():
+                col.label(text=f"{LABELS.get(key, key)}: {value:.2f} cm")
         collection = active_mannequin(context)
         if collection is not None and collection.ellimann.has_measured:
             col = layout.column(align=True)

@@ -1,9 +1,10 @@
-"""Synthesize: five measurements in, a mannequin out; presets, and Live updates of the last one."""
+"""Synthesize: five measurements (and any of the extra ones) in, a mannequin out; presets, Live updates of the last
+one, and Synthesize from Mesh (a body mesh's twin)."""
 
-from . import live, operators, panel, presets, props
+from . import from_mesh, live, operators, panel, presets, props
 
 # Registered in this order (the property group before the pointer to it), unregistered in reverse.
-classes = props.classes + operators.classes + presets.classes + panel.classes
+classes = props.classes + operators.classes + from_mesh.classes + presets.classes + panel.classes
 
 
 def register_hooks():

@@ -3,6 +3,7 @@
 
 import bpy
 
+from ....core.constants import MEASUREMENTS
 from ....core.errors import ElliMannError
 from ....core.measure import measurement_line
 from ....core.synthesis import relative_error
@@ -10,7 +11,7 @@ from ... import ids
 from ...bridge.convert import ellipsoid_objects
 from ...services.rig import build_rig, check_rig
 from ...services.scene import add_mannequin
-from .request import request_of, synthesize_request
+from .request import extra_of, request_of, synthesize_request
 
 
 class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
@@ -28,9 +29,10 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
         props = context.scene.ellimann_synthesis
         try:
             mannequin, measured, warnings = synthesize_request(props)
+            five = {key: measured[key] for key in MEASUREMENTS}
             if mannequin.joints is not None:
                 check_rig(mannequin)  # before the scene changes
-            collection = add_mannequin(mannequin, measured, cushions=props.output == "CUSHIONS")
+            collection = add_mannequin(mannequin, five, cushions=props.output == "CUSHIONS")
             rig = build_rig(collection, mannequin) if mannequin.joints is not None else None
         except ElliMannError as error:
             self.report({"ERROR"}, str(error))
@@ -39,8 +41,8 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
         props.status = "; ".join(warnings)
         for warning in warnings:
             self.report({"WARNING"}, warning)
-        worst = relative_error(measured, request_of(props)).max()
-        values = measurement_line(measured)
+        worst = relative_error(five, request_of(props)).max()
+        values = measurement_line(five) + "".join(f", {key} {measured[key]:.2f}" for key in extra_of(props))
         self.report({"INFO"}, f"Synthesized '{collection.name}' ({len(ellipsoid_objects(collection))} ellipsoids, "
                               f"{props.mode.lower()}{', with an armature' if rig else ''}): m_T {values} cm, "
                               f"max error {worst:.2f}%")

@@ -3,6 +3,7 @@
 import bpy
 
 from ....core.constants import MEASUREMENT_LABELS, MEASUREMENTS
+from ....core.extra_measures import EXTRA_MEASUREMENTS
 from ... import ids
 from ..base import SubPanel
 from .presets import ELLIMANN_MT_measurement_presets
@@ -40,6 +41,15 @@ class ELLIMANN_PT_synthesize(SubPanel, bpy.types.Panel):
             row.prop(props, FIELDS[key], text=MEASUREMENT_LABELS[key])
             row.label(text=f"{measured[index]:.2f}" if measured else "")
 
+        extra = layout.column(align=True)
+        extra.label(text="More (optional, cm)")
+        for key in EXTRA_MEASUREMENTS:
+            row = extra.row(align=True)
+            row.prop(props, f"use_{key}", text="")
+            field = row.row(align=True)
+            field.active = getattr(props, f"use_{key}")
+            field.prop(props, key)
+
         layout.row().prop(props, "mode", expand=True)
         layout.row().prop(props, "output", expand=True)
         options = layout.column(align=True)
@@ -51,6 +61,7 @@ class ELLIMANN_PT_synthesize(SubPanel, bpy.types.Panel):
             layout.prop(props, "references")
 
         layout.operator(ids.SYNTHESIZE_MANNEQUIN, icon="OUTLINER_OB_ARMATURE")
+        layout.operator(ids.SYNTHESIZE_FROM_MESH, icon="MESH_DATA")
         row = layout.row()
         row.prop(props, "live")
         if target is not None:

@@ -5,6 +5,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, PointerProperty, StringProperty
 
 from ....core.constants import ABSURD_LIMITS, MEASUREMENT_LABELS, RANGES, REFERENCE_MEASUREMENTS
+from ....core.extra_measures import EXTRA_ABSURD_LIMITS, EXTRA_DEFAULTS, EXTRA_LABELS, EXTRA_MEASUREMENTS
 from ....core.options import SYNTHESIS
 from .live import on_request_change
 from .request import REFERENCE_SET_ITEMS
@@ -66,6 +67,23 @@ class ELLIMANN_PG_synthesis(bpy.types.PropertyGroup):
     live_ms: FloatProperty(name="Live Update Time", description="Duration of the last live update (ms)")
 
 
+def _extra_fields():
+    """Each extra measurement: a checkbox (given or not) and its value in cm (docs/measurements.md)."""
+    fields = {}
+    for key in EXTRA_MEASUREMENTS:
+        low, high = EXTRA_ABSURD_LIMITS[key]
+        label = EXTRA_LABELS[key]
+        fields[f"use_{key}"] = BoolProperty(
+            name=label, default=False, update=on_request_change,
+            description=f"Give the {label.lower()} too (exact mode meets it with pieces of its own; unticked, the "
+                        "reference set gives it)")
+        fields[key] = FloatProperty(
+            name=label, default=EXTRA_DEFAULTS[key], min=low, max=high, step=25, precision=2,
+            update=on_request_change, description=f"{label} in cm (docs/measurements.md); accepted {low:g}-{high:g} cm")
+    return fields
+
+
+ELLIMANN_PG_synthesis.__annotations__.update(_extra_fields())
 classes = (ELLIMANN_PG_synthesis,)
 
 

@@ -5,10 +5,11 @@ import bpy
 
 from ....core.constants import FEMALE_SET, MEASUREMENTS
 from ....core.errors import ReferenceSetError
+from ....core.extra_measures import EXTRA_MEASUREMENTS
 from ....core.options import SynthesisOptions
 from ....core.reference_set import cached_reference_set
+from ....core.refine_extra import synthesize_extra
 from ....core.shipped_sets import MALE_SET, SHIPPED_SETS
-from ....core.synthesis import synthesize
 
 FIELDS = {key: key.lower() for key in MEASUREMENTS}  # He -> props.he
 REFERENCE_SET_ITEMS = (
@@ -32,8 +33,16 @@ def reference_of(props):
     return cached_reference_set(bpy.path.abspath(props.references))
 
 
-def synthesize_request(props):
-    return synthesize(reference_of(props), request_of(props), options_of(props))
+def extra_of(props):
+    """The extra measurements the panel gives (ticked), in cm."""
+    return {key: float(getattr(props, key)) for key in EXTRA_MEASUREMENTS if getattr(props, f"use_{key}")}
+
+
+def synthesize_request(props, extra=None):
+    """(Mannequin, measured {the five and the extra ones: cm}, warnings) of the panel's request; ``extra``
+    overrides the panel's extra measurements (a body's, for Synthesize from Mesh)."""
+    return synthesize_extra(reference_of(props), request_of(props), extra_of(props) if extra is None else extra,
+                            options_of(props))
 
 
 def options_of(props):

@@ -1,0 +1,70 @@
+"""Scan to mannequin: the time to measure a body mesh, and how much the extra measurements make a synthesized
+twin overlap its body (core.volume.voxel_iou of its ellipsoids, the twin stood as tools/overlap.py stands it), on
+the six female reference bodies of ../shared/refmodels.
+
+Per body: measure the mesh (core.body_measure, no labels), synthesize in exact mode with the five it found, with
+the five and each extra measurement alone, and with all it found (core.refine_extra), and count the IoU of each
+twin with the body. Also: the time to
+measure one 27k-triangle body (the median of three runs) and what the five's measurement differs from the
+README's table by.
+"""
+
+import statistics
+import time
+
+from ellimann_addon.core.body_measure import measure_body_mesh
+from ellimann_addon.core.body_mesh import read_obj
+from ellimann_addon.core.constants import MEASUREMENTS
+from ellimann_addon.core.refine_extra import synthesize_extra
+from ellimann_addon.core.shipped_sets import named_reference_set
+from ellimann_addon.core.volume import IOU_MARGIN, BodyVolume, voxel_iou
+from tools.bodies import body_measurements, load_labels
+from tools.overlap import standing_in
+from tools.reference_sets import TRACING_FOLDER
+
+BODIES = ("reference_female", "small_slim", "tall_slim", "small_chubby", "tall_chubby", "average")
+SPACING = 0.005
+
+
+def overlap(mannequin, body):
+    """IoU of the mannequin's ellipsoids and the body, the mannequin stood where the body stands."""
+    grid = BodyVolume(body.vertices, body.faces).grid(SPACING, margin=IOU_MARGIN)
+    return voxel_iou(standing_in(grid, mannequin), grid=grid, cushions=False)
+
+
+def run():
+    reference = named_reference_set("female")
+    labels = load_labels(TRACING_FOLDER)
+    print(f"{'body':<17} {'measure s':>9} {'max |five - README| cm':>22} {'IoU five':>9} {'IoU all':>8} "
+          f"{'gain':>6}")
+    gains = []
+    for name in BODIES:
+        body = read_obj(TRACING_FOLDER / f"{name}.obj")
+        times = []
+        for _ in range(3):
+            start = time.perf_counter()
+            result = measure_body_mesh(body.vertices, body.faces)
+            times.append(time.perf_counter() - start)
+        readme = body_measurements(body, labels)
+        worst = max(abs(result.values[key] - readme[key]) for key in MEASUREMENTS if key in result.values)
+        five = {key: result.values[key] for key in MEASUREMENTS}
+        extra = {key: value for key, value in result.values.items() if key not in MEASUREMENTS}
+        iou, missed = [], []
+        for given in ({}, extra):
+            mannequin, _, warnings = synthesize_extra(reference, five, given)
+            missed += [line.split()[3] for line in warnings if line.startswith("exact mode missed")]
+            iou.append(overlap(mannequin, body))
+        gains.append(iou[1] - iou[0])
+        alone = []
+        for key, value in extra.items():
+            mannequin, _, _ = synthesize_extra(reference, five, {key: value})
+            alone.append(f"{key} {overlap(mannequin, body) - iou[0]:+.3f}")
+        print(f"{name:<17} {statistics.median(times):9.2f} {worst:22.3f} {iou[0]:9.3f} {iou[1]:8.3f} "
+              f"{iou[1] - iou[0]:+6.3f}  ({len(body.faces)} triangles; not measured: {result.missing or 'none'}; "
+              f"missed by the twin: {missed or 'none'})")
+        print(f"{'':<17} IoU change with one extra measurement alone: {', '.join(alone)}")
+    print(f"mean IoU gain with all measurements: {statistics.mean(gains):+.3f}")
+
+
+if __name__ == "__main__":
+    run()

@@ -1,0 +1,232 @@
+"""Exact mode for the extra measurements: degrees of freedom of their own (a neck, the upper arms, the thighs,
+the calves, the leg and arm lengths), alternated with the five's refinement (``core.refine``) until every given
+measurement is met.
+
+Each extra measurement moves only its own pieces: its girth scales the pieces its section cuts across their
+horizontal (or, for the upper arm, across the arm's) axes; the crotch height stretches the legs against the
+trunk; the arm length stretches the arm along itself about the shoulder point. One log-factor per given
+measurement, solved by secant steps per factor (each measurement responds almost only to its own factor),
+with the five re-met by ``core.refine.refine`` after every round (the extra factors nudge He and the girths).
+"""
+
+import numpy as np
+
+from .constants import MEASUREMENTS
+from .errors import ElliMannError
+from .extra_measures import (
+    CALF_BAND,
+    EXTRA_ABSURD_LIMITS,
+    EXTRA_LABELS,
+    EXTRA_MEASUREMENTS,
+    SIDES,
+    THIGH_DROP,
+    MannequinLandmarks,
+    mannequin_extra_measurements,
+)
+from .joints import anchor_indices, follow_pieces
+from .measure import tailor_measurements
+from .refine import refine
+from .synthesis import synthesize
+
+EXTRA_TOLERANCE_CM = 0.01  # every given extra measurement within 0.1 mm
+EXTRA_MAX_ROUNDS = 12
+MISS_CM = 0.1  # a given extra measurement further off than this (1 mm) is a miss
+FIVE_TOLERANCE_CM = 0.01  # a round that moves any of the five further than this is never the result
+EXTRA_FACTOR_LIMIT = 2.0  # no piece scaled beyond this or below its inverse (it would no longer look like itself)
+_MAX_LOG_STEP = 0.25
+
+
+class ExtraRequestError(ElliMannError):
+    """A request for extra measurements that no body can meet (one line, with the amount)."""
+
+
+def extra_request_problems(request, extra):
+    """Lines saying which given extra measurements are outside their limits or contradict the others (with the
+    amount), for a request dict of the five (cm) and a dict of extra measurements (cm)."""
+    problems = []
+    for key, value in extra.items():
+        if key not in EXTRA_MEASUREMENTS:
+            problems.append(f"{key}: not a measurement (one of {', '.join(EXTRA_MEASUREMENTS)})")
+            continue
+        low, high = EXTRA_ABSURD_LIMITS[key]
+        if not (np.isfinite(value) and low <= value <= high):
+            problems.append(f"{key} ({EXTRA_LABELS[key]}) must be {low:g}-{high:g} cm, got {value:g}")
+    if problems:
+        return problems
+    he, hi, br = request["He"], request["Hi"], request["Br"]
+    rules = (("thigh", hi, "Hi", "a thigh cannot be larger than the hip"),
+             ("neck", br, "Br", "a neck cannot be larger than the breast"),
+             ("calf", extra.get("thigh", hi), "thigh" if "thigh" in extra else "Hi",
+              "a calf cannot be larger than the thigh"),
+             ("upper_arm", 0.5 * br, "Br/2", "an upper arm cannot be larger than half the breast"),
+             ("crotch_height", 0.6 * he, "0.6 He", "the crotch cannot be above 0.6 He"),
+             ("arm_length", 0.5 * he, "0.5 He", "the arm cannot be longer than half of He"))
+    for key, limit, name, why in rules:
+        if key in extra and extra[key] >= limit:
+            problems.append(f"{key} {extra[key]:g} cm >= {name} {limit:g} cm by {extra[key] - limit:.2f} cm: {why}")
+    if "crotch_height" in extra and extra["crotch_height"] <= 0.3 * he:
+        problems.append(f"crotch_height {extra['crotch_height']:g} cm <= 0.3 He {0.3 * he:g} cm by "
+                        f"{0.3 * he - extra['crotch_height']:.2f} cm: the legs cannot be that short")
+    return problems
+
+
+def _scale_across(rotation, semi, rows, axis, factor):
+    """Scale the semi-axes of pieces ``rows`` across ``axis`` (a unit vector; their shares along it stay)."""
+    along = np.einsum("nik,i->nk", rotation[rows], axis) ** 2  # share of each local axis along ``axis``
+    semi[rows] *= factor ** (1.0 - along)
+
+
+def _apply(key, factor, mannequin, rotation, center, semi):
+    """Deform (in place) the pieces of measurement ``key`` by ``factor``."""
+    marks = MannequinLandmarks(mannequin.copy(center=center, semi_axes=semi))
+    topology = mannequin.topology
+    region = np.array([part.region for part in topology])
+    up = np.array([0.0, 0.0, 1.0])
+    if key == "neck":
+        _scale_across(rotation, semi, np.nonzero(region == "neck")[0], up, factor)
+    elif key in ("thigh", "calf"):
+        legs = region == "legs"
+        crotch = marks.crotch()
+        if key == "thigh":
+            z = marks.bottom + crotch - THIGH_DROP * marks.height
+        else:  # the height of the largest calf girth, on a grid over the band (enough to pick the pieces)
+            heights = marks.bottom + np.linspace(*CALF_BAND, 48) * crotch
+            z = heights[int(np.argmax(marks.girths_at(heights, marks.leg_mask("L"))))]
+        half = np.sqrt(np.einsum("nk,nk->n", rotation[:, 2, :] ** 2, semi**2))
+        rows = np.nonzero(legs & (np.abs(center[:, 2] - z) < half))[0]
+        _scale_across(rotation, semi, rows, up, factor)
+    elif key == "crotch_height":
+        crotch = marks.bottom + marks.crotch()
+        lower = np.isin(region, ("legs", "feet"))
+        center[lower, 2] = marks.bottom + factor * (center[lower, 2] - marks.bottom)
+        center[~lower, 2] += (factor - 1.0) * (crotch - marks.bottom)
+        semi[lower] *= factor ** (rotation[lower, 2, :] ** 2)  # each local axis by its share along z
+    elif key in ("upper_arm", "arm_length"):
+        for side in SIDES:
+            start, axis, _ = marks.arm_axis(side)
+            arm = np.nonzero(marks.arm & (marks.side == side))[0]
+            if key == "upper_arm":
+                upper = arm[np.argmax(center[arm, 2])]
+                _scale_across(rotation, semi, [upper], axis, factor)
+            else:
+                center[arm] = start + factor * (center[arm] - start)
+                along = np.einsum("nik,i->nk", rotation[arm], axis) ** 2
+                semi[arm] *= factor**along
+
+
+def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXTRA_MAX_ROUNDS):
+    """Deform a synthesized mannequin until its m_T meets its request (``mannequin.measurements``) and its
+    extra measurements meet ``extra`` {key: cm}. Returns (mannequin, measured {all keys: cm}, misses [lines]).
+
+    All at once first; if that misses any, one measurement at a time (in EXTRA_MEASUREMENTS order), each kept
+    only if it and those kept before are met with the five: one that the pieces cannot reach (or only by
+    giving up the five) is left where the reference set puts it, and named in the misses."""
+    final, measured, misses = _extra_pieces(mannequin, extra, tolerance_cm, max_rounds)
+    if final.joints is not None:  # the joints ride on their anchor pieces, as through the five's refinement
+        before = (mannequin.rotation, mannequin.center, mannequin.semi_axes)
+        after = (final.rotation, final.center, final.semi_axes)
+        final = final.copy(joints=follow_pieces(mannequin.joints, anchor_indices(mannequin.topology), before, after))
+    return final, measured, misses
+
+
+def _extra_pieces(mannequin, extra, tolerance_cm, max_rounds):
+    """meet_extra's pieces (the joints left where they were)."""
+    result = _meet(mannequin, extra, tolerance_cm, max_rounds)
+    if not result[2]:
+        return result
+    kept, current = {}, mannequin
+    for key in (key for key in EXTRA_MEASUREMENTS if key in extra):
+        trial = _meet(current, {**kept, key: extra[key]}, tolerance_cm, max_rounds)
+        if not trial[2]:
+            kept[key] = extra[key]
+            current = trial[0]
+    final, measured, _ = _meet(current, kept, tolerance_cm, max_rounds) if kept else (current, None, [])
+    if measured is None:
+        measured = _all_measured(final)
+    return final, measured, _misses(measured, extra)
+
+
+def _all_measured(mannequin):
+    five = tailor_measurements(mannequin.rotation, mannequin.center, mannequin.semi_axes,
+                               mannequin.topology.girth_mask, mannequin.section_fractions)
+    return {**dict(zip(MEASUREMENTS, (float(v) for v in five))), **mannequin_extra_measurements(mannequin)}
+
+
+def _misses(measured, extra):
+    return [f"{key} {measured[key]:.2f} cm, asked {extra[key]:.2f} (off by {measured[key] - extra[key]:+.2f} cm)"
+            for key in EXTRA_MEASUREMENTS if key in extra and abs(measured[key] - extra[key]) > MISS_CM]
+
+
+def _meet(mannequin, extra, tolerance_cm, max_rounds):
+    """meet_extra for all of ``extra`` at once."""
+    targets = np.array([mannequin.measurements[key] for key in MEASUREMENTS])
+    rotation, center, semi = mannequin.rotation.copy(), mannequin.center.copy(), mannequin.semi_axes.copy()
+    keys = [key for key in EXTRA_MEASUREMENTS if key in extra]
+    log_factor = {key: 0.0 for key in keys}
+    limit = np.log(EXTRA_FACTOR_LIMIT)
+    slope = {key: 1.0 for key in keys}
+    previous = {}
+    girth = mannequin.topology.girth_mask
+    fractions = mannequin.section_fractions
+
+    def measure():  # a snapshot: the arrays go on being deformed in place
+        current = mannequin.copy(rotation=rotation.copy(), center=center.copy(), semi_axes=semi.copy())
+        return current, mannequin_extra_measurements(current)
+
+    def worst_miss(current, values):
+        """(whether the five miss, the largest miss of the given extra ones in cm): the five come first."""
+        five = tailor_measurements(current.rotation, current.center, current.semi_axes, girth, fractions)
+        return (bool(np.any(np.abs(five - targets) > FIVE_TOLERANCE_CM)),
+                max(abs(values[key] - extra[key]) for key in keys))
+
+    current, values = measure()
+    best = (worst_miss(current, values), current, values)
+    for _ in range(max_rounds):
+        residual = {key: np.log(values[key] / extra[key]) for key in keys}
+        if all(abs(values[key] - extra[key]) <= tolerance_cm for key in keys):
+            break
+        for key in keys:
+            if key in previous and abs(log_factor[key] - previous[key][0]) > 1e-9:
+                secant = (residual[key] - previous[key][1]) / (log_factor[key] - previous[key][0])
+                slope[key] = secant if secant > 0.05 else slope[key]
+            previous[key] = (log_factor[key], residual[key])
+        for key in keys:
+            if abs(log_factor[key]) >= limit:
+                continue  # at its limit: this measurement is as close as its pieces go
+            step = float(np.clip(-residual[key] / slope[key], -_MAX_LOG_STEP, _MAX_LOG_STEP))
+            wanted = float(np.clip(log_factor[key] + step, -limit, limit))
+            _apply(key, np.exp(wanted - log_factor[key]), current, rotation, center, semi)
+            log_factor[key] = wanted
+            current = mannequin.copy(rotation=rotation, center=center, semi_axes=semi)
+        result = refine(mannequin.topology, rotation[None], center[None], semi[None], targets[None],
+                        fractions=fractions)
+        center, semi = result.center[0], result.semi_axes[0]
+        current, values = measure()
+        worst = worst_miss(current, values)
+        if worst < best[0]:
+            best = (worst, current, values)
+    # the round closest to the given extra ones among those meeting the five (the synthesized one is such a round)
+    _, current, values = best
+    measured = _all_measured(current)
+    misses = _misses(measured, extra)
+    if worst_miss(current, values)[0]:
+        misses.append("the five")
+    return current, measured, misses
+
+
+def synthesize_extra(reference, request, extra, options=None):
+    """One mannequin meeting the five of ``request`` (dict, cm) and the given ``extra`` measurements (exact mode;
+    IDW leaves the extra ones as the reference set gives them). Returns (Mannequin, measured {all: cm},
+    warnings); raises ExtraRequestError for a contradiction."""
+    problems = extra_request_problems(request, extra)
+    if problems:
+        raise ExtraRequestError(problems[0])
+    mannequin, measured, warnings = synthesize(reference, request, options)
+    if extra and getattr(options, "mode", "exact") == "exact":
+        mannequin, measured, misses = meet_extra(mannequin, extra)
+        warnings += [f"exact mode missed {line}" for line in misses]
+    else:
+        measured = dict(measured, **mannequin_extra_measurements(mannequin))
+        if extra:
+            warnings.append("the extra measurements are met in exact mode only (IDW gives the reference set's)")
+    return mannequin, measured, warnings
