@@ -102,7 +102,7 @@ def compare(mannequin, body_vertices, body_faces, frames=FRAMES, repeat=REPEAT, 
         settings = drape.DrapeSettings(frames=frames, edge=EDGE)
         with blender_output():
             empty_scene()
-            _, obj = drape.setup(garment, pieces, settings, "bench")
+            _, obj, _ = drape.setup(garment, pieces, settings, "bench")
             wall, cpu = drape.bake(bpy.context.scene, obj, frames)
         return float(np.mean(wall)), float(np.mean(cpu)), drape.evaluated_vertices(obj)
 

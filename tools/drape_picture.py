@@ -72,7 +72,7 @@ def main(argv=None):
                 add_mannequin(copy, cushions=True)
                 pieces = collision_pieces(copy, True, settings.sphere_subdivisions, settings.cushion_subdivisions)
                 label = f"{garment.name} on the mannequin"
-            _, cloth = drape.setup(moved, pieces, settings, label)
+            _, cloth, _ = drape.setup(moved, pieces, settings, label)
             drape.bake(scene, cloth, args.frames)
             lo, hi = bounds(mannequin.rotation, mannequin.center, mannequin.semi_axes)
             render._add_label(label, (offset[0], lo[:, 1].min() - 0.2, -0.04), size=0.05)
