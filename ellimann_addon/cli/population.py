@@ -6,6 +6,7 @@ import csv
 import io
 import sys
 
+from ..core.constants import MEASUREMENTS
 from ..core.population import MAX_SAMPLES, load_population, shipped_populations
 from . import batch, common
 from .common import PROG, UsageError
@@ -15,14 +16,18 @@ def add_parser(commands):
     population = commands.add_parser(
         "population", help="sample measurement rows from a survey's statistics",
         description="Sample N rows of measurements (cm) from a survey's mean and covariance (a multivariate "
-                    "normal; docs/population.md) into a CSV for batch: name, He, Sh, Br, Wa, Hi and the survey's "
-                    "other measurements. The same --seed gives the same rows everywhere. Rows outside what a body "
-                    "can be are refused and counted.")
+                    "normal; docs/population.md) into a CSV for batch: name, He, Sh, Br, Wa, Hi (and with --extras "
+                    "the survey's other measurements). The same --seed gives the same rows everywhere. Rows outside "
+                    "what a body can be are refused and counted.")
     population.add_argument("--stats", required=True, metavar="NAME",
                             help=f"a shipped survey ({', '.join(shipped_populations())}) or a statistics .json file")
     population.add_argument("--n", required=True, type=int, metavar="N", help=f"rows to sample (1 to {MAX_SAMPLES:,})")
     population.add_argument("--seed", type=int, default=0, metavar="S", help="seed of the sampling (default 0)")
     population.add_argument("-o", "--output", required=True, metavar="PEOPLE.csv", help="the CSV to write")
+    population.add_argument("--extras", action="store_true",
+                            help="also write the survey's other measurements; batch then meets those it knows (neck, "
+                                 "thigh, calf, crotch_height...) in exact mode, at seconds per mannequin instead of "
+                                 "milliseconds")
     population.add_argument("--synthesize", metavar="DIR",
                             help="also synthesize every row into DIR, as batch does (report.csv and --format)")
     population.add_argument("--format", default="npz",
@@ -49,7 +54,9 @@ def run(args):
     if refused:
         common.say(f"{PROG} population: refused {refused} of {len(rows)} sampled rows outside what a body can be "
                    "(a value <= 0 cm or outside the plausible limits)")
-    common.write_text(args.output, population_csv(population.keys, rows, accepted))
+    keys = list(population.keys)
+    columns = range(len(keys)) if args.extras else [keys.index(key) for key in MEASUREMENTS]
+    common.write_text(args.output, population_csv([keys[c] for c in columns], rows[:, list(columns)], accepted))
     common.say(f"{PROG} population: wrote {len(rows) - refused} rows sampled from {population.name} (seed "
                f"{args.seed}) to {args.output}", file=sys.stdout)
     if not args.synthesize:

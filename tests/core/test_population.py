@@ -131,3 +131,18 @@ def test_synthesize_writes_the_batch(tmp_path, capsys):
     people = list(csv.DictReader((tmp_path / "p.csv").open(encoding="utf-8")))
     assert [r["name"] for r in report] == [p["name"] for p in people]
     assert [r["He"] for r in report] == [f"{float(p['He']):g}" for p in people]
+
+
+def test_the_csv_holds_the_five_unless_extras_are_asked(tmp_path, capsys):
+    """The survey's other measurements (neck, thigh, ...) would make batch meet them in exact mode, seconds per
+    mannequin: they are written only with --extras, on the same sampled rows."""
+    five, every = tmp_path / "five.csv", tmp_path / "every.csv"
+    for path, more in ((five, []), (every, ["--extras"])):
+        code, _, err = run(["population", "--stats", "ansur2_female", "--n", "20", "--seed", "3", "-q",
+                            "-o", str(path), *more], capsys)
+        assert code == 0, err
+    short = list(csv.DictReader(five.open(encoding="utf-8")))
+    full = list(csv.DictReader(every.open(encoding="utf-8")))
+    assert list(short[0]) == ["name", "He", "Sh", "Br", "Wa", "Hi"]
+    assert len(full[0]) > 6 and "neck" in full[0]
+    assert [{k: r[k] for k in short[0]} for r in full] == short
