@@ -10,6 +10,7 @@ male body as on a female one.
 import pathlib
 from dataclasses import dataclass
 
+from ellimann_addon.cli.references import read_targets
 from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
@@ -33,16 +34,11 @@ class BuildSet:
 FEMALE = BuildSet("female", "female", SHARED / "refmodels", "reference_female", REFERENCE_MEASUREMENTS,
                   SECTION_FRACTIONS, REPO / "reference_blends", "reference_mannequins.md", "reference_lineup.png")
 
-# ../shared/refmodels_male/README.md: the male targets, chosen to span a male population, and the section
-# heights the male bodies were fitted and measured with (the natural waist of the neutral male at 0.625 He,
-# the hip cut at 0.515 He, clear of the crotch at 0.477).
-MALE_TARGETS = {
-    "small_slim": {"He": 162.0, "Sh": 44.0, "Br": 88.0, "Wa": 72.0, "Hi": 88.0},
-    "tall_slim": {"He": 189.0, "Sh": 46.0, "Br": 90.0, "Wa": 74.0, "Hi": 90.0},
-    "small_chubby": {"He": 162.0, "Sh": 55.0, "Br": 122.0, "Wa": 116.0, "Hi": 114.0},
-    "tall_chubby": {"He": 189.0, "Sh": 58.0, "Br": 128.0, "Wa": 120.0, "Hi": 118.0},
-    "average": {"He": 176.0, "Sh": 51.0, "Br": 104.0, "Wa": 92.0, "Hi": 101.0},
-}
+# ../shared/refmodels_male: the male targets (its measurements.csv, read as `ellimann references build` reads a
+# targets CSV), chosen to span a male population, and the section heights the male bodies were fitted and
+# measured with (the natural waist of the neutral male at 0.625 He, the hip cut at 0.515 He, clear of the
+# crotch at 0.477).
+MALE_TARGETS = read_targets(SHARED / "refmodels_male" / "measurements.csv")
 MALE_FRACTIONS = {"Sh": 0.800, "Br": 0.720, "Wa": 0.625, "Hi": 0.515}
 MALE = BuildSet("male", "male", SHARED / "refmodels_male", "reference_male", MALE_TARGETS, MALE_FRACTIONS,
                 REPO / "reference_blends" / "male", "reference_mannequins_male.md", "reference_lineup_male.png")
