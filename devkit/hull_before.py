@@ -7,15 +7,24 @@ import numpy as np
 from ellimann_addon.core.measure import (
     _GL_NODES,
     _GL_WEIGHTS,
-    DETECTION_SAMPLES,
     QUADRATURE_CELLS,
-    REFINE_FACTOR,
     _compact,
     _kinks,
-    _max_curvature_radius,
     _next_in_section,
     _support_2d,
 )
+
+DETECTION_SAMPLES = 128  # its grid: every cell where the outermost ellipse may change sampled 16 times finer
+REFINE_FACTOR = 16
+
+
+def _max_curvature_radius(k):
+    """Largest radius of curvature of each ellipse: a^2 / b with a >= b its semi-axes."""
+    tr = k[..., 0, 0] + k[..., 1, 1]
+    det = k[..., 0, 0] * k[..., 1, 1] - k[..., 0, 1] ** 2
+    disc = np.sqrt(np.clip(0.25 * tr * tr - det, 0.0, None))
+    big, small = 0.5 * tr + disc, np.clip(0.5 * tr - disc, 1e-30, None)
+    return big / np.sqrt(small)
 
 
 def _winners(centre, k, active, sec, theta):
