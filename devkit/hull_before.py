@@ -9,13 +9,31 @@ from ellimann_addon.core.measure import (
     _GL_WEIGHTS,
     QUADRATURE_CELLS,
     _compact,
-    _kinks,
     _next_in_section,
     _support_2d,
+    _support_2d_with_derivative,
 )
 
 DETECTION_SAMPLES = 128  # its grid: every cell where the outermost ellipse may change sampled 16 times finer
 REFINE_FACTOR = 16
+
+
+NEWTON_STEPS = 3
+
+
+def _kinks(cp, kp, lo, hi):
+    """The angles in [lo, hi] where the outermost ellipse changes from cp[0], kp[0] to cp[1], kp[1] (2, K, ...):
+    h_0 = h_1 by a secant start and NEWTON_STEPS Newton steps."""
+    g_lo, g_hi = np.subtract(*_support_2d(cp, kp, lo)), np.subtract(*_support_2d(cp, kp, hi))
+    denom = g_lo - g_hi
+    frac = np.divide(g_lo, denom, out=np.full_like(g_lo, 0.5), where=np.abs(denom) > 0.0)
+    theta = lo + (hi - lo) * np.clip(frac, 0.0, 1.0)
+    for _ in range(NEWTON_STEPS):
+        value, slope = _support_2d_with_derivative(cp, kp, theta)
+        g, dg = value[0] - value[1], slope[0] - slope[1]
+        update = np.divide(g, dg, out=np.zeros_like(g), where=np.abs(dg) > 1e-300)
+        theta = np.minimum(np.maximum(theta - update, lo), hi)
+    return theta
 
 
 def _max_curvature_radius(k):
@@ -61,7 +79,7 @@ def hull_perimeter_before(centre, k, active):
     sec = det_sec[change]
     lo, hi = det_theta[change], nxt_theta[change]
     pair = np.stack([det_winner[change], nxt_winner[change]])
-    theta = _kinks(centre[sec, pair], k[sec, pair], lo, hi)  # unchanged: shared with today's
+    theta = _kinks(centre[sec, pair], k[sec, pair], lo, hi)
     cells = np.arange(QUADRATURE_CELLS) * (2.0 * np.pi / QUADRATURE_CELLS)
     cut_theta = np.concatenate([np.tile(cells, sections), np.mod(theta, 2.0 * np.pi)])
     cut_sec = np.concatenate([np.repeat(np.arange(sections), QUADRATURE_CELLS), sec])

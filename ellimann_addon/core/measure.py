@@ -178,7 +178,7 @@ def hull_perimeter(centre, k, active):
     ends = (h[sec_r, :, cell_r], h[sec_r, :, (cell_r + 1) % DETECTION_SAMPLES])  # (R, n) each
     kinks = []
     for level in range(REFINE_LEVELS + 1):
-        theta, kink_row, doubtful = _scan(centre, k, coefficients, active, (largest, smallest), sec_r, start, width,
+        theta, kink_row, doubtful = _scan(coefficients, active, (largest, smallest), sec_r, start, width,
                                           REFINE_FACTOR**level, ends)
         keep = ~doubtful[kink_row] if level < REFINE_LEVELS else np.ones(len(kink_row), dtype=bool)
         kinks.append((theta[keep], sec_r[kink_row[keep]]))
@@ -220,7 +220,7 @@ def hull_perimeter(centre, k, active):
     return np.bincount(cut_sec, weights=piece, minlength=sections)
 
 
-def _scan(centre, k, coefficients, active, radii, sec, start, width, samples, ends):
+def _scan(coefficients, active, radii, sec, start, width, samples, ends):
     """Find the kinks in the intervals [start, start + width] (R,) of sections ``sec``, given every ellipse's h at
     both ends (``ends``: two (R, n)), from ``samples`` equal sub-intervals: in each one where the outermost
     ellipse changes, h_0 = h_1 is solved (:func:`_kinks`).
@@ -252,7 +252,9 @@ def _scan(centre, k, coefficients, active, radii, sec, start, width, samples, en
     lo, hi = theta[row, at], theta[row, at + 1]
     pair = np.stack([winner[row, at], winner[row, at + 1]])  # (2, K)
     kink_sec = sec[row]
-    kink = _kinks(centre[kink_sec, pair], k[kink_sec, pair], lo, hi)
+    # h_A - h_B at the sub-interval's ends: B's gap to A at the start, minus A's gap to B at the end.
+    kink = _kinks(coefficients, ((kink_sec, pair[0]), (kink_sec, pair[1])), lo, hi, gap[row, at, pair[1]],
+                  -gap[row, at + 1, pair[0]])
     h_kink = coefficients.support((kink_sec[:, None], np.arange(n)), np.cos(kink)[:, None], np.sin(kink)[:, None])
     np.copyto(h_kink, -np.inf, where=~active[kink_sec])  # (K, n)
     columns = np.arange(n)
@@ -274,16 +276,25 @@ def _scan(centre, k, coefficients, active, radii, sec, start, width, samples, en
     return kink, row, doubtful
 
 
-def _kinks(cp, kp, lo, hi):
-    """The angles in [lo, hi] where the outermost ellipse changes from cp[0], kp[0] to cp[1], kp[1] (2, K, ...):
-    h_0 = h_1 by a secant start and NEWTON_STEPS Newton steps."""
-    g_lo, g_hi = np.subtract(*_support_2d(cp, kp, lo)), np.subtract(*_support_2d(cp, kp, hi))
+def _kinks(coefficients, index, lo, hi, g_lo, g_hi):
+    """The angles in [lo, hi] where the outermost ellipse changes from the ellipse index[0] to index[1] (each a
+    tuple (section, ellipse) of (K,) arrays): h_0 = h_1 by a secant start from g = h_0 - h_1 at lo and hi, and
+    NEWTON_STEPS Newton steps kept in [lo, hi]."""
     denom = g_lo - g_hi
     frac = np.divide(g_lo, denom, out=np.full_like(g_lo, 0.5), where=np.abs(denom) > 0.0)
     theta = lo + (hi - lo) * np.clip(frac, 0.0, 1.0)
+    (a0, b0, d0), (a1, b1, d1) = ((coefficients.a[i], coefficients.b[i], coefficients.d[i]) for i in index)
+    dcx = coefficients.cx[index[0]] - coefficients.cx[index[1]]
+    dcy = coefficients.cy[index[0]] - coefficients.cy[index[1]]
     for _ in range(NEWTON_STEPS):
-        value, slope = _support_2d_with_derivative(cp, kp, theta)
-        g, dg = value[0] - value[1], slope[0] - slope[1]
+        c, s = np.cos(theta), np.sin(theta)
+        cc, cs, ss = c * c, c * s, s * s
+        root0 = np.sqrt(np.maximum(a0 * cc + b0 * cs + d0 * ss, 1e-30))
+        root1 = np.sqrt(np.maximum(a1 * cc + b1 * cs + d1 * ss, 1e-30))
+        g = dcx * c + dcy * s + root0 - root1
+        turn = cc - ss  # d(a cc + b cs + d ss)/dtheta = 2 (d - a) cs + b (cc - ss)
+        dg = (dcy * c - dcx * s + (2.0 * (d0 - a0) * cs + b0 * turn) / (2.0 * root0)
+              - (2.0 * (d1 - a1) * cs + b1 * turn) / (2.0 * root1))
         update = np.divide(g, dg, out=np.zeros_like(g), where=np.abs(dg) > 1e-300)
         theta = np.minimum(np.maximum(theta - update, lo), hi)
     return theta
