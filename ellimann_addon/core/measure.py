@@ -22,12 +22,12 @@ from .mesh import convex_hull_2d, plane_section_points, polygon_perimeter
 
 DETECTION_SAMPLES = 32  # grid used to find which ellipse is outermost in each direction
 QUADRATURE_CELLS = 32  # fixed cuts so that every smooth piece spans at most 2pi/32
-GAUSS_ORDER = 12
+GAUSS_ORDERS = (8, 12, 16, 24)  # Gauss-Legendre nodes per piece: the fewest that _gauss_orders' bound allows
+QUADRATURE_TOLERANCE = 1e-16  # that bound on the quadrature's error, relative to the perimeter
 NEWTON_STEPS = 6  # from a secant start across a whole grid cell
 KINK_TOLERANCE = 1e-10  # |h_0 - h_1| at a kink found, relative to the ellipses' size (else: sampled finer)
 REFINE_FACTOR = 8  # a grid cell in doubt is sampled this many times finer, ...
 REFINE_LEVELS = 3  # ... at most this many times
-_GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(GAUSS_ORDER)
 _GROUP_MIN_SECTIONS = 64  # from this many sections, those with fewer ellipses are measured apart (less padding)
 _CHUNK = 256  # mannequins per batch chunk (bounds the temporary arrays to tens of MB)
 
@@ -200,22 +200,28 @@ def hull_perimeter(centre, k, active):
     whole = (cell >= 0) & (next_cell >= 0)
     split = ~whole
     cell_winner = winner[:, _GRID_PER_CELL // 2::_GRID_PER_CELL]  # (S, cells)
-    cells = (np.arange(sections)[:, None], cell_winner)
-    cell_root = _weighted_sum(coefficients.root((cells[0][..., None], cell_winner[..., None]), *_CELL_NODE_DIRECTIONS),
-                              _GL_WEIGHTS)  # (S, cells)
-    cell_integral = _CELL_HALF * cell_root + coefficients.centre_integral(cells, *_CELL_ENDS)
     piece_winner = np.empty(len(cut_sec), dtype=np.int64)
     piece_winner[whole] = cell_winner[cut_sec[whole], cell[whole]]
     piece_winner[split] = _winners(coefficients, active, cut_sec[split], cut_theta[split] + half[split])
+    order = _gauss_orders(coefficients, active)  # (S,)
     piece = np.empty(len(cut_sec))
-    piece[whole] = cell_integral[cut_sec[whole], cell[whole]]
-    nodes = (cut_theta[split] + half[split])[:, None] + half[split, None] * _GL_NODES
-    index = (cut_sec[split], piece_winner[split])
-    root = _weighted_sum(coefficients.root((index[0][:, None], index[1][:, None]), np.cos(nodes), np.sin(nodes)),
-                         _GL_WEIGHTS)
-    low, high = cut_theta[split], end[split]
-    piece[split] = half[split] * root + coefficients.centre_integral(index, np.cos(low), np.sin(low),
-                                                                     np.cos(high), np.sin(high))
+    for nodes in np.unique(order):
+        rule, weights, directions = _RULES[nodes]
+        rows = np.nonzero(order == nodes)[0]
+        cells = (rows[:, None], cell_winner[rows])
+        cell_root = _weighted_sum(coefficients.root((rows[:, None, None], cells[1][..., None]), *directions), weights)
+        cell_integral = _CELL_HALF * cell_root + coefficients.centre_integral(cells, *_CELL_ENDS)  # (rows, cells)
+        mine = order[cut_sec] == nodes
+        pick = whole & mine
+        piece[pick] = cell_integral[np.searchsorted(rows, cut_sec[pick]), cell[pick]]
+        pick = np.nonzero(split & mine)[0]
+        at = (cut_theta[pick] + half[pick])[:, None] + half[pick, None] * rule
+        index = (cut_sec[pick], piece_winner[pick])
+        root = _weighted_sum(coefficients.root((index[0][:, None], index[1][:, None]), np.cos(at), np.sin(at)),
+                             weights)
+        low, high = cut_theta[pick], end[pick]
+        piece[pick] = half[pick] * root + coefficients.centre_integral(index, np.cos(low), np.sin(low),
+                                                                       np.cos(high), np.sin(high))
     piece = np.where(active[cut_sec, piece_winner], piece, 0.0)
     return np.bincount(cut_sec, weights=piece, minlength=sections)
 
@@ -304,17 +310,41 @@ _CELLS = np.arange(QUADRATURE_CELLS) * (2.0 * np.pi / QUADRATURE_CELLS)
 _GRID_PER_CELL = DETECTION_SAMPLES // QUADRATURE_CELLS
 
 
-def _cell_nodes():
-    """The Gauss-Legendre nodes of every whole cell (QUADRATURE_CELLS, GAUSS_ORDER), computed as
-    :func:`hull_perimeter` computes a piece's."""
-    end = np.append(_CELLS[1:], _CELLS[0] + 2.0 * np.pi)
-    half = 0.5 * (end - _CELLS)
-    return (_CELLS + half)[:, None] + half[:, None] * _GL_NODES
-
-
-_CELL_NODE_DIRECTIONS = _directions(_cell_nodes())
-_CELL_END = np.append(_CELLS[1:], 2.0 * np.pi)
+_CELL_END = np.append(_CELLS[1:], _CELLS[0] + 2.0 * np.pi)
 _CELL_HALF = 0.5 * (_CELL_END - _CELLS)
+
+
+def _rule(nodes):
+    """A Gauss-Legendre rule on [-1, 1] and the directions of its nodes in every whole cell (QUADRATURE_CELLS,
+    nodes), computed as :func:`hull_perimeter` computes a piece's."""
+    rule, weights = np.polynomial.legendre.leggauss(nodes)
+    return rule, weights, _directions((_CELLS + _CELL_HALF)[:, None] + _CELL_HALF[:, None] * rule)
+
+
+_RULES = {nodes: _rule(nodes) for nodes in GAUSS_ORDERS}
+
+
+def _gauss_orders(coefficients, active):
+    """Gauss-Legendre nodes per piece for each section (S,): the fewest of GAUSS_ORDERS whose error bound, for
+    every active ellipse, is within QUADRATURE_TOLERANCE of the perimeter (else the most).
+
+    The root integrated, sqrt(alpha + beta cos 2(theta - phi)), is analytic up to |Im theta| = y0 =
+    acosh(alpha / beta) / 2 (alpha +- beta the squared semi-axes); in the Bernstein ellipse of a cell (half-width
+    h) reaching 0.9 y0, rho = t + sqrt(1 + t^2) with t = 0.9 y0 / h, it is at most sqrt(2 alpha), so n nodes
+    err by at most h 64/15 sqrt(2 alpha) rho^-2n / (rho^2 - 1) per cell (Trefethen, Approximation Theory and
+    Approximation Practice, Thm 19.3); a piece split by a kink is shorter and errs less. The perimeter is at
+    least the ellipse's, 4 sqrt(alpha + beta)."""
+    alpha = 0.5 * (coefficients.a + coefficients.d)
+    beta = np.sqrt(0.25 * (coefficients.a - coefficients.d) ** 2 + 0.25 * coefficients.b**2)
+    half = np.pi / QUADRATURE_CELLS
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # circles (beta 0), inactive ellipses
+        reach = 0.45 * np.arccosh(np.maximum(alpha / beta, 1.0)) / half
+        rho = reach + np.sqrt(1.0 + reach * reach)
+        allowed = QUADRATURE_TOLERANCE * 4.0 * np.sqrt(alpha + beta) / (QUADRATURE_CELLS * half * 64.0 / 15.0
+                                                                         * np.sqrt(2.0 * alpha))
+        fails = sum((rho ** (-2.0 * n) / (rho * rho - 1.0) > allowed) | ~np.isfinite(allowed) for n in GAUSS_ORDERS)
+    need = np.where(active, np.minimum(fails, len(GAUSS_ORDERS) - 1), 0)
+    return np.asarray(GAUSS_ORDERS)[need.max(axis=1)]
 _CELL_ENDS = (np.cos(_CELLS), np.sin(_CELLS), np.cos(_CELL_END), np.sin(_CELL_END))  # each cell's start and end
 
 
