@@ -24,7 +24,8 @@ DETECTION_SAMPLES = 32  # grid used to find which ellipse is outermost in each d
 QUADRATURE_CELLS = 32  # fixed cuts so that every smooth piece spans at most 2pi/32
 GAUSS_ORDERS = (8, 12, 16, 24)  # Gauss-Legendre nodes per piece: the fewest that _gauss_orders' bound allows
 QUADRATURE_TOLERANCE = 1e-16  # that bound on the quadrature's error, relative to the perimeter
-NEWTON_STEPS = 6  # from a secant start across a whole grid cell
+NEWTON_STEPS = 8  # from a secant start across a whole grid cell ...
+NEWTON_DONE = 1e-13  # ... until a kink moves less than this (radians)
 KINK_TOLERANCE = 1e-10  # |h_0 - h_1| at a kink found, relative to the ellipses' size (else: sampled finer)
 REFINE_FACTOR = 8  # a grid cell in doubt is sampled this many times finer, ...
 REFINE_LEVELS = 3  # ... at most this many times
@@ -102,13 +103,6 @@ class _Coefficients:
         return self.cx[index] * (s1 - s0) - self.cy[index] * (c1 - c0)
 
 
-def _winners(coefficients, active, sec, theta):
-    """Index of the outermost active ellipse of section ``sec`` in direction ``theta`` (flat arrays)."""
-    c, s = np.cos(theta)[:, None], np.sin(theta)[:, None]
-    h = coefficients.support((sec,), c, s)
-    return np.argmax(np.where(active[sec], h, -np.inf), axis=1)
-
-
 _GRID_STEP = 2.0 * np.pi / DETECTION_SAMPLES
 _GRID = np.arange(DETECTION_SAMPLES) * _GRID_STEP
 
@@ -178,31 +172,30 @@ def hull_perimeter(centre, k, active):
     ends = (h[sec_r, :, cell_r], h[sec_r, :, (cell_r + 1) % DETECTION_SAMPLES])  # (R, n) each
     kinks = []
     for level in range(REFINE_LEVELS + 1):
-        theta, kink_row, doubtful = _scan(coefficients, active, (largest, smallest), sec_r, start, width,
+        theta, kink_row, after, doubtful = _scan(coefficients, active, (largest, smallest), sec_r, start, width,
                                           REFINE_FACTOR**level, ends)
         keep = ~doubtful[kink_row] if level < REFINE_LEVELS else np.ones(len(kink_row), dtype=bool)
-        kinks.append((theta[keep], sec_r[kink_row[keep]]))
+        kinks.append((theta[keep], sec_r[kink_row[keep]], after[keep]))
         if level == REFINE_LEVELS or not doubtful.any():
             break
         sec_r, start, width = sec_r[doubtful], start[doubtful], width[doubtful]
         ends = (ends[0][doubtful], ends[1][doubtful])
-    theta = np.concatenate([t for t, _ in kinks])
-    sec = np.concatenate([s for _, s in kinks])
+    theta, sec, after = (np.concatenate(column) for column in zip(*kinks))
 
     # 4. Cut the circle at the kinks and at fixed cells; integrate each piece's outermost ellipse: the linear
     #    part of its support in closed form, the root by Gauss-Legendre. A piece between two fixed cuts (no kink
     #    inside) is a whole cell: its outermost ellipse is the grid's in the cell, and every section's cells are
     #    integrated at once from a table of the nodes' directions (the integrals of cells that a kink splits are
     #    not used).
-    cut_theta, cut_sec, cell = _cuts(sections, np.mod(theta, 2.0 * np.pi), sec)
+    cut_theta, cut_sec, cell, cut_after = _cuts(sections, np.mod(theta, 2.0 * np.pi), sec, after)
     end, next_cell = _next_in_section(cut_sec, cut_theta, cell)
     half = 0.5 * (end - cut_theta)
     whole = (cell >= 0) & (next_cell >= 0)
     split = ~whole
-    cell_winner = winner[:, _GRID_PER_CELL // 2::_GRID_PER_CELL]  # (S, cells)
-    piece_winner = np.empty(len(cut_sec), dtype=np.int64)
-    piece_winner[whole] = cell_winner[cut_sec[whole], cell[whole]]
-    piece_winner[split] = _winners(coefficients, active, cut_sec[split], cut_theta[split] + half[split])
+    cell_winner = winner[:, ::_GRID_PER_CELL]  # (S, cells): at each cell's start
+    # A piece from a cut at a cell's start has the grid's outermost ellipse there, one from a kink the ellipse
+    # outermost after it.
+    piece_winner = np.where(cell >= 0, cell_winner[cut_sec, np.maximum(cell, 0)], cut_after)
     order = _gauss_orders(coefficients, active)  # (S,)
     piece = np.empty(len(cut_sec))
     for nodes in np.unique(order):
@@ -231,10 +224,11 @@ def _scan(coefficients, active, radii, sec, start, width, samples, ends):
     both ends (``ends``: two (R, n)), from ``samples`` equal sub-intervals: in each one where the outermost
     ellipse changes, h_0 = h_1 is solved (:func:`_kinks`).
 
-    Returns (theta (K,), row (K,) the interval of each kink, doubtful (R,)): an interval is doubtful where
-    :func:`_may_surface` cannot rule out an ellipse rising above the outermost one inside a sub-interval with
-    one outermost ellipse, or on either side of a kink (up to the kink, from it), or a third ellipse is above
-    the pair at the kink, or the pair's supports differ there by more than KINK_TOLERANCE."""
+    Returns (theta (K,), row (K,) the interval of each kink, the ellipse outermost after it (K,), doubtful
+    (R,)): an interval is doubtful where :func:`_may_surface` cannot rule out an ellipse rising above the
+    outermost one inside a sub-interval with one outermost ellipse, or on either side of a kink (up to the kink,
+    from it), or a third ellipse is above the pair at the kink, or the pair's supports differ there by more than
+    KINK_TOLERANCE."""
     n = active.shape[1]
     inner = np.arange(1, samples) / samples
     theta = np.concatenate([start[:, None], start[:, None] + width[:, None] * inner, (start + width)[:, None]],
@@ -279,30 +273,40 @@ def _scan(coefficients, active, radii, sec, start, width, samples, ends):
         doubt |= _may_surface(gap[row, at], before - h_kink, bend_before, (kink - lo)[:, None]) & not_before
         doubt |= _may_surface(after - h_kink, gap[row, at + 1], bend_after, (hi - kink)[:, None]) & not_after
     doubtful[row[doubt.any(axis=1)]] = True
-    return kink, row, doubtful
+    return kink, row, pair[1], doubtful
 
 
 def _kinks(coefficients, index, lo, hi, g_lo, g_hi):
     """The angles in [lo, hi] where the outermost ellipse changes from the ellipse index[0] to index[1] (each a
-    tuple (section, ellipse) of (K,) arrays): h_0 = h_1 by a secant start from g = h_0 - h_1 at lo and hi, and
-    NEWTON_STEPS Newton steps kept in [lo, hi]."""
+    tuple (section, ellipse) of (K,) arrays): h_0 = h_1 by a secant start from g = h_0 - h_1 at lo and hi, then
+    Newton steps kept in [lo, hi], at most NEWTON_STEPS, each kink's until its step is below NEWTON_DONE."""
     denom = g_lo - g_hi
     frac = np.divide(g_lo, denom, out=np.full_like(g_lo, 0.5), where=np.abs(denom) > 0.0)
     theta = lo + (hi - lo) * np.clip(frac, 0.0, 1.0)
     (a0, b0, d0), (a1, b1, d1) = ((coefficients.a[i], coefficients.b[i], coefficients.d[i]) for i in index)
     dcx = coefficients.cx[index[0]] - coefficients.cx[index[1]]
     dcy = coefficients.cy[index[0]] - coefficients.cy[index[1]]
+    todo = np.arange(len(theta))
     for _ in range(NEWTON_STEPS):
-        c, s = np.cos(theta), np.sin(theta)
+        t = theta[todo]
+        c, s = np.cos(t), np.sin(t)
         cc, cs, ss = c * c, c * s, s * s
-        root0 = np.sqrt(np.maximum(a0 * cc + b0 * cs + d0 * ss, 1e-30))
-        root1 = np.sqrt(np.maximum(a1 * cc + b1 * cs + d1 * ss, 1e-30))
-        g = dcx * c + dcy * s + root0 - root1
+        p0 = (a0[todo], b0[todo], d0[todo])
+        p1 = (a1[todo], b1[todo], d1[todo])
+        root0 = np.sqrt(np.maximum(p0[0] * cc + p0[1] * cs + p0[2] * ss, 1e-30))
+        root1 = np.sqrt(np.maximum(p1[0] * cc + p1[1] * cs + p1[2] * ss, 1e-30))
+        x, y = dcx[todo], dcy[todo]
+        g = x * c + y * s + root0 - root1
         turn = cc - ss  # d(a cc + b cs + d ss)/dtheta = 2 (d - a) cs + b (cc - ss)
-        dg = (dcy * c - dcx * s + (2.0 * (d0 - a0) * cs + b0 * turn) / (2.0 * root0)
-              - (2.0 * (d1 - a1) * cs + b1 * turn) / (2.0 * root1))
+        dg = (y * c - x * s + (2.0 * (p0[2] - p0[0]) * cs + p0[1] * turn) / (2.0 * root0)
+              - (2.0 * (p1[2] - p1[0]) * cs + p1[1] * turn) / (2.0 * root1))
         update = np.divide(g, dg, out=np.zeros_like(g), where=np.abs(dg) > 1e-300)
-        theta = np.minimum(np.maximum(theta - update, lo), hi)
+        new = np.minimum(np.maximum(t - update, lo[todo]), hi[todo])
+        moved = np.abs(new - t) > NEWTON_DONE
+        theta[todo] = new
+        todo = todo[moved]
+        if not len(todo):
+            break
     return theta
 
 
@@ -348,12 +352,12 @@ def _gauss_orders(coefficients, active):
 _CELL_ENDS = (np.cos(_CELLS), np.sin(_CELLS), np.cos(_CELL_END), np.sin(_CELL_END))  # each cell's start and end
 
 
-def _cuts(sections, theta, sec):
-    """The fixed cells of every section and the kinks (theta, sec), sorted by (section, angle), a cell before
-    a kink at the same angle: (theta, sec, cell index or -1 for a kink) of every cut. Only the kinks are
-    sorted; the cells are merged in."""
+def _cuts(sections, theta, sec, after):
+    """The fixed cells of every section and the kinks (theta, sec, the ellipse outermost after each), sorted by
+    (section, angle), a cell before a kink at the same angle: (theta, sec, cell index or -1 for a kink, the
+    ellipse after a kink or -1 for a cell) of every cut. Only the kinks are sorted; the cells are merged in."""
     order = np.lexsort((theta, sec))
-    theta, sec = theta[order], sec[order]
+    theta, sec, after = theta[order], sec[order], after[order]
     # A kink goes after the cells of the sections before it, the cells of its own section up to its angle
     # and the kinks sorted before it.
     kink_at = sec * QUADRATURE_CELLS + np.searchsorted(_CELLS, theta, side="right") + np.arange(len(theta))
@@ -364,7 +368,9 @@ def _cuts(sections, theta, sec):
     cut_theta[kink_at], cut_sec[kink_at] = theta, sec
     cut_theta[is_cell], cut_sec[is_cell] = np.tile(_CELLS, sections), np.repeat(np.arange(sections), QUADRATURE_CELLS)
     cell[is_cell] = np.tile(np.arange(QUADRATURE_CELLS), sections)
-    return cut_theta, cut_sec, cell
+    cut_after = np.full(total, -1)
+    cut_after[kink_at] = after
+    return cut_theta, cut_sec, cell, cut_after
 
 
 def _weighted_sum(values, weights):
