@@ -81,7 +81,8 @@ def _deform_basis(topology, rotation, center, semi_axes, measured, fractions=Non
     fractions = fractions or SECTION_FRACTIONS
     knots = _knots(fractions)
     bottom, height, z = section_heights(rotation, center, semi_axes, fractions)
-    span = center[..., 2, None] + axis_extent(rotation, semi_axes, 2)[..., None] * _SPAN  # (B, n, q)
+    half_z = axis_extent(rotation, semi_axes, 2)  # (B, n)
+    span = center[..., 2, None] + half_z[..., None] * _SPAN  # (B, n, q)
     fraction = (span - bottom[:, None, None]) / height[:, None, None]
     girth = topology.girth_mask
     weight = np.stack([_dot(_hat(fraction, _GIRTH_KNOT[key], knots), _SPAN_WEIGHT) for key in GIRTHS], axis=-1)
@@ -101,7 +102,6 @@ def _deform_basis(topology, rotation, center, semi_axes, measured, fractions=Non
     heights = [fractions[key] for key in ("Hi", "Wa", "Br")]
     origin_y = _interp_rows(fraction, heights, centre_y[:, order])
     # Where each section cuts each girth part, relative to the part's middle (-1 bottom .. 1 top).
-    half_z = axis_extent(rotation, semi_axes, 2)  # (B, n)
     cut = np.stack([(z[key][:, None] - center[..., 2]) / half_z for key in GIRTHS], axis=-1)  # (B, n, 3)
     crossing = (np.abs(cut) < 1.0) & girth[:, None]
     taper = np.where(crossing, np.abs(cut), 0.0)
