@@ -3,7 +3,8 @@
 243 requests: every combination of the three inner quartile points of the male ranges L. Each is synthesized
 with the paper's IDW (``normalize="none"``), proportional IDW (the default) and exact mode, and measured with
 m_T at the male section heights; the relative error |m_T - request| / request is summarised per measurement
-as Table 2.4 is (mean / max / min, %). The female set's figures are bench_synthesis's.
+as Table 2.4 is (mean / max / min, %); then the cost of exact mode against proportional IDW (bench_synthesis.
+population_scale). The female set's figures are bench_synthesis's.
 """
 
 import itertools
@@ -11,7 +12,7 @@ import time
 
 import numpy as np
 
-from bench.bench_synthesis import table
+from bench.bench_synthesis import population_scale, table
 from ellimann_addon.core import synthesis
 from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
 from ellimann_addon.core.shipped_sets import MALE_SET, named_reference_set
@@ -39,6 +40,10 @@ def run():
         table(f"\nTable 2.4 on the male set, {title}: {seconds:.2f} s", result.relative_error(), paper=False)
         if options["mode"] == "exact":
             spread = np.abs(result.factors - 1.0) * 100.0
+            refined = synthesis.refine(reference.topology, *synthesis.interpolate(reference, requests), requests,
+                                       jacobian=reference.refine_jacobian(), fractions=reference.section_fractions)
+            print(f"  iterations (slowest mannequin): {refined.iterations}")
             print(f"  converged: {int(result.converged.sum())}/{len(requests)} within "
                   f"{synthesis.EXACT_TOLERANCE * 100:g}% (largest error {result.relative_error().max():.1e}%); "
                   f"largest |factor - 1|: {spread.max():.2f}%")
+    population_scale(reference, requests)

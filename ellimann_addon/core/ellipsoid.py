@@ -60,22 +60,39 @@ def bounds(rotation, center, semi_axes):
     return center - half, center + half
 
 
-def section_at_height(rotation, center, semi_axes, height):
+def section_shape(rotation, semi_axes):
+    """What every horizontal section of an ellipsoid shares: (M_zz (...), m = M[:2, 2] / M_zz (..., 2), the Schur
+    complement M_xy - m m^T M_zz (..., 2, 2)), M the shape matrix, entry by entry in a fixed order (a mannequin
+    gets the same bits alone as in a batch)."""
+    r = np.asarray(rotation, dtype=float)
+    d2 = np.asarray(semi_axes, dtype=float) ** 2
+
+    def entry(i, j):
+        return r[..., i, 0] * r[..., j, 0] * d2[..., 0] + r[..., i, 1] * r[..., j, 1] * d2[..., 1] + \
+            r[..., i, 2] * r[..., j, 2] * d2[..., 2]
+
+    mzz = entry(2, 2)
+    slope = np.stack([entry(0, 2), entry(1, 2)], axis=-1) / mzz[..., None]
+    xy = entry(0, 1) - slope[..., 0] * slope[..., 1] * mzz
+    schur = np.stack([np.stack([entry(0, 0) - slope[..., 0] ** 2 * mzz, xy], axis=-1),
+                      np.stack([xy, entry(1, 1) - slope[..., 1] ** 2 * mzz], axis=-1)], axis=-2)
+    return mzz, slope, schur
+
+
+def section_at_height(rotation, center, semi_axes, height, shape=None):
     """Horizontal section z = height of each ellipsoid, in closed form.
 
     A plane section of an ellipsoid is an ellipse {u : (u - c2)^T K^-1 (u - c2) <= 1} in (x, y).
     With M the shape matrix, m = M[:2, 2], dz = height - c_z:
         c2 = c_xy + dz m / M_zz,   K = (1 - dz^2 / M_zz) (M_xy - m m^T / M_zz).
+    ``shape``: :func:`section_shape` of the ellipsoids when it is at hand (several heights).
     Returns (centre (..., 2), K (..., 2, 2), hit (...)); hit is False where the plane misses.
     """
-    m = shape_matrix(rotation, semi_axes)
-    mzz = m[..., 2, 2]
-    mxz = m[..., :2, 2]
+    mzz, slope, schur = section_shape(rotation, semi_axes) if shape is None else shape
     dz = np.asarray(height) - center[..., 2]
     shrink = 1.0 - dz * dz / mzz
     hit = shrink > 0.0
-    centre2 = center[..., :2] + (dz / mzz)[..., None] * mxz
-    schur = m[..., :2, :2] - mxz[..., :, None] * mxz[..., None, :] / mzz[..., None, None]
+    centre2 = center[..., :2] + dz[..., None] * slope
     k = np.clip(shrink, 0.0, None)[..., None, None] * schur
     return centre2, k, hit
 

@@ -17,15 +17,18 @@ piece is integrated by Gauss-Legendre quadrature.
 import numpy as np
 
 from .constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
-from .ellipsoid import axis_extent, section_at_height
+from .ellipsoid import axis_extent, section_at_height, section_shape
 from .mesh import convex_hull_2d, plane_section_points, polygon_perimeter
 
-DETECTION_SAMPLES = 128  # grid used to find which ellipse is outermost in each direction
+DETECTION_SAMPLES = 32  # grid used to find which ellipse is outermost in each direction
 QUADRATURE_CELLS = 32  # fixed cuts so that every smooth piece spans at most 2pi/32
-GAUSS_ORDER = 12
-NEWTON_STEPS = 3
-REFINE_FACTOR = 16  # sub-samples in a grid cell where a hidden outermost ellipse is possible
-_GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(GAUSS_ORDER)
+GAUSS_ORDERS = (8, 12, 16, 24)  # Gauss-Legendre nodes per piece: the fewest that _gauss_orders' bound allows
+QUADRATURE_TOLERANCE = 1e-16  # that bound on the quadrature's error, relative to the perimeter
+NEWTON_STEPS = 8  # from a secant start across a whole grid cell ...
+NEWTON_DONE = 1e-13  # ... until a kink moves less than this (radians)
+KINK_TOLERANCE = 1e-10  # |h_0 - h_1| at a kink found, relative to the ellipses' size (else: sampled finer)
+REFINE_FACTOR = 8  # a grid cell in doubt is sampled this many times finer, ...
+REFINE_LEVELS = 3  # ... at most this many times
 _GROUP_MIN_SECTIONS = 64  # from this many sections, those with fewer ellipses are measured apart (less padding)
 _CHUNK = 256  # mannequins per batch chunk (bounds the temporary arrays to tens of MB)
 
@@ -60,13 +63,13 @@ def _compact(centre, k, active):
     return centre[rows, order], k[rows, order], active[rows, order]
 
 
-def _max_curvature_radius(k):
-    """Largest radius of curvature of each ellipse: a^2 / b with a >= b its semi-axes."""
+def _curvature_radii(k):
+    """Largest and smallest radius of curvature of each ellipse: a^2 / b and b^2 / a, a >= b its semi-axes."""
     tr = k[..., 0, 0] + k[..., 1, 1]
     det = k[..., 0, 0] * k[..., 1, 1] - k[..., 0, 1] ** 2
     disc = np.sqrt(np.clip(0.25 * tr * tr - det, 0.0, None))
     big, small = 0.5 * tr + disc, np.clip(0.5 * tr - disc, 1e-30, None)
-    return big / np.sqrt(small)
+    return big / np.sqrt(small), small / np.sqrt(np.maximum(big, 1e-30))
 
 
 class _Coefficients:
@@ -78,30 +81,30 @@ class _Coefficients:
         self.a, self.d = np.ascontiguousarray(k[..., 0, 0]), np.ascontiguousarray(k[..., 1, 1])
         self.b = 2.0 * k[..., 0, 1]
 
-    def support(self, index, c, s, cc=None, cs=None, ss=None):
-        """h of the ellipses ``index`` (a tuple of index arrays) in the directions (cos, sin) = (c, s), arrays
-        broadcastable against them; cc, cs, ss: c*c, c*s, s*s when a table has them. Elementwise only, so a
-        direction's value does not depend on what else is evaluated with it."""
+    def root(self, index, c, s, cc=None, cs=None, ss=None):
+        """sqrt(n^T k n) of the ellipses ``index`` (a tuple of index arrays) in the directions (cos, sin) = (c, s),
+        arrays broadcastable against them; cc, cs, ss: c*c, c*s, s*s when a table has them. Elementwise only, so
+        a direction's value does not depend on what else is evaluated with it."""
         h = self.a[index] * (c * c if cc is None else cc)
         h += self.b[index] * (c * s if cs is None else cs)
         h += self.d[index] * (s * s if ss is None else ss)
         np.maximum(h, 0.0, out=h)
-        np.sqrt(h, out=h)
+        return np.sqrt(h, out=h)
+
+    def support(self, index, c, s, cc=None, cs=None, ss=None):
+        """h of the ellipses ``index`` in the directions (c, s) (as :meth:`root`)."""
+        h = self.root(index, c, s, cc, cs, ss)
         h += self.cx[index] * c
         h += self.cy[index] * s
         return h
 
-
-def _winners(coefficients, active, sec, theta):
-    """Index of the outermost active ellipse of section ``sec`` in direction ``theta`` (flat arrays)."""
-    c, s = np.cos(theta)[:, None], np.sin(theta)[:, None]
-    h = coefficients.support((sec,), c, s)
-    return np.argmax(np.where(active[sec], h, -np.inf), axis=1)
+    def centre_integral(self, index, c0, s0, c1, s1):
+        """The integral of cx cos + cy sin from the angle (c0, s0) to (c1, s1): the support's linear part."""
+        return self.cx[index] * (s1 - s0) - self.cy[index] * (c1 - c0)
 
 
 _GRID_STEP = 2.0 * np.pi / DETECTION_SAMPLES
 _GRID = np.arange(DETECTION_SAMPLES) * _GRID_STEP
-_FINE = np.arange(REFINE_FACTOR + 1) / REFINE_FACTOR  # a refined cell's samples, in cells from its start
 
 
 def _directions(theta):
@@ -111,7 +114,19 @@ def _directions(theta):
 
 
 _GRID_DIRECTIONS = _directions(_GRID)
-_FINE_DIRECTIONS = _directions((np.arange(DETECTION_SAMPLES)[:, None] + _FINE[1:-1]) * _GRID_STEP)  # (N, F - 1)
+
+
+def _may_surface(gap_start, gap_end, bend, length):
+    """Whether an ellipse j below the outermost one w at both ends of an interval of ``length`` (gaps
+    g = h_w - h_j >= 0 there) can rise above it inside. With h'' + h = rho (the radius of curvature),
+    f = h_j - h_w has f'' = rho_j - rho_w - f >= -bend - max(f, 0), ``bend`` = max rho_w - min rho_j (_bend): f
+    stays below its chord plus (bend + max f) v (L - v) / 2 (v from the start), so it can only turn positive where
+    that parabola with bend alone does, i.e. its vertex v* = L/2 + (g_start - g_end) / (bend L) is inside and
+    bend v*^2 / 2 > g_start. w itself (gaps 0) and inactive ellipses (gaps inf) never surface."""
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # inf gaps, zero bends
+        vertex = 0.5 * length + (gap_start - gap_end) / (bend * length)
+        return ((vertex > 0.0) & (vertex < length) & (0.5 * bend * vertex * vertex > gap_start)
+                & (np.maximum(gap_start, gap_end) > 0.0) & np.isfinite(gap_start) & np.isfinite(gap_end))
 
 
 def hull_perimeter(centre, k, active):
@@ -134,81 +149,164 @@ def hull_perimeter(centre, k, active):
     if sections == 0:
         return np.zeros(0)
     coefficients = _Coefficients(centre, k)
+    largest, smallest = _curvature_radii(k)  # (S, n)
 
     # 1. Which ellipse is outermost in each grid direction.
-    step = _GRID_STEP
     h = coefficients.support((Ellipsis, None), *_GRID_DIRECTIONS)  # (S, n, N)
     np.copyto(h, -np.inf, where=~active[:, :, None])
     winner = np.argmax(h, axis=1)  # (S, N)
 
-    # 2. An ellipse that is outermost only between two grid directions would be missed. Where the
-    #    winner is the same at both ends of a cell, (h_j - h_max)'' <= rho_j + gap (rho_j its
-    #    largest radius of curvature), so it can only surface if its gap to the maximum is below
-    #    that bound times step^2 / 8. Where the winner changes, h_max has a kink and no such bound
-    #    holds. Sample both kinds of cell finely.
+    # 2. An ellipse that is outermost only between two grid directions would be missed: cells where one may
+    #    surface (_may_surface) and cells where the winner changes (h_max has a kink there) are sampled finely.
     with np.errstate(invalid="ignore"):  # inactive ellipses' gaps are inf (or nan without any active one)
-        gap = h.max(axis=1)[:, None, :] - h
-        gap_next = np.concatenate([gap[..., 1:], gap[..., :1]], axis=2)
-        low = np.minimum(gap, gap_next)
-        reach = np.maximum(gap, gap_next, out=gap_next)
-        reach += _max_curvature_radius(k)[:, :, None]
-        reach *= step * step / 8.0
-        suspect = (low > 0.0) & (low <= reach) & active[:, :, None]
+        gap = h.max(axis=1)[:, None, :] - h  # (S, n, N)
+    gap_next = np.concatenate([gap[..., 1:], gap[..., :1]], axis=2)
+    bend = np.maximum(largest[np.arange(sections)[:, None], winner][:, None, :] - smallest[:, :, None], 0.0)
+    suspect = _may_surface(gap, gap_next, bend, _GRID_STEP).any(axis=1)  # (S, N): where the winner stays
     changes = winner != np.concatenate([winner[:, 1:], winner[:, :1]], axis=1)
-    sec_r, cell_r = np.nonzero(suspect.any(axis=1) | changes)
+    sec_r, cell_r = np.nonzero(suspect | changes)
 
-    # 3. Kinks: where the winner changes between consecutive directions, solve h_i = h_j. Every cell
-    #    where it changes is sampled, so the kinks are in those cells, between two of their samples:
-    #    the cell's start, REFINE_FACTOR - 1 points inside, the next cell's start.
-    theta_r = (cell_r[:, None] + _FINE) * step  # (R, REFINE_FACTOR + 1)
-    section = (sec_r[:, None, None], np.arange(centre.shape[1]))  # (R, 1, n)
-    h_r = coefficients.support(section, *(t[cell_r, :, None] for t in _FINE_DIRECTIONS))  # (R, F - 1, n)
-    np.copyto(h_r, -np.inf, where=~active[sec_r, None, :])
-    inside = np.argmax(h_r, axis=2)
-    winner_r = np.concatenate([winner[sec_r, cell_r, None], inside,
-                               winner[sec_r, (cell_r + 1) % DETECTION_SAMPLES, None]], axis=1)
-    row, at = np.nonzero(winner_r[:, :-1] != winner_r[:, 1:])
-    sec = sec_r[row]
-    lo, hi = theta_r[row, at], theta_r[row, at + 1]
-    pair = np.stack([winner_r[row, at], winner_r[row, at + 1]])  # (2, K): outermost before, after
-    theta = _kinks(centre[sec, pair], k[sec, pair], lo, hi)
+    # 3. Kinks, where the outermost ellipse changes, in the cells sampled finely (_scan); a cell that the
+    #    sampling cannot clear of a hidden ellipse is sampled again, finer.
+    start, width = cell_r * _GRID_STEP, np.full(len(cell_r), _GRID_STEP)
+    ends = (h[sec_r, :, cell_r], h[sec_r, :, (cell_r + 1) % DETECTION_SAMPLES])  # (R, n) each
+    kinks = []
+    for level in range(REFINE_LEVELS + 1):
+        theta, kink_row, after, doubtful = _scan(coefficients, active, (largest, smallest), sec_r, start, width,
+                                          REFINE_FACTOR**level, ends)
+        keep = ~doubtful[kink_row] if level < REFINE_LEVELS else np.ones(len(kink_row), dtype=bool)
+        kinks.append((theta[keep], sec_r[kink_row[keep]], after[keep]))
+        if level == REFINE_LEVELS or not doubtful.any():
+            break
+        sec_r, start, width = sec_r[doubtful], start[doubtful], width[doubtful]
+        ends = (ends[0][doubtful], ends[1][doubtful])
+    theta, sec, after = (np.concatenate(column) for column in zip(*kinks))
 
-    # 4. Cut the circle at the kinks and at fixed cells; integrate each piece's outermost ellipse.
-    #    A piece between two fixed cuts (no kink inside) is a whole cell: its outermost ellipse is the
-    #    grid's in the middle of the cell, and every section's cells are integrated at once from a table
-    #    of the nodes' directions (the integrals of cells that a kink splits are not used).
-    cut_theta, cut_sec, cell = _cuts(sections, np.mod(theta, 2.0 * np.pi), sec)
+    # 4. Cut the circle at the kinks and at fixed cells; integrate each piece's outermost ellipse: the linear
+    #    part of its support in closed form, the root by Gauss-Legendre. A piece between two fixed cuts (no kink
+    #    inside) is a whole cell: its outermost ellipse is the grid's in the cell, and every section's cells are
+    #    integrated at once from a table of the nodes' directions (the integrals of cells that a kink splits are
+    #    not used).
+    cut_theta, cut_sec, cell, cut_after = _cuts(sections, np.mod(theta, 2.0 * np.pi), sec, after)
     end, next_cell = _next_in_section(cut_sec, cut_theta, cell)
     half = 0.5 * (end - cut_theta)
     whole = (cell >= 0) & (next_cell >= 0)
     split = ~whole
-    cell_winner = winner[:, _GRID_PER_CELL // 2::_GRID_PER_CELL]  # (S, cells)
-    cells = (np.arange(sections)[:, None, None], cell_winner[:, :, None])
-    cell_integral = _weighted_sum(coefficients.support(cells, *_CELL_NODE_DIRECTIONS), _GL_WEIGHTS)  # (S, cells)
-    piece_winner = np.empty(len(cut_sec), dtype=np.int64)
-    piece_winner[whole] = cell_winner[cut_sec[whole], cell[whole]]
-    piece_winner[split] = _winners(coefficients, active, cut_sec[split], cut_theta[split] + half[split])
-    nodes = (cut_theta[split] + half[split])[:, None] + half[split, None] * _GL_NODES
-    integral = np.empty(len(cut_sec))
-    integral[whole] = cell_integral[cut_sec[whole], cell[whole]]
-    integral[split] = _weighted_sum(coefficients.support((cut_sec[split, None], piece_winner[split, None]),
-                                                         np.cos(nodes), np.sin(nodes)), _GL_WEIGHTS)
-    piece = np.where(active[cut_sec, piece_winner], half * integral, 0.0)
+    cell_winner = winner[:, ::_GRID_PER_CELL]  # (S, cells): at each cell's start
+    # A piece from a cut at a cell's start has the grid's outermost ellipse there, one from a kink the ellipse
+    # outermost after it.
+    piece_winner = np.where(cell >= 0, cell_winner[cut_sec, np.maximum(cell, 0)], cut_after)
+    order = _gauss_orders(coefficients, active)  # (S,)
+    piece = np.empty(len(cut_sec))
+    for nodes in np.unique(order):
+        rule, weights, directions = _RULES[nodes]
+        rows = np.nonzero(order == nodes)[0]
+        cells = (rows[:, None], cell_winner[rows])
+        cell_root = _weighted_sum(coefficients.root((rows[:, None, None], cells[1][..., None]), *directions), weights)
+        cell_integral = _CELL_HALF * cell_root + coefficients.centre_integral(cells, *_CELL_ENDS)  # (rows, cells)
+        mine = order[cut_sec] == nodes
+        pick = whole & mine
+        piece[pick] = cell_integral[np.searchsorted(rows, cut_sec[pick]), cell[pick]]
+        pick = np.nonzero(split & mine)[0]
+        at = (cut_theta[pick] + half[pick])[:, None] + half[pick, None] * rule
+        index = (cut_sec[pick], piece_winner[pick])
+        root = _weighted_sum(coefficients.root((index[0][:, None], index[1][:, None]), np.cos(at), np.sin(at)),
+                             weights)
+        low, high = cut_theta[pick], end[pick]
+        piece[pick] = half[pick] * root + coefficients.centre_integral(index, np.cos(low), np.sin(low),
+                                                                       np.cos(high), np.sin(high))
+    piece = np.where(active[cut_sec, piece_winner], piece, 0.0)
     return np.bincount(cut_sec, weights=piece, minlength=sections)
 
 
-def _kinks(cp, kp, lo, hi):
-    """The angles in [lo, hi] where the outermost ellipse changes from cp[0], kp[0] to cp[1], kp[1] (2, K, ...):
-    h_0 = h_1 by a secant start and NEWTON_STEPS Newton steps."""
-    g_lo, g_hi = np.subtract(*_support_2d(cp, kp, lo)), np.subtract(*_support_2d(cp, kp, hi))
+def _scan(coefficients, active, radii, sec, start, width, samples, ends):
+    """Find the kinks in the intervals [start, start + width] (R,) of sections ``sec``, given every ellipse's h at
+    both ends (``ends``: two (R, n)), from ``samples`` equal sub-intervals: in each one where the outermost
+    ellipse changes, h_0 = h_1 is solved (:func:`_kinks`).
+
+    Returns (theta (K,), row (K,) the interval of each kink, the ellipse outermost after it (K,), doubtful
+    (R,)): an interval is doubtful where :func:`_may_surface` cannot rule out an ellipse rising above the
+    outermost one inside a sub-interval with one outermost ellipse, or on either side of a kink (up to the kink,
+    from it), or a third ellipse is above the pair at the kink, or the pair's supports differ there by more than
+    KINK_TOLERANCE."""
+    n = active.shape[1]
+    inner = np.arange(1, samples) / samples
+    theta = np.concatenate([start[:, None], start[:, None] + width[:, None] * inner, (start + width)[:, None]],
+                           axis=1)  # (R, samples + 1)
+    h = np.empty((len(sec), samples + 1, n))
+    h[:, 0], h[:, -1] = ends
+    h[:, 1:-1] = coefficients.support((sec[:, None, None], np.arange(n)), np.cos(theta[:, 1:-1, None]),
+                                      np.sin(theta[:, 1:-1, None]))
+    np.copyto(h[:, 1:-1], -np.inf, where=~active[sec, None, :])
+    winner = np.argmax(h, axis=2)  # (R, samples + 1)
+    with np.errstate(invalid="ignore"):
+        gap = np.take_along_axis(h, winner[..., None], axis=2) - h  # (R, samples + 1, n)
+    step = width / samples
+    same = winner[:, :-1] == winner[:, 1:]
+    largest, smallest = radii
+    bend = np.maximum(largest[sec[:, None], winner[:, :-1]][..., None] - smallest[sec, None, :], 0.0)
+    hidden = _may_surface(gap[:, :-1], gap[:, 1:], bend, step[:, None, None]).any(axis=2)
+    doubtful = (same & hidden).any(axis=1)
+
+    row, at = np.nonzero(~same)
+    lo, hi = theta[row, at], theta[row, at + 1]
+    pair = np.stack([winner[row, at], winner[row, at + 1]])  # (2, K)
+    kink_sec = sec[row]
+    # h_A - h_B at the sub-interval's ends: B's gap to A at the start, minus A's gap to B at the end.
+    kink = _kinks(coefficients, ((kink_sec, pair[0]), (kink_sec, pair[1])), lo, hi, gap[row, at, pair[1]],
+                  -gap[row, at + 1, pair[0]])
+    h_kink = coefficients.support((kink_sec[:, None], np.arange(n)), np.cos(kink)[:, None], np.sin(kink)[:, None])
+    np.copyto(h_kink, -np.inf, where=~active[kink_sec])  # (K, n)
+    columns = np.arange(n)
+    not_before, not_after = columns != pair[0][:, None], columns != pair[1][:, None]  # (K, n)
+    before = np.take_along_axis(h_kink, pair[0][:, None], axis=1)
+    after = np.take_along_axis(h_kink, pair[1][:, None], axis=1)
+    bend_before = np.maximum(largest[kink_sec, pair[0]][:, None] - smallest[kink_sec], 0.0)
+    bend_after = np.maximum(largest[kink_sec, pair[1]][:, None] - smallest[kink_sec], 0.0)
+    with np.errstate(invalid="ignore"):
+        # A third ellipse above both at the kink; or any ellipse, the other of the pair too (a second crossing),
+        # rising above the one outermost from the sub-interval's start to the kink, or from the kink to its end.
+        doubt = (h_kink > np.maximum(before, after)) & not_before & not_after
+        size = coefficients.root((kink_sec, pair[0]), np.cos(kink), np.sin(kink))
+        size += coefficients.root((kink_sec, pair[1]), np.cos(kink), np.sin(kink))
+        doubt[np.abs(before - after)[:, 0] > KINK_TOLERANCE * size] = True  # Newton has not converged
+        doubt |= _may_surface(gap[row, at], before - h_kink, bend_before, (kink - lo)[:, None]) & not_before
+        doubt |= _may_surface(after - h_kink, gap[row, at + 1], bend_after, (hi - kink)[:, None]) & not_after
+    doubtful[row[doubt.any(axis=1)]] = True
+    return kink, row, pair[1], doubtful
+
+
+def _kinks(coefficients, index, lo, hi, g_lo, g_hi):
+    """The angles in [lo, hi] where the outermost ellipse changes from the ellipse index[0] to index[1] (each a
+    tuple (section, ellipse) of (K,) arrays): h_0 = h_1 by a secant start from g = h_0 - h_1 at lo and hi, then
+    Newton steps kept in [lo, hi], at most NEWTON_STEPS, each kink's until its step is below NEWTON_DONE."""
     denom = g_lo - g_hi
     frac = np.divide(g_lo, denom, out=np.full_like(g_lo, 0.5), where=np.abs(denom) > 0.0)
     theta = lo + (hi - lo) * np.clip(frac, 0.0, 1.0)
+    (a0, b0, d0), (a1, b1, d1) = ((coefficients.a[i], coefficients.b[i], coefficients.d[i]) for i in index)
+    dcx = coefficients.cx[index[0]] - coefficients.cx[index[1]]
+    dcy = coefficients.cy[index[0]] - coefficients.cy[index[1]]
+    todo = np.arange(len(theta))
     for _ in range(NEWTON_STEPS):
-        value, slope = _support_2d_with_derivative(cp, kp, theta)
-        g, dg = value[0] - value[1], slope[0] - slope[1]
+        t = theta[todo]
+        c, s = np.cos(t), np.sin(t)
+        cc, cs, ss = c * c, c * s, s * s
+        p0 = (a0[todo], b0[todo], d0[todo])
+        p1 = (a1[todo], b1[todo], d1[todo])
+        root0 = np.sqrt(np.maximum(p0[0] * cc + p0[1] * cs + p0[2] * ss, 1e-30))
+        root1 = np.sqrt(np.maximum(p1[0] * cc + p1[1] * cs + p1[2] * ss, 1e-30))
+        x, y = dcx[todo], dcy[todo]
+        g = x * c + y * s + root0 - root1
+        turn = cc - ss  # d(a cc + b cs + d ss)/dtheta = 2 (d - a) cs + b (cc - ss)
+        dg = (y * c - x * s + (2.0 * (p0[2] - p0[0]) * cs + p0[1] * turn) / (2.0 * root0)
+              - (2.0 * (p1[2] - p1[0]) * cs + p1[1] * turn) / (2.0 * root1))
         update = np.divide(g, dg, out=np.zeros_like(g), where=np.abs(dg) > 1e-300)
-        theta = np.minimum(np.maximum(theta - update, lo), hi)
+        new = np.minimum(np.maximum(t - update, lo[todo]), hi[todo])
+        moved = np.abs(new - t) > NEWTON_DONE
+        theta[todo] = new
+        todo = todo[moved]
+        if not len(todo):
+            break
     return theta
 
 
@@ -216,23 +314,50 @@ _CELLS = np.arange(QUADRATURE_CELLS) * (2.0 * np.pi / QUADRATURE_CELLS)
 _GRID_PER_CELL = DETECTION_SAMPLES // QUADRATURE_CELLS
 
 
-def _cell_nodes():
-    """The Gauss-Legendre nodes of every whole cell (QUADRATURE_CELLS, GAUSS_ORDER), computed as
-    :func:`hull_perimeter` computes a piece's."""
-    end = np.append(_CELLS[1:], _CELLS[0] + 2.0 * np.pi)
-    half = 0.5 * (end - _CELLS)
-    return (_CELLS + half)[:, None] + half[:, None] * _GL_NODES
+_CELL_END = np.append(_CELLS[1:], _CELLS[0] + 2.0 * np.pi)
+_CELL_HALF = 0.5 * (_CELL_END - _CELLS)
 
 
-_CELL_NODE_DIRECTIONS = _directions(_cell_nodes())
+def _rule(nodes):
+    """A Gauss-Legendre rule on [-1, 1] and the directions of its nodes in every whole cell (QUADRATURE_CELLS,
+    nodes), computed as :func:`hull_perimeter` computes a piece's."""
+    rule, weights = np.polynomial.legendre.leggauss(nodes)
+    return rule, weights, _directions((_CELLS + _CELL_HALF)[:, None] + _CELL_HALF[:, None] * rule)
 
 
-def _cuts(sections, theta, sec):
-    """The fixed cells of every section and the kinks (theta, sec), sorted by (section, angle), a cell before
-    a kink at the same angle: (theta, sec, cell index or -1 for a kink) of every cut. Only the kinks are
-    sorted; the cells are merged in."""
+_RULES = {nodes: _rule(nodes) for nodes in GAUSS_ORDERS}
+
+
+def _gauss_orders(coefficients, active):
+    """Gauss-Legendre nodes per piece for each section (S,): the fewest of GAUSS_ORDERS whose error bound, for
+    every active ellipse, is within QUADRATURE_TOLERANCE of the perimeter (else the most).
+
+    The root integrated, sqrt(alpha + beta cos 2(theta - phi)), is analytic up to |Im theta| = y0 =
+    acosh(alpha / beta) / 2 (alpha +- beta the squared semi-axes); in the Bernstein ellipse of a cell (half-width
+    h) reaching 0.9 y0, rho = t + sqrt(1 + t^2) with t = 0.9 y0 / h, it is at most sqrt(2 alpha), so n nodes
+    err by at most h 64/15 sqrt(2 alpha) rho^-2n / (rho^2 - 1) per cell (Trefethen, Approximation Theory and
+    Approximation Practice, Thm 19.3); a piece split by a kink is shorter and errs less. The perimeter is at
+    least the ellipse's, 4 sqrt(alpha + beta)."""
+    alpha = 0.5 * (coefficients.a + coefficients.d)
+    beta = np.sqrt(0.25 * (coefficients.a - coefficients.d) ** 2 + 0.25 * coefficients.b**2)
+    half = np.pi / QUADRATURE_CELLS
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # circles (beta 0), inactive ellipses
+        reach = 0.45 * np.arccosh(np.maximum(alpha / beta, 1.0)) / half
+        rho = reach + np.sqrt(1.0 + reach * reach)
+        allowed = QUADRATURE_TOLERANCE * 4.0 * np.sqrt(alpha + beta) / (QUADRATURE_CELLS * half * 64.0 / 15.0
+                                                                         * np.sqrt(2.0 * alpha))
+        fails = sum((rho ** (-2.0 * n) / (rho * rho - 1.0) > allowed) | ~np.isfinite(allowed) for n in GAUSS_ORDERS)
+    need = np.where(active, np.minimum(fails, len(GAUSS_ORDERS) - 1), 0)
+    return np.asarray(GAUSS_ORDERS)[need.max(axis=1)]
+_CELL_ENDS = (np.cos(_CELLS), np.sin(_CELLS), np.cos(_CELL_END), np.sin(_CELL_END))  # each cell's start and end
+
+
+def _cuts(sections, theta, sec, after):
+    """The fixed cells of every section and the kinks (theta, sec, the ellipse outermost after each), sorted by
+    (section, angle), a cell before a kink at the same angle: (theta, sec, cell index or -1 for a kink, the
+    ellipse after a kink or -1 for a cell) of every cut. Only the kinks are sorted; the cells are merged in."""
     order = np.lexsort((theta, sec))
-    theta, sec = theta[order], sec[order]
+    theta, sec, after = theta[order], sec[order], after[order]
     # A kink goes after the cells of the sections before it, the cells of its own section up to its angle
     # and the kinks sorted before it.
     kink_at = sec * QUADRATURE_CELLS + np.searchsorted(_CELLS, theta, side="right") + np.arange(len(theta))
@@ -243,7 +368,9 @@ def _cuts(sections, theta, sec):
     cut_theta[kink_at], cut_sec[kink_at] = theta, sec
     cut_theta[is_cell], cut_sec[is_cell] = np.tile(_CELLS, sections), np.repeat(np.arange(sections), QUADRATURE_CELLS)
     cell[is_cell] = np.tile(np.arange(QUADRATURE_CELLS), sections)
-    return cut_theta, cut_sec, cell
+    cut_after = np.full(total, -1)
+    cut_after[kink_at] = after
+    return cut_theta, cut_sec, cell, cut_after
 
 
 def _weighted_sum(values, weights):
@@ -320,19 +447,22 @@ def _measure_chunk(rotation, center, semi_axes, girth, fractions):
     batch = rotation.shape[0]
     _, height, z = section_heights(rotation, center, semi_axes, fractions)
     result = {"He": height}
+    shape = section_shape(rotation, semi_axes)
 
-    centre, k, hit = section_at_height(rotation, center, semi_axes, z["Sh"][:, None])
+    centre, k, hit = section_at_height(rotation, center, semi_axes, z["Sh"][:, None], shape)
     half_x = np.sqrt(k[..., 0, 0])
     right = np.where(hit, centre[..., 0] + half_x, -np.inf).max(axis=-1)
     left = np.where(hit, centre[..., 0] - half_x, np.inf).min(axis=-1)
     result["Sh"] = np.where(np.isfinite(right), right - left, 0.0)
 
+    # The girth sections through the girth parts only (the others would only be dropped).
+    parts = np.nonzero(girth)[0]
     heights = np.stack([z[key] for key in GIRTHS], axis=1)  # (B, 3)
-    centre, k, hit = section_at_height(rotation[:, None], center[:, None], semi_axes[:, None],
-                                       heights[:, :, None])
-    active = hit & girth
-    n = rotation.shape[1]
-    perimeters = hull_perimeter(centre.reshape(-1, n, 2), k.reshape(-1, n, 2, 2), active.reshape(-1, n))
+    centre, k, hit = section_at_height(rotation[:, None, parts], center[:, None, parts], semi_axes[:, None, parts],
+                                       heights[:, :, None], tuple(a[:, None, parts] for a in shape))
+    sections, n = batch * len(GIRTHS), len(parts)
+    perimeters = hull_perimeter(centre.reshape(sections, n, 2), k.reshape(sections, n, 2, 2),
+                                hit.reshape(sections, n)) if n else np.zeros(sections)
     perimeters = perimeters.reshape(batch, len(GIRTHS))
     for index, key in enumerate(GIRTHS):
         result[key] = perimeters[:, index]

@@ -11,7 +11,7 @@ from .constants import (
     MEASUREMENTS,
     SECTION_FRACTIONS,
 )
-from .ellipsoid import axis_extent, section_at_height
+from .ellipsoid import axis_extent, section_at_height, section_shape
 from .measure import section_heights, tailor_measurements
 
 # Exact mode.
@@ -81,27 +81,27 @@ def _deform_basis(topology, rotation, center, semi_axes, measured, fractions=Non
     fractions = fractions or SECTION_FRACTIONS
     knots = _knots(fractions)
     bottom, height, z = section_heights(rotation, center, semi_axes, fractions)
-    span = center[..., 2, None] + axis_extent(rotation, semi_axes, 2)[..., None] * _SPAN  # (B, n, q)
+    half_z = axis_extent(rotation, semi_axes, 2)  # (B, n)
+    span = center[..., 2, None] + half_z[..., None] * _SPAN  # (B, n, q)
     fraction = (span - bottom[:, None, None]) / height[:, None, None]
     girth = topology.girth_mask
     weight = np.stack([_dot(_hat(fraction, _GIRTH_KNOT[key], knots), _SPAN_WEIGHT) for key in GIRTHS], axis=-1)
     weight = weight * girth[:, None]
     fraction = (center[..., 2] - bottom[:, None]) / height[:, None]
     # Each girth section's own centre in y (middle of its extent), interpolated between sections.
-    centre_y = []
-    for key in GIRTHS:
-        c2, k2, hit = section_at_height(rotation, center, semi_axes, z[key][:, None])
-        active = hit & girth
-        half = np.sqrt(k2[..., 1, 1])
-        top = np.where(active, c2[..., 1] + half, -np.inf).max(axis=-1)
-        low = np.where(active, c2[..., 1] - half, np.inf).min(axis=-1)
-        centre_y.append(np.where(np.isfinite(top), 0.5 * (top + low), 0.0))
-    centre_y = np.stack(centre_y, axis=-1)  # (B, 3) in GIRTHS order: Br, Wa, Hi
+    parts = np.nonzero(girth)[0]
+    shape = tuple(a[:, None] for a in section_shape(rotation[:, parts], semi_axes[:, parts]))
+    heights = np.stack([z[key] for key in GIRTHS], axis=1)[:, :, None]  # (B, 3, 1)
+    c2, k2, hit = section_at_height(rotation[:, None, parts], center[:, None, parts], semi_axes[:, None, parts],
+                                    heights, shape)
+    half = np.sqrt(k2[..., 1, 1])
+    top = np.where(hit, c2[..., 1] + half, -np.inf).max(axis=-1, initial=-np.inf)
+    low = np.where(hit, c2[..., 1] - half, np.inf).min(axis=-1, initial=np.inf)
+    centre_y = np.where(np.isfinite(top), 0.5 * (top + low), 0.0)  # (B, 3) in GIRTHS order: Br, Wa, Hi
     order = [GIRTHS.index(key) for key in ("Hi", "Wa", "Br")]
     heights = [fractions[key] for key in ("Hi", "Wa", "Br")]
     origin_y = _interp_rows(fraction, heights, centre_y[:, order])
     # Where each section cuts each girth part, relative to the part's middle (-1 bottom .. 1 top).
-    half_z = axis_extent(rotation, semi_axes, 2)  # (B, n)
     cut = np.stack([(z[key][:, None] - center[..., 2]) / half_z for key in GIRTHS], axis=-1)  # (B, n, 3)
     crossing = (np.abs(cut) < 1.0) & girth[:, None]
     taper = np.where(crossing, np.abs(cut), 0.0)
