@@ -15,7 +15,7 @@ from ellimann_addon.core.extra_measures import (
     EXTRA_MEASUREMENTS,
     ISO_ALLOWANCE,
     MannequinLandmarks,
-    _farthest_distance,
+    _farthest_points,
     extreme_over_band,
     mannequin_extra_measurements,
 )
@@ -67,12 +67,14 @@ def test_tilted_prism_across_its_axis():
 
 def test_farthest_point_of_a_sphere_and_an_ellipsoid():
     rotation = np.eye(3)[None]
-    assert _farthest_distance(rotation, np.zeros((1, 3)), np.full((1, 3), 0.1), np.array([0.3, 0.4, 0.0]))[0] == \
-        pytest.approx(0.6, abs=1e-12)
+    distance, point = _farthest_points(rotation, np.zeros((1, 3)), np.full((1, 3), 0.1), np.array([0.3, 0.4, 0.0]))
+    assert distance[0] == pytest.approx(0.6, abs=1e-12)
+    assert point[0] == pytest.approx([-0.06, -0.08, 0.0], abs=1e-12)
     # from (0, 0.05, 0) inside, the far end of the major axis: |(0, -0.25, 0) - (0, 0.05, 0)| = 0.3
     semi = np.array([[0.1, 0.25, 0.05]])
-    assert _farthest_distance(rotation, np.zeros((1, 3)), semi, np.array([0.0, 0.05, 0.0]))[0] == \
-        pytest.approx(0.3, abs=1e-12)
+    distance, point = _farthest_points(rotation, np.zeros((1, 3)), semi, np.array([0.0, 0.05, 0.0]))
+    assert distance[0] == pytest.approx(0.3, abs=1e-12)
+    assert point[0] == pytest.approx([0.0, -0.25, 0.0], abs=1e-12)
 
 
 def test_band_extremes_and_a_narrow_dip():
