@@ -55,8 +55,8 @@ GOLDEN_STEPS = 40  # golden-section steps: the band's grid cell shrinks below a 
 BRACKET_DONE = 3e-9  # m: a smooth band search's bracket this narrow is done (a girth within nanometres)
 PROBE_FLOOR = 1e-9  # m: the closest spacing of a smooth search's parabolic probes
 END_PROBE = 1e-10  # m: how far beside a piece's end a smooth search looks (the limit there)
-PROBES_PER_STEP = 48  # a smooth search's probes per call, shared among the brackets still open
-MAX_PROBE_PAIRS = 6
+PROBES_PER_STEP = 24  # a smooth search's probes per call, shared among the brackets still open
+MAX_PROBE_PAIRS = 3
 MAX_BRACKET_STEPS = 60  # a smooth search's bound (halving from a cell: some 25 steps at worst)
 GIRTH_CHUNK = 48  # sections per hull_perimeter call
 SIDES = ("L", "R")
@@ -177,7 +177,7 @@ def _probes(a, x, b, fa, fx, fb, stalled, lowest, highest, pairs):
     A bracket reaching a piece's end that is worse than its best point: twice beside that end (a section that
     loses a piece there jumps: the extreme may be the limit at the end) and the parabola's. A step that did not
     halve the bracket (or values not finite): cutting it evenly. Otherwise the vertex of the parabola through
-    the three points and either side of it at a quarter of the vertex's move, a quarter of that, ... Parabola
+    the three points and either side of it at half the vertex's move, 0.35 of that, ... Parabola
     and cuts in the angle t of ``_angle``: a
     section gaining a piece at a piece's end grows like the square root of the distance, smooth in t."""
     ta, tx, tb = (_angle(z, lowest, highest) for z in (a, x, b))
@@ -323,11 +323,21 @@ class MannequinLandmarks:
 
     def arm_axis(self, side):
         """(shoulder point, unit axis, length m): from the shoulder point to the arm's farthest point."""
-        start = self.shoulder_point(side)
-        mask = self.arm_mask(side)
-        reach, farthest = _farthest_points(self.rotation[mask], self.center[mask], self.semi[mask], start)
-        i = int(np.argmax(reach))
-        return start, (farthest[i] - start) / reach[i], float(reach[i])
+        return self.arm_axes((side,))[0]
+
+    def arm_axes(self, sides=SIDES):
+        """arm_axis of each side, the arms' farthest points found together (each row's bits as alone)."""
+        starts = [self.shoulder_point(side) for side in sides]
+        rows = [np.nonzero(self.arm_mask(side))[0] for side in sides]
+        every = np.concatenate(rows)
+        points = np.concatenate([np.broadcast_to(start, (len(r), 3)) for start, r in zip(starts, rows)])
+        reach, farthest = _farthest_points(self.rotation[every], self.center[every], self.semi[every], points)
+        axes, first = [], 0
+        for start, r in zip(starts, rows):
+            i = first + int(np.argmax(reach[first:first + len(r)]))
+            axes.append((start, (farthest[i] - start) / reach[i], float(reach[i])))
+            first += len(r)
+        return axes
 
     def across_arm(self, side, start, axis):
         """The sections of the arm ``side``'s ellipsoids across ``axis`` (unit, from ``start``), as functions of
@@ -383,7 +393,7 @@ def mannequin_extra_measurements(mannequin):
     legs = [marks.leg_mask(side) for side in SIDES]
     neck_mask = np.ones(len(marks.girth), bool)  # the whole section: no arm reaches the neck's band apart
     has_arms = all(marks.arm_mask(side).any() for side in SIDES)
-    axes = [marks.arm_axis(side) for side in SIDES] if has_arms else []
+    axes = marks.arm_axes() if has_arms else []
     arms = [(*marks.across_arm(side, start, axis), marks.arm_mask(side)) for side, (start, axis, _) in zip(SIDES, axes)]
     families = _GirthFamilies(marks, legs + [neck_mask], [False, False, True], arms)
     neck = (2, *(marks.at(f) for f in NECK_BAND), False, marks.piece_ends(neck_mask))
