@@ -17,10 +17,12 @@ from contextlib import contextmanager
 import numpy as np
 
 from devkit.extra_before import MannequinLandmarksBefore, mannequin_extra_measurements_before
-from ellimann_addon.core import refine_extra, synthesis
+from ellimann_addon.core import body_measure, refine_extra, synthesis
+from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
 from ellimann_addon.core.extra_measures import EXTRA_MEASUREMENTS, mannequin_extra_measurements
 from ellimann_addon.core.shipped_sets import FEMALE_SET, MALE_SET, named_reference_set
+from tools.reference_sets import TRACING_FOLDER
 
 GRID_STEP = 27  # every 27th of the 243 inner-quartile requests: 9 per set
 MEET_PER_SET = 2
@@ -41,6 +43,20 @@ def best_time(function, repeat=3):
         result = function()
         times.append(time.perf_counter() - start)
     return min(times), result
+
+
+BODIES = ("reference_female", "small_slim", "tall_slim", "small_chubby", "tall_chubby", "average")
+
+
+@contextmanager
+def every_triangle_cut():
+    """core.body_measure cutting every triangle of the mesh at every height (main's way)."""
+    saved = body_measure.StandingBody.crossed
+    body_measure.StandingBody.crossed = lambda body, z, rows=None: np.arange(len(body.faces)) if rows is None else rows
+    try:
+        yield
+    finally:
+        body_measure.StandingBody.crossed = saved
 
 
 @contextmanager
@@ -91,6 +107,24 @@ def run():
                   f"{difference:13.1e}  {misses or 'none'}")
     print(f"meet_extra: {totals[0] / totals[1]:.1f}x faster over {2 * MEET_PER_SET} mannequins "
           f"({totals[0] / (2 * MEET_PER_SET):.2f} s -> {totals[1] / (2 * MEET_PER_SET):.2f} s per mannequin)")
+
+    bodies()
+
+
+def bodies():
+    print(f"\nmeasure_body_mesh:\n{'body':<17} {'triangles':>9} {'before s':>8} {'now s':>6} {'ratio':>6} "
+          f"{'max |diff| cm':>13}")
+    totals = [0.0, 0.0]
+    for name in BODIES:
+        mesh = read_obj(TRACING_FOLDER / f"{name}.obj")
+        with every_triangle_cut():
+            before, old = best_time(lambda m=mesh: body_measure.measure_body_mesh(m.vertices, m.faces), repeat=2)
+        now, new = best_time(lambda m=mesh: body_measure.measure_body_mesh(m.vertices, m.faces), repeat=2)
+        totals[0] += before
+        totals[1] += now
+        difference = max(abs(new.values[key] - old.values[key]) for key in old.values)
+        print(f"{name:<17} {len(mesh.faces):9d} {before:8.2f} {now:6.2f} {before / now:6.1f} {difference:13.1e}")
+    print(f"measure_body_mesh: {totals[0] / totals[1]:.1f}x faster over the six bodies")
 
 
 if __name__ == "__main__":
