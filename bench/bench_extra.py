@@ -10,13 +10,16 @@ their extra measurements moved by a few per cent, timed once each way (main's me
 """
 
 import itertools
+import pathlib
 import statistics
+import tempfile
 import time
 from contextlib import contextmanager
 
 import numpy as np
 
 from devkit.extra_before import MannequinLandmarksBefore, mannequin_extra_measurements_before
+from ellimann_addon.cli import main as ellimann
 from ellimann_addon.core import body_measure, refine_extra, synthesis
 from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
@@ -109,6 +112,24 @@ def run():
           f"({totals[0] / (2 * MEET_PER_SET):.2f} s -> {totals[1] / (2 * MEET_PER_SET):.2f} s per mannequin)")
 
     bodies()
+    population()
+
+
+def population(rows=12):
+    def once():
+        with tempfile.TemporaryDirectory() as folder:
+            folder = pathlib.Path(folder)
+            start = time.perf_counter()
+            code = ellimann(["population", "--stats", "ansur2_female", "--n", str(rows), "--seed", "1", "-q",
+                             "-o", str(folder / "people.csv"), "--extras", "--synthesize", str(folder / "out")])
+            assert code == 0
+            return time.perf_counter() - start
+
+    with measured_as_before():
+        before = once()
+    now = once()
+    print(f"\npopulation --n {rows} --extras --synthesize: before {before:.1f} s, now {now:.1f} s, "
+          f"{before / now:.1f}x faster")
 
 
 def bodies():

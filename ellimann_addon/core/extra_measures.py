@@ -114,11 +114,10 @@ def extremes_over_bands(evaluate, bands, points=(), samples=BAND_SAMPLES):
     ``evaluate(family, heights)``: values at arrays of (family index, height); ``bands``: (family, low, high,
     largest, breaks) each; ``points``: (family, height) pairs evaluated with the grids (one call for both).
     Each band is gridded as :func:`extreme_over_band` grids it and the cell beside each piece's best sample
-    refined by parabolic steps: three probes a step (the vertex of the parabola through the bracket's best
-    point and its neighbours, and either side of it), quartering the bracket instead where a step did not
-    halve it, where the best point is a piece's end or where a value is not finite. Between breaks a girth is
-    smooth (its slope continuous), so a bracket closes in a handful of steps instead of golden section's 40.
-    Returns (the extremes [float], the values at ``points`` (p,))."""
+    refined by steps of a few probes per bracket in one call (:func:`_probes`: a piece's end checked, the
+    parabola's vertex, even cuts where a step did not halve the bracket) until it is BRACKET_DONE wide.
+    Between breaks a girth is smooth but for kinks, so a bracket closes in a handful of steps instead of golden
+    section's 40. Returns (the extremes [float], the values at ``points`` (p,))."""
     grids = [_band_grid(low, high, breaks, samples) for _, low, high, _, breaks in bands]
     signs = np.array([-1.0 if band[3] else 1.0 for band in bands])
     band_of_sample = np.concatenate([np.full(grid.size, i) for i, grid in enumerate(grids)]).astype(int)
@@ -163,9 +162,9 @@ def _refine_brackets(evaluate, heights, values, ends):
         found[used] = evaluate(np.broadcast_to(rows[:, None], probes.shape)[used], probes[used])
         points = np.concatenate([np.stack([a[rows], x[rows], b[rows]], axis=1), probes], axis=1)
         point_values = np.concatenate([np.stack([fa[rows], fx[rows], fb[rows]], axis=1), found], axis=1)
-        width, quartered = b[rows] - a[rows], stalled[rows]
+        width, cut = b[rows] - a[rows], stalled[rows]
         a[rows], x[rows], b[rows], fa[rows], fx[rows], fb[rows] = _narrowed(points, point_values)
-        stalled[rows] = ~quartered & (b[rows] - a[rows] > 0.5 * width)  # after quarters, the parabola again
+        stalled[rows] = ~cut & (b[rows] - a[rows] > 0.5 * width)  # after even cuts, the parabola again
     return fx
 
 
@@ -177,9 +176,9 @@ def _probes(a, x, b, fa, fx, fb, stalled, lowest, highest, pairs):
     A bracket reaching a piece's end that is worse than its best point: twice beside that end (a section that
     loses a piece there jumps: the extreme may be the limit at the end) and the parabola's. A step that did not
     halve the bracket (or values not finite): cutting it evenly. Otherwise the vertex of the parabola through
-    the three points and either side of it at half the vertex's move, 0.35 of that, ... Parabola
-    and cuts in the angle t of ``_angle``: a
-    section gaining a piece at a piece's end grows like the square root of the distance, smooth in t."""
+    the three points and either side of it at half the vertex's move, 0.35 of that, ... Parabola and cuts in
+    the angle t of ``_angle``: a section gaining a piece at a piece's end grows like the square root of the
+    distance, smooth in t."""
     ta, tx, tb = (_angle(z, lowest, highest) for z in (a, x, b))
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         p = (tx - ta) ** 2 * (fx - fb) - (tx - tb) ** 2 * (fx - fa)
@@ -195,7 +194,7 @@ def _probes(a, x, b, fa, fx, fb, stalled, lowest, highest, pairs):
     around = np.sign(offsets) * np.maximum(np.abs(around), PROBE_FLOOR * np.abs(offsets) / offsets.max())
     parabolic = centre[:, None] + around
     even = (column + 1) / (len(column) + 1.0)
-    quarters = _height(ta[:, None] + (tb - ta)[:, None] * even, lowest[:, None], highest[:, None])
+    cuts = _height(ta[:, None] + (tb - ta)[:, None] * even, lowest[:, None], highest[:, None])
     at_low, at_high = x <= a, x >= b
     beside = np.where(at_low, END_PROBE, -END_PROBE)[:, None] * (column == 0)
     toward_low = (a == lowest) & (fa > fx) & (x - a > 2.0 * END_PROBE)
@@ -204,8 +203,8 @@ def _probes(a, x, b, fa, fx, fb, stalled, lowest, highest, pairs):
     end = np.where(toward_low, a, b)[:, None]
     beside_end = np.where(column < 2, end + inward * END_PROBE * (column + 1), parabolic)
     finite = np.isfinite(fa) & np.isfinite(fx) & np.isfinite(fb)
-    use_quarters = stalled | ~finite | (tb - ta < 4.0 * spread)
-    probes = np.where(use_quarters[:, None], quarters, parabolic)
+    use_cuts = stalled | ~finite | (tb - ta < 4.0 * spread)
+    probes = np.where(use_cuts[:, None], cuts, parabolic)
     probes = np.where((toward_low | toward_high)[:, None], beside_end, probes)
     probes = np.where((at_low | at_high)[:, None], x[:, None] + beside, probes)
     return np.clip(probes, a[:, None], b[:, None])
@@ -395,9 +394,11 @@ def mannequin_extra_measurements(mannequin):
     has_arms = all(marks.arm_mask(side).any() for side in SIDES)
     axes = marks.arm_axes() if has_arms else []
     arms = [(*marks.across_arm(side, start, axis), marks.arm_mask(side)) for side, (start, axis, _) in zip(SIDES, axes)]
-    families = _GirthFamilies(marks, legs + [neck_mask], [False, False, True], arms)
-    neck = (2, *(marks.at(f) for f in NECK_BAND), False, marks.piece_ends(neck_mask))
-    bands, points = [neck], [(3 + i, UPPER_ARM_FRACTION * length) for i, (_, _, length) in enumerate(axes)]
+    families = _GirthFamilies(marks, legs + [neck_mask], [False] * len(legs) + [True], arms)  # then the arms
+    neck_family, first_arm = len(legs), len(legs) + 1
+    neck = (neck_family, *(marks.at(f) for f in NECK_BAND), False, marks.piece_ends(neck_mask))
+    bands = [neck]
+    points = [(first_arm + i, UPPER_ARM_FRACTION * length) for i, (_, _, length) in enumerate(axes)]
     if np.isfinite(crotch):
         low, high = (marks.bottom + f * crotch for f in CALF_BAND)
         bands += [(i, low, high, True, marks.piece_ends(mask)) for i, mask in enumerate(legs)]

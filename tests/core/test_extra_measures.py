@@ -7,11 +7,18 @@ import itertools
 import numpy as np
 import pytest
 
-from devkit.extra_before import mannequin_extra_measurements_before
+from devkit.extra_before import MannequinLandmarksBefore, _farthest_distance, mannequin_extra_measurements_before
 from devkit.toy import make_toy_mannequin
 from ellimann_addon.core import synthesis
 from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
-from ellimann_addon.core.extra_measures import EXTRA_MEASUREMENTS, extremes_over_bands, mannequin_extra_measurements
+from ellimann_addon.core.extra_measures import (
+    EXTRA_MEASUREMENTS,
+    SIDES,
+    MannequinLandmarks,
+    _farthest_points,
+    extremes_over_bands,
+    mannequin_extra_measurements,
+)
 from ellimann_addon.core.shipped_sets import FEMALE_SET, MALE_SET, named_reference_set
 
 SAME_CM = 1e-6
@@ -74,3 +81,18 @@ def test_the_toy_neck_tends_to_nothing():
     assert 0.0 < now["neck"] < 0.01 and 0.0 < before["neck"] < 0.01
     for key in EXTRA_MEASUREMENTS[1:]:
         assert now[key] == pytest.approx(before[key], abs=SAME_CM, nan_ok=True), key
+
+
+def test_the_farthest_points_stop_with_the_bits_of_a_hundred_steps():
+    """The bisection stops when its bracket stops shrinking: the distances of main's 100 steps, bit for bit;
+    the arm axes agree with main's (its tip from a second bisection) to rounding."""
+    for mannequin in named_reference_set(FEMALE_SET).mannequins:
+        marks, before = MannequinLandmarks(mannequin), MannequinLandmarksBefore(mannequin)
+        for side, (start, axis, length) in zip(SIDES, marks.arm_axes()):
+            arm = marks.arm_mask(side)
+            rotation, center, semi = mannequin.rotation[arm], mannequin.center[arm], mannequin.semi_axes[arm]
+            assert np.array_equal(_farthest_points(rotation, center, semi, start)[0],
+                                  _farthest_distance(rotation, center, semi, start))
+            old_start, old_axis, old_length = before.arm_axis(side)
+            assert np.array_equal(start, old_start) and length == old_length
+            assert axis == pytest.approx(old_axis, abs=1e-12)
