@@ -8,14 +8,20 @@ import pytest
 
 from devkit.cli_runs import assert_one_line_error, run
 from devkit.toy import make_toy_mannequin
-from ellimann_addon.core.body_measure import ALL_MEASUREMENTS, hull_girth, measure_body_mesh
+from ellimann_addon.core.body_measure import (
+    ALL_MEASUREMENTS,
+    StandingBody,
+    hull_girth,
+    measure_body_mesh,
+    section_blobs,
+)
 from ellimann_addon.core.body_mesh import BodyMeshError, read_body_mesh
 from ellimann_addon.core.constants import MEASUREMENTS, SECTION_FRACTIONS
 from ellimann_addon.core.extra_measures import (
     EXTRA_MEASUREMENTS,
     ISO_ALLOWANCE,
     MannequinLandmarks,
-    _farthest_distance,
+    _farthest_points,
     extreme_over_band,
     mannequin_extra_measurements,
 )
@@ -67,12 +73,14 @@ def test_tilted_prism_across_its_axis():
 
 def test_farthest_point_of_a_sphere_and_an_ellipsoid():
     rotation = np.eye(3)[None]
-    assert _farthest_distance(rotation, np.zeros((1, 3)), np.full((1, 3), 0.1), np.array([0.3, 0.4, 0.0]))[0] == \
-        pytest.approx(0.6, abs=1e-12)
+    distance, point = _farthest_points(rotation, np.zeros((1, 3)), np.full((1, 3), 0.1), np.array([0.3, 0.4, 0.0]))
+    assert distance[0] == pytest.approx(0.6, abs=1e-12)
+    assert point[0] == pytest.approx([-0.06, -0.08, 0.0], abs=1e-12)
     # from (0, 0.05, 0) inside, the far end of the major axis: |(0, -0.25, 0) - (0, 0.05, 0)| = 0.3
     semi = np.array([[0.1, 0.25, 0.05]])
-    assert _farthest_distance(rotation, np.zeros((1, 3)), semi, np.array([0.0, 0.05, 0.0]))[0] == \
-        pytest.approx(0.3, abs=1e-12)
+    distance, point = _farthest_points(rotation, np.zeros((1, 3)), semi, np.array([0.0, 0.05, 0.0]))
+    assert distance[0] == pytest.approx(0.3, abs=1e-12)
+    assert point[0] == pytest.approx([0.0, -0.25, 0.0], abs=1e-12)
 
 
 def test_band_extremes_and_a_narrow_dip():
@@ -143,6 +151,21 @@ def test_open_mesh_names_what_it_cannot_take():
     closed = measure_body_mesh(v, f)
     lost = set(closed.values) - set(result.values)
     assert "Wa" in lost and all(key in result.problems[-1] for key in lost)
+
+
+def test_sections_from_the_crossed_triangles_are_the_whole_meshs():
+    """StandingBody cuts only the triangles whose z range holds the height: the same segments, in the same order,
+    as cutting every triangle, also where the plane runs through vertices (they count as above it)."""
+    vertices, faces = mesh_of(make_toy_mannequin())
+    body = StandingBody(vertices, faces)
+    rows = np.arange(0, len(faces), 3)
+    for z in [*np.linspace(body.at(0.05), body.at(0.95), 7), vertices[17, 2], vertices[len(vertices) // 2, 2]]:
+        segments, triangles = body.section(z)
+        expected, expected_rows = section_segments(vertices, faces, z)
+        assert np.array_equal(segments, expected) and np.array_equal(triangles, expected_rows)
+        crossed = section_blobs(vertices, faces[body.crossed(z, rows)], z)
+        every = section_blobs(vertices, faces[rows], z)
+        assert np.array_equal(crossed[0], every[0]) and np.array_equal(crossed[2], every[2])  # segments, blobs
 
 
 def test_arms_against_the_torso():

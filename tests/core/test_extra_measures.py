@@ -1,0 +1,98 @@
+"""The extra measurements' smooth band search (core.extra_measures.extremes_over_bands) against known extremes,
+and the mannequin's measurements against main's (devkit.extra_before: golden section per band) on the shipped
+sets and synthesized mannequins: the same values (1e-6 cm), the same local extremes."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+from devkit.extra_before import MannequinLandmarksBefore, _farthest_distance, mannequin_extra_measurements_before
+from devkit.toy import make_toy_mannequin
+from ellimann_addon.core import synthesis
+from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
+from ellimann_addon.core.extra_measures import (
+    EXTRA_MEASUREMENTS,
+    SIDES,
+    MannequinLandmarks,
+    _farthest_points,
+    extremes_over_bands,
+    mannequin_extra_measurements,
+)
+from ellimann_addon.core.shipped_sets import FEMALE_SET, MALE_SET, named_reference_set
+
+SAME_CM = 1e-6
+
+
+def search(functions, bands, points=()):
+    """extremes_over_bands with one plain function of the height per family."""
+    def evaluate(family, heights):
+        out = np.empty(len(heights))
+        for index, function in enumerate(functions):
+            rows = family == index
+            out[rows] = function(heights[rows])
+        return out
+    return extremes_over_bands(evaluate, bands, points)
+
+
+def test_smooth_extremes_kinks_jumps_and_square_roots():
+    functions = [
+        lambda z: np.cos(3.0 * (z - 0.3137)),  # smooth: largest 1 at 0.3137
+        lambda z: np.abs(z - 0.4711) + 0.2,  # a kink inside a piece: smallest 0.2
+        lambda z: np.where(z > 0.6, 1.0 + np.sqrt(np.maximum(z - 0.6, 0.0)) - 2.0 * (z - 0.6), 1.0),  # sqrt at a break
+        lambda z: np.where(z <= 0.5, 2.0, 1.0 + (z - 0.5)),  # a jump at a break: the limit 1 beside it
+    ]
+    bands = [(0, 0.0, 1.0, True, ()), (1, 0.0, 1.0, False, ()), (2, 0.0, 1.0, True, (0.6,)),
+             (3, 0.0, 1.0, False, (0.5,))]
+    extremes, at_points = search(functions, bands, [(0, 0.3137), (1, 0.0)])
+    assert extremes[0] == pytest.approx(1.0, abs=1e-12)
+    assert extremes[1] == pytest.approx(0.2, abs=1e-9)
+    assert extremes[2] == pytest.approx(1.125, abs=1e-9)  # 1 + s - 2 s^2 at s = 1/4
+    assert extremes[3] == pytest.approx(1.0, abs=1e-9)
+    assert at_points == pytest.approx([1.0, 0.6711], abs=1e-12)
+
+
+def test_an_empty_band_and_no_bands():
+    extremes, at_points = search([lambda z: np.full(len(z), np.inf)], [(0, 0.0, 1.0, False, ())])
+    assert extremes == [np.inf] and len(at_points) == 0
+
+
+def reference_and_synthesized(set_name):
+    """The set's Reference Mannequins and three synthesized on its inner-quartile grid of requests."""
+    reference = named_reference_set(set_name)
+    requests = np.array(list(itertools.product(*[quartile_points(k, reference.ranges) for k in MEASUREMENTS])))
+    batch = synthesis.synthesize_batch(reference, requests[::120])
+    return reference.mannequins + [batch.mannequin(i, f"{set_name} {i}") for i in range(len(batch.measured))]
+
+
+@pytest.mark.parametrize("set_name", [FEMALE_SET, MALE_SET])
+def test_the_same_as_golden_section_on_the_shipped_and_synthesized_mannequins(set_name):
+    for mannequin in reference_and_synthesized(set_name):
+        now, before = mannequin_extra_measurements(mannequin), mannequin_extra_measurements_before(mannequin)
+        for key in EXTRA_MEASUREMENTS:
+            assert now[key] == pytest.approx(before[key], abs=SAME_CM), (mannequin.name, key)
+
+
+def test_the_toy_neck_tends_to_nothing():
+    """The toy's neck band holds the tip of a piece (the section shrinks to a point): the smallest girth is the
+    limit 0 there, which both searches approach only as far as their last probe; every other key agrees."""
+    toy = make_toy_mannequin()
+    now, before = mannequin_extra_measurements(toy), mannequin_extra_measurements_before(toy)
+    assert 0.0 < now["neck"] < 0.01 and 0.0 < before["neck"] < 0.01
+    for key in EXTRA_MEASUREMENTS[1:]:
+        assert now[key] == pytest.approx(before[key], abs=SAME_CM, nan_ok=True), key
+
+
+def test_the_farthest_points_stop_with_the_bits_of_a_hundred_steps():
+    """The bisection stops when its bracket stops shrinking: the distances of main's 100 steps, bit for bit;
+    the arm axes agree with main's (its tip from a second bisection) to rounding."""
+    for mannequin in named_reference_set(FEMALE_SET).mannequins:
+        marks, before = MannequinLandmarks(mannequin), MannequinLandmarksBefore(mannequin)
+        for side, (start, axis, length) in zip(SIDES, marks.arm_axes()):
+            arm = marks.arm_mask(side)
+            rotation, center, semi = mannequin.rotation[arm], mannequin.center[arm], mannequin.semi_axes[arm]
+            assert np.array_equal(_farthest_points(rotation, center, semi, start)[0],
+                                  _farthest_distance(rotation, center, semi, start))
+            old_start, old_axis, old_length = before.arm_axis(side)
+            assert np.array_equal(start, old_start) and length == old_length
+            assert axis == pytest.approx(old_axis, abs=1e-12)
