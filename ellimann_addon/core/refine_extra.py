@@ -12,12 +12,14 @@ with the five re-met by ``core.refine.refine`` after every round (the extra fact
 import numpy as np
 
 from .constants import MEASUREMENTS
+from .ellipsoid import axis_extent
 from .errors import ElliMannError
 from .extra_measures import (
     CALF_BAND,
     EXTRA_ABSURD_LIMITS,
     EXTRA_LABELS,
     EXTRA_MEASUREMENTS,
+    NECK_BAND,
     SIDES,
     THIGH_DROP,
     MannequinLandmarks,
@@ -76,25 +78,53 @@ def _scale_across(rotation, semi, rows, axis, factor):
     semi[rows] *= factor ** (1.0 - along)
 
 
+def _section_rows(rotation, center, semi, z, mask):
+    """(rows, cut, half height) of the pieces ``mask`` a horizontal section at ``z`` cuts; cut is where, from the
+    piece's middle (-1 its bottom .. 1 its top)."""
+    half = axis_extent(rotation, semi, 2)
+    cut = (z - center[:, 2]) / half
+    rows = np.nonzero(mask & (np.abs(cut) < 1.0))[0]
+    return rows, cut[rows], half[rows]
+
+
+def _widen_at(rotation, center, semi, z, mask, factor, mid_x=None):
+    """Widen (factor > 1) the section at height ``z`` of the pieces ``mask`` by about ``factor``, locally: a piece
+    cut off its middle (|cut| near 1) is mostly lengthened from its far end, which widens it at the section and
+    leaves its far end where it was (refine's girth taper); one cut near its middle is mostly scaled across.
+    With ``mid_x``, each piece keeps the edge facing the mid-plane (a thigh must not cross into the other: the
+    crotch would drop)."""
+    rows, cut, half = _section_rows(rotation, center, semi, z, mask)
+    share = np.abs(cut)
+    lengthen = factor**share
+    anchor = center[rows, 2] - np.sign(cut) * half
+    center[rows, 2] = anchor + lengthen * (center[rows, 2] - anchor)
+    semi[rows] *= lengthen[:, None] ** (rotation[rows, 2, :] ** 2)
+    inner = axis_extent(rotation[rows], semi[rows], 0)
+    semi[rows] *= (factor ** (1.0 - share))[:, None] ** (1.0 - rotation[rows, 2, :] ** 2)
+    if mid_x is not None:
+        grown = axis_extent(rotation[rows], semi[rows], 0) - inner
+        center[rows, 0] += np.sign(center[rows, 0] - mid_x) * grown
+
+
 def _apply(key, factor, mannequin, rotation, center, semi):
     """Deform (in place) the pieces of measurement ``key`` by ``factor``."""
     marks = MannequinLandmarks(mannequin.copy(center=center, semi_axes=semi))
     topology = mannequin.topology
     region = np.array([part.region for part in topology])
-    up = np.array([0.0, 0.0, 1.0])
-    if key == "neck":
-        _scale_across(rotation, semi, np.nonzero(region == "neck")[0], up, factor)
+    if key == "neck":  # at the height of the smallest girth, on a grid over the band (enough to pick the pieces)
+        everything = np.ones(len(region), bool)
+        heights = marks.bottom + np.linspace(*NECK_BAND, 48) * marks.height
+        z = heights[int(np.argmin(marks.nonzero_girths_at(heights, everything)))]
+        _widen_at(rotation, center, semi, z, everything, factor)
     elif key in ("thigh", "calf"):
-        legs = region == "legs"
+        legs = marks.leg_mask("L") | marks.leg_mask("R")
         crotch = marks.crotch()
         if key == "thigh":
             z = marks.bottom + crotch - THIGH_DROP * marks.height
         else:  # the height of the largest calf girth, on a grid over the band (enough to pick the pieces)
             heights = marks.bottom + np.linspace(*CALF_BAND, 48) * crotch
             z = heights[int(np.argmax(marks.girths_at(heights, marks.leg_mask("L"))))]
-        half = np.sqrt(np.einsum("nk,nk->n", rotation[:, 2, :] ** 2, semi**2))
-        rows = np.nonzero(legs & (np.abs(center[:, 2] - z) < half))[0]
-        _scale_across(rotation, semi, rows, up, factor)
+        _widen_at(rotation, center, semi, z, legs, factor, mid_x=marks.mid_x)
     elif key == "crotch_height":
         crotch = marks.bottom + marks.crotch()
         lower = np.isin(region, ("legs", "feet"))
