@@ -2,9 +2,10 @@
 the calves, the leg and arm lengths), alternated with the five's refinement (``core.refine``) until every given
 measurement is met.
 
-Each extra measurement moves only its own pieces: its girth scales the pieces its section cuts across their
-horizontal (or, for the upper arm, across the arm's) axes; the crotch height stretches the legs against the
-trunk; the arm length stretches the arm along itself about the shoulder point. One log-factor per given
+Each extra measurement moves only its own pieces: a girth widens the section of the pieces it cuts (horizontal;
+the upper arm's across the arm) as locally as ellipsoids allow, a piece cut off its middle lengthened from its
+far end rather than scaled whole (``_widen_at``); the crotch height stretches the legs against the trunk; the
+arm length stretches the arm along itself about the shoulder point. One log-factor per given
 measurement, solved by secant steps per factor (each measurement responds almost only to its own factor),
 with the five re-met by ``core.refine.refine`` after every round (the extra factors nudge He and the girths).
 """
@@ -22,6 +23,7 @@ from .extra_measures import (
     NECK_BAND,
     SIDES,
     THIGH_DROP,
+    UPPER_ARM_FRACTION,
     MannequinLandmarks,
     mannequin_extra_measurements,
 )
@@ -36,6 +38,9 @@ MISS_CM = 0.1  # a given extra measurement further off than this (1 mm) is a mis
 FIVE_TOLERANCE_CM = 0.01  # a round that moves any of the five further than this is never the result
 EXTRA_FACTOR_LIMIT = 2.0  # no piece scaled beyond this or below its inverse (it would no longer look like itself)
 _MAX_LOG_STEP = 0.25
+# How much of a girth's factor lengthens a piece cut off its middle (times |cut|), per measurement: measured by
+# bench_scan (twin vs body IoU); more on the neck moves its smallest girth up into the head instead.
+_LENGTHEN_SHARE = {"neck": 1.0, "thigh": 2.0, "calf": 2.0, "upper_arm": 2.0}
 
 
 class ExtraRequestError(ElliMannError):
@@ -72,10 +77,12 @@ def extra_request_problems(request, extra):
     return problems
 
 
-def _scale_across(rotation, semi, rows, axis, factor):
-    """Scale the semi-axes of pieces ``rows`` across ``axis`` (a unit vector; their shares along it stay)."""
-    along = np.einsum("nik,i->nk", rotation[rows], axis) ** 2  # share of each local axis along ``axis``
-    semi[rows] *= factor ** (1.0 - along)
+def _frame_along(axis):
+    """Rows of an orthonormal frame whose third is ``axis`` (a unit vector)."""
+    helper = np.array([0.0, 0.0, 1.0]) if abs(axis[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    first = np.cross(helper, axis)
+    first /= np.linalg.norm(first)
+    return np.stack([first, np.cross(axis, first), axis])
 
 
 def _section_rows(rotation, center, semi, z, mask):
@@ -87,23 +94,29 @@ def _section_rows(rotation, center, semi, z, mask):
     return rows, cut[rows], half[rows]
 
 
-def _widen_at(rotation, center, semi, z, mask, factor, mid_x=None):
-    """Widen (factor > 1) the section at height ``z`` of the pieces ``mask`` by about ``factor``, locally: a piece
-    cut off its middle (|cut| near 1) is mostly lengthened from its far end, which widens it at the section and
-    leaves its far end where it was (refine's girth taper); one cut near its middle is mostly scaled across.
-    With ``mid_x``, each piece keeps the edge facing the mid-plane (a thigh must not cross into the other: the
-    crotch would drop)."""
+def _widen_at(rotation, center, semi, z, mask, factor, lengthen_share, mid_x=None):
+    """Widen (factor > 1) or narrow the section at height ``z`` of the pieces ``mask``, as locally as ellipsoids
+    allow. A piece cut at ``cut`` from its middle is lengthened by factor^(lengthen_share |cut|) from its far
+    end (which stays: refine's girth taper), bringing its wider middle towards the section; one cut within
+    1/lengthen_share of its middle is also scaled across by the rest. Scaling a whole piece across widens it
+    end to end (a thigh down to the knee, outside the body), lengthening much less so.
+
+    With ``mid_x`` (the legs) the across scaling is front to back only and each piece keeps the edge facing the
+    mid-plane: a thigh grown sideways crosses into the other and drops the crotch, and the thigh's section with
+    it (the heavy bodies' thigh was missed so)."""
     rows, cut, half = _section_rows(rotation, center, semi, z, mask)
-    share = np.abs(cut)
-    lengthen = factor**share
+    share = np.minimum(lengthen_share * np.abs(cut), 1.0)
+    lengthen = factor ** (lengthen_share * np.abs(cut))
+    inner = axis_extent(rotation[rows], semi[rows], 0)  # a tilted piece lengthened reaches further sideways too
     anchor = center[rows, 2] - np.sign(cut) * half
     center[rows, 2] = anchor + lengthen * (center[rows, 2] - anchor)
     semi[rows] *= lengthen[:, None] ** (rotation[rows, 2, :] ** 2)
-    inner = axis_extent(rotation[rows], semi[rows], 0)
-    semi[rows] *= (factor ** (1.0 - share))[:, None] ** (1.0 - rotation[rows, 2, :] ** 2)
-    if mid_x is not None:
-        grown = axis_extent(rotation[rows], semi[rows], 0) - inner
-        center[rows, 0] += np.sign(center[rows, 0] - mid_x) * grown
+    across = (factor ** (1.0 - share))[:, None]
+    if mid_x is None:
+        semi[rows] *= across ** (1.0 - rotation[rows, 2, :] ** 2)
+    else:
+        semi[rows] *= across ** (rotation[rows, 1, :] ** 2)
+        center[rows, 0] += np.sign(center[rows, 0] - mid_x) * (axis_extent(rotation[rows], semi[rows], 0) - inner)
 
 
 def _apply(key, factor, mannequin, rotation, center, semi):
@@ -115,7 +128,7 @@ def _apply(key, factor, mannequin, rotation, center, semi):
         everything = np.ones(len(region), bool)
         heights = marks.bottom + np.linspace(*NECK_BAND, 48) * marks.height
         z = heights[int(np.argmin(marks.nonzero_girths_at(heights, everything)))]
-        _widen_at(rotation, center, semi, z, everything, factor)
+        _widen_at(rotation, center, semi, z, everything, factor, _LENGTHEN_SHARE[key])
     elif key in ("thigh", "calf"):
         legs = marks.leg_mask("L") | marks.leg_mask("R")
         crotch = marks.crotch()
@@ -124,7 +137,7 @@ def _apply(key, factor, mannequin, rotation, center, semi):
         else:  # the height of the largest calf girth, on a grid over the band (enough to pick the pieces)
             heights = marks.bottom + np.linspace(*CALF_BAND, 48) * crotch
             z = heights[int(np.argmax(marks.girths_at(heights, marks.leg_mask("L"))))]
-        _widen_at(rotation, center, semi, z, legs, factor, mid_x=marks.mid_x)
+        _widen_at(rotation, center, semi, z, legs, factor, _LENGTHEN_SHARE[key], mid_x=marks.mid_x)
     elif key == "crotch_height":
         crotch = marks.bottom + marks.crotch()
         lower = np.isin(region, ("legs", "feet"))
@@ -133,11 +146,15 @@ def _apply(key, factor, mannequin, rotation, center, semi):
         semi[lower] *= factor ** (rotation[lower, 2, :] ** 2)  # each local axis by its share along z
     elif key in ("upper_arm", "arm_length"):
         for side in SIDES:
-            start, axis, _ = marks.arm_axis(side)
+            start, axis, length = marks.arm_axis(side)
             arm = np.nonzero(marks.arm & (marks.side == side))[0]
-            if key == "upper_arm":
-                upper = arm[np.argmax(center[arm, 2])]
-                _scale_across(rotation, semi, [upper], axis, factor)
+            if key == "upper_arm":  # the section across the arm, as a horizontal one in the arm's own frame
+                frame = _frame_along(axis)
+                origin = start + UPPER_ARM_FRACTION * length * axis
+                arm_rotation, arm_center, arm_semi = frame @ rotation[arm], (center[arm] - origin) @ frame.T, semi[arm]
+                _widen_at(arm_rotation, arm_center, arm_semi, 0.0, np.ones(len(arm), bool), factor,
+                          _LENGTHEN_SHARE[key])
+                center[arm], semi[arm] = arm_center @ frame + origin, arm_semi
             else:
                 center[arm] = start + factor * (center[arm] - start)
                 along = np.einsum("nik,i->nk", rotation[arm], axis) ** 2
