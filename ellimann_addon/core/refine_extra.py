@@ -95,16 +95,19 @@ def _section_rows(rotation, center, semi, z, mask):
 
 
 def _widen_at(rotation, center, semi, z, mask, factor, lengthen_share, mid_x=None):
-    """Widen (factor > 1) or narrow the section at height ``z`` of the pieces ``mask``, as locally as ellipsoids
-    allow. A piece cut at ``cut`` from its middle is lengthened by factor^(lengthen_share |cut|) from its far
-    end (which stays: refine's girth taper), bringing its wider middle towards the section; one cut within
-    1/lengthen_share of its middle is also scaled across by the rest. Scaling a whole piece across widens it
-    end to end (a thigh down to the knee, outside the body), lengthening much less so.
+    """Widen (factor > 1) the section at height ``z`` of the pieces ``mask`` as locally as ellipsoids allow, or
+    narrow it (scaled across only). A piece cut at ``cut`` from its middle is lengthened by
+    factor^(lengthen_share |cut|) from its far end (which stays: refine's girth taper), bringing its wider middle
+    towards the section; one cut within 1/lengthen_share of its middle is also scaled across by the rest.
+    Scaling a whole piece across widens it end to end (a thigh down to the knee, outside the body), lengthening
+    much less so.
 
     With ``mid_x`` (the legs) the across scaling is front to back only and each piece keeps the edge facing the
     mid-plane: a thigh grown sideways crosses into the other and drops the crotch, and the thigh's section with
     it (the heavy bodies' thigh was missed so)."""
     rows, cut, half = _section_rows(rotation, center, semi, z, mask)
+    if factor < 1.0:  # never shortened: a piece's near end could leave a gap in its chain (the knee and calf)
+        lengthen_share = 0.0
     share = np.minimum(lengthen_share * np.abs(cut), 1.0)
     lengthen = factor ** (lengthen_share * np.abs(cut))
     inner = axis_extent(rotation[rows], semi[rows], 0)  # a tilted piece lengthened reaches further sideways too
