@@ -94,27 +94,30 @@ def _section_rows(rotation, center, semi, z, mask):
     return rows, cut[rows], half[rows]
 
 
-def _widen_at(rotation, center, semi, z, mask, factor, lengthen_share, mid_x=None):
-    """Widen (factor > 1) the section at height ``z`` of the pieces ``mask`` as locally as ellipsoids allow, or
-    narrow it (scaled across only). A piece cut at ``cut`` from its middle is lengthened by
-    factor^(lengthen_share |cut|) from its far end (which stays: refine's girth taper), bringing its wider middle
-    towards the section; one cut within 1/lengthen_share of its middle is also scaled across by the rest.
-    Scaling a whole piece across widens it end to end (a thigh down to the knee, outside the body), lengthening
-    much less so.
+def _widen_at(rotation, center, semi, z, mask, factor, lengthen_share, stretch, mid_x=None):
+    """Widen (factor > 1) or narrow the section at height ``z`` of the pieces ``mask`` as locally as ellipsoids
+    allow. A piece cut at ``cut`` from its middle is lengthened by factor^(lengthen_share |cut|) from its far
+    end (which stays: refine's girth taper), bringing its wider middle towards the section; one cut within
+    1/lengthen_share of its middle is also scaled across by the rest. Scaling a whole piece across widens it
+    end to end (a thigh down to the knee, outside the body), lengthening much less so. ``stretch`` (per piece,
+    updated) is the log-lengthening so far: narrowing shortens a piece only back to its own length, then scales
+    it across (shorter, its near end could leave a gap in its chain: the knee and calf).
 
     With ``mid_x`` (the legs) the across scaling is front to back only and each piece keeps the edge facing the
     mid-plane: a thigh grown sideways crosses into the other and drops the crotch, and the thigh's section with
     it (the heavy bodies' thigh was missed so)."""
     rows, cut, half = _section_rows(rotation, center, semi, z, mask)
-    if factor < 1.0:  # never shortened: a piece's near end could leave a gap in its chain (the knee and calf)
-        lengthen_share = 0.0
-    share = np.minimum(lengthen_share * np.abs(cut), 1.0)
-    lengthen = factor ** (lengthen_share * np.abs(cut))
+    log_factor = np.log(factor)
+    share = lengthen_share * np.abs(cut)
+    if log_factor < 0.0:
+        share = np.minimum(share, stretch[rows] / -log_factor)
+    lengthen = np.exp(share * log_factor)
+    stretch[rows] += share * log_factor
     inner = axis_extent(rotation[rows], semi[rows], 0)  # a tilted piece lengthened reaches further sideways too
     anchor = center[rows, 2] - np.sign(cut) * half
     center[rows, 2] = anchor + lengthen * (center[rows, 2] - anchor)
     semi[rows] *= lengthen[:, None] ** (rotation[rows, 2, :] ** 2)
-    across = (factor ** (1.0 - share))[:, None]
+    across = np.exp((1.0 - np.minimum(share, 1.0)) * log_factor)[:, None]
     if mid_x is None:
         semi[rows] *= across ** (1.0 - rotation[rows, 2, :] ** 2)
     else:
@@ -122,8 +125,8 @@ def _widen_at(rotation, center, semi, z, mask, factor, lengthen_share, mid_x=Non
         center[rows, 0] += np.sign(center[rows, 0] - mid_x) * (axis_extent(rotation[rows], semi[rows], 0) - inner)
 
 
-def _apply(key, factor, mannequin, rotation, center, semi):
-    """Deform (in place) the pieces of measurement ``key`` by ``factor``."""
+def _apply(key, factor, mannequin, rotation, center, semi, stretch):
+    """Deform (in place) the pieces of measurement ``key`` by ``factor`` (``stretch``: see _widen_at)."""
     marks = MannequinLandmarks(mannequin.copy(center=center, semi_axes=semi))
     topology = mannequin.topology
     region = np.array([part.region for part in topology])
@@ -131,7 +134,7 @@ def _apply(key, factor, mannequin, rotation, center, semi):
         everything = np.ones(len(region), bool)
         heights = marks.bottom + np.linspace(*NECK_BAND, 48) * marks.height
         z = heights[int(np.argmin(marks.nonzero_girths_at(heights, everything)))]
-        _widen_at(rotation, center, semi, z, everything, factor, _LENGTHEN_SHARE[key])
+        _widen_at(rotation, center, semi, z, everything, factor, _LENGTHEN_SHARE[key], stretch)
     elif key in ("thigh", "calf"):
         legs = marks.leg_mask("L") | marks.leg_mask("R")
         crotch = marks.crotch()
@@ -140,7 +143,7 @@ def _apply(key, factor, mannequin, rotation, center, semi):
         else:  # the height of the largest calf girth, on a grid over the band (enough to pick the pieces)
             heights = marks.bottom + np.linspace(*CALF_BAND, 48) * crotch
             z = heights[int(np.argmax(marks.girths_at(heights, marks.leg_mask("L"))))]
-        _widen_at(rotation, center, semi, z, legs, factor, _LENGTHEN_SHARE[key], mid_x=marks.mid_x)
+        _widen_at(rotation, center, semi, z, legs, factor, _LENGTHEN_SHARE[key], stretch, mid_x=marks.mid_x)
     elif key == "crotch_height":
         crotch = marks.bottom + marks.crotch()
         lower = np.isin(region, ("legs", "feet"))
@@ -155,9 +158,10 @@ def _apply(key, factor, mannequin, rotation, center, semi):
                 frame = _frame_along(axis)
                 origin = start + UPPER_ARM_FRACTION * length * axis
                 arm_rotation, arm_center, arm_semi = frame @ rotation[arm], (center[arm] - origin) @ frame.T, semi[arm]
+                arm_stretch = stretch[arm]
                 _widen_at(arm_rotation, arm_center, arm_semi, 0.0, np.ones(len(arm), bool), factor,
-                          _LENGTHEN_SHARE[key])
-                center[arm], semi[arm] = arm_center @ frame + origin, arm_semi
+                          _LENGTHEN_SHARE[key], arm_stretch)
+                center[arm], semi[arm], stretch[arm] = arm_center @ frame + origin, arm_semi, arm_stretch
             else:
                 center[arm] = start + factor * (center[arm] - start)
                 along = np.einsum("nik,i->nk", rotation[arm], axis) ** 2
@@ -213,6 +217,7 @@ def _meet(mannequin, extra, tolerance_cm, max_rounds):
     rotation, center, semi = mannequin.rotation.copy(), mannequin.center.copy(), mannequin.semi_axes.copy()
     keys = [key for key in EXTRA_MEASUREMENTS if key in extra]
     log_factor = {key: 0.0 for key in keys}
+    stretch = np.zeros(len(center))  # log-lengthening of each piece by the girths so far (see _widen_at)
     limit = np.log(EXTRA_FACTOR_LIMIT)
     slope = {key: 1.0 for key in keys}
     previous = {}
@@ -245,7 +250,7 @@ def _meet(mannequin, extra, tolerance_cm, max_rounds):
                 continue  # at its limit: this measurement is as close as its pieces go
             step = float(np.clip(-residual[key] / slope[key], -_MAX_LOG_STEP, _MAX_LOG_STEP))
             wanted = float(np.clip(log_factor[key] + step, -limit, limit))
-            _apply(key, np.exp(wanted - log_factor[key]), current, rotation, center, semi)
+            _apply(key, np.exp(wanted - log_factor[key]), current, rotation, center, semi, stretch)
             log_factor[key] = wanted
             current = mannequin.copy(rotation=rotation, center=center, semi_axes=semi)
         result = refine(mannequin.topology, rotation[None], center[None], semi[None], targets[None],

@@ -29,6 +29,9 @@ FIVE_RELATIVE = 1e-5  # the five's exact-mode tolerance (0.001 %)
 SLIM = dict(zip(MEASUREMENTS, (148.0, 31.11, 84.97, 63.0, 83.0)))
 SLIM_EXTRA = {"neck": 29.68, "upper_arm": 19.95, "thigh": 43.85, "calf": 32.30, "crotch_height": 67.17,
               "arm_length": 57.02}
+TALL = dict(zip(MEASUREMENTS, (170.99, 30.22, 83.98, 62.99, 84.01)))
+TALL_EXTRA = {"neck": 31.17, "upper_arm": 19.50, "thigh": 43.55, "calf": 35.17, "crotch_height": 80.07,
+              "arm_length": 64.09}
 HEAVY = dict(zip(MEASUREMENTS, (148.64, 47.69, 144.41, 138.79, 152.08)))
 HEAVY_EXTRA = {"neck": 42.64, "upper_arm": 26.12, "thigh": 86.13, "calf": 47.40, "crotch_height": 65.38,
                "arm_length": 55.83}
@@ -40,7 +43,11 @@ def reference():
 
 
 def assert_met(reference, five, extra):
+    start = synthesize_extra(reference, five, {})[0]
     mannequin, measured, warnings = synthesize_extra(reference, five, extra)
+    # no piece deformed past recognition (the thigh's and calf's steps once ratcheted a calf to half its depth)
+    ratio = mannequin.semi_axes / start.semi_axes
+    assert ratio.min() > 0.75 and ratio.max() < 1.6, (ratio.min(), ratio.max())
     assert not [line for line in warnings if "missed" in line], warnings
     for key, value in extra.items():
         assert abs(measured[key] - value) <= MISS_CM, (key, measured[key], value)
@@ -59,9 +66,9 @@ def test_each_extra_measurement_of_a_body_is_met_alone(reference, key, body):
     assert_met(reference, five, {key: extra[key]})
 
 
-@pytest.mark.parametrize("body", ["slim", "heavy"])
-def test_all_six_of_a_body_are_met_at_once(reference, body):
-    five, extra = (SLIM, SLIM_EXTRA) if body == "slim" else (HEAVY, HEAVY_EXTRA)
+@pytest.mark.parametrize("five, extra", [(SLIM, SLIM_EXTRA), (TALL, TALL_EXTRA), (HEAVY, HEAVY_EXTRA)],
+                         ids=["slim", "tall", "heavy"])
+def test_all_six_of_a_body_are_met_at_once(reference, five, extra):
     assert_met(reference, five, extra)
 
 
@@ -89,7 +96,7 @@ def test_a_thigh_widened_keeps_its_mid_plane_edge_and_far_ends(reference):
     inner = np.abs(center[rows, 0] - marks.mid_x) - axis_extent(rotation[rows], semi[rows], 0)
     far = center[rows, 2] - np.sign(cut) * half
     before = marks.girths_at([z], marks.leg_mask("L"))[0]
-    _widen_at(rotation, center, semi, z, legs, 1.2, 2.0, mid_x=marks.mid_x)
+    _widen_at(rotation, center, semi, z, legs, 1.2, 2.0, np.zeros(len(center)), mid_x=marks.mid_x)
     widened = mannequin.copy(center=center, semi_axes=semi)
     after = MannequinLandmarks(widened)
     assert after.crotch() == pytest.approx(marks.crotch(), abs=1e-9)
@@ -100,6 +107,28 @@ def test_a_thigh_widened_keeps_its_mid_plane_edge_and_far_ends(reference):
     assert after.girths_at([z], after.leg_mask("L"))[0] > 1.1 * before
     untouched = np.setdiff1d(np.arange(len(center)), rows)
     assert np.array_equal(center[untouched], mannequin.center[untouched])
+
+
+def test_narrowing_shortens_a_piece_only_back_to_its_own_length(reference):
+    mannequin = synthesize_extra(reference, HEAVY, {})[0]
+    marks = MannequinLandmarks(mannequin)
+    z = marks.bottom + 0.4 * marks.crotch()  # the calves
+    legs = marks.leg_mask("L") | marks.leg_mask("R")
+    rotation, center, semi = mannequin.rotation, mannequin.center.copy(), mannequin.semi_axes.copy()
+    rows = _section_rows(rotation, center, semi, z, legs)[0]
+    height = axis_extent(rotation, semi, 2)
+    stretch = np.zeros(len(center))
+    _widen_at(rotation, center, semi, z, legs, 0.9, 2.0, stretch)  # from the start: across only
+    # (a tilted piece's height changes a little with its across axes: they lean)
+    assert np.allclose(axis_extent(rotation, semi, 2)[rows], height[rows], rtol=5e-3) and not stretch.any()
+    _widen_at(rotation, center, semi, z, legs, 1.2, 2.0, stretch)
+    assert (axis_extent(rotation, semi, 2)[rows] > height[rows]).all() and (stretch[rows] > 0.0).all()
+    for _ in range(3):  # narrowing past the lengthening: back to its own length, never shorter
+        _widen_at(rotation, center, semi, z, legs, 0.8, 2.0, stretch)
+        assert (stretch >= -1e-15).all()
+    assert np.allclose(stretch, 0.0, atol=1e-12)
+    # its own length but for the lean of its across axes, narrowed by 0.6 in all
+    assert np.allclose(axis_extent(rotation, semi, 2)[rows], height[rows], rtol=2e-2)
 
 
 def test_a_request_beyond_the_pieces_is_named_and_the_five_kept(reference):
