@@ -2,9 +2,10 @@
 the calves, the leg and arm lengths), alternated with the five's refinement (``core.refine``) until every given
 measurement is met.
 
-Each extra measurement moves only its own pieces: its girth scales the pieces its section cuts across their
-horizontal (or, for the upper arm, across the arm's) axes; the crotch height stretches the legs against the
-trunk; the arm length stretches the arm along itself about the shoulder point. One log-factor per given
+Each extra measurement moves only its own pieces: a girth widens the section of the pieces it cuts (horizontal;
+the upper arm's across the arm) as locally as ellipsoids allow, a piece cut off its middle lengthened from its
+far end rather than scaled whole (``_widen_at``); the crotch height stretches the legs against the trunk; the
+arm length stretches the arm along itself about the shoulder point. One log-factor per given
 measurement, solved by secant steps per factor (each measurement responds almost only to its own factor),
 with the five re-met by ``core.refine.refine`` after every round (the extra factors nudge He and the girths).
 """
@@ -12,14 +13,17 @@ with the five re-met by ``core.refine.refine`` after every round (the extra fact
 import numpy as np
 
 from .constants import MEASUREMENTS
+from .ellipsoid import axis_extent
 from .errors import ElliMannError
 from .extra_measures import (
     CALF_BAND,
     EXTRA_ABSURD_LIMITS,
     EXTRA_LABELS,
     EXTRA_MEASUREMENTS,
+    NECK_BAND,
     SIDES,
     THIGH_DROP,
+    UPPER_ARM_FRACTION,
     MannequinLandmarks,
     mannequin_extra_measurements,
 )
@@ -34,6 +38,9 @@ MISS_CM = 0.1  # a given extra measurement further off than this (1 mm) is a mis
 FIVE_TOLERANCE_CM = 0.01  # a round that moves any of the five further than this is never the result
 EXTRA_FACTOR_LIMIT = 2.0  # no piece scaled beyond this or below its inverse (it would no longer look like itself)
 _MAX_LOG_STEP = 0.25
+# How much of a girth's factor lengthens a piece cut off its middle (times |cut|), per measurement: measured by
+# bench_scan (twin vs body IoU); more on the neck moves its smallest girth up into the head instead.
+_LENGTHEN_SHARE = {"neck": 1.0, "thigh": 2.0, "calf": 2.0, "upper_arm": 2.0}
 
 
 class ExtraRequestError(ElliMannError):
@@ -70,31 +77,73 @@ def extra_request_problems(request, extra):
     return problems
 
 
-def _scale_across(rotation, semi, rows, axis, factor):
-    """Scale the semi-axes of pieces ``rows`` across ``axis`` (a unit vector; their shares along it stay)."""
-    along = np.einsum("nik,i->nk", rotation[rows], axis) ** 2  # share of each local axis along ``axis``
-    semi[rows] *= factor ** (1.0 - along)
+def _frame_along(axis):
+    """Rows of an orthonormal frame whose third is ``axis`` (a unit vector)."""
+    helper = np.array([0.0, 0.0, 1.0]) if abs(axis[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    first = np.cross(helper, axis)
+    first /= np.linalg.norm(first)
+    return np.stack([first, np.cross(axis, first), axis])
 
 
-def _apply(key, factor, mannequin, rotation, center, semi):
-    """Deform (in place) the pieces of measurement ``key`` by ``factor``."""
+def _section_rows(rotation, center, semi, z, mask):
+    """(rows, cut, half height) of the pieces ``mask`` a horizontal section at ``z`` cuts; cut is where, from the
+    piece's middle (-1 its bottom .. 1 its top)."""
+    half = axis_extent(rotation, semi, 2)
+    cut = (z - center[:, 2]) / half
+    rows = np.nonzero(mask & (np.abs(cut) < 1.0))[0]
+    return rows, cut[rows], half[rows]
+
+
+def _widen_at(rotation, center, semi, z, mask, factor, lengthen_share, stretch, mid_x=None):
+    """Widen (factor > 1) or narrow the section at height ``z`` of the pieces ``mask`` as locally as ellipsoids
+    allow. A piece cut at ``cut`` from its middle is lengthened by factor^(lengthen_share |cut|) from its far
+    end (which stays: refine's girth taper), bringing its wider middle towards the section; one cut within
+    1/lengthen_share of its middle is also scaled across by the rest. Scaling a whole piece across widens it
+    end to end (a thigh down to the knee, outside the body), lengthening much less so. ``stretch`` (per piece,
+    updated) is the log-lengthening so far: narrowing shortens a piece only back to its own length, then scales
+    it across (shorter, its near end could leave a gap in its chain: the knee and calf).
+
+    With ``mid_x`` (the legs) the across scaling is front to back only and each piece keeps the edge facing the
+    mid-plane: a thigh grown sideways crosses into the other and drops the crotch, and the thigh's section with
+    it (the heavy bodies' thigh was missed so)."""
+    rows, cut, half = _section_rows(rotation, center, semi, z, mask)
+    log_factor = np.log(factor)
+    share = lengthen_share * np.abs(cut)
+    if log_factor < 0.0:
+        share = np.minimum(share, stretch[rows] / -log_factor)
+    lengthen = np.exp(share * log_factor)
+    stretch[rows] += share * log_factor
+    inner = axis_extent(rotation[rows], semi[rows], 0)  # a tilted piece lengthened reaches further sideways too
+    anchor = center[rows, 2] - np.sign(cut) * half
+    center[rows, 2] = anchor + lengthen * (center[rows, 2] - anchor)
+    semi[rows] *= lengthen[:, None] ** (rotation[rows, 2, :] ** 2)
+    across = np.exp((1.0 - np.minimum(share, 1.0)) * log_factor)[:, None]
+    if mid_x is None:
+        semi[rows] *= across ** (1.0 - rotation[rows, 2, :] ** 2)
+    else:
+        semi[rows] *= across ** (rotation[rows, 1, :] ** 2)
+        center[rows, 0] += np.sign(center[rows, 0] - mid_x) * (axis_extent(rotation[rows], semi[rows], 0) - inner)
+
+
+def _apply(key, factor, mannequin, rotation, center, semi, stretch):
+    """Deform (in place) the pieces of measurement ``key`` by ``factor`` (``stretch``: see _widen_at)."""
     marks = MannequinLandmarks(mannequin.copy(center=center, semi_axes=semi))
     topology = mannequin.topology
     region = np.array([part.region for part in topology])
-    up = np.array([0.0, 0.0, 1.0])
-    if key == "neck":
-        _scale_across(rotation, semi, np.nonzero(region == "neck")[0], up, factor)
+    if key == "neck":  # at the height of the smallest girth, on a grid over the band (enough to pick the pieces)
+        everything = np.ones(len(region), bool)
+        heights = marks.bottom + np.linspace(*NECK_BAND, 48) * marks.height
+        z = heights[int(np.argmin(marks.nonzero_girths_at(heights, everything)))]
+        _widen_at(rotation, center, semi, z, everything, factor, _LENGTHEN_SHARE[key], stretch)
     elif key in ("thigh", "calf"):
-        legs = region == "legs"
+        legs = marks.leg_mask("L") | marks.leg_mask("R")
         crotch = marks.crotch()
         if key == "thigh":
             z = marks.bottom + crotch - THIGH_DROP * marks.height
         else:  # the height of the largest calf girth, on a grid over the band (enough to pick the pieces)
             heights = marks.bottom + np.linspace(*CALF_BAND, 48) * crotch
             z = heights[int(np.argmax(marks.girths_at(heights, marks.leg_mask("L"))))]
-        half = np.sqrt(np.einsum("nk,nk->n", rotation[:, 2, :] ** 2, semi**2))
-        rows = np.nonzero(legs & (np.abs(center[:, 2] - z) < half))[0]
-        _scale_across(rotation, semi, rows, up, factor)
+        _widen_at(rotation, center, semi, z, legs, factor, _LENGTHEN_SHARE[key], stretch, mid_x=marks.mid_x)
     elif key == "crotch_height":
         crotch = marks.bottom + marks.crotch()
         lower = np.isin(region, ("legs", "feet"))
@@ -103,11 +152,16 @@ def _apply(key, factor, mannequin, rotation, center, semi):
         semi[lower] *= factor ** (rotation[lower, 2, :] ** 2)  # each local axis by its share along z
     elif key in ("upper_arm", "arm_length"):
         for side in SIDES:
-            start, axis, _ = marks.arm_axis(side)
+            start, axis, length = marks.arm_axis(side)
             arm = np.nonzero(marks.arm & (marks.side == side))[0]
-            if key == "upper_arm":
-                upper = arm[np.argmax(center[arm, 2])]
-                _scale_across(rotation, semi, [upper], axis, factor)
+            if key == "upper_arm":  # the section across the arm, as a horizontal one in the arm's own frame
+                frame = _frame_along(axis)
+                origin = start + UPPER_ARM_FRACTION * length * axis
+                arm_rotation, arm_center, arm_semi = frame @ rotation[arm], (center[arm] - origin) @ frame.T, semi[arm]
+                arm_stretch = stretch[arm]
+                _widen_at(arm_rotation, arm_center, arm_semi, 0.0, np.ones(len(arm), bool), factor,
+                          _LENGTHEN_SHARE[key], arm_stretch)
+                center[arm], semi[arm], stretch[arm] = arm_center @ frame + origin, arm_semi, arm_stretch
             else:
                 center[arm] = start + factor * (center[arm] - start)
                 along = np.einsum("nik,i->nk", rotation[arm], axis) ** 2
@@ -163,6 +217,7 @@ def _meet(mannequin, extra, tolerance_cm, max_rounds):
     rotation, center, semi = mannequin.rotation.copy(), mannequin.center.copy(), mannequin.semi_axes.copy()
     keys = [key for key in EXTRA_MEASUREMENTS if key in extra]
     log_factor = {key: 0.0 for key in keys}
+    stretch = np.zeros(len(center))  # log-lengthening of each piece by the girths so far (see _widen_at)
     limit = np.log(EXTRA_FACTOR_LIMIT)
     slope = {key: 1.0 for key in keys}
     previous = {}
@@ -195,7 +250,7 @@ def _meet(mannequin, extra, tolerance_cm, max_rounds):
                 continue  # at its limit: this measurement is as close as its pieces go
             step = float(np.clip(-residual[key] / slope[key], -_MAX_LOG_STEP, _MAX_LOG_STEP))
             wanted = float(np.clip(log_factor[key] + step, -limit, limit))
-            _apply(key, np.exp(wanted - log_factor[key]), current, rotation, center, semi)
+            _apply(key, np.exp(wanted - log_factor[key]), current, rotation, center, semi, stretch)
             log_factor[key] = wanted
             current = mannequin.copy(rotation=rotation, center=center, semi_axes=semi)
         result = refine(mannequin.topology, rotation[None], center[None], semi[None], targets[None],
