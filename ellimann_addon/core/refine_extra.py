@@ -133,7 +133,8 @@ def _apply(key, factor, mannequin, rotation, center, semi, stretch):
     if key == "neck":  # at the height of the smallest girth, on a grid over the band (enough to pick the pieces)
         everything = np.ones(len(region), bool)
         heights = marks.bottom + np.linspace(*NECK_BAND, 48) * marks.height
-        z = heights[int(np.argmin(marks.nonzero_girths_at(heights, everything)))]
+        girths = marks.girths_at(heights, everything)
+        z = heights[int(np.argmin(np.where(girths > 0.0, girths, np.inf)))]  # an empty section is no minimum
         _widen_at(rotation, center, semi, z, everything, factor, _LENGTHEN_SHARE[key], stretch)
     elif key in ("thigh", "calf"):
         legs = marks.leg_mask("L") | marks.leg_mask("R")
