@@ -101,7 +101,8 @@ def _widen_at(rotation, center, semi, z, mask, factor, lengthen_share, stretch, 
     1/lengthen_share of its middle is also scaled across by the rest. Scaling a whole piece across widens it
     end to end (a thigh down to the knee, outside the body), lengthening much less so. ``stretch`` (per piece,
     updated) is the log-lengthening so far: narrowing shortens a piece only back to its own length, then scales
-    it across (shorter, its near end could leave a gap in its chain: the knee and calf).
+    it across (shorter, its near end could leave a gap in its chain: the knee and calf); widening lengthens it
+    up to EXTRA_FACTOR_LIMIT.
 
     With ``mid_x`` (the legs) the across scaling is front to back only and each piece keeps the edge facing the
     mid-plane: a thigh grown sideways crosses into the other and drops the crotch, and the thigh's section with
@@ -111,6 +112,8 @@ def _widen_at(rotation, center, semi, z, mask, factor, lengthen_share, stretch, 
     share = lengthen_share * np.abs(cut)
     if log_factor < 0.0:
         share = np.minimum(share, stretch[rows] / -log_factor)
+    elif log_factor > 0.0:  # no piece lengthened beyond EXTRA_FACTOR_LIMIT: the rest scales it across
+        share = np.minimum(share, (np.log(EXTRA_FACTOR_LIMIT) - stretch[rows]) / log_factor)
     lengthen = np.exp(share * log_factor)
     stretch[rows] += share * log_factor
     inner = axis_extent(rotation[rows], semi[rows], 0)  # a tilted piece lengthened reaches further sideways too

@@ -15,6 +15,7 @@ from ellimann_addon.core.extra_measures import (
     mannequin_extra_measurements,
 )
 from ellimann_addon.core.refine_extra import (
+    EXTRA_FACTOR_LIMIT,
     MISS_CM,
     ExtraRequestError,
     _section_rows,
@@ -130,6 +131,25 @@ def test_narrowing_shortens_a_piece_only_back_to_its_own_length(reference):
     assert np.allclose(stretch, 0.0, atol=1e-12)
     # its own length but for the lean of its across axes, narrowed by 0.6 in all
     assert np.allclose(axis_extent(rotation, semi, 2)[rows], height[rows], rtol=2e-2)
+
+
+def test_widening_lengthens_a_piece_at_most_by_the_factor_limit(reference):
+    mannequin = synthesize_extra(reference, HEAVY, {})[0]
+    marks = MannequinLandmarks(mannequin)
+    z = marks.bottom + marks.crotch() - THIGH_DROP * marks.height
+    legs = marks.leg_mask("L") | marks.leg_mask("R")
+    rotation, center, semi = mannequin.rotation, mannequin.center.copy(), mannequin.semi_axes.copy()
+    rows = _section_rows(rotation, center, semi, z, legs)[0]
+    limit = np.log(EXTRA_FACTOR_LIMIT)
+    free_center, free_semi = center.copy(), semi.copy()
+    _widen_at(rotation, free_center, free_semi, z, legs, 1.5, 2.0, np.zeros(len(center)), mid_x=marks.mid_x)
+    stretch = np.zeros(len(center))
+    stretch[rows] = limit - 0.01  # lengthened nearly to the limit already
+    _widen_at(rotation, center, semi, z, legs, 1.5, 2.0, stretch, mid_x=marks.mid_x)
+    assert np.allclose(stretch[rows], limit, atol=1e-12)
+    # 0.01 of lengthening where it would be 2 |cut| log 1.5: shorter, and the rest went across (front to back)
+    assert (axis_extent(rotation, semi, 2)[rows] < axis_extent(rotation, free_semi, 2)[rows]).all()
+    assert (axis_extent(rotation, semi, 1)[rows] > axis_extent(rotation, free_semi, 1)[rows]).all()
 
 
 def test_a_request_beyond_the_pieces_is_named_and_the_five_kept(reference):
