@@ -1,0 +1,56 @@
+"""Dev tool (not shipped): a body's twin synthesized from the five measurements and from all it measures,
+stood in the body as bench_scan stands it, the body a ghost over each (docs/images/twin_five_vs_all.png).
+
+    .venv/bin/python -m tools.twin_picture [--bodies small_chubby tall_slim] [--out PNG]
+"""
+
+import argparse
+import tempfile
+from pathlib import Path
+
+from ellimann_addon.core.body_measure import measure_body_mesh
+from ellimann_addon.core.body_mesh import read_obj
+from ellimann_addon.core.constants import MEASUREMENTS
+from ellimann_addon.core.refine_extra import synthesize_extra
+from ellimann_addon.core.shipped_sets import named_reference_set
+from ellimann_addon.core.volume import IOU_MARGIN, BodyVolume
+from tools import render
+from tools.build_reference import DEFAULT_REFMODELS
+from tools.overlap import standing_in
+
+SPACING = 0.005  # m, bench_scan's grid
+
+
+def twins(name, reference):
+    """(five-measurement twin, all-measurement twin) of body ``name``, each stood in the body."""
+    body = read_obj(DEFAULT_REFMODELS / f"{name}.obj")
+    found = measure_body_mesh(body.vertices, body.faces).values
+    five = {key: found[key] for key in MEASUREMENTS}
+    extra = {key: value for key, value in found.items() if key not in MEASUREMENTS}
+    grid = BodyVolume(body.vertices, body.faces).grid(SPACING, margin=IOU_MARGIN)
+    return tuple(standing_in(grid, synthesize_extra(reference, five, given)[0]) for given in ({}, extra))
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m tools.twin_picture", description=__doc__.splitlines()[0])
+    parser.add_argument("--bodies", nargs="+", default=["small_chubby", "tall_slim"])
+    parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parent.parent / "docs" / "images"
+                        / "twin_five_vs_all.png")
+    args = parser.parse_args(argv)
+    reference = named_reference_set("female")
+    with tempfile.TemporaryDirectory() as folder:
+        files, ghosts = [], []
+        for name in args.bodies:
+            for label, twin in zip(("five", "all"), twins(name, reference)):
+                path = Path(folder) / f"{name} {label}.json"
+                twin.copy(name=f"{name}, {label}").save(path)
+                files.append(path)
+                ghosts.append(DEFAULT_REFMODELS / f"{name}.obj")
+        return render.main(["mannequins", *map(str, files), *sum((["--ghost", str(g)] for g in ghosts), []),
+                            "--side-too", "--out", str(args.out)])
+
+
+if __name__ == "__main__":
+    from ellimann_addon.blender.services import teardown
+
+    teardown.exit_with(main())
