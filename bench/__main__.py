@@ -8,7 +8,7 @@ import importlib
 import sys
 
 BENCHES = ("bench_core", "bench_synthesis", "bench_male", "bench_pose", "bench_drape", "bench_walk_drape",
-           "bench_references", "bench_scan", "bench_extra")
+           "bench_references", "bench_scan", "bench_scan_held_out", "bench_extra")
 
 
 def main(names=None, verbose=False):
