@@ -38,7 +38,7 @@ def test_ellipse_perimeter_is_the_complete_elliptic_integral(a, b, angle):
 @pytest.mark.parametrize("angle", [0.0, 0.3, 1.1])
 def test_ellipse_perimeter_to_rounding_with_the_nodes_the_error_bound_chooses(aspect, angle):
     """8 Gauss-Legendre nodes per cell up to aspect ~2 (every girth section of the shipped sets), more for flatter
-    ellipses (measure._gauss_orders): within a few ulps of the complete elliptic integral throughout."""
+    ellipses (core.hull._gauss_orders): within a few ulps of the complete elliptic integral throughout."""
     rot = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
     k = rot @ np.diag([aspect**2 * 0.01, 0.01]) @ rot.T
     exact = 4 * 0.1 * aspect * ellipe(1 - aspect**-2)
