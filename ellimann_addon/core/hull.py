@@ -1,0 +1,400 @@
+"""The perimeter of the convex hull of ellipses in a plane, per section, batched: Cauchy's formula
+P = integral_0^2pi max_i h_i(theta) dtheta, h_i the ellipses' support functions, exact up to floating point.
+
+The angles where the maximising ellipse changes (the kinks of max_i h_i) are found from a grid of directions:
+a cell is cleared of an ellipse hidden between its ends by a bound on how far one can rise above the
+outermost (:func:`_may_surface`); where the outermost changes, the kink is solved by Newton (:func:`_kinks`);
+whatever the bound cannot clear is sampled finer (:func:`_scan`). Each smooth piece is integrated: the linear
+part of the support in closed form, the root by Gauss-Legendre with as many nodes as an error bound asks
+(:func:`_gauss_orders`). m_T (``core.measure``) measures its girths with it.
+"""
+
+import numpy as np
+
+DETECTION_SAMPLES = 32  # grid used to find which ellipse is outermost in each direction
+QUADRATURE_CELLS = 32  # fixed cuts so that every smooth piece spans at most 2pi/32
+GAUSS_ORDERS = (8, 12, 16, 24)  # Gauss-Legendre nodes per piece: the fewest that _gauss_orders' bound allows
+QUADRATURE_TOLERANCE = 1e-16  # that bound on the quadrature's error, relative to the perimeter
+NEWTON_STEPS = 8  # from a secant start across a whole grid cell ...
+NEWTON_DONE = 1e-13  # ... until a kink moves less than this (radians)
+KINK_TOLERANCE = 1e-10  # |h_0 - h_1| at a kink found, relative to the ellipses' size (else: sampled finer)
+REFINE_FACTOR = 8  # a grid cell in doubt is sampled this many times finer, ...
+REFINE_LEVELS = 3  # ... at most this many times
+_GROUP_MIN_SECTIONS = 64  # from this many sections, those with fewer ellipses are measured apart (less padding)
+
+
+def _quadratic_form(k, c, s):
+    """n^T k n for the directions n = (cos, sin) = (c, s)."""
+    return k[..., 0, 0] * c * c + 2.0 * k[..., 0, 1] * c * s + k[..., 1, 1] * s * s
+
+
+def _support_2d(centre, k, theta):
+    """Support function of section ellipses: centre (..., 2), k (..., 2, 2), theta broadcastable."""
+    c, s = np.cos(theta), np.sin(theta)
+    return centre[..., 0] * c + centre[..., 1] * s + np.sqrt(np.maximum(_quadratic_form(k, c, s), 0.0))
+
+
+def _support_2d_with_derivative(centre, k, theta):
+    """(h, dh/dtheta) of section ellipses, sharing the trigonometry."""
+    c, s = np.cos(theta), np.sin(theta)
+    root = np.sqrt(np.maximum(_quadratic_form(k, c, s), 1e-30))
+    dquad = (k[..., 1, 1] - k[..., 0, 0]) * c * s + k[..., 0, 1] * (c * c - s * s)
+    value = centre[..., 0] * c + centre[..., 1] * s + root
+    slope = centre[..., 1] * c - centre[..., 0] * s + dquad / root
+    return value, slope
+
+
+def _compact(centre, k, active):
+    """Move each section's active ellipses to the front; drop columns no section uses."""
+    count = active.sum(axis=-1)
+    width = max(int(count.max(initial=0)), 1)
+    order = np.argsort(~active, axis=-1, kind="stable")[:, :width]
+    rows = np.arange(active.shape[0])[:, None]
+    return centre[rows, order], k[rows, order], active[rows, order]
+
+
+def _curvature_radii(k):
+    """Largest and smallest radius of curvature of each ellipse: a^2 / b and b^2 / a, a >= b its semi-axes."""
+    tr = k[..., 0, 0] + k[..., 1, 1]
+    det = k[..., 0, 0] * k[..., 1, 1] - k[..., 0, 1] ** 2
+    disc = np.sqrt(np.clip(0.25 * tr * tr - det, 0.0, None))
+    big, small = 0.5 * tr + disc, np.clip(0.5 * tr - disc, 1e-30, None)
+    return big / np.sqrt(small), small / np.sqrt(np.maximum(big, 1e-30))
+
+
+class _Coefficients:
+    """Each section ellipse's support function h = cx cos + cy sin + sqrt(a cos^2 + b cos sin + d sin^2), as
+    contiguous (S, n) arrays (fast to gather by section and by ellipse)."""
+
+    def __init__(self, centre, k):
+        self.cx, self.cy = np.ascontiguousarray(centre[..., 0]), np.ascontiguousarray(centre[..., 1])
+        self.a, self.d = np.ascontiguousarray(k[..., 0, 0]), np.ascontiguousarray(k[..., 1, 1])
+        self.b = 2.0 * k[..., 0, 1]
+
+    def root(self, index, c, s, cc=None, cs=None, ss=None):
+        """sqrt(n^T k n) of the ellipses ``index`` (a tuple of index arrays) in the directions (cos, sin) = (c, s),
+        arrays broadcastable against them; cc, cs, ss: c*c, c*s, s*s when a table has them. Elementwise only, so
+        a direction's value does not depend on what else is evaluated with it."""
+        h = self.a[index] * (c * c if cc is None else cc)
+        h += self.b[index] * (c * s if cs is None else cs)
+        h += self.d[index] * (s * s if ss is None else ss)
+        np.maximum(h, 0.0, out=h)
+        return np.sqrt(h, out=h)
+
+    def support(self, index, c, s, cc=None, cs=None, ss=None):
+        """h of the ellipses ``index`` in the directions (c, s) (as :meth:`root`)."""
+        h = self.root(index, c, s, cc, cs, ss)
+        h += self.cx[index] * c
+        h += self.cy[index] * s
+        return h
+
+    def centre_integral(self, index, c0, s0, c1, s1):
+        """The integral of cx cos + cy sin from the angle (c0, s0) to (c1, s1): the support's linear part."""
+        return self.cx[index] * (s1 - s0) - self.cy[index] * (c1 - c0)
+
+
+_GRID_STEP = 2.0 * np.pi / DETECTION_SAMPLES
+_GRID = np.arange(DETECTION_SAMPLES) * _GRID_STEP
+
+
+def _directions(theta):
+    """cos, sin and their products c*c, c*s, s*s of the angles ``theta`` (a table for :meth:`_Coefficients.support`)."""
+    c, s = np.cos(theta), np.sin(theta)
+    return c, s, c * c, c * s, s * s
+
+
+_GRID_DIRECTIONS = _directions(_GRID)
+
+
+def _may_surface(gap_start, gap_end, bend, length):
+    """Whether an ellipse j below the outermost one w at both ends of an interval of ``length`` (gaps
+    g = h_w - h_j >= 0 there) can rise above it inside. With h'' + h = rho (the radius of curvature),
+    f = h_j - h_w has f'' = rho_j - rho_w - f >= -bend - max(f, 0), ``bend`` = max rho_w - min rho_j (_bend): f
+    stays below its chord plus (bend + max f) v (L - v) / 2 (v from the start), so it can only turn positive where
+    that parabola with bend alone does, i.e. its vertex v* = L/2 + (g_start - g_end) / (bend L) is inside and
+    bend v*^2 / 2 > g_start. w itself (gaps 0) and inactive ellipses (gaps inf) never surface."""
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # inf gaps, zero bends
+        vertex = 0.5 * length + (gap_start - gap_end) / (bend * length)
+        return ((vertex > 0.0) & (vertex < length) & (0.5 * bend * vertex * vertex > gap_start)
+                & (np.maximum(gap_start, gap_end) > 0.0) & np.isfinite(gap_start) & np.isfinite(gap_end))
+
+
+def hull_perimeter(centre, k, active):
+    """Perimeter of the convex hull of several ellipses per section.
+
+    centre (S, n, 2), k (S, n, 2, 2) section ellipses {u: (u-c)^T k^-1 (u-c) <= 1}, active (S, n)
+    bool. Returns (S,) perimeters; a section with no active ellipse has perimeter 0.
+    """
+    centre, k, active = np.asarray(centre, float), np.asarray(k, float), np.asarray(active, bool)
+    count = active.sum(axis=-1)
+    if len(count) >= _GROUP_MIN_SECTIONS and count.min() != count.max():
+        # Sections are independent: measured in groups of equal ellipse counts, none is padded with others'.
+        out = np.zeros(len(count))
+        for size in np.unique(count):
+            rows = np.nonzero(count == size)[0]
+            out[rows] = hull_perimeter(centre[rows], k[rows], active[rows])
+        return out
+    centre, k, active = _compact(centre, k, active)
+    sections = centre.shape[0]
+    if sections == 0:
+        return np.zeros(0)
+    coefficients = _Coefficients(centre, k)
+    largest, smallest = _curvature_radii(k)  # (S, n)
+
+    # 1. Which ellipse is outermost in each grid direction.
+    h = coefficients.support((Ellipsis, None), *_GRID_DIRECTIONS)  # (S, n, N)
+    np.copyto(h, -np.inf, where=~active[:, :, None])
+    winner = np.argmax(h, axis=1)  # (S, N)
+
+    # 2. An ellipse that is outermost only between two grid directions would be missed: cells where one may
+    #    surface (_may_surface) and cells where the winner changes (h_max has a kink there) are sampled finely.
+    with np.errstate(invalid="ignore"):  # inactive ellipses' gaps are inf (or nan without any active one)
+        gap = h.max(axis=1)[:, None, :] - h  # (S, n, N)
+    gap_next = np.concatenate([gap[..., 1:], gap[..., :1]], axis=2)
+    bend = np.maximum(largest[np.arange(sections)[:, None], winner][:, None, :] - smallest[:, :, None], 0.0)
+    suspect = _may_surface(gap, gap_next, bend, _GRID_STEP).any(axis=1)  # (S, N): where the winner stays
+    changes = winner != np.concatenate([winner[:, 1:], winner[:, :1]], axis=1)
+    sec_r, cell_r = np.nonzero(suspect | changes)
+
+    # 3. Kinks, where the outermost ellipse changes, in the cells sampled finely (_scan); a cell that the
+    #    sampling cannot clear of a hidden ellipse is sampled again, finer.
+    start, width = cell_r * _GRID_STEP, np.full(len(cell_r), _GRID_STEP)
+    ends = (h[sec_r, :, cell_r], h[sec_r, :, (cell_r + 1) % DETECTION_SAMPLES])  # (R, n) each
+    kinks = []
+    for level in range(REFINE_LEVELS + 1):
+        theta, kink_row, after, doubtful = _scan(coefficients, active, (largest, smallest), sec_r, start, width,
+                                          REFINE_FACTOR**level, ends)
+        keep = ~doubtful[kink_row] if level < REFINE_LEVELS else np.ones(len(kink_row), dtype=bool)
+        kinks.append((theta[keep], sec_r[kink_row[keep]], after[keep]))
+        if level == REFINE_LEVELS or not doubtful.any():
+            break
+        sec_r, start, width = sec_r[doubtful], start[doubtful], width[doubtful]
+        ends = (ends[0][doubtful], ends[1][doubtful])
+    theta, sec, after = (np.concatenate(column) for column in zip(*kinks))
+
+    # 4. Cut the circle at the kinks and at fixed cells; integrate each piece's outermost ellipse: the linear
+    #    part of its support in closed form, the root by Gauss-Legendre. A piece between two fixed cuts (no kink
+    #    inside) is a whole cell: its outermost ellipse is the grid's in the cell, and every section's cells are
+    #    integrated at once from a table of the nodes' directions (the integrals of cells that a kink splits are
+    #    not used).
+    cut_theta, cut_sec, cell, cut_after = _cuts(sections, np.mod(theta, 2.0 * np.pi), sec, after)
+    end, next_cell = _next_in_section(cut_sec, cut_theta, cell)
+    half = 0.5 * (end - cut_theta)
+    whole = (cell >= 0) & (next_cell >= 0)
+    split = ~whole
+    cell_winner = winner[:, ::_GRID_PER_CELL]  # (S, cells): at each cell's start
+    # A piece from a cut at a cell's start has the grid's outermost ellipse there, one from a kink the ellipse
+    # outermost after it.
+    piece_winner = np.where(cell >= 0, cell_winner[cut_sec, np.maximum(cell, 0)], cut_after)
+    order = _gauss_orders(coefficients, active)  # (S,)
+    piece = np.empty(len(cut_sec))
+    for nodes in np.unique(order):
+        rule, weights, directions = _RULES[nodes]
+        rows = np.nonzero(order == nodes)[0]
+        cells = (rows[:, None], cell_winner[rows])
+        cell_root = _weighted_sum(coefficients.root((rows[:, None, None], cells[1][..., None]), *directions), weights)
+        cell_integral = _CELL_HALF * cell_root + coefficients.centre_integral(cells, *_CELL_ENDS)  # (rows, cells)
+        mine = order[cut_sec] == nodes
+        pick = whole & mine
+        piece[pick] = cell_integral[np.searchsorted(rows, cut_sec[pick]), cell[pick]]
+        pick = np.nonzero(split & mine)[0]
+        at = (cut_theta[pick] + half[pick])[:, None] + half[pick, None] * rule
+        index = (cut_sec[pick], piece_winner[pick])
+        root = _weighted_sum(coefficients.root((index[0][:, None], index[1][:, None]), np.cos(at), np.sin(at)),
+                             weights)
+        low, high = cut_theta[pick], end[pick]
+        piece[pick] = half[pick] * root + coefficients.centre_integral(index, np.cos(low), np.sin(low),
+                                                                       np.cos(high), np.sin(high))
+    piece = np.where(active[cut_sec, piece_winner], piece, 0.0)
+    return np.bincount(cut_sec, weights=piece, minlength=sections)
+
+
+def _scan(coefficients, active, radii, sec, start, width, samples, ends):
+    """Find the kinks in the intervals [start, start + width] (R,) of sections ``sec``, given every ellipse's h at
+    both ends (``ends``: two (R, n)), from ``samples`` equal sub-intervals: in each one where the outermost
+    ellipse changes, h_0 = h_1 is solved (:func:`_kinks`).
+
+    Returns (theta (K,), row (K,) the interval of each kink, the ellipse outermost after it (K,), doubtful
+    (R,)): an interval is doubtful where :func:`_may_surface` cannot rule out an ellipse rising above the
+    outermost one inside a sub-interval with one outermost ellipse, or on either side of a kink (up to the kink,
+    from it), or a third ellipse is above the pair at the kink, or the pair's supports differ there by more than
+    KINK_TOLERANCE."""
+    n = active.shape[1]
+    inner = np.arange(1, samples) / samples
+    theta = np.concatenate([start[:, None], start[:, None] + width[:, None] * inner, (start + width)[:, None]],
+                           axis=1)  # (R, samples + 1)
+    h = np.empty((len(sec), samples + 1, n))
+    h[:, 0], h[:, -1] = ends
+    h[:, 1:-1] = coefficients.support((sec[:, None, None], np.arange(n)), np.cos(theta[:, 1:-1, None]),
+                                      np.sin(theta[:, 1:-1, None]))
+    np.copyto(h[:, 1:-1], -np.inf, where=~active[sec, None, :])
+    winner = np.argmax(h, axis=2)  # (R, samples + 1)
+    with np.errstate(invalid="ignore"):
+        gap = np.take_along_axis(h, winner[..., None], axis=2) - h  # (R, samples + 1, n)
+    step = width / samples
+    same = winner[:, :-1] == winner[:, 1:]
+    largest, smallest = radii
+    bend = np.maximum(largest[sec[:, None], winner[:, :-1]][..., None] - smallest[sec, None, :], 0.0)
+    hidden = _may_surface(gap[:, :-1], gap[:, 1:], bend, step[:, None, None]).any(axis=2)
+    doubtful = (same & hidden).any(axis=1)
+
+    row, at = np.nonzero(~same)
+    lo, hi = theta[row, at], theta[row, at + 1]
+    pair = np.stack([winner[row, at], winner[row, at + 1]])  # (2, K)
+    kink_sec = sec[row]
+    # h_A - h_B at the sub-interval's ends: B's gap to A at the start, minus A's gap to B at the end.
+    kink = _kinks(coefficients, ((kink_sec, pair[0]), (kink_sec, pair[1])), lo, hi, gap[row, at, pair[1]],
+                  -gap[row, at + 1, pair[0]])
+    h_kink = coefficients.support((kink_sec[:, None], np.arange(n)), np.cos(kink)[:, None], np.sin(kink)[:, None])
+    np.copyto(h_kink, -np.inf, where=~active[kink_sec])  # (K, n)
+    columns = np.arange(n)
+    not_before, not_after = columns != pair[0][:, None], columns != pair[1][:, None]  # (K, n)
+    before = np.take_along_axis(h_kink, pair[0][:, None], axis=1)
+    after = np.take_along_axis(h_kink, pair[1][:, None], axis=1)
+    bend_before = np.maximum(largest[kink_sec, pair[0]][:, None] - smallest[kink_sec], 0.0)
+    bend_after = np.maximum(largest[kink_sec, pair[1]][:, None] - smallest[kink_sec], 0.0)
+    with np.errstate(invalid="ignore"):
+        # A third ellipse above both at the kink; or any ellipse, the other of the pair too (a second crossing),
+        # rising above the one outermost from the sub-interval's start to the kink, or from the kink to its end.
+        doubt = (h_kink > np.maximum(before, after)) & not_before & not_after
+        size = coefficients.root((kink_sec, pair[0]), np.cos(kink), np.sin(kink))
+        size += coefficients.root((kink_sec, pair[1]), np.cos(kink), np.sin(kink))
+        doubt[np.abs(before - after)[:, 0] > KINK_TOLERANCE * size] = True  # Newton has not converged
+        doubt |= _may_surface(gap[row, at], before - h_kink, bend_before, (kink - lo)[:, None]) & not_before
+        doubt |= _may_surface(after - h_kink, gap[row, at + 1], bend_after, (hi - kink)[:, None]) & not_after
+    doubtful[row[doubt.any(axis=1)]] = True
+    return kink, row, pair[1], doubtful
+
+
+def _kinks(coefficients, index, lo, hi, g_lo, g_hi):
+    """The angles in [lo, hi] where the outermost ellipse changes from the ellipse index[0] to index[1] (each a
+    tuple (section, ellipse) of (K,) arrays): h_0 = h_1 by a secant start from g = h_0 - h_1 at lo and hi, then
+    Newton steps kept in [lo, hi], at most NEWTON_STEPS, each kink's until its step is below NEWTON_DONE."""
+    denom = g_lo - g_hi
+    frac = np.divide(g_lo, denom, out=np.full_like(g_lo, 0.5), where=np.abs(denom) > 0.0)
+    theta = lo + (hi - lo) * np.clip(frac, 0.0, 1.0)
+    (a0, b0, d0), (a1, b1, d1) = ((coefficients.a[i], coefficients.b[i], coefficients.d[i]) for i in index)
+    dcx = coefficients.cx[index[0]] - coefficients.cx[index[1]]
+    dcy = coefficients.cy[index[0]] - coefficients.cy[index[1]]
+    todo = np.arange(len(theta))
+    for _ in range(NEWTON_STEPS):
+        t = theta[todo]
+        c, s = np.cos(t), np.sin(t)
+        cc, cs, ss = c * c, c * s, s * s
+        p0 = (a0[todo], b0[todo], d0[todo])
+        p1 = (a1[todo], b1[todo], d1[todo])
+        root0 = np.sqrt(np.maximum(p0[0] * cc + p0[1] * cs + p0[2] * ss, 1e-30))
+        root1 = np.sqrt(np.maximum(p1[0] * cc + p1[1] * cs + p1[2] * ss, 1e-30))
+        x, y = dcx[todo], dcy[todo]
+        g = x * c + y * s + root0 - root1
+        turn = cc - ss  # d(a cc + b cs + d ss)/dtheta = 2 (d - a) cs + b (cc - ss)
+        dg = (y * c - x * s + (2.0 * (p0[2] - p0[0]) * cs + p0[1] * turn) / (2.0 * root0)
+              - (2.0 * (p1[2] - p1[0]) * cs + p1[1] * turn) / (2.0 * root1))
+        update = np.divide(g, dg, out=np.zeros_like(g), where=np.abs(dg) > 1e-300)
+        new = np.minimum(np.maximum(t - update, lo[todo]), hi[todo])
+        moved = np.abs(new - t) > NEWTON_DONE
+        theta[todo] = new
+        todo = todo[moved]
+        if not len(todo):
+            break
+    return theta
+
+
+_CELLS = np.arange(QUADRATURE_CELLS) * (2.0 * np.pi / QUADRATURE_CELLS)
+_GRID_PER_CELL = DETECTION_SAMPLES // QUADRATURE_CELLS
+
+
+_CELL_END = np.append(_CELLS[1:], _CELLS[0] + 2.0 * np.pi)
+_CELL_HALF = 0.5 * (_CELL_END - _CELLS)
+
+
+def _rule(nodes):
+    """A Gauss-Legendre rule on [-1, 1] and the directions of its nodes in every whole cell (QUADRATURE_CELLS,
+    nodes), computed as :func:`hull_perimeter` computes a piece's."""
+    rule, weights = np.polynomial.legendre.leggauss(nodes)
+    return rule, weights, _directions((_CELLS + _CELL_HALF)[:, None] + _CELL_HALF[:, None] * rule)
+
+
+_RULES = {nodes: _rule(nodes) for nodes in GAUSS_ORDERS}
+
+
+def _gauss_orders(coefficients, active):
+    """Gauss-Legendre nodes per piece for each section (S,): the fewest of GAUSS_ORDERS whose error bound, for
+    every active ellipse, is within QUADRATURE_TOLERANCE of the perimeter (else the most).
+
+    The root integrated, sqrt(alpha + beta cos 2(theta - phi)), is analytic up to |Im theta| = y0 =
+    acosh(alpha / beta) / 2 (alpha +- beta the squared semi-axes); in the Bernstein ellipse of a cell (half-width
+    h) reaching 0.9 y0, rho = t + sqrt(1 + t^2) with t = 0.9 y0 / h, it is at most sqrt(2 alpha), so n nodes
+    err by at most h 64/15 sqrt(2 alpha) rho^-2n / (rho^2 - 1) per cell (Trefethen, Approximation Theory and
+    Approximation Practice, Thm 19.3); a piece split by a kink is shorter and errs less. The perimeter is at
+    least the ellipse's, 4 sqrt(alpha + beta)."""
+    alpha = 0.5 * (coefficients.a + coefficients.d)
+    beta = np.sqrt(0.25 * (coefficients.a - coefficients.d) ** 2 + 0.25 * coefficients.b**2)
+    half = np.pi / QUADRATURE_CELLS
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # circles (beta 0), inactive ellipses
+        reach = 0.45 * np.arccosh(np.maximum(alpha / beta, 1.0)) / half
+        rho = reach + np.sqrt(1.0 + reach * reach)
+        allowed = QUADRATURE_TOLERANCE * 4.0 * np.sqrt(alpha + beta) / (QUADRATURE_CELLS * half * 64.0 / 15.0
+                                                                         * np.sqrt(2.0 * alpha))
+        fails = sum((rho ** (-2.0 * n) / (rho * rho - 1.0) > allowed) | ~np.isfinite(allowed) for n in GAUSS_ORDERS)
+    need = np.where(active, np.minimum(fails, len(GAUSS_ORDERS) - 1), 0)
+    return np.asarray(GAUSS_ORDERS)[need.max(axis=1)]
+_CELL_ENDS = (np.cos(_CELLS), np.sin(_CELLS), np.cos(_CELL_END), np.sin(_CELL_END))  # each cell's start and end
+
+
+def _cuts(sections, theta, sec, after):
+    """The fixed cells of every section and the kinks (theta, sec, the ellipse outermost after each), sorted by
+    (section, angle), a cell before a kink at the same angle: (theta, sec, cell index or -1 for a kink, the
+    ellipse after a kink or -1 for a cell) of every cut. Only the kinks are sorted; the cells are merged in."""
+    order = np.lexsort((theta, sec))
+    theta, sec, after = theta[order], sec[order], after[order]
+    # A kink goes after the cells of the sections before it, the cells of its own section up to its angle
+    # and the kinks sorted before it.
+    kink_at = sec * QUADRATURE_CELLS + np.searchsorted(_CELLS, theta, side="right") + np.arange(len(theta))
+    total = sections * QUADRATURE_CELLS + len(theta)
+    is_cell = np.ones(total, dtype=bool)
+    is_cell[kink_at] = False
+    cut_theta, cut_sec, cell = np.empty(total), np.empty(total, dtype=np.int64), np.full(total, -1)
+    cut_theta[kink_at], cut_sec[kink_at] = theta, sec
+    cut_theta[is_cell], cut_sec[is_cell] = np.tile(_CELLS, sections), np.repeat(np.arange(sections), QUADRATURE_CELLS)
+    cell[is_cell] = np.tile(np.arange(QUADRATURE_CELLS), sections)
+    cut_after = np.full(total, -1)
+    cut_after[kink_at] = after
+    return cut_theta, cut_sec, cell, cut_after
+
+
+def _weighted_sum(values, weights):
+    """values (..., q) @ weights (q,), summed in a fixed order: the same bits for a row whatever the batch (a
+    matrix product's summation order depends on the array's size and alignment)."""
+    total = values[..., 0] * weights[0]
+    for j in range(1, len(weights)):
+        total += values[..., j] * weights[j]
+    return total
+
+
+def _next_in_section(sec, theta, value):
+    """For rows sorted by (sec, theta): the next row's theta and value, wrapping around the circle."""
+    nxt = np.arange(1, len(sec) + 1)
+    last = np.ones(len(sec), dtype=bool)
+    last[:-1] = sec[1:] != sec[:-1]
+    nxt[last] = np.searchsorted(sec, sec[last])
+    nxt_theta = theta[nxt] + np.where(last, 2.0 * np.pi, 0.0)
+    return nxt_theta, value[nxt]
+
+
+def hull_boundary(centre, k, active, samples=256):
+    """Points along the convex hull of one section's ellipses (for drawing): (samples, 2).
+
+    Each point is the support point of the outermost ellipse in that direction; consecutive
+    points across a change of ellipse form the hull's straight bridges.
+    """
+    centre, k, active = np.asarray(centre, float), np.asarray(k, float), np.asarray(active, bool)
+    if not active.any():
+        return np.zeros((0, 2))
+    theta = np.linspace(0.0, 2.0 * np.pi, samples, endpoint=False)
+    h = np.where(active[:, None], _support_2d(centre[:, None, :], k[:, None, :, :], theta), -np.inf)
+    winner = np.argmax(h, axis=0)
+    # The support point in direction n = (cos, sin) is h n + h' n_perp (h' = dh/dtheta).
+    value, slope = _support_2d_with_derivative(centre[winner], k[winner], theta)
+    c, s = np.cos(theta), np.sin(theta)
+    return np.stack([value * c - slope * s, value * s + slope * c], axis=-1)
