@@ -18,6 +18,7 @@ from .errors import ElliMannError
 from .extra_measures import (
     CALF_BAND,
     EXTRA_ABSURD_LIMITS,
+    EXTRA_GIRTHS,
     EXTRA_LABELS,
     EXTRA_MEASUREMENTS,
     NECK_BAND,
@@ -94,7 +95,7 @@ def _section_rows(rotation, center, semi, z, mask):
     return rows, cut[rows], half[rows]
 
 
-def _widen_at(rotation, center, semi, z, mask, factor, lengthen_share, stretch, mid_x=None):
+def _widen_at(rotation, center, semi, z, mask, factor, lengthen_share, stretch, spread, mid_x=None):
     """Widen (factor > 1) or narrow the section at height ``z`` of the pieces ``mask`` as locally as ellipsoids
     allow. A piece cut at ``cut`` from its middle is lengthened by factor^(lengthen_share |cut|) from its far
     end (which stays: refine's girth taper), bringing its wider middle towards the section; one cut within
@@ -102,7 +103,9 @@ def _widen_at(rotation, center, semi, z, mask, factor, lengthen_share, stretch, 
     end to end (a thigh down to the knee, outside the body), lengthening much less so. ``stretch`` (per piece,
     updated) is the log-lengthening so far: narrowing shortens a piece only back to its own length, then scales
     it across (shorter, its near end could leave a gap in its chain: the knee and calf); widening lengthens it
-    up to EXTRA_FACTOR_LIMIT.
+    up to EXTRA_FACTOR_LIMIT. ``spread`` (per piece, updated) is the log-scaling across so far, kept within
+    EXTRA_FACTOR_LIMIT either way: the limit is each piece's, not the measurement factor's (a neck piece cut
+    off its middle takes only part of the factor each way, so a factor limit stopped it well short of 2x).
 
     With ``mid_x`` (the legs) the across scaling is front to back only and each piece keeps the edge facing the
     mid-plane: a thigh grown sideways crosses into the other and drops the crotch, and the thigh's section with
@@ -120,7 +123,12 @@ def _widen_at(rotation, center, semi, z, mask, factor, lengthen_share, stretch, 
     anchor = center[rows, 2] - np.sign(cut) * half
     center[rows, 2] = anchor + lengthen * (center[rows, 2] - anchor)
     semi[rows] *= lengthen[:, None] ** (rotation[rows, 2, :] ** 2)
-    across = np.exp((1.0 - np.minimum(share, 1.0)) * log_factor)[:, None]
+    across_share = 1.0 - np.minimum(share, 1.0)
+    if log_factor != 0.0:  # no piece scaled across beyond EXTRA_FACTOR_LIMIT or below its inverse
+        room = np.log(EXTRA_FACTOR_LIMIT) - np.sign(log_factor) * spread[rows]
+        across_share = np.clip(np.minimum(across_share, room / abs(log_factor)), 0.0, None)
+    spread[rows] += across_share * log_factor
+    across = np.exp(across_share * log_factor)[:, None]
     if mid_x is None:
         semi[rows] *= across ** (1.0 - rotation[rows, 2, :] ** 2)
     else:
@@ -128,8 +136,8 @@ def _widen_at(rotation, center, semi, z, mask, factor, lengthen_share, stretch, 
         center[rows, 0] += np.sign(center[rows, 0] - mid_x) * (axis_extent(rotation[rows], semi[rows], 0) - inner)
 
 
-def _apply(key, factor, mannequin, rotation, center, semi, stretch):
-    """Deform (in place) the pieces of measurement ``key`` by ``factor`` (``stretch``: see _widen_at)."""
+def _apply(key, factor, mannequin, rotation, center, semi, stretch, spread):
+    """Deform (in place) the pieces of measurement ``key`` by ``factor`` (``stretch``, ``spread``: see _widen_at)."""
     marks = MannequinLandmarks(mannequin.copy(center=center, semi_axes=semi))
     topology = mannequin.topology
     region = np.array([part.region for part in topology])
@@ -138,7 +146,7 @@ def _apply(key, factor, mannequin, rotation, center, semi, stretch):
         heights = marks.bottom + np.linspace(*NECK_BAND, 48) * marks.height
         girths = marks.girths_at(heights, everything)
         z = heights[int(np.argmin(np.where(girths > 0.0, girths, np.inf)))]  # an empty section is no minimum
-        _widen_at(rotation, center, semi, z, everything, factor, _LENGTHEN_SHARE[key], stretch)
+        _widen_at(rotation, center, semi, z, everything, factor, _LENGTHEN_SHARE[key], stretch, spread)
     elif key in ("thigh", "calf"):
         legs = marks.leg_mask("L") | marks.leg_mask("R")
         crotch = marks.crotch()
@@ -147,7 +155,8 @@ def _apply(key, factor, mannequin, rotation, center, semi, stretch):
         else:  # the height of the largest calf girth, on a grid over the band (enough to pick the pieces)
             heights = marks.bottom + np.linspace(*CALF_BAND, 48) * crotch
             z = heights[int(np.argmax(marks.girths_at(heights, marks.leg_mask("L"))))]
-        _widen_at(rotation, center, semi, z, legs, factor, _LENGTHEN_SHARE[key], stretch, mid_x=marks.mid_x)
+        _widen_at(rotation, center, semi, z, legs, factor, _LENGTHEN_SHARE[key], stretch, spread,
+                  mid_x=marks.mid_x)
     elif key == "crotch_height":
         crotch = marks.bottom + marks.crotch()
         lower = np.isin(region, ("legs", "feet"))
@@ -162,10 +171,11 @@ def _apply(key, factor, mannequin, rotation, center, semi, stretch):
                 frame = _frame_along(axis)
                 origin = start + UPPER_ARM_FRACTION * length * axis
                 arm_rotation, arm_center, arm_semi = frame @ rotation[arm], (center[arm] - origin) @ frame.T, semi[arm]
-                arm_stretch = stretch[arm]
+                arm_stretch, arm_spread = stretch[arm], spread[arm]
                 _widen_at(arm_rotation, arm_center, arm_semi, 0.0, np.ones(len(arm), bool), factor,
-                          _LENGTHEN_SHARE[key], arm_stretch)
-                center[arm], semi[arm], stretch[arm] = arm_center @ frame + origin, arm_semi, arm_stretch
+                          _LENGTHEN_SHARE[key], arm_stretch, arm_spread)
+                center[arm], semi[arm] = arm_center @ frame + origin, arm_semi
+                stretch[arm], spread[arm] = arm_stretch, arm_spread
             else:
                 center[arm] = start + factor * (center[arm] - start)
                 along = np.einsum("nik,i->nk", rotation[arm], axis) ** 2
@@ -222,7 +232,8 @@ def _meet(mannequin, extra, tolerance_cm, max_rounds):
     keys = [key for key in EXTRA_MEASUREMENTS if key in extra]
     log_factor = {key: 0.0 for key in keys}
     stretch = np.zeros(len(center))  # log-lengthening of each piece by the girths so far (see _widen_at)
-    limit = np.log(EXTRA_FACTOR_LIMIT)
+    spread = np.zeros(len(center))  # and log-scaling across
+    limit = np.log(EXTRA_FACTOR_LIMIT)  # the girths' pieces are limited in _widen_at, each piece by its own
     slope = {key: 1.0 for key in keys}
     previous = {}
     girth = mannequin.topology.girth_mask
@@ -250,11 +261,12 @@ def _meet(mannequin, extra, tolerance_cm, max_rounds):
                 slope[key] = secant if secant > 0.05 else slope[key]
             previous[key] = (log_factor[key], residual[key])
         for key in keys:
-            if abs(log_factor[key]) >= limit:
+            scales_whole = key not in EXTRA_GIRTHS  # its factor scales its pieces as they are
+            if scales_whole and abs(log_factor[key]) >= limit:
                 continue  # at its limit: this measurement is as close as its pieces go
             step = float(np.clip(-residual[key] / slope[key], -_MAX_LOG_STEP, _MAX_LOG_STEP))
-            wanted = float(np.clip(log_factor[key] + step, -limit, limit))
-            _apply(key, np.exp(wanted - log_factor[key]), current, rotation, center, semi, stretch)
+            wanted = float(np.clip(log_factor[key] + step, -limit, limit)) if scales_whole else log_factor[key] + step
+            _apply(key, np.exp(wanted - log_factor[key]), current, rotation, center, semi, stretch, spread)
             log_factor[key] = wanted
             current = mannequin.copy(rotation=rotation, center=center, semi_axes=semi)
         result = refine(mannequin.topology, rotation[None], center[None], semi[None], targets[None],
