@@ -32,6 +32,23 @@ def overlap(mannequin, body):
     return voxel_iou(standing_in(grid, mannequin), grid=grid, cushions=False)
 
 
+def split(found):
+    """(the five {key: cm}, the extra ones {key: cm}) of what a body mesh measured."""
+    return ({key: found[key] for key in MEASUREMENTS},
+            {key: value for key, value in found.items() if key not in MEASUREMENTS})
+
+
+def twin_overlaps(reference, body, found):
+    """(IoU of the twin from the five, IoU of the twin from all of ``found``, the extra measurements missed)."""
+    five, extra = split(found)
+    iou, missed = [], []
+    for given in ({}, extra):
+        mannequin, _, warnings = synthesize_extra(reference, five, given)
+        missed += [line.split()[3] for line in warnings if line.startswith("exact mode missed")]
+        iou.append(overlap(mannequin, body))
+    return iou[0], iou[1], missed
+
+
 def run():
     reference = named_reference_set("female")
     labels = load_labels(TRACING_FOLDER)
@@ -47,20 +64,15 @@ def run():
             times.append(time.perf_counter() - start)
         readme = body_measurements(body, labels)
         worst = max(abs(result.values[key] - readme[key]) for key in MEASUREMENTS if key in result.values)
-        five = {key: result.values[key] for key in MEASUREMENTS}
-        extra = {key: value for key, value in result.values.items() if key not in MEASUREMENTS}
-        iou, missed = [], []
-        for given in ({}, extra):
-            mannequin, _, warnings = synthesize_extra(reference, five, given)
-            missed += [line.split()[3] for line in warnings if line.startswith("exact mode missed")]
-            iou.append(overlap(mannequin, body))
-        gains.append(iou[1] - iou[0])
+        five, extra = split(result.values)
+        five_iou, all_iou, missed = twin_overlaps(reference, body, result.values)
+        gains.append(all_iou - five_iou)
         alone = []
         for key, value in extra.items():
             mannequin, _, _ = synthesize_extra(reference, five, {key: value})
-            alone.append(f"{key} {overlap(mannequin, body) - iou[0]:+.3f}")
-        print(f"{name:<17} {statistics.median(times):9.2f} {worst:22.3f} {iou[0]:9.3f} {iou[1]:8.3f} "
-              f"{iou[1] - iou[0]:+6.3f}  ({len(body.faces)} triangles; not measured: {result.missing or 'none'}; "
+            alone.append(f"{key} {overlap(mannequin, body) - five_iou:+.3f}")
+        print(f"{name:<17} {statistics.median(times):9.2f} {worst:22.3f} {five_iou:9.3f} {all_iou:8.3f} "
+              f"{all_iou - five_iou:+6.3f}  ({len(body.faces)} triangles; not measured: {result.missing or 'none'}; "
               f"missed by the twin: {missed or 'none'})")
         print(f"{'':<17} IoU change with one extra measurement alone: {', '.join(alone)}")
     print(f"mean IoU gain with all measurements: {statistics.mean(gains):+.3f}")

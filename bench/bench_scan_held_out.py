@@ -12,12 +12,10 @@ import statistics
 
 import numpy as np
 
-from bench.bench_scan import overlap
+from bench.bench_scan import twin_overlaps
 from ellimann_addon.core.body_measure import measure_body_mesh
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.reference_manifest import Manifest, targets_range
 from ellimann_addon.core.reference_set import ReferenceSet
-from ellimann_addon.core.refine_extra import synthesize_extra
 from tools.build_reference import DEFAULT_REFMODELS
 from tools.held_out import six_rms
 
@@ -36,16 +34,9 @@ def run(workers=2):
     gains = []
     for held, body in bodies.items():
         found = measure_body_mesh(body.vertices, body.faces).values
-        five = {key: found[key] for key in MEASUREMENTS}
-        extra = {key: value for key, value in found.items() if key not in MEASUREMENTS}
-        reference = held_out_set(rms, targets, held)
-        iou, missed = [], []
-        for given in ({}, extra):
-            mannequin, _, warnings = synthesize_extra(reference, five, given)
-            missed += [line.split()[3] for line in warnings if line.startswith("exact mode missed")]
-            iou.append(overlap(mannequin, body))
-        gains.append(iou[1] - iou[0])
-        print(f"{held:<17} {iou[0]:9.3f} {iou[1]:8.3f} {iou[1] - iou[0]:+6.3f}  {', '.join(missed) or 'none'}")
+        five_iou, all_iou, missed = twin_overlaps(held_out_set(rms, targets, held), body, found)
+        gains.append(all_iou - five_iou)
+        print(f"{held:<17} {five_iou:9.3f} {all_iou:8.3f} {all_iou - five_iou:+6.3f}  {', '.join(missed) or 'none'}")
     print(f"mean IoU gain with all measurements, held out: {statistics.mean(gains):+.3f} "
           f"(min {min(gains):+.3f}, max {max(gains):+.3f}; {int(np.sum(np.array(gains) > 0))} of {len(gains)} gain)")
 
