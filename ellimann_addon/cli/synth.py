@@ -85,17 +85,17 @@ def run(args):
     five, extra = _wanted(args)
     request = [five[key] for key in MEASUREMENTS]
     reference = common.references(args)
-    warnings = validate_request(request, reference.ranges, reference.absurd_limits)
+    validate_request(request, reference.ranges, reference.absurd_limits)  # refused before any work; its warnings
+    # come back from synthesis with the others
     options = common.synthesis_options(args, args.name)
     try:
-        mannequin, measured, more = synthesize_extra(reference, five, extra, options)
+        mannequin, measured, warnings = synthesize_extra(reference, five, extra, options)
     except ElliMannError as error:
         raise UsageError(common.one_line(error)) from None
     achieved = [measured[key] for key in MEASUREMENTS]
     misses = common.misses(achieved, request) if args.mode == "exact" else []
-    missed_extra = [line for line in more if line.startswith("exact mode missed")]
-    more = [line for line in more if line not in warnings]  # synthesis checks the request as validate_request did
-    for warning in warnings + more + ([common.missed_text(misses)] if misses else []):
+    missed_extra = [line for line in warnings if line.startswith("exact mode missed")]
+    for warning in warnings + ([common.missed_text(misses)] if misses else []):
         common.say(f"{PROG} synth: warning: {warning}")
     frames = common.pose_frames(args, mannequin, pose_file)
     common.write(mannequin, [args.output], {key: measured[key] for key in MEASUREMENTS},
