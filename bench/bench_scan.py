@@ -15,6 +15,7 @@ import time
 from ellimann_addon.core.body_measure import measure_body_mesh
 from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import MEASUREMENTS
+from ellimann_addon.core.extra_measures import split_measurements
 from ellimann_addon.core.refine_extra import synthesize_extra
 from ellimann_addon.core.shipped_sets import named_reference_set
 from ellimann_addon.core.volume import IOU_MARGIN, BodyVolume, voxel_iou
@@ -32,15 +33,9 @@ def overlap(mannequin, body):
     return voxel_iou(standing_in(grid, mannequin), grid=grid, cushions=False)
 
 
-def split(found):
-    """(the five {key: cm}, the extra ones {key: cm}) of what a body mesh measured."""
-    return ({key: found[key] for key in MEASUREMENTS},
-            {key: value for key, value in found.items() if key not in MEASUREMENTS})
-
-
 def twin_overlaps(reference, body, found):
     """(IoU of the twin from the five, IoU of the twin from all of ``found``, the extra measurements missed)."""
-    five, extra = split(found)
+    five, extra = split_measurements(found)
     iou, missed = [], []
     for given in ({}, extra):
         mannequin, _, warnings = synthesize_extra(reference, five, given)
@@ -64,7 +59,7 @@ def run():
             times.append(time.perf_counter() - start)
         readme = body_measurements(body, labels)
         worst = max(abs(result.values[key] - readme[key]) for key in MEASUREMENTS if key in result.values)
-        five, extra = split(result.values)
+        five, extra = split_measurements(result.values)
         five_iou, all_iou, missed = twin_overlaps(reference, body, result.values)
         gains.append(all_iou - five_iou)
         alone = []

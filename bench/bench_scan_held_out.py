@@ -14,18 +14,8 @@ import numpy as np
 
 from bench.bench_scan import twin_overlaps
 from ellimann_addon.core.body_measure import measure_body_mesh
-from ellimann_addon.core.reference_manifest import Manifest, targets_range
-from ellimann_addon.core.reference_set import ReferenceSet
 from tools.build_reference import DEFAULT_REFMODELS
-from tools.held_out import six_rms
-
-
-def held_out_set(rms, targets, held):
-    """The reference set of the five RMs other than ``held``'s."""
-    names = [name for name in rms if name != held]
-    chosen = {name: targets[name] for name in names}
-    manifest = Manifest("held out", names, ranges_cm=targets_range(chosen), targets_cm=chosen)
-    return ReferenceSet([rms[name] for name in names], names=names, manifest=manifest)
+from tools.held_out import six_rms, subset_set
 
 
 def run(workers=2):
@@ -34,7 +24,8 @@ def run(workers=2):
     gains = []
     for held, body in bodies.items():
         found = measure_body_mesh(body.vertices, body.faces).values
-        five_iou, all_iou, missed = twin_overlaps(held_out_set(rms, targets, held), body, found)
+        others = subset_set(rms, targets, [name for name in rms if name != held])
+        five_iou, all_iou, missed = twin_overlaps(others, body, found)
         gains.append(all_iou - five_iou)
         print(f"{held:<17} {five_iou:9.3f} {all_iou:8.3f} {all_iou - five_iou:+6.3f}  {', '.join(missed) or 'none'}")
     print(f"mean IoU gain with all measurements, held out: {statistics.mean(gains):+.3f} "

@@ -51,6 +51,13 @@ def six_rms(refmodels, workers):
     return rms, targets, report.shifts, bodies
 
 
+def subset_set(rms, targets, names):
+    """The reference set of the RMs ``names`` (their targets its ranges)."""
+    chosen = {name: targets[name] for name in names}
+    manifest = Manifest("held out", list(names), ranges_cm=targets_range(chosen), targets_cm=chosen)
+    return ReferenceSet([rms[name] for name in names], names=list(names), manifest=manifest)
+
+
 def held_out_table(rms, targets, shifts, bodies):
     """Rows {held-out stem: {"own": (cushions, ellipsoids), size: [(cushions, ellipsoids) per set]}}."""
     rows = {}
@@ -63,9 +70,7 @@ def held_out_table(rms, targets, shifts, bodies):
         for size in SIZES:
             row[size] = []
             for subset in itertools.combinations(others, size):
-                chosen = {name: targets[name] for name in subset}
-                manifest = Manifest("held out", list(subset), ranges_cm=targets_range(chosen), targets_cm=chosen)
-                reference = ReferenceSet([rms[name] for name in subset], names=list(subset), manifest=manifest)
+                reference = subset_set(rms, targets, subset)
                 mannequin = synthesize_batch(reference, request, mode="exact").mannequin(0)
                 row[size].append((voxel_iou(mannequin, grid=grid), voxel_iou(mannequin, cushions=False, grid=grid)))
         rows[held] = row

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from ellimann_addon.core.body_measure import measure_body_mesh
 from ellimann_addon.core.body_mesh import read_obj
-from ellimann_addon.core.constants import MEASUREMENTS
+from ellimann_addon.core.extra_measures import split_measurements
 from ellimann_addon.core.refine_extra import synthesize_extra
 from ellimann_addon.core.shipped_sets import named_reference_set
 from ellimann_addon.core.volume import IOU_MARGIN, BodyVolume
@@ -25,8 +25,7 @@ def twins(name, reference):
     """(five-measurement twin, all-measurement twin) of body ``name``, each stood in the body."""
     body = read_obj(DEFAULT_REFMODELS / f"{name}.obj")
     found = measure_body_mesh(body.vertices, body.faces).values
-    five = {key: found[key] for key in MEASUREMENTS}
-    extra = {key: value for key, value in found.items() if key not in MEASUREMENTS}
+    five, extra = split_measurements(found)
     grid = BodyVolume(body.vertices, body.faces).grid(SPACING, margin=IOU_MARGIN)
     return tuple(standing_in(grid, synthesize_extra(reference, five, given)[0]) for given in ({}, extra))
 

@@ -20,7 +20,7 @@ measured and their mean reported.
 
 import numpy as np
 
-from .constants import CM_PER_M
+from .constants import CM_PER_M, MEASUREMENTS
 from .ellipsoid import axis_extent, section_at_height
 from .measure import hull_perimeter, section_heights
 
@@ -381,6 +381,13 @@ def _chunked_hull_perimeter(centre, k, active):
         rows = order[start:start + GIRTH_CHUNK]
         out[rows] = hull_perimeter(centre[rows], k[rows], active[rows])
     return out
+
+
+def split_measurements(values):
+    """(the five {key: cm}, the extra ones {key: cm}) of measurements ``values`` holding at least the five (what a
+    body mesh measured, for synthesis)."""
+    return ({key: values[key] for key in MEASUREMENTS},
+            {key: value for key, value in values.items() if key not in MEASUREMENTS})
 
 
 def mannequin_extra_measurements(mannequin):

@@ -18,6 +18,7 @@ from ellimann_addon.core.extra_measures import (
     _farthest_points,
     extremes_over_bands,
     mannequin_extra_measurements,
+    split_measurements,
 )
 from ellimann_addon.core.shipped_sets import FEMALE_SET, MALE_SET, named_reference_set
 
@@ -108,3 +109,10 @@ def test_the_farthest_points_stop_with_the_bits_of_a_hundred_steps():
             old_start, old_axis, old_length = before.arm_axis(side)
             assert np.array_equal(start, old_start) and length == old_length
             assert axis == pytest.approx(old_axis, abs=1e-12)
+
+
+def test_split_measurements_parts_the_five_from_the_extra_ones():
+    values = {"neck": 33.0, "He": 160.0, "Sh": 40.0, "Br": 95.0, "Wa": 80.0, "Hi": 105.0, "thigh": 55.0}
+    five, extra = split_measurements(values)
+    assert list(five) == ["He", "Sh", "Br", "Wa", "Hi"] and five["Br"] == 95.0
+    assert extra == {"neck": 33.0, "thigh": 55.0}

@@ -7,6 +7,7 @@ from mathutils import Vector
 
 from ....core.constants import MEASUREMENTS
 from ....core.errors import ElliMannError
+from ....core.extra_measures import split_measurements
 from ....core.measure import measurement_line
 from ... import ids
 from ...services.rig import build_rig, check_rig
@@ -46,8 +47,7 @@ class ELLIMANN_OT_synthesize_from_mesh(ElliMannOperator, bpy.types.Operator):
             if missing:
                 raise OperatorError(f"'{obj.name}': {problems[0] if problems else 'not measured'}; "
                                     f"{', '.join(missing)} missing: cannot synthesize")
-            five = {key: values[key] for key in MEASUREMENTS}
-            extra = {key: value for key, value in values.items() if key not in MEASUREMENTS}
+            five, extra = split_measurements(values)
             try:
                 mannequin, measured, warnings = synthesize_extra(reference, five, extra, options_of(props))
             except ElliMannError as error:
