@@ -11,8 +11,7 @@ part of the support in closed form, the root by Gauss-Legendre with as many node
 
 import numpy as np
 
-DETECTION_SAMPLES = 32  # grid used to find which ellipse is outermost in each direction
-QUADRATURE_CELLS = 32  # fixed cuts so that every smooth piece spans at most 2pi/32
+CELLS = 32  # grid directions over the circle, which find the outermost ellipses and cut the quadrature's pieces
 GAUSS_ORDERS = (8, 12, 16, 24)  # Gauss-Legendre nodes per piece: the fewest that _gauss_orders' bound allows
 QUADRATURE_TOLERANCE = 1e-16  # that bound on the quadrature's error, relative to the perimeter
 NEWTON_STEPS = 8  # from a secant start across a whole grid cell ...
@@ -93,17 +92,42 @@ class _Coefficients:
         return self.cx[index] * (s1 - s0) - self.cy[index] * (c1 - c0)
 
 
-_GRID_STEP = 2.0 * np.pi / DETECTION_SAMPLES
-_GRID = np.arange(DETECTION_SAMPLES) * _GRID_STEP
-
-
 def _directions(theta):
     """cos, sin and their products c*c, c*s, s*s of the angles ``theta`` (a table for :meth:`_Coefficients.support`)."""
     c, s = np.cos(theta), np.sin(theta)
     return c, s, c * c, c * s, s * s
 
 
-_GRID_DIRECTIONS = _directions(_GRID)
+class _Arc:
+    """The directions a group of sections is integrated over, cut into equal cells (each a cell of the grid that
+    finds the outermost ellipses and a fixed cut of the quadrature): the whole circle, or, for a section symmetric
+    about x = 0, the right half [-pi/2, pi/2] counted twice (its support H has H(pi - theta) = H(theta)), with the
+    poles' directions exact."""
+
+    def __init__(self, start, cells, copies):
+        self.cells, self.copies = cells, copies
+        span = 2.0 * np.pi / copies
+        self.step = span / cells
+        grid = start + np.arange(cells + 1) * self.step
+        grid[-1] = start + span
+        self.end = grid[-1]
+        c, s = np.cos(grid), np.sin(grid)
+        if copies == 2:
+            c[[0, -1]], s[[0, -1]] = 0.0, (-1.0, 1.0)
+        self.directions = (c, s, c * c, c * s, s * s)  # at the cells' ends, (cells + 1,) each
+        self.cell_start = grid[:-1]
+        self.cell_width = grid[1:] - grid[:-1]
+        self.cell_half = 0.5 * self.cell_width
+        self.cell_ends = (c[:-1], s[:-1], c[1:], s[1:])  # each cell's start and end
+        middle = self.cell_start + self.cell_half
+        self.rules = {}  # nodes: a Gauss-Legendre rule on [-1, 1] and its nodes' directions in every cell
+        for nodes in GAUSS_ORDERS:
+            rule, weights = np.polynomial.legendre.leggauss(nodes)
+            self.rules[nodes] = (rule, weights, _directions(middle[:, None] + self.cell_half[:, None] * rule))
+
+
+_FULL = _Arc(0.0, CELLS, 1)
+_RIGHT_HALF = _Arc(-0.5 * np.pi, CELLS // 2, 2)
 
 
 def _may_surface(gap_start, gap_end, bend, length):
@@ -123,47 +147,73 @@ def hull_perimeter(centre, k, active):
     """Perimeter of the convex hull of several ellipses per section.
 
     centre (S, n, 2), k (S, n, 2, 2) section ellipses {u: (u-c)^T k^-1 (u-c) <= 1}, active (S, n)
-    bool. Returns (S,) perimeters; a section with no active ellipse has perimeter 0.
+    bool. Returns (S,) perimeters; a section with no active ellipse has perimeter 0. A section that is its own
+    mirror image in x = 0, bit for bit (a synthesized mannequin's), is integrated over its right half only, without
+    the left ellipses that cannot reach into it (:func:`_right_half`).
     """
     centre, k, active = np.asarray(centre, float), np.asarray(k, float), np.asarray(active, bool)
-    count = active.sum(axis=-1)
-    if len(count) >= _GROUP_MIN_SECTIONS and count.min() != count.max():
-        # Sections are independent: measured in groups of equal ellipse counts, none is padded with others'.
-        out = np.zeros(len(count))
-        for size in np.unique(count):
-            rows = np.nonzero(count == size)[0]
-            out[rows] = hull_perimeter(centre[rows], k[rows], active[rows])
-        return out
-    centre, k, active = _compact(centre, k, active)
-    sections = centre.shape[0]
-    if sections == 0:
+    if centre.shape[0] == 0:
         return np.zeros(0)
+    centre, k, active = _compact(centre, k, active)
+    mirrored, used = _right_half(centre, k, active)
+    count = used.sum(axis=-1)
+    # Sections are independent: measured in groups of one arc and, from _GROUP_MIN_SECTIONS on, of equal ellipse
+    # counts, so that none is padded with others' ellipses.
+    group = 2 * count + mirrored if len(count) >= _GROUP_MIN_SECTIONS else mirrored.astype(int)
+    out = np.zeros(len(count))
+    for key in np.unique(group):
+        rows = np.nonzero(group == key)[0]
+        arc = _RIGHT_HALF if mirrored[rows[0]] else _FULL
+        out[rows] = _arc_perimeter(*_compact(centre[rows], k[rows], used[rows]), arc)
+    return out
+
+
+def _right_half(centre, k, active):
+    """Which sections are their own mirror image in x = 0 (S,), and the ellipses their right half needs (S, n).
+
+    An ellipse L left of the mid-plane whose mirror image R is right of it never rises above R on the right half
+    when |c_x| b > |k_xy| (b the smallest semi-axis): h_L - h_R = -2 cos(theta) (c_x + 2 k_xy sin(theta) /
+    (sqrt(q_L) + sqrt(q_R))), with q = n^T k n >= b^2. Any other left ellipse is kept."""
+    cx, cy = centre[..., 0], centre[..., 1]
+    a, b, d = k[..., 0, 0], k[..., 0, 1], k[..., 1, 1]
+    pair = ((cx[:, :, None] == -cx[:, None, :]) & (cy[:, :, None] == cy[:, None, :]) & (a[:, :, None] == a[:, None, :])
+            & (b[:, :, None] == -b[:, None, :]) & (d[:, :, None] == d[:, None, :]) & active[:, None, :])
+    mirrored = np.all(pair.any(axis=2) | ~active, axis=1) & active.any(axis=1)
+    smallest = 0.5 * (a + d) - np.sqrt(np.maximum(0.25 * (a - d) ** 2 + b * b, 0.0))
+    with np.errstate(invalid="ignore"):
+        dominated = np.abs(cx) * np.sqrt(np.maximum(smallest, 0.0)) > np.abs(b)
+    return mirrored, np.where(mirrored[:, None], active & ((cx >= 0.0) | ~dominated), active)
+
+
+def _arc_perimeter(centre, k, active, arc):
+    """The integral of max_i h_i over ``arc`` (an :class:`_Arc`) times its copies: the perimeter, per section."""
+    sections = centre.shape[0]
     coefficients = _Coefficients(centre, k)
     largest, smallest = _curvature_radii(k)  # (S, n)
 
     # 1. Which ellipse is outermost in each grid direction.
-    h = coefficients.support((Ellipsis, None), *_GRID_DIRECTIONS)  # (S, n, N)
+    h = coefficients.support((Ellipsis, None), *arc.directions)  # (S, n, cells + 1)
     np.copyto(h, -np.inf, where=~active[:, :, None])
-    winner = np.argmax(h, axis=1)  # (S, N)
+    winner = np.argmax(h, axis=1)  # (S, cells + 1)
 
     # 2. An ellipse that is outermost only between two grid directions would be missed: cells where one may
     #    surface (_may_surface) and cells where the winner changes (h_max has a kink there) are sampled finely.
     with np.errstate(invalid="ignore"):  # inactive ellipses' gaps are inf (or nan without any active one)
-        gap = h.max(axis=1)[:, None, :] - h  # (S, n, N)
-    gap_next = np.concatenate([gap[..., 1:], gap[..., :1]], axis=2)
-    bend = np.maximum(largest[np.arange(sections)[:, None], winner][:, None, :] - smallest[:, :, None], 0.0)
-    suspect = _may_surface(gap, gap_next, bend, _GRID_STEP).any(axis=1)  # (S, N): where the winner stays
-    changes = winner != np.concatenate([winner[:, 1:], winner[:, :1]], axis=1)
+        gap = h.max(axis=1)[:, None, :] - h  # (S, n, cells + 1)
+    cell_winner = winner[:, :-1]  # (S, cells): at each cell's start
+    bend = np.maximum(largest[np.arange(sections)[:, None], cell_winner][:, None, :] - smallest[:, :, None], 0.0)
+    suspect = _may_surface(gap[..., :-1], gap[..., 1:], bend, arc.step).any(axis=1)  # (S, cells): the winner stays
+    changes = cell_winner != winner[:, 1:]
     sec_r, cell_r = np.nonzero(suspect | changes)
 
     # 3. Kinks, where the outermost ellipse changes, in the cells sampled finely (_scan); a cell that the
     #    sampling cannot clear of a hidden ellipse is sampled again, finer.
-    start, width = cell_r * _GRID_STEP, np.full(len(cell_r), _GRID_STEP)
-    ends = (h[sec_r, :, cell_r], h[sec_r, :, (cell_r + 1) % DETECTION_SAMPLES])  # (R, n) each
+    start, width = arc.cell_start[cell_r], arc.cell_width[cell_r]
+    ends = (h[sec_r, :, cell_r], h[sec_r, :, cell_r + 1])  # (R, n) each
     kinks = []
     for level in range(REFINE_LEVELS + 1):
         theta, kink_row, after, doubtful = _scan(coefficients, active, (largest, smallest), sec_r, start, width,
-                                          REFINE_FACTOR**level, ends)
+                                                 REFINE_FACTOR**level, ends)
         keep = ~doubtful[kink_row] if level < REFINE_LEVELS else np.ones(len(kink_row), dtype=bool)
         kinks.append((theta[keep], sec_r[kink_row[keep]], after[keep]))
         if level == REFINE_LEVELS or not doubtful.any():
@@ -172,28 +222,26 @@ def hull_perimeter(centre, k, active):
         ends = (ends[0][doubtful], ends[1][doubtful])
     theta, sec, after = (np.concatenate(column) for column in zip(*kinks))
 
-    # 4. Cut the circle at the kinks and at fixed cells; integrate each piece's outermost ellipse: the linear
-    #    part of its support in closed form, the root by Gauss-Legendre. A piece between two fixed cuts (no kink
-    #    inside) is a whole cell: its outermost ellipse is the grid's in the cell, and every section's cells are
-    #    integrated at once from a table of the nodes' directions (the integrals of cells that a kink splits are
-    #    not used).
-    cut_theta, cut_sec, cell, cut_after = _cuts(sections, np.mod(theta, 2.0 * np.pi), sec, after)
-    end, next_cell = _next_in_section(cut_sec, cut_theta, cell)
+    # 4. Cut the arc at the kinks and at its cells; integrate each piece's outermost ellipse: the linear part of its
+    #    support in closed form, the root by Gauss-Legendre. A piece between two cells' cuts (no kink inside) is a
+    #    whole cell: its outermost ellipse is the grid's in the cell, and every section's cells are integrated at
+    #    once from a table of the nodes' directions (the integrals of cells that a kink splits are not used).
+    cut_theta, cut_sec, cell, cut_after = _cuts(sections, theta, sec, after, arc)
+    end, next_cell = _next_in_section(cut_sec, cut_theta, cell, arc)
     half = 0.5 * (end - cut_theta)
     whole = (cell >= 0) & (next_cell >= 0)
     split = ~whole
-    cell_winner = winner[:, ::_GRID_PER_CELL]  # (S, cells): at each cell's start
     # A piece from a cut at a cell's start has the grid's outermost ellipse there, one from a kink the ellipse
     # outermost after it.
     piece_winner = np.where(cell >= 0, cell_winner[cut_sec, np.maximum(cell, 0)], cut_after)
-    order = _gauss_orders(coefficients, active)  # (S,)
+    order = _gauss_orders(coefficients, active, arc)  # (S,)
     piece = np.empty(len(cut_sec))
     for nodes in np.unique(order):
-        rule, weights, directions = _RULES[nodes]
+        rule, weights, directions = arc.rules[nodes]
         rows = np.nonzero(order == nodes)[0]
         cells = (rows[:, None], cell_winner[rows])
         cell_root = _weighted_sum(coefficients.root((rows[:, None, None], cells[1][..., None]), *directions), weights)
-        cell_integral = _CELL_HALF * cell_root + coefficients.centre_integral(cells, *_CELL_ENDS)  # (rows, cells)
+        cell_integral = arc.cell_half * cell_root + coefficients.centre_integral(cells, *arc.cell_ends)
         mine = order[cut_sec] == nodes
         pick = whole & mine
         piece[pick] = cell_integral[np.searchsorted(rows, cut_sec[pick]), cell[pick]]
@@ -206,7 +254,7 @@ def hull_perimeter(centre, k, active):
         piece[pick] = half[pick] * root + coefficients.centre_integral(index, np.cos(low), np.sin(low),
                                                                        np.cos(high), np.sin(high))
     piece = np.where(active[cut_sec, piece_winner], piece, 0.0)
-    return np.bincount(cut_sec, weights=piece, minlength=sections)
+    return arc.copies * np.bincount(cut_sec, weights=piece, minlength=sections)
 
 
 def _scan(coefficients, active, radii, sec, start, width, samples, ends):
@@ -300,25 +348,7 @@ def _kinks(coefficients, index, lo, hi, g_lo, g_hi):
     return theta
 
 
-_CELLS = np.arange(QUADRATURE_CELLS) * (2.0 * np.pi / QUADRATURE_CELLS)
-_GRID_PER_CELL = DETECTION_SAMPLES // QUADRATURE_CELLS
-
-
-_CELL_END = np.append(_CELLS[1:], _CELLS[0] + 2.0 * np.pi)
-_CELL_HALF = 0.5 * (_CELL_END - _CELLS)
-
-
-def _rule(nodes):
-    """A Gauss-Legendre rule on [-1, 1] and the directions of its nodes in every whole cell (QUADRATURE_CELLS,
-    nodes), computed as :func:`hull_perimeter` computes a piece's."""
-    rule, weights = np.polynomial.legendre.leggauss(nodes)
-    return rule, weights, _directions((_CELLS + _CELL_HALF)[:, None] + _CELL_HALF[:, None] * rule)
-
-
-_RULES = {nodes: _rule(nodes) for nodes in GAUSS_ORDERS}
-
-
-def _gauss_orders(coefficients, active):
+def _gauss_orders(coefficients, active, arc):
     """Gauss-Legendre nodes per piece for each section (S,): the fewest of GAUSS_ORDERS whose error bound, for
     every active ellipse, is within QUADRATURE_TOLERANCE of the perimeter (else the most).
 
@@ -326,41 +356,50 @@ def _gauss_orders(coefficients, active):
     acosh(alpha / beta) / 2 (alpha +- beta the squared semi-axes); in the Bernstein ellipse of a cell (half-width
     h) reaching 0.9 y0, rho = t + sqrt(1 + t^2) with t = 0.9 y0 / h, it is at most sqrt(2 alpha), so n nodes
     err by at most h 64/15 sqrt(2 alpha) rho^-2n / (rho^2 - 1) per cell (Trefethen, Approximation Theory and
-    Approximation Practice, Thm 19.3); a piece split by a kink is shorter and errs less. The perimeter is at
-    least the ellipse's, 4 sqrt(alpha + beta)."""
+    Approximation Practice, Thm 19.3), and the arc's cells count ``copies`` times; a piece split by a kink is
+    shorter and errs less. The perimeter is at least the ellipse's, 4 sqrt(alpha + beta)."""
     alpha = 0.5 * (coefficients.a + coefficients.d)
     beta = np.sqrt(0.25 * (coefficients.a - coefficients.d) ** 2 + 0.25 * coefficients.b**2)
-    half = np.pi / QUADRATURE_CELLS
+    half = 0.5 * arc.step
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # circles (beta 0), inactive ellipses
         reach = 0.45 * np.arccosh(np.maximum(alpha / beta, 1.0)) / half
         rho = reach + np.sqrt(1.0 + reach * reach)
-        allowed = QUADRATURE_TOLERANCE * 4.0 * np.sqrt(alpha + beta) / (QUADRATURE_CELLS * half * 64.0 / 15.0
+        allowed = QUADRATURE_TOLERANCE * 4.0 * np.sqrt(alpha + beta) / (arc.copies * arc.cells * half * 64.0 / 15.0
                                                                          * np.sqrt(2.0 * alpha))
         fails = sum((rho ** (-2.0 * n) / (rho * rho - 1.0) > allowed) | ~np.isfinite(allowed) for n in GAUSS_ORDERS)
     need = np.where(active, np.minimum(fails, len(GAUSS_ORDERS) - 1), 0)
     return np.asarray(GAUSS_ORDERS)[need.max(axis=1)]
-_CELL_ENDS = (np.cos(_CELLS), np.sin(_CELLS), np.cos(_CELL_END), np.sin(_CELL_END))  # each cell's start and end
 
 
-def _cuts(sections, theta, sec, after):
-    """The fixed cells of every section and the kinks (theta, sec, the ellipse outermost after each), sorted by
+def _cuts(sections, theta, sec, after, arc):
+    """The cells of every section's arc and the kinks (theta, sec, the ellipse outermost after each), sorted by
     (section, angle), a cell before a kink at the same angle: (theta, sec, cell index or -1 for a kink, the
     ellipse after a kink or -1 for a cell) of every cut. Only the kinks are sorted; the cells are merged in."""
     order = np.lexsort((theta, sec))
     theta, sec, after = theta[order], sec[order], after[order]
     # A kink goes after the cells of the sections before it, the cells of its own section up to its angle
     # and the kinks sorted before it.
-    kink_at = sec * QUADRATURE_CELLS + np.searchsorted(_CELLS, theta, side="right") + np.arange(len(theta))
-    total = sections * QUADRATURE_CELLS + len(theta)
+    cells = arc.cells
+    kink_at = sec * cells + np.searchsorted(arc.cell_start, theta, side="right") + np.arange(len(theta))
+    total = sections * cells + len(theta)
     is_cell = np.ones(total, dtype=bool)
     is_cell[kink_at] = False
     cut_theta, cut_sec, cell = np.empty(total), np.empty(total, dtype=np.int64), np.full(total, -1)
     cut_theta[kink_at], cut_sec[kink_at] = theta, sec
-    cut_theta[is_cell], cut_sec[is_cell] = np.tile(_CELLS, sections), np.repeat(np.arange(sections), QUADRATURE_CELLS)
-    cell[is_cell] = np.tile(np.arange(QUADRATURE_CELLS), sections)
+    cut_theta[is_cell], cut_sec[is_cell] = np.tile(arc.cell_start, sections), np.repeat(np.arange(sections), cells)
+    cell[is_cell] = np.tile(np.arange(cells), sections)
     cut_after = np.full(total, -1)
     cut_after[kink_at] = after
     return cut_theta, cut_sec, cell, cut_after
+
+
+def _next_in_section(sec, theta, value, arc):
+    """For rows sorted by (sec, theta): the next row's theta and value; after a section's last row, the arc's end
+    (and the cell count: the end of a cell)."""
+    nxt = np.minimum(np.arange(1, len(sec) + 1), len(sec) - 1)
+    last = np.ones(len(sec), dtype=bool)
+    last[:-1] = sec[1:] != sec[:-1]
+    return np.where(last, arc.end, theta[nxt]), np.where(last, arc.cells, value[nxt])
 
 
 def _weighted_sum(values, weights):
@@ -370,16 +409,6 @@ def _weighted_sum(values, weights):
     for j in range(1, len(weights)):
         total += values[..., j] * weights[j]
     return total
-
-
-def _next_in_section(sec, theta, value):
-    """For rows sorted by (sec, theta): the next row's theta and value, wrapping around the circle."""
-    nxt = np.arange(1, len(sec) + 1)
-    last = np.ones(len(sec), dtype=bool)
-    last[:-1] = sec[1:] != sec[:-1]
-    nxt[last] = np.searchsorted(sec, sec[last])
-    nxt_theta = theta[nxt] + np.where(last, 2.0 * np.pi, 0.0)
-    return nxt_theta, value[nxt]
 
 
 def hull_boundary(centre, k, active, samples=256):

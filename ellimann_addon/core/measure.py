@@ -60,19 +60,30 @@ def _measure_chunk(rotation, center, semi_axes, girth, fractions):
     batch = rotation.shape[0]
     _, height, z = section_heights(rotation, center, semi_axes, fractions)
     result = {"He": height}
-    shape = section_shape(rotation, semi_axes)
+    # Each section only through the parts that reach its height in some mannequin of the chunk (with a margin:
+    # whether a part is cut is decided below, as for every part; those left out would not be cut, and a part's
+    # section does not depend on which others are computed with it).
+    reach = axis_extent(rotation, semi_axes, 2) * (1.0 + 1e-9)
 
-    centre, k, hit = section_at_height(rotation, center, semi_axes, z["Sh"][:, None], shape)
+    def cut(key, parts):
+        return parts[np.any(np.abs(z[key][:, None] - center[:, parts, 2]) <= reach[:, parts], axis=0)]
+
+    parts = cut("Sh", np.arange(rotation.shape[1]))
+    shape = section_shape(rotation[:, parts], semi_axes[:, parts])
+    centre, k, hit = section_at_height(rotation[:, parts], center[:, parts], semi_axes[:, parts], z["Sh"][:, None],
+                                       shape)
     half_x = np.sqrt(k[..., 0, 0])
-    right = np.where(hit, centre[..., 0] + half_x, -np.inf).max(axis=-1)
-    left = np.where(hit, centre[..., 0] - half_x, np.inf).min(axis=-1)
+    right = np.where(hit, centre[..., 0] + half_x, -np.inf).max(axis=-1, initial=-np.inf)
+    left = np.where(hit, centre[..., 0] - half_x, np.inf).min(axis=-1, initial=np.inf)
     result["Sh"] = np.where(np.isfinite(right), right - left, 0.0)
 
     # The girth sections through the girth parts only (the others would only be dropped).
-    parts = np.nonzero(girth)[0]
+    girth_parts = np.nonzero(girth)[0]
+    parts = np.unique(np.concatenate([cut(key, girth_parts) for key in GIRTHS]))
     heights = np.stack([z[key] for key in GIRTHS], axis=1)  # (B, 3)
-    centre, k, hit = section_at_height(rotation[:, None, parts], center[:, None, parts], semi_axes[:, None, parts],
-                                       heights[:, :, None], tuple(a[:, None, parts] for a in shape))
+    rotation, center, semi_axes = rotation[:, None, parts], center[:, None, parts], semi_axes[:, None, parts]
+    centre, k, hit = section_at_height(rotation, center, semi_axes, heights[:, :, None],
+                                       section_shape(rotation, semi_axes))
     sections, n = batch * len(GIRTHS), len(parts)
     perimeters = hull_perimeter(centre.reshape(sections, n, 2), k.reshape(sections, n, 2, 2),
                                 hit.reshape(sections, n)) if n else np.zeros(sections)

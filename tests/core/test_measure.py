@@ -221,3 +221,76 @@ def test_section_hulls_trace_the_measured_sections(toy):
             assert np.ptp(points[:, 0]) * 100 == pytest.approx(values["Sh"], rel=1e-4)
         else:
             assert ConvexHull(points).area * 100 == pytest.approx(values[key], rel=1e-4)
+
+
+def _mirror_pairs(rng, pairs, central):
+    """A section symmetric about x = 0 bit for bit: random ellipses right of the mid-plane, their mirror images, and
+    central ones (k_xy = 0)."""
+    centres, ks = [], []
+    for _ in range(pairs):
+        a, b, angle = rng.uniform(0.03, 0.2), rng.uniform(0.02, 0.1), rng.uniform(0, np.pi)
+        rot = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+        k = rot @ np.diag([a * a, b * b]) @ rot.T
+        c = (rng.uniform(-0.05, 0.25), rng.uniform(-0.1, 0.1))
+        centres += [c, (-c[0], c[1])]
+        ks += [k, k * np.array([[1.0, -1.0], [-1.0, 1.0]])]
+    for _ in range(central):
+        centres.append((0.0, rng.uniform(-0.1, 0.1)))
+        ks.append(np.diag(rng.uniform(0.02, 0.2, 2) ** 2))
+    return np.array(centres), np.array(ks)
+
+
+def _hull_of_points(centres, ks, count=20_000):
+    t = np.linspace(0.0, 2 * np.pi, count, endpoint=False)
+    circle = np.stack([np.cos(t), np.sin(t)], axis=1)
+    return ConvexHull(np.concatenate([c + circle @ np.linalg.cholesky(k).T for c, k in zip(centres, ks)])).area
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_a_symmetric_section_measured_on_its_right_half_equals_the_whole_circle(seed):
+    """core.hull integrates a section that is its own mirror image over the right half only, without the left
+    ellipses that cannot reach into it: the same perimeter as the whole circle's (the section moved by 1e-12 m, no
+    longer symmetric bit for bit) and as a brute-force hull. Some ellipses cross the mid-plane (kept both)."""
+    from ellimann_addon.core import hull
+    rng = np.random.default_rng(seed)
+    centres, ks = _mirror_pairs(rng, pairs=int(rng.integers(1, 4)), central=int(rng.integers(0, 3)))
+    active = np.ones((1, len(centres)), bool)
+    mirrored, used = hull._right_half(centres[None], ks[None], active)
+    assert mirrored[0]
+    half = measure.hull_perimeter(centres[None], ks[None], active)[0]
+    moved = centres.copy()
+    moved[0, 0] += 1e-12
+    assert not hull._right_half(moved[None], ks[None], active)[0][0]
+    whole = measure.hull_perimeter(moved[None], ks[None], active)[0]
+    assert half == pytest.approx(whole, rel=1e-11)  # 1e-12 m moved, perimeter ~1 m
+    assert half == pytest.approx(_hull_of_points(centres, ks), rel=1e-6)
+
+
+def test_the_right_half_drops_the_left_ellipses_their_mirror_images_cover():
+    from ellimann_addon.core import hull
+    centres, ks = _mirror_pairs(np.random.default_rng(5), pairs=3, central=1)
+    centres[:6:2, 0] = np.abs(centres[:6:2, 0]) + 0.3  # every pair well apart
+    centres[1:6:2, 0] = -centres[:6:2, 0]
+    mirrored, used = hull._right_half(centres[None], ks[None], np.ones((1, 7), bool))
+    assert mirrored[0] and list(used[0]) == [True, False] * 3 + [True]
+
+
+def test_a_left_ellipse_reaching_across_the_mid_plane_is_kept():
+    """A long ellipse tilted across x = 0 (|c_x| b < |k_xy|): its mirror image does not cover it on the right half,
+    so both are integrated (dropping the left one would miss the hull's right tip)."""
+    from ellimann_addon.core import hull
+    angle = 0.6
+    rot = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+    k = rot @ np.diag([0.3**2, 0.03**2]) @ rot.T
+    centres = np.array([(0.02, 0.0), (-0.02, 0.0)])
+    ks = np.stack([k, k * np.array([[1.0, -1.0], [-1.0, 1.0]])])
+    mirrored, used = hull._right_half(centres[None], ks[None], np.ones((1, 2), bool))
+    assert mirrored[0] and used.all()
+    assert perimeter(centres, ks) == pytest.approx(_hull_of_points(centres, ks, 100_000), rel=1e-7)
+
+
+@pytest.mark.parametrize("d", [0.0, 0.05, 0.7])
+def test_two_mirrored_circles_give_the_stadium(d):
+    r = 0.15
+    k = np.eye(2) * r * r
+    assert perimeter([(d / 2, 0.1), (-d / 2, 0.1)], [k, k]) == pytest.approx(2 * np.pi * r + 2 * d, rel=1e-14)
