@@ -9,6 +9,8 @@ part of the support in closed form, the root by Gauss-Legendre with as many node
 (:func:`_gauss_orders`). m_T (``core.measure``) measures its girths with it.
 """
 
+from dataclasses import dataclass
+
 import numpy as np
 
 CELLS = 32  # grid directions over the circle, which find the outermost ellipses and cut the quadrature's pieces
@@ -44,12 +46,13 @@ def _support_2d_with_derivative(centre, k, theta):
 
 
 def _compact(centre, k, active):
-    """Move each section's active ellipses to the front; drop columns no section uses."""
+    """Move each section's active ellipses to the front; drop columns no section uses. Returns the moved arrays and
+    the column each came from (S, width)."""
     count = active.sum(axis=-1)
     width = max(int(count.max(initial=0)), 1)
     order = np.argsort(~active, axis=-1, kind="stable")[:, :width]
     rows = np.arange(active.shape[0])[:, None]
-    return centre[rows, order], k[rows, order], active[rows, order]
+    return centre[rows, order], k[rows, order], active[rows, order], order
 
 
 def _curvature_radii(k):
@@ -143,29 +146,183 @@ def _may_surface(gap_start, gap_end, bend, length):
                 & (np.maximum(gap_start, gap_end) > 0.0) & np.isfinite(gap_start) & np.isfinite(gap_end))
 
 
-def hull_perimeter(centre, k, active):
+@dataclass
+class HullStructure:
+    """Where the outermost ellipse of each section changes (the kinks of max_i h_i), in the caller's ellipse columns:
+    what :func:`hull_perimeter` needs to measure the sections again after a small move without searching (``warm``)."""
+
+    mirrored: np.ndarray  # (S,) bool: integrated over the right half (:func:`_right_half`)
+    first: np.ndarray  # (S,) the ellipse outermost at the arc's start (-1 where no ellipse is active)
+    kink_section: np.ndarray  # (K,) sorted by section, then angle
+    kink_theta: np.ndarray  # (K,)
+    kink_after: np.ndarray  # (K,) the ellipse outermost after the kink
+
+    def take(self, rows):
+        """The structure of the sections ``rows``, numbered from 0 in that order."""
+        rows = np.asarray(rows, dtype=np.int64)
+        renumber = np.full(len(self.first), -1)
+        renumber[rows] = np.arange(len(rows))
+        keep = renumber[self.kink_section] >= 0
+        return HullStructure(self.mirrored[rows], self.first[rows],
+                             *_sorted_kinks(renumber[self.kink_section[keep]], self.kink_theta[keep],
+                                            self.kink_after[keep]))
+
+    def replaced(self, rows, other):
+        """This structure with the sections ``rows`` those of ``other`` (one for each, in that order)."""
+        rows = np.asarray(rows, dtype=np.int64)
+        mirrored, first = self.mirrored.copy(), self.first.copy()
+        mirrored[rows], first[rows] = other.mirrored, other.first
+        mine = np.ones(len(first), dtype=bool)
+        mine[rows] = False
+        keep = mine[self.kink_section]
+        return HullStructure(mirrored, first, *_sorted_kinks(
+            np.concatenate([self.kink_section[keep], rows[other.kink_section]]),
+            np.concatenate([self.kink_theta[keep], other.kink_theta]),
+            np.concatenate([self.kink_after[keep], other.kink_after])))
+
+    def renamed(self, names):
+        """The same structure with every ellipse e called names[e] (-1 stays -1, and so does a name of -1)."""
+        names = np.asarray(names)
+
+        def rename(e):
+            return np.where(e >= 0, names[np.maximum(e, 0)], -1) if len(names) else np.full_like(e, -1)
+
+        return HullStructure(self.mirrored, rename(self.first), self.kink_section, self.kink_theta,
+                             rename(self.kink_after))
+
+    @staticmethod
+    def concatenate(parts):
+        """One structure of the sections of ``parts``, in order."""
+        if not parts:
+            return _empty_structure(0)
+        offsets = np.cumsum([0] + [len(part.first) for part in parts])
+        return HullStructure(np.concatenate([part.mirrored for part in parts]),
+                             np.concatenate([part.first for part in parts]),
+                             np.concatenate([part.kink_section + offset for part, offset in zip(parts, offsets)]),
+                             np.concatenate([part.kink_theta for part in parts]),
+                             np.concatenate([part.kink_after for part in parts]))
+
+
+def hull_perimeter(centre, k, active, warm=None, structure=False):
     """Perimeter of the convex hull of several ellipses per section.
 
     centre (S, n, 2), k (S, n, 2, 2) section ellipses {u: (u-c)^T k^-1 (u-c) <= 1}, active (S, n)
     bool. Returns (S,) perimeters; a section with no active ellipse has perimeter 0. A section that is its own
     mirror image in x = 0, bit for bit (a synthesized mannequin's), is integrated over its right half only, without
     the left ellipses that cannot reach into it (:func:`_right_half`).
+
+    ``structure=True`` returns (perimeters, :class:`HullStructure`). ``warm``: the structure of the same sections a
+    moment ago, the ellipses having moved a little since: each kink is solved again by Newton from where it was and
+    nothing is searched, so an ellipse that has risen above the others since would be missed (for the steps of a
+    refinement, not for a result); a section whose kinks do not follow (one does not converge, two swap, an
+    outermost ellipse is no longer cut, the section's symmetry changed) is measured from scratch.
     """
     centre, k, active = np.asarray(centre, float), np.asarray(k, float), np.asarray(active, bool)
-    if centre.shape[0] == 0:
-        return np.zeros(0)
-    centre, k, active = _compact(centre, k, active)
+    sections = centre.shape[0]
+    out, first = np.zeros(sections), np.full(sections, -1)
+    if sections == 0 or centre.shape[1] == 0:
+        return (out, _empty_structure(sections)) if structure else out
+    kinks = [(np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(0, dtype=np.int64))]  # section, angle, after
+    centre, k, active, columns = _compact(centre, k, active)
     mirrored, used = _right_half(centre, k, active)
+    centre, k, used, kept = _compact(centre, k, used)
+    columns = np.take_along_axis(columns, kept, axis=1)
+    cold = np.ones(sections, dtype=bool)
+    if warm is not None:
+        cold, perimeter, (warm_first, sec, theta, after) = _warm_perimeter(centre, k, used, mirrored,
+                                                                           _to_columns(warm, columns))
+        out[~cold], first[~cold] = perimeter[~cold], warm_first[~cold]
+        kinks.append((sec[~cold[sec]], theta[~cold[sec]], after[~cold[sec]]))
     count = used.sum(axis=-1)
     # Sections are independent: measured in groups of one arc and, from _GROUP_MIN_SECTIONS on, of equal ellipse
     # counts, so that none is padded with others' ellipses.
-    group = 2 * count + mirrored if len(count) >= _GROUP_MIN_SECTIONS else mirrored.astype(int)
-    out = np.zeros(len(count))
-    for key in np.unique(group):
-        rows = np.nonzero(group == key)[0]
+    group = 2 * count + mirrored if sections >= _GROUP_MIN_SECTIONS else mirrored.astype(int)
+    for key in np.unique(group[cold]):
+        rows = np.nonzero(cold & (group == key))[0]
         arc = _RIGHT_HALF if mirrored[rows[0]] else _FULL
-        out[rows] = _arc_perimeter(*_compact(centre[rows], k[rows], used[rows]), arc)
-    return out
+        group_centre, group_k, group_used, group_columns = _compact(centre[rows], k[rows], used[rows])
+        out[rows], group_first, theta, sec, after = _arc_perimeter(group_centre, group_k, group_used, arc)
+        first[rows] = np.where(group_first >= 0, group_columns[np.arange(len(rows)), np.maximum(group_first, 0)], -1)
+        kinks.append((rows[sec], theta, group_columns[sec, after]))
+    if not structure:
+        return out
+    sec, theta, after = _sorted_kinks(*(np.concatenate(column) for column in zip(*kinks)))
+    return out, HullStructure(mirrored, np.where(first >= 0, columns[np.arange(sections), np.maximum(first, 0)], -1),
+                              sec, theta, columns[sec, after])
+
+
+def _sorted_kinks(sec, theta, after):
+    order = np.lexsort((theta, sec))
+    return sec[order], theta[order], after[order]
+
+
+def _empty_structure(sections):
+    return HullStructure(np.zeros(sections, dtype=bool), np.full(sections, -1), np.zeros(0, dtype=np.int64),
+                         np.zeros(0), np.zeros(0, dtype=np.int64))
+
+
+def _to_columns(structure, columns):
+    """``structure`` (in the caller's ellipse columns) in the compacted ones, ``columns`` (S, width) the caller's
+    column of each: -1 for an ellipse not among them."""
+    width = max(int(columns.max(initial=0)), int(structure.first.max(initial=0)),
+                int(structure.kink_after.max(initial=0))) + 1
+    inverse = np.full((len(columns), width), -1)
+    np.put_along_axis(inverse, columns, np.broadcast_to(np.arange(columns.shape[1]), columns.shape), axis=1)
+
+    def convert(sec, column):
+        return np.where(column >= 0, inverse[sec, np.maximum(column, 0)], -1)
+
+    return HullStructure(structure.mirrored, convert(np.arange(len(columns)), structure.first), structure.kink_section,
+                         structure.kink_theta, convert(structure.kink_section, structure.kink_after))
+
+
+def _warm_perimeter(centre, k, used, mirrored, warm):
+    """Perimeters from a former structure (:func:`hull_perimeter`'s ``warm``), all in compacted columns: (the
+    sections to measure from scratch (S,), perimeters (S,), the structure followed: (first, section, angle, after))."""
+    sections = len(mirrored)
+    rows = np.arange(sections)
+    sec, theta, after = warm.kink_section, warm.kink_theta, warm.kink_after
+    opens = np.ones(len(sec), dtype=bool)
+    opens[1:] = sec[1:] != sec[:-1]
+    before = np.where(opens, warm.first[sec], np.roll(after, 1))
+    ok = (warm.mirrored == mirrored) & (warm.first >= 0) & used[rows, np.maximum(warm.first, 0)]
+    cut = (before >= 0) & (after >= 0) & used[sec, np.maximum(before, 0)] & used[sec, np.maximum(after, 0)]
+    ok[sec[~cut]] = False
+    lo = np.where(mirrored[sec], _RIGHT_HALF.cell_start[0], _FULL.cell_start[0])
+    hi = np.where(mirrored[sec], _RIGHT_HALF.end, _FULL.end)
+    coefficients = _Coefficients(centre, k)
+    index = ((sec, np.maximum(before, 0)), (sec, np.maximum(after, 0)))
+    theta = _newton(coefficients, index, theta.copy(), lo, hi)
+    c, s = np.cos(theta), np.sin(theta)
+    size = coefficients.root(index[0], c, s) + coefficients.root(index[1], c, s)
+    miss = np.abs(coefficients.support(index[0], c, s) - coefficients.support(index[1], c, s)) > KINK_TOLERANCE * size
+    ok[sec[miss]] = False
+    swapped = (sec[1:] == sec[:-1]) & (theta[1:] < theta[:-1])
+    ok[sec[1:][swapped]] = False
+    perimeter = np.zeros(sections)
+    for arc, mine in ((_FULL, ~mirrored), (_RIGHT_HALF, mirrored)):
+        chosen = np.nonzero(ok & mine)[0]
+        if not len(chosen):
+            continue
+        renumber = np.full(sections, -1)
+        renumber[chosen] = np.arange(len(chosen))
+        take = renumber[sec] >= 0
+        part_sec, part_theta, part_after = renumber[sec[take]], theta[take], after[take]
+        cell_winner = _cell_winners(warm.first[chosen], part_sec, part_theta, part_after, arc)
+        perimeter[chosen] = _integrate(_Coefficients(centre[chosen], k[chosen]), used[chosen], arc, cell_winner,
+                                       part_theta, part_sec, part_after)
+    return ~ok, perimeter, (warm.first, sec, theta, after)
+
+
+def _cell_winners(first, sec, theta, after, arc):
+    """The outermost ellipse at each cell's start (S, cells) from the kinks (sorted by section, then angle): after
+    the last kink before it, else ``first``. A kink at a cell's very start comes after it (as in :func:`_cuts`)."""
+    marker = np.full((len(first), arc.cells + 1), -1)
+    np.maximum.at(marker, (sec, np.searchsorted(arc.cell_start, theta, side="right")), np.arange(len(sec)))
+    last = np.maximum.accumulate(marker, axis=1)[:, :arc.cells]
+    if not len(after):
+        return np.repeat(first[:, None], arc.cells, axis=1)
+    return np.where(last >= 0, after[np.maximum(last, 0)], first[:, None])
 
 
 def _right_half(centre, k, active):
@@ -186,7 +343,9 @@ def _right_half(centre, k, active):
 
 
 def _arc_perimeter(centre, k, active, arc):
-    """The integral of max_i h_i over ``arc`` (an :class:`_Arc`) times its copies: the perimeter, per section."""
+    """The integral of max_i h_i over ``arc`` (an :class:`_Arc`) times its copies, per section: (perimeter, the
+    ellipse outermost at the arc's start (-1 if none is active), and the kinks: angle, section, the ellipse outermost
+    after it)."""
     sections = centre.shape[0]
     coefficients = _Coefficients(centre, k)
     largest, smallest = _curvature_radii(k)  # (S, n)
@@ -222,6 +381,14 @@ def _arc_perimeter(centre, k, active, arc):
         ends = (ends[0][doubtful], ends[1][doubtful])
     theta, sec, after = (np.concatenate(column) for column in zip(*kinks))
 
+    first = np.where(active.any(axis=1), winner[:, 0], -1)
+    return _integrate(coefficients, active, arc, cell_winner, theta, sec, after), first, theta, sec, after
+
+
+def _integrate(coefficients, active, arc, cell_winner, theta, sec, after):
+    """The perimeter of each section from its outermost ellipse at every cell's start (S, cells) and its kinks
+    (angle, section, the ellipse outermost after it)."""
+    sections = cell_winner.shape[0]
     # 4. Cut the arc at the kinks and at its cells; integrate each piece's outermost ellipse: the linear part of its
     #    support in closed form, the root by Gauss-Legendre. A piece between two cells' cuts (no kink inside) is a
     #    whole cell: its outermost ellipse is the grid's in the cell, and every section's cells are integrated at
@@ -317,10 +484,17 @@ def _scan(coefficients, active, radii, sec, start, width, samples, ends):
 def _kinks(coefficients, index, lo, hi, g_lo, g_hi):
     """The angles in [lo, hi] where the outermost ellipse changes from the ellipse index[0] to index[1] (each a
     tuple (section, ellipse) of (K,) arrays): h_0 = h_1 by a secant start from g = h_0 - h_1 at lo and hi, then
-    Newton steps kept in [lo, hi], at most NEWTON_STEPS, each kink's until its step is below NEWTON_DONE."""
+    Newton steps (:func:`_newton`)."""
     denom = g_lo - g_hi
     frac = np.divide(g_lo, denom, out=np.full_like(g_lo, 0.5), where=np.abs(denom) > 0.0)
     theta = lo + (hi - lo) * np.clip(frac, 0.0, 1.0)
+    return _newton(coefficients, index, theta, lo, hi)
+
+
+def _newton(coefficients, index, theta, lo, hi):
+    """h_0 = h_1 for the ellipses index[0] and index[1] (each a tuple (section, ellipse) of (K,) arrays) by Newton
+    steps from ``theta`` (changed in place), kept in [lo, hi], at most NEWTON_STEPS, each kink's until its step is
+    below NEWTON_DONE."""
     (a0, b0, d0), (a1, b1, d1) = ((coefficients.a[i], coefficients.b[i], coefficients.d[i]) for i in index)
     dcx = coefficients.cx[index[0]] - coefficients.cx[index[1]]
     dcy = coefficients.cy[index[0]] - coefficients.cy[index[1]]

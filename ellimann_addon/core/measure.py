@@ -17,7 +17,7 @@ import numpy as np
 
 from .constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
 from .ellipsoid import axis_extent, section_at_height, section_shape
-from .hull import hull_boundary, hull_perimeter
+from .hull import HullStructure, hull_boundary, hull_perimeter
 from .mesh import convex_hull_2d, plane_section_points, polygon_perimeter
 
 _CHUNK = 256  # mannequins per batch chunk (bounds the temporary arrays to tens of MB)
@@ -50,13 +50,34 @@ def tailor_measurements(rotation, center, semi_axes, girth, fractions=None):
     if single:
         rotation, center, semi_axes = rotation[None], center[None], semi_axes[None]
     out = np.concatenate([
-        _measure_chunk(rotation[i:i + _CHUNK], center[i:i + _CHUNK], semi_axes[i:i + _CHUNK], girth, fractions)
+        _measure_chunk(rotation[i:i + _CHUNK], center[i:i + _CHUNK], semi_axes[i:i + _CHUNK], girth, fractions)[0]
         for i in range(0, rotation.shape[0], _CHUNK)
     ]) if rotation.shape[0] else np.zeros((0, len(MEASUREMENTS)))
     return out[0] if single else out
 
 
-def _measure_chunk(rotation, center, semi_axes, girth, fractions):
+def followed_measurements(rotation, center, semi_axes, girth, fractions=None, warm=None):
+    """m_T of a batch (B, n, ...) as :func:`tailor_measurements`, and where the outermost piece of each girth section
+    changes (a :class:`core.hull.HullStructure` of B * 3 sections, mannequin by mannequin in GIRTHS order, pieces by
+    part index), for measuring the same mannequins again after a small change. With ``warm`` (such a structure)
+    the girths follow it instead of searching (``hull_perimeter``'s warm): for a refinement's steps, not a result.
+    """
+    rotation, center, semi_axes = (np.asarray(a, dtype=float) for a in (rotation, center, semi_axes))
+    girth = np.asarray(girth, dtype=bool)
+    values, structures = [], []
+    for i in range(0, rotation.shape[0], _CHUNK):
+        chunk = slice(i, i + _CHUNK)
+        rows = np.arange(len(GIRTHS) * i, len(GIRTHS) * min(i + _CHUNK, rotation.shape[0]))
+        value, structure = _measure_chunk(rotation[chunk], center[chunk], semi_axes[chunk], girth, fractions,
+                                          None if warm is None else warm.take(rows), follow=True)
+        values.append(value)
+        structures.append(structure)
+    if not values:
+        return np.zeros((0, len(MEASUREMENTS))), HullStructure.concatenate([])
+    return np.concatenate(values), HullStructure.concatenate(structures)
+
+
+def _measure_chunk(rotation, center, semi_axes, girth, fractions, warm=None, follow=False):
     batch = rotation.shape[0]
     _, height, z = section_heights(rotation, center, semi_axes, fractions)
     result = {"He": height}
@@ -85,12 +106,16 @@ def _measure_chunk(rotation, center, semi_axes, girth, fractions):
     centre, k, hit = section_at_height(rotation, center, semi_axes, heights[:, :, None],
                                        section_shape(rotation, semi_axes))
     sections, n = batch * len(GIRTHS), len(parts)
-    perimeters = hull_perimeter(centre.reshape(sections, n, 2), k.reshape(sections, n, 2, 2),
-                                hit.reshape(sections, n)) if n else np.zeros(sections)
-    perimeters = perimeters.reshape(batch, len(GIRTHS))
+    if warm is not None:  # the structure names pieces by part index; hull_perimeter by column
+        column = np.full(len(girth), -1)
+        column[parts] = np.arange(n)
+        warm = warm.renamed(column)
+    perimeters, structure = hull_perimeter(centre.reshape(sections, n, 2), k.reshape(sections, n, 2, 2),
+                                           hit.reshape(sections, n), warm=warm, structure=True)
     for index, key in enumerate(GIRTHS):
-        result[key] = perimeters[:, index]
-    return np.stack([result[key] for key in MEASUREMENTS], axis=-1) * CM_PER_M
+        result[key] = perimeters.reshape(batch, len(GIRTHS))[:, index]
+    values = np.stack([result[key] for key in MEASUREMENTS], axis=-1) * CM_PER_M
+    return values, structure.renamed(parts) if follow else None
 
 
 def as_dict(values):

@@ -12,7 +12,8 @@ from .constants import (
     SECTION_FRACTIONS,
 )
 from .ellipsoid import axis_extent, section_at_height, section_shape
-from .measure import section_heights, tailor_measurements
+from .hull import HullStructure
+from .measure import followed_measurements, section_heights, tailor_measurements
 
 # Exact mode.
 EXACT_TOLERANCE = 1e-5  # relative m_T error at which refinement stops (0.001 %)
@@ -24,6 +25,9 @@ _FD_STEP = 1e-4  # log-factor step of the finite-difference Jacobian
 _TIKHONOV = 1e-10  # keeps the Newton system solvable when a measurement does not respond
 _TAPER = 1.0  # how strongly a section's factor lengthens the parts it cuts off their middle
 _DAMPING = 1e-3  # initial Levenberg-Marquardt damping (relative to each factor's own curvature)
+# A step from further than this (the largest |log m_T - log target|) is measured by following the girth sections'
+# structure (core.measure.followed_measurements), as it is rarely the last; a step from nearer, exactly.
+_FOLLOW_ABOVE = 1e-3
 _GIRTH_KNOT = {"Hi": 1, "Wa": 2, "Br": 3}
 _INDEX = {key: i for i, key in enumerate(MEASUREMENTS)}
 
@@ -172,8 +176,13 @@ class Refinement:
     converged: np.ndarray  # (B,) bool: every measurement within the tolerance
 
 
+def _girth_sections(rows):
+    """The rows of the girth sections of mannequins ``rows`` in followed_measurements' structure."""
+    return (len(GIRTHS) * np.asarray(rows)[:, None] + np.arange(len(GIRTHS))).ravel()
+
+
 def refine(topology, rotation, center, semi_axes, targets, measured=None, tolerance=EXACT_TOLERANCE,
-           max_iterations=EXACT_MAX_ITERATIONS, jacobian=None, fractions=None):
+           max_iterations=EXACT_MAX_ITERATIONS, jacobian=None, fractions=None, structure=None):
     """Deform mannequins (B, n, ...) so that m_T matches ``targets`` (B, 5) cm (exact mode).
 
     Solves r(x) = log m_T(deform(exp x)) - log target = 0 for the log factors x, Levenberg-Marquardt
@@ -183,16 +192,23 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
     forward-difference Jacobian if a mannequin is slow to converge. The result is never further from
     the request than the IDW mannequin it starts from. All batched; mannequins already within
     ``tolerance`` are returned unchanged. ``fractions``: the section heights m_T measures at (the reference
-    set's; default SECTION_FRACTIONS).
+    set's; default SECTION_FRACTIONS). ``measured`` and ``structure``: m_T of the start and where its girth
+    sections' outermost pieces change (``core.measure.followed_measurements``), when the caller has them.
+
+    The steps far from the target are measured by following the girth sections' structure from the step before
+    (cheaper; exact as long as no hidden piece surfaces); whatever a mannequin's last measurement, the one
+    returned, and the convergence it shows, is m_T's.
     """
     girth = topology.girth_mask
     targets = np.atleast_2d(np.asarray(targets, dtype=float))
-    if measured is None:
-        measured = tailor_measurements(rotation, center, semi_axes, girth, fractions)
+    if structure is None:
+        start, structure = followed_measurements(rotation, center, semi_axes, girth, fractions)
+        measured = start if measured is None else measured
     basis = _deform_basis(topology, rotation, center, semi_axes, measured, fractions)
     count = len(MEASUREMENTS)
     x = np.zeros((len(targets), count))
     current = measured.copy()
+    exact = np.ones(len(targets), dtype=bool)  # current[b] is m_T's, not a followed measurement
     residual = np.log(np.maximum(current, 1e-12) / targets)
     if jacobian is None:
         jacobian = np.zeros((len(targets), count, count))
@@ -208,15 +224,24 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
     lo, hi = np.log(FACTOR_LIMITS)
     eye = np.eye(count)
     iterations = 0
-    for _ in range(max_iterations):
+    while True:
         todo = np.nonzero((np.abs(residual) * free).max(axis=1) > tolerance)[0]
-        if not len(todo):
-            break
+        if not len(todo) or iterations == max_iterations:
+            # Done as far as the last measurements tell: those that followed a structure are measured now.
+            unsure = np.nonzero(~exact)[0]
+            if not len(unsure):
+                break
+            current[unsure] = tailor_measurements(rotation[unsure], out_center[unsure], out_semi[unsure], girth,
+                                                  basis.fractions)
+            residual[unsure] = np.log(np.maximum(current[unsure], 1e-12) / targets[unsure])
+            exact[unsure] = True
+            continue
         iterations += 1
         stale = todo[(age[todo] < 0) | (age[todo] >= _JACOBIAN_REFRESH)]
         if len(stale):
             jacobian[stale] = _fd_jacobian(basis, rows=stale, rotation=rotation, center=center, semi_axes=semi_axes,
-                                           x=x, base=np.log(np.maximum(current[stale], 1e-12)), girth=girth)
+                                           x=x, base=np.log(np.maximum(current[stale], 1e-12)), girth=girth,
+                                           structure=structure.take(_girth_sections(stale)))
             age[stale] = 0
         j = jacobian[todo]
         mask = free[todo]
@@ -229,7 +254,15 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
         wanted = x[todo] + np.clip(step, -_MAX_STEP, _MAX_STEP)
         new_x = np.clip(wanted, lo, hi)
         c, d = deform(basis.take(todo), center[todo], semi_axes[todo], np.exp(new_x))
-        m = tailor_measurements(rotation[todo], c, d, girth, basis.fractions)
+        follow = np.abs(residual[todo]).max(axis=1) > _FOLLOW_ABOVE
+        m = np.empty((len(todo), count))
+        found = [None, None]
+        for followed in (False, True):
+            rows = np.nonzero(follow == followed)[0]
+            if len(rows):
+                warm = structure.take(_girth_sections(todo[rows])) if followed else None
+                m[rows], found[followed] = followed_measurements(rotation[todo[rows]], c[rows], d[rows], girth,
+                                                                 basis.fractions, warm=warm)
         new_residual = np.log(np.maximum(m, 1e-12) / targets[todo])
         # Broyden: the secant of this step corrects the Jacobian along the step, kept or not.
         dx = new_x - x[todo]
@@ -243,6 +276,13 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
         keep = todo[better]
         x[keep], residual[keep], current[keep] = new_x[better], new_residual[better], m[better]
         out_center[keep], out_semi[keep] = c[better], d[better]
+        exact[keep] = ~follow[better]
+        for followed in (False, True):
+            rows = np.nonzero(follow == followed)[0]
+            kept = better[rows]
+            if kept.any():
+                structure = structure.replaced(_girth_sections(todo[rows][kept]),
+                                               found[followed].take(_girth_sections(np.nonzero(kept)[0])))
         free[keep] &= new_x[better] == wanted[better]
     converged = np.abs(residual).max(axis=1) <= tolerance
     return Refinement(out_center, out_semi, current, np.exp(x), iterations, converged)
@@ -277,12 +317,18 @@ def _solve_positive(system, rhs):
     return x
 
 
-def _fd_jacobian(basis, rows, rotation, center, semi_axes, x, base, girth):
-    """d log m_T / d log factor (T, measurement, factor) by forward differences at x[rows]."""
+def _fd_jacobian(basis, rows, rotation, center, semi_axes, x, base, girth, structure=None):
+    """d log m_T / d log factor (T, measurement, factor) by forward differences at x[rows]; with ``structure`` (of
+    the mannequins ``rows`` at x) the probes' girths follow it."""
     count = len(MEASUREMENTS)
     probes = np.concatenate([x[rows] + _FD_STEP * np.eye(count)[j] for j in range(count)])
     c, d = deform(basis.take(rows).tile(count), np.tile(center[rows], (count, 1, 1)),
                   np.tile(semi_axes[rows], (count, 1, 1)), np.exp(probes))
-    m = tailor_measurements(np.tile(rotation[rows], (count, 1, 1, 1)), c, d, girth, basis.fractions)
+    tiled = np.tile(rotation[rows], (count, 1, 1, 1))
+    if structure is None:
+        m = tailor_measurements(tiled, c, d, girth, basis.fractions)
+    else:
+        m = followed_measurements(tiled, c, d, girth, basis.fractions,
+                                  warm=HullStructure.concatenate([structure] * count))[0]
     m = np.log(np.maximum(m, 1e-12)).reshape(count, len(rows), count)
     return np.moveaxis((m - base[None]) / _FD_STEP, 0, -1)

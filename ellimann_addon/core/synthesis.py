@@ -56,7 +56,7 @@ from .errors import ElliMannError, MannequinError
 from .idw import idw_weights, interpolate
 from .joints import anchor_indices, follow_pieces, interpolate_joints
 from .mannequin import Mannequin
-from .measure import as_dict, tailor_measurements
+from .measure import as_dict, followed_measurements, tailor_measurements
 from .options import (
     DEFAULT_NORMALIZE,
     DEFAULT_POWER,
@@ -158,13 +158,16 @@ def synthesize_batch(reference, requests, options=None, *, measure=True, toleran
     joints = interpolate_joints(reference, requests, options.metric, options.power, options.normalize)
     girth = reference.topology.girth_mask
     fractions = reference.section_fractions
-    measured = (tailor_measurements(rotation, center, semi_axes, girth, fractions) if (measure or mode == "exact")
-                else None)
+    measured, structure = None, None
+    if mode == "exact":  # the start's girth sections' structure too, for the refinement's steps to follow
+        measured, structure = followed_measurements(rotation, center, semi_axes, girth, fractions)
+    elif measure:
+        measured = tailor_measurements(rotation, center, semi_axes, girth, fractions)
     factors = np.ones_like(requests)
     converged = np.ones(len(requests), dtype=bool)
     if mode == "exact":
         result = refine(reference.topology, rotation, center, semi_axes, requests, measured, tolerance,
-                        jacobian=reference.refine_jacobian(), fractions=fractions)
+                        jacobian=reference.refine_jacobian(), fractions=fractions, structure=structure)
         if joints is not None:  # the joints move with their anchor pieces
             joints = follow_pieces(joints, anchor_indices(reference.topology), (rotation, center, semi_axes),
                                    (rotation, result.center, result.semi_axes))

@@ -294,3 +294,61 @@ def test_two_mirrored_circles_give_the_stadium(d):
     r = 0.15
     k = np.eye(2) * r * r
     assert perimeter([(d / 2, 0.1), (-d / 2, 0.1)], [k, k]) == pytest.approx(2 * np.pi * r + 2 * d, rel=1e-14)
+
+
+def _moved_grid_sections(scale_x=1.01, scale_y=0.995):
+    """The girth sections of a few random bodies (full circle) and of the same sections symmetrised (half), then moved
+    a little (a horizontal scaling, as a refinement step does)."""
+    rng = np.random.default_rng(21)
+    r, c, d, g = zip(*[random_mannequin_arrays(rng, 20) for _ in range(6)])
+    r, c, d = np.stack(r), np.stack(c), np.stack(d)
+    _, _, z = measure.section_heights(r, c, d)
+    heights = np.stack([z[key] for key in ("Br", "Wa", "Hi")], axis=1)
+    centre, k, hit = measure.section_at_height(r[:, None], c[:, None], d[:, None], heights[:, :, None])
+    centre, k, active = centre.reshape(-1, 20, 2), k.reshape(-1, 20, 2, 2), (hit & g[0]).reshape(-1, 20)
+    flip = np.array([[1.0, -1.0], [-1.0, 1.0]])
+    # the same sections padded to 40 ellipses, and each with its mirror image added (measured on the right half)
+    centre = np.concatenate([np.concatenate([centre, centre], axis=1),
+                             np.concatenate([centre, centre * (-1, 1)], axis=1)])
+    k = np.concatenate([np.concatenate([k, k], axis=1), np.concatenate([k, k * flip], axis=1)])
+    active = np.concatenate([np.concatenate([active, np.zeros_like(active)], axis=1),
+                             np.concatenate([active, active], axis=1)])
+    scale = np.array([scale_x, scale_y])
+    return (centre, k, active), (centre * scale, k * scale[:, None] * scale[None, :], active)
+
+
+def test_followed_sections_give_the_searched_perimeters():
+    """hull_perimeter(warm=structure) solves the kinks again from where they were instead of searching: after a
+    small move it gives the perimeters a search gives, and the same structure; one section alone gives the bits it
+    gives in the batch."""
+    from ellimann_addon.core import hull
+    before, after = _moved_grid_sections()
+    _, structure = measure.hull_perimeter(*before, structure=True)
+    half = len(structure.mirrored) // 2
+    np.testing.assert_array_equal(structure.mirrored, (np.arange(2 * half) >= half) & before[2].any(axis=1))
+    assert len(structure.kink_theta)
+    searched, found = measure.hull_perimeter(*after, structure=True)
+    followed, moved = measure.hull_perimeter(*after, warm=structure, structure=True)
+    np.testing.assert_allclose(followed, searched, rtol=1e-14)
+    np.testing.assert_array_equal(moved.kink_section, found.kink_section)
+    np.testing.assert_array_equal(moved.kink_after, found.kink_after)
+    np.testing.assert_allclose(moved.kink_theta, found.kink_theta, atol=1e-12)
+    for i in (0, 5, len(followed) - 1):
+        one = measure.hull_perimeter(*(a[i:i + 1] for a in after), warm=structure.take([i]))
+        assert one[0] == followed[i]
+    assert isinstance(structure.take([0]), hull.HullStructure)
+
+
+def test_a_structure_that_no_longer_holds_is_searched_again():
+    """Kinks that swap, a structure from other sections, an outermost ellipse no longer cut: the section is measured
+    by the search (the same perimeters)."""
+    before, after = _moved_grid_sections()
+    searched = measure.hull_perimeter(*after)
+    _, structure = measure.hull_perimeter(*before, structure=True)
+    reversed_rows = structure.take(np.arange(len(structure.first))[::-1])  # every section another's structure
+    np.testing.assert_allclose(measure.hull_perimeter(*after, warm=reversed_rows), searched, rtol=1e-14)
+    centre, k, active = after
+    cut = active.copy()
+    cut[np.arange(len(cut)), np.maximum(structure.first, 0)] = False  # the first outermost ellipse gone
+    np.testing.assert_allclose(measure.hull_perimeter(centre, k, cut, warm=structure),
+                               measure.hull_perimeter(centre, k, cut), rtol=1e-14)
