@@ -4,9 +4,11 @@ P = integral_0^2pi max_i h_i(theta) dtheta, h_i the ellipses' support functions,
 The angles where the maximising ellipse changes (the kinks of max_i h_i) are found from a grid of directions:
 a cell is cleared of an ellipse hidden between its ends by a bound on how far one can rise above the
 outermost (:func:`_may_surface`); where the outermost changes, the kink is solved by Newton (:func:`_kinks`);
-whatever the bound cannot clear is sampled finer (:func:`_scan`). Each smooth piece is integrated: the linear
-part of the support in closed form, the root by Gauss-Legendre with as many nodes as an error bound asks
-(:func:`_gauss_orders`). m_T (``core.measure``) measures its girths with it.
+whatever the bound cannot clear is sampled finer (:func:`_scan`). Each smooth piece, one ellipse's support between
+two kinks, is integrated in closed form: the linear part directly, the root by the elliptic integral of the second
+kind (:func:`_integrate`, Carlson's duplication). A section symmetric about x = 0 is integrated over its right half
+(:func:`_right_half`); one measured a moment ago can follow its kinks instead of searching (``warm``). m_T
+(``core.measure``) measures its girths with it.
 """
 
 from dataclasses import dataclass
@@ -14,8 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 CELLS = 32  # grid directions over the circle, which find the outermost ellipses and cut the quadrature's pieces
-GAUSS_ORDERS = (8, 12, 16, 24)  # Gauss-Legendre nodes per piece: the fewest that _gauss_orders' bound allows
-QUADRATURE_TOLERANCE = 1e-16  # that bound on the quadrature's error, relative to the perimeter
+DUPLICATIONS = 8  # Carlson's duplication steps for the elliptic integrals (7 reach rounding; one to spare)
 NEWTON_STEPS = 8  # from a secant start across a whole grid cell ...
 NEWTON_DONE = 1e-13  # ... until a kink moves less than this (radians)
 KINK_TOLERANCE = 1e-10  # |h_0 - h_1| at a kink found, relative to the ellipses' size (else: sampled finer)
@@ -120,13 +121,6 @@ class _Arc:
         self.directions = (c, s, c * c, c * s, s * s)  # at the cells' ends, (cells + 1,) each
         self.cell_start = grid[:-1]
         self.cell_width = grid[1:] - grid[:-1]
-        self.cell_half = 0.5 * self.cell_width
-        self.cell_ends = (c[:-1], s[:-1], c[1:], s[1:])  # each cell's start and end
-        middle = self.cell_start + self.cell_half
-        self.rules = {}  # nodes: a Gauss-Legendre rule on [-1, 1] and its nodes' directions in every cell
-        for nodes in GAUSS_ORDERS:
-            rule, weights = np.polynomial.legendre.leggauss(nodes)
-            self.rules[nodes] = (rule, weights, _directions(middle[:, None] + self.cell_half[:, None] * rule))
 
 
 _FULL = _Arc(0.0, CELLS, 1)
@@ -308,21 +302,9 @@ def _warm_perimeter(centre, k, used, mirrored, warm):
         renumber[chosen] = np.arange(len(chosen))
         take = renumber[sec] >= 0
         part_sec, part_theta, part_after = renumber[sec[take]], theta[take], after[take]
-        cell_winner = _cell_winners(warm.first[chosen], part_sec, part_theta, part_after, arc)
-        perimeter[chosen] = _integrate(_Coefficients(centre[chosen], k[chosen]), used[chosen], arc, cell_winner,
+        perimeter[chosen] = _integrate(_Coefficients(centre[chosen], k[chosen]), used[chosen], arc, warm.first[chosen],
                                        part_theta, part_sec, part_after)
     return ~ok, perimeter, (warm.first, sec, theta, after)
-
-
-def _cell_winners(first, sec, theta, after, arc):
-    """The outermost ellipse at each cell's start (S, cells) from the kinks (sorted by section, then angle): after
-    the last kink before it, else ``first``. A kink at a cell's very start comes after it (as in :func:`_cuts`)."""
-    marker = np.full((len(first), arc.cells + 1), -1)
-    np.maximum.at(marker, (sec, np.searchsorted(arc.cell_start, theta, side="right")), np.arange(len(sec)))
-    last = np.maximum.accumulate(marker, axis=1)[:, :arc.cells]
-    if not len(after):
-        return np.repeat(first[:, None], arc.cells, axis=1)
-    return np.where(last >= 0, after[np.maximum(last, 0)], first[:, None])
 
 
 def _right_half(centre, k, active):
@@ -382,46 +364,73 @@ def _arc_perimeter(centre, k, active, arc):
     theta, sec, after = (np.concatenate(column) for column in zip(*kinks))
 
     first = np.where(active.any(axis=1), winner[:, 0], -1)
-    return _integrate(coefficients, active, arc, cell_winner, theta, sec, after), first, theta, sec, after
+    return _integrate(coefficients, active, arc, first, theta, sec, after), first, theta, sec, after
 
 
-def _integrate(coefficients, active, arc, cell_winner, theta, sec, after):
-    """The perimeter of each section from its outermost ellipse at every cell's start (S, cells) and its kinks
-    (angle, section, the ellipse outermost after it)."""
-    sections = cell_winner.shape[0]
-    # 4. Cut the arc at the kinks and at its cells; integrate each piece's outermost ellipse: the linear part of its
-    #    support in closed form, the root by Gauss-Legendre. A piece between two cells' cuts (no kink inside) is a
-    #    whole cell: its outermost ellipse is the grid's in the cell, and every section's cells are integrated at
-    #    once from a table of the nodes' directions (the integrals of cells that a kink splits are not used).
-    cut_theta, cut_sec, cell, cut_after = _cuts(sections, theta, sec, after, arc)
-    end, next_cell = _next_in_section(cut_sec, cut_theta, cell, arc)
-    half = 0.5 * (end - cut_theta)
-    whole = (cell >= 0) & (next_cell >= 0)
-    split = ~whole
-    # A piece from a cut at a cell's start has the grid's outermost ellipse there, one from a kink the ellipse
-    # outermost after it.
-    piece_winner = np.where(cell >= 0, cell_winner[cut_sec, np.maximum(cell, 0)], cut_after)
-    order = _gauss_orders(coefficients, active, arc)  # (S,)
-    piece = np.empty(len(cut_sec))
-    for nodes in np.unique(order):
-        rule, weights, directions = arc.rules[nodes]
-        rows = np.nonzero(order == nodes)[0]
-        cells = (rows[:, None], cell_winner[rows])
-        cell_root = _weighted_sum(coefficients.root((rows[:, None, None], cells[1][..., None]), *directions), weights)
-        cell_integral = arc.cell_half * cell_root + coefficients.centre_integral(cells, *arc.cell_ends)
-        mine = order[cut_sec] == nodes
-        pick = whole & mine
-        piece[pick] = cell_integral[np.searchsorted(rows, cut_sec[pick]), cell[pick]]
-        pick = np.nonzero(split & mine)[0]
-        at = (cut_theta[pick] + half[pick])[:, None] + half[pick, None] * rule
-        index = (cut_sec[pick], piece_winner[pick])
-        root = _weighted_sum(coefficients.root((index[0][:, None], index[1][:, None]), np.cos(at), np.sin(at)),
-                             weights)
-        low, high = cut_theta[pick], end[pick]
-        piece[pick] = half[pick] * root + coefficients.centre_integral(index, np.cos(low), np.sin(low),
-                                                                       np.cos(high), np.sin(high))
-    piece = np.where(active[cut_sec, piece_winner], piece, 0.0)
-    return arc.copies * np.bincount(cut_sec, weights=piece, minlength=sections)
+def _integrate(coefficients, active, arc, first, theta, sec, after):
+    """The perimeter of each section from its outermost ellipse at the arc's start (S,) and its kinks (angle,
+    section, the ellipse outermost after it): each piece between them is its ellipse's support integrated in closed
+    form, the linear part and the root, sqrt(q) = sqrt(alpha + beta) sqrt(1 - m sin^2(theta - phi)) with
+    alpha +- beta the squared semi-axes and m = 2 beta / (alpha + beta), by the elliptic integral E
+    (:func:`_elliptic_e`)."""
+    sections = len(first)
+    # Each piece from its start (the arc's, or a kink; the arc's first where they coincide) to the next.
+    sec, start, winner = _sorted_kinks(np.concatenate([np.arange(sections), sec]),
+                                       np.concatenate([np.full(sections, arc.cell_start[0]), theta]),
+                                       np.concatenate([first, after]))
+    last = np.ones(len(sec), dtype=bool)
+    last[:-1] = sec[1:] != sec[:-1]
+    end = np.where(last, arc.end, np.roll(start, -1))
+    index = (sec, np.maximum(winner, 0))
+    a, b, d = coefficients.a[index], coefficients.b[index], coefficients.d[index]
+    alpha, spread, turn = 0.5 * (a + d), 0.5 * (a - d), 0.5 * b
+    beta = np.sqrt(spread * spread + turn * turn)
+    phase = 0.5 * np.arctan2(turn, spread)
+    top = alpha + beta
+    m = np.divide(2.0 * beta, top, out=np.zeros_like(top), where=top > 0.0)
+    e = _elliptic_e(np.concatenate([start - phase, end - phase]), np.concatenate([m, m]))
+    root = np.sqrt(top) * (e[len(m):] - e[:len(m)])
+    linear = coefficients.centre_integral(index, np.cos(start), np.sin(start), np.cos(end), np.sin(end))
+    piece = np.where((winner >= 0) & active[index], root + linear, 0.0)
+    return arc.copies * np.bincount(sec, weights=piece, minlength=sections)
+
+
+def _elliptic_e(u, m):
+    """The incomplete elliptic integral of the second kind E(u | m) = integral_0^u sqrt(1 - m sin^2 t) dt for any
+    real u, 0 <= m < 1: E(k pi + r) = 2 k E(m) + E(r) with |r| <= pi / 2, E(r) = sin r R_F(cos^2 r, 1 - m sin^2 r, 1)
+    - m/3 sin^3 r R_D(cos^2 r, 1 - m sin^2 r, 1) and the complete E(m) with r = pi / 2 (Carlson 1995, eq. 4.5)."""
+    turns = np.round(u / np.pi)
+    r = u - turns * np.pi
+    s, c = np.sin(r), np.cos(r)
+    count = len(u)
+    rf, rd = _carlson(np.concatenate([c * c, np.zeros(count)]), np.concatenate([1.0 - m * s * s, 1.0 - m]))
+    complete = rf[count:] - m / 3.0 * rd[count:]
+    return s * rf[:count] - m / 3.0 * s * s * s * rd[:count] + 2.0 * turns * complete
+
+
+def _carlson(x, y):
+    """Carlson's symmetric integrals R_F(x, y, 1) and R_D(x, y, 1), by DUPLICATIONS duplication steps (each shrinks
+    the arguments' spread fourfold) and the series of Carlson 1995 (eqs. 2.7, 2.29): the same iterates serve both."""
+    z = np.ones_like(x)
+    total, scale = np.zeros_like(x), np.ones_like(x)
+    for _ in range(DUPLICATIONS):
+        sx, sy, sz = np.sqrt(x), np.sqrt(y), np.sqrt(z)
+        lam = sx * (sy + sz) + sy * sz
+        total += scale / (sz * (z + lam))
+        scale *= 0.25
+        x, y, z = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam)
+    mean = (x + y + z) / 3.0
+    dx, dy, dz = 1.0 - x / mean, 1.0 - y / mean, 1.0 - z / mean
+    e2, e3 = dx * dy - dz * dz, dx * dy * dz
+    rf = (1.0 + (e2 / 24.0 - 0.1 - 3.0 / 44.0 * e3) * e2 + e3 / 14.0) / np.sqrt(mean)
+    mean = 0.2 * (x + y + 3.0 * z)
+    dx, dy, dz = (mean - x) / mean, (mean - y) / mean, (mean - z) / mean
+    ea, eb = dx * dy, dz * dz
+    ec, ed = ea - eb, ea - 6.0 * eb
+    ee = ed + 2.0 * ec
+    series = (1.0 + ed * (-3.0 / 14.0 + 9.0 / 88.0 * ed - 9.0 / 52.0 * dz * ee)
+              + dz * (ee / 6.0 + dz * (-9.0 / 22.0 * ec + 3.0 / 26.0 * dz * ea)))
+    return rf, 3.0 * total + scale * series / (mean * np.sqrt(mean))
 
 
 def _scan(coefficients, active, radii, sec, start, width, samples, ends):
@@ -520,69 +529,6 @@ def _newton(coefficients, index, theta, lo, hi):
         if not len(todo):
             break
     return theta
-
-
-def _gauss_orders(coefficients, active, arc):
-    """Gauss-Legendre nodes per piece for each section (S,): the fewest of GAUSS_ORDERS whose error bound, for
-    every active ellipse, is within QUADRATURE_TOLERANCE of the perimeter (else the most).
-
-    The root integrated, sqrt(alpha + beta cos 2(theta - phi)), is analytic up to |Im theta| = y0 =
-    acosh(alpha / beta) / 2 (alpha +- beta the squared semi-axes); in the Bernstein ellipse of a cell (half-width
-    h) reaching 0.9 y0, rho = t + sqrt(1 + t^2) with t = 0.9 y0 / h, it is at most sqrt(2 alpha), so n nodes
-    err by at most h 64/15 sqrt(2 alpha) rho^-2n / (rho^2 - 1) per cell (Trefethen, Approximation Theory and
-    Approximation Practice, Thm 19.3), and the arc's cells count ``copies`` times; a piece split by a kink is
-    shorter and errs less. The perimeter is at least the ellipse's, 4 sqrt(alpha + beta)."""
-    alpha = 0.5 * (coefficients.a + coefficients.d)
-    beta = np.sqrt(0.25 * (coefficients.a - coefficients.d) ** 2 + 0.25 * coefficients.b**2)
-    half = 0.5 * arc.step
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # circles (beta 0), inactive ellipses
-        reach = 0.45 * np.arccosh(np.maximum(alpha / beta, 1.0)) / half
-        rho = reach + np.sqrt(1.0 + reach * reach)
-        allowed = QUADRATURE_TOLERANCE * 4.0 * np.sqrt(alpha + beta) / (arc.copies * arc.cells * half * 64.0 / 15.0
-                                                                         * np.sqrt(2.0 * alpha))
-        fails = sum((rho ** (-2.0 * n) / (rho * rho - 1.0) > allowed) | ~np.isfinite(allowed) for n in GAUSS_ORDERS)
-    need = np.where(active, np.minimum(fails, len(GAUSS_ORDERS) - 1), 0)
-    return np.asarray(GAUSS_ORDERS)[need.max(axis=1)]
-
-
-def _cuts(sections, theta, sec, after, arc):
-    """The cells of every section's arc and the kinks (theta, sec, the ellipse outermost after each), sorted by
-    (section, angle), a cell before a kink at the same angle: (theta, sec, cell index or -1 for a kink, the
-    ellipse after a kink or -1 for a cell) of every cut. Only the kinks are sorted; the cells are merged in."""
-    order = np.lexsort((theta, sec))
-    theta, sec, after = theta[order], sec[order], after[order]
-    # A kink goes after the cells of the sections before it, the cells of its own section up to its angle
-    # and the kinks sorted before it.
-    cells = arc.cells
-    kink_at = sec * cells + np.searchsorted(arc.cell_start, theta, side="right") + np.arange(len(theta))
-    total = sections * cells + len(theta)
-    is_cell = np.ones(total, dtype=bool)
-    is_cell[kink_at] = False
-    cut_theta, cut_sec, cell = np.empty(total), np.empty(total, dtype=np.int64), np.full(total, -1)
-    cut_theta[kink_at], cut_sec[kink_at] = theta, sec
-    cut_theta[is_cell], cut_sec[is_cell] = np.tile(arc.cell_start, sections), np.repeat(np.arange(sections), cells)
-    cell[is_cell] = np.tile(np.arange(cells), sections)
-    cut_after = np.full(total, -1)
-    cut_after[kink_at] = after
-    return cut_theta, cut_sec, cell, cut_after
-
-
-def _next_in_section(sec, theta, value, arc):
-    """For rows sorted by (sec, theta): the next row's theta and value; after a section's last row, the arc's end
-    (and the cell count: the end of a cell)."""
-    nxt = np.minimum(np.arange(1, len(sec) + 1), len(sec) - 1)
-    last = np.ones(len(sec), dtype=bool)
-    last[:-1] = sec[1:] != sec[:-1]
-    return np.where(last, arc.end, theta[nxt]), np.where(last, arc.cells, value[nxt])
-
-
-def _weighted_sum(values, weights):
-    """values (..., q) @ weights (q,), summed in a fixed order: the same bits for a row whatever the batch (a
-    matrix product's summation order depends on the array's size and alignment)."""
-    total = values[..., 0] * weights[0]
-    for j in range(1, len(weights)):
-        total += values[..., j] * weights[j]
-    return total
 
 
 def hull_boundary(centre, k, active, samples=256):
