@@ -352,3 +352,17 @@ def test_a_structure_that_no_longer_holds_is_searched_again():
     cut[np.arange(len(cut)), np.maximum(structure.first, 0)] = False  # the first outermost ellipse gone
     np.testing.assert_allclose(measure.hull_perimeter(centre, k, cut, warm=structure),
                                measure.hull_perimeter(centre, k, cut), rtol=1e-14)
+
+
+def test_the_elliptic_integral_of_the_pieces_matches_scipys_for_any_angle():
+    """core.hull._elliptic_e, E(u | m) for any real u (whole turns of pi add twice the complete integral), against
+    scipy.special.ellipeinc, up to aspect ratios of 100 (m = 1 - 1e-4)."""
+    from scipy.special import ellipeinc
+
+    from ellimann_addon.core import hull
+    rng = np.random.default_rng(4)
+    m = np.concatenate([rng.uniform(0.0, 1.0, 4000), 1.0 - 10.0 ** rng.uniform(-4, -1, 1000), [0.0, 0.0]])
+    u = np.concatenate([rng.uniform(-np.pi, 2.5 * np.pi, len(m) - 2), [np.pi / 2, -np.pi]])
+    np.testing.assert_allclose(hull._elliptic_e(u, m), ellipeinc(u, m), rtol=0, atol=3e-14)
+    sharp = m < 1.0 - 1.0 / 150.0  # aspect below about 12
+    np.testing.assert_allclose(hull._elliptic_e(u[sharp], m[sharp]), ellipeinc(u[sharp], m[sharp]), rtol=0, atol=1e-14)
