@@ -23,6 +23,7 @@ KINK_TOLERANCE = 1e-10  # |h_0 - h_1| at a kink found, relative to the ellipses'
 REFINE_FACTOR = 8  # a grid cell in doubt is sampled this many times finer, ...
 REFINE_LEVELS = 3  # ... at most this many times
 _GROUP_MIN_SECTIONS = 64  # from this many sections, those with fewer ellipses are measured apart (less padding)
+_PAIRED_WIDTH = 12  # wider sections are compacted before their columns are compared pairwise
 
 
 def _quadratic_form(k, c, s):
@@ -217,10 +218,12 @@ def hull_perimeter(centre, k, active, warm=None, structure=False):
     if sections == 0 or centre.shape[1] == 0:
         return (out, _empty_structure(sections)) if structure else out
     kinks = [(np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(0, dtype=np.int64))]  # section, angle, after
-    centre, k, active, columns = _compact(centre, k, active)
+    given = np.broadcast_to(np.arange(centre.shape[1]), active.shape)
+    if centre.shape[1] > _PAIRED_WIDTH:  # _right_half compares every pair of columns: the unused ones go first
+        centre, k, active, given = _compact(centre, k, active)
     mirrored, used = _right_half(centre, k, active)
-    centre, k, used, kept = _compact(centre, k, used)
-    columns = np.take_along_axis(columns, kept, axis=1)
+    centre, k, used, columns = _compact(centre, k, used)
+    columns = np.take_along_axis(given, columns, axis=1)
     cold = np.ones(sections, dtype=bool)
     if warm is not None:
         cold, perimeter, (warm_first, sec, theta, after) = _warm_perimeter(centre, k, used, mirrored,
@@ -234,10 +237,11 @@ def hull_perimeter(centre, k, active, warm=None, structure=False):
     for key in np.unique(group[cold]):
         rows = np.nonzero(cold & (group == key))[0]
         arc = _RIGHT_HALF if mirrored[rows[0]] else _FULL
-        group_centre, group_k, group_used, group_columns = _compact(centre[rows], k[rows], used[rows])
-        out[rows], group_first, theta, sec, after = _arc_perimeter(group_centre, group_k, group_used, arc)
-        first[rows] = np.where(group_first >= 0, group_columns[np.arange(len(rows)), np.maximum(group_first, 0)], -1)
-        kinks.append((rows[sec], theta, group_columns[sec, after]))
+        width = max(int(count[rows].max()), 1)  # the sections' ellipses are in front: narrower groups drop the rest
+        out[rows], group_first, theta, sec, after = _arc_perimeter(centre[rows, :width], k[rows, :width],
+                                                                   used[rows, :width], arc)
+        first[rows] = group_first
+        kinks.append((rows[sec], theta, after))
     if not structure:
         return out
     sec, theta, after = _sorted_kinks(*(np.concatenate(column) for column in zip(*kinks)))
