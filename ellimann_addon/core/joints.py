@@ -149,10 +149,11 @@ def follow_pieces(joints, anchors, before, after):
             + r1[..., 2] * scaled[..., 2, None])
 
 
-def interpolate_joints(reference, requests, metric, power, normalize):
+def interpolate_joints(reference, requests, metric, power, normalize, weights=None):
     """(B, 24, 3) joints of synthesized mannequins, or None if some Reference Mannequin has none: each left and
     central joint with its anchor part's IDW weights and proportional scales (as that part's centre), the right
-    joints their mirror images. At an RM's measurements, that RM's joints."""
+    joints their mirror images. At an RM's measurements, that RM's joints. ``weights``: the requests'
+    ``idw.idw_weights`` (same metric and power) when they are at hand, e.g. shared with the pieces'."""
     if reference.joints is None:
         return None
     from .idw import _center_scale, idw_weights
@@ -166,7 +167,9 @@ def interpolate_joints(reference, requests, metric, power, normalize):
         raise MannequinError([Problem(JOINT_ANCHORS[missing[0]], "joints", "anchor of a left or central joint "
                                       "must be a left or central part")])
     slots = np.array([source[int(anchors[j])] for j in own])
-    weights = idw_weights(reference, requests, metric, power)[:, slots]  # (B, J, k)
+    if weights is None:
+        weights = idw_weights(reference, requests, metric, power)
+    weights = weights[:, slots]  # (B, J, k)
     rm_joints = reference.joints[:, own]  # (k, J, 3)
     if normalize != "none":
         horizontal, vertical = reference.size_scales(reference.measurements, normalize)  # (k, s)

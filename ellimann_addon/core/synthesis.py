@@ -154,8 +154,10 @@ def synthesize_batch(reference, requests, options=None, *, measure=True, toleran
     options = options_of(options, **fields).checked()
     mode = options.mode
     requests = validate_requests(requests, reference.ranges, reference.absurd_limits)
-    rotation, center, semi_axes = interpolate(reference, requests, options.metric, options.power, options.normalize)
-    joints = interpolate_joints(reference, requests, options.metric, options.power, options.normalize)
+    weights = idw_weights(reference, requests, options.metric, options.power)  # for the pieces and the joints alike
+    rotation, center, semi_axes = interpolate(reference, requests, options.metric, options.power, options.normalize,
+                                              weights)
+    joints = interpolate_joints(reference, requests, options.metric, options.power, options.normalize, weights)
     girth = reference.topology.girth_mask
     fractions = reference.section_fractions
     measured = (tailor_measurements(rotation, center, semi_axes, girth, fractions) if (measure or mode == "exact")

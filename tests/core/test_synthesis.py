@@ -325,6 +325,42 @@ def test_missing_unknown_and_short_requests_are_refused():
     assert info.value.field == "Br"
 
 
+def _row_by_row(requests, limits=None):
+    """The batch check as validate_request on every row in turn: the first bad row's message, with its row."""
+    for row, values in enumerate(np.asarray(requests, dtype=float)):
+        try:
+            synthesis.validate_request([float(v) for v in values], None, limits)
+        except MeasurementError as error:
+            return error.field, f"{error.field}: row {row}: {str(error).partition(': ')[2]}"
+    return None
+
+
+@pytest.mark.parametrize("limits", [None, {**ABSURD_LIMITS, "He": (100.0, 200.0), "Hi": (60.0, 160.0)},
+                                    {**ABSURD_LIMITS, "Sh": (-10.0, 100.0)}])  # > 0 whatever the limits
+def test_a_batch_is_refused_at_its_first_bad_row_and_field_as_row_by_row(limits):
+    good = list(GOOD.values())
+    bad_values = [float("nan"), float("inf"), -float("inf"), -1.0, 0.0, -0.0, 1e-300, 2.0, 5.0, 300.0, 1e308]
+    for field, value, row in itertools.product(range(5), bad_values, range(3)):
+        requests = np.array([good] * 4)
+        requests[row, field] = value
+        requests[3, (field + 1) % 5] = -5.0  # a later bad row does not take the message
+        if row == 1:
+            requests[1, (field + 3) % 5] = 1e4  # nor does a later bad field of the same row, if that is later
+        expected = _row_by_row(requests, limits)
+        with pytest.raises(MeasurementError) as info:
+            synthesis.validate_requests(requests, None, limits)
+        assert (info.value.field, str(info.value)) == expected
+    with pytest.raises(MeasurementError, match=r"^Br: row 2: must be a finite number, got nan \(accepted") as info:
+        synthesis.validate_requests([good, good, [159.0, 43.0, float("nan"), 104.0, 117.0]])
+    assert info.value.field == "Br"
+    with pytest.raises(MeasurementError, match=r"^Hi: row 0: must be > 0, got -0 \(accepted range"):
+        synthesis.validate_requests([[159.0, 43.0, 117.0, 104.0, -0.0]])
+    with pytest.raises(MeasurementError, match=r"^He: row 1: 500 cm is not a plausible value \(accepted range 50-250"):
+        synthesis.validate_requests([good, [500.0, 43.0, 117.0, 104.0, 117.0]])
+    edge = [[ABSURD_LIMITS[k][0] for k in MEASUREMENTS], [ABSURD_LIMITS[k][1] for k in MEASUREMENTS]]
+    assert np.array_equal(synthesis.validate_requests(edge + [good]), edge + [good])  # the limits are accepted
+
+
 def test_values_outside_L_are_allowed_with_a_warning_saying_how_far():
     warnings = synthesis.validate_request(dict(GOOD, He=175.0, Wa=60.0))
     assert len(warnings) == 2
