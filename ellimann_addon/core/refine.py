@@ -47,6 +47,8 @@ class _DeformBasis:
     _SHARED = ("shoulder_scaled", "shoulder_carried", "fractions")  # per part or set, not per mannequin
 
     def take(self, rows):
+        if len(rows) == len(self.bottom) and np.array_equal(rows, np.arange(len(rows))):
+            return self  # every mannequin in order (deform only reads the basis)
         return _DeformBasis(**{f.name: getattr(self, f.name) if f.name in self._SHARED else getattr(self, f.name)[rows]
                                for f in fields(self)})
 
