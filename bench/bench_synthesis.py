@@ -202,6 +202,8 @@ def run():
     print(f"  exact mode costs {t_exact / t_idw:.2f}x proportional IDW, m_T {t_mt / t_idw:.2f}x (wall time; the CPU "
           f"time ratios below are steadier)")
     population_scale(reference, requests)
+    exact_parts(reference, requests)
+    exact_parts(reference, requests[121:122], repeat=30)
     one = requests[121:122]
     t_one = {}
     for name, fn in (("idw, paper", lambda: synthesis.synthesize_batch(reference, one, mode="idw", normalize="none")),
@@ -266,6 +268,68 @@ def population_scale(reference, requests, repeat=5):
     print(f"  ratios to proportional IDW (the interpolation): m_T {best['m_T, now'] / idw:.2f}x (before "
           f"{best['m_T, before'] / idw:.2f}x), exact {now / idw:.2f}x (before {before / idw:.2f}x); exact / IDW with "
           f"its m_T {now / measured:.2f}x (before {before / measured:.2f}x)")
+
+
+def exact_parts(reference, requests, repeat=5):
+    """Where exact mode's CPU time goes, part by part: each function synthesize_batch and refine call, timed where
+    it is called (time.process_time), best of ``repeat`` runs of synthesize_batch. What is neither IDW nor m_T is
+    exact mode's own overhead (issue 14 asks for exact mode at about 2x IDW at most)."""
+    from ellimann_addon.core import refine as refine_module
+
+    timed = {  # label: the (module, name) places where synthesize_batch and refine call it
+        "validate_requests": [(synthesis, "validate_requests")],
+        "IDW weights": [(synthesis, "idw_weights")],
+        "interpolate (IDW)": [(synthesis, "interpolate")],
+        "interpolate_joints": [(synthesis, "interpolate_joints")],
+        "m_T of the IDW result": [(synthesis, "tailor_measurements")],
+        "refine": [(synthesis, "refine")],
+        "  m_T in refine": [(refine_module, "tailor_measurements")],
+        "  _deform_basis": [(refine_module, "_deform_basis")],
+        "  deform": [(refine_module, "deform")],
+        "follow_pieces": [(synthesis, "follow_pieces")],
+        "check_plausible": [(synthesis, "check_plausible")],
+    }
+    spent = {}
+
+    def clocked(label, fn):
+        def run(*args, **kwargs):
+            start = time.process_time()
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                spent[label] += time.process_time() - start
+        return run
+
+    originals = [(module, name, getattr(module, name)) for places in timed.values() for module, name in places]
+    best = {}
+    reference.refine_jacobian()
+    try:
+        for label, places in timed.items():
+            for module, name in places:
+                setattr(module, name, clocked(label, getattr(module, name)))
+        for _ in range(repeat):
+            spent.update(dict.fromkeys(timed, 0.0))
+            start = time.process_time()
+            synthesis.synthesize_batch(reference, requests, mode="exact")
+            total = time.process_time() - start
+            idw = spent["IDW weights"] + spent["interpolate (IDW)"]
+            m_t = spent["m_T of the IDW result"] + spent["  m_T in refine"]
+            run = dict(spent, **{
+                "  refine's own loop": spent["refine"] - spent["  m_T in refine"] - spent["  _deform_basis"]
+                - spent["  deform"],
+                "exact mode (synthesize_batch)": total, "  IDW": idw, "  m_T": m_t,
+                "  neither IDW nor m_T": total - idw - m_t})
+            best = {k: min(v, best.get(k, float("inf"))) for k, v in run.items()}
+    finally:
+        for module, name, fn in originals:
+            setattr(module, name, fn)
+    order = list(timed)
+    order.insert(order.index("  deform") + 1, "  refine's own loop")
+    print(f"\nexact mode part by part (batch {len(requests)}; CPU ms, best of {repeat} runs, each part timed where "
+          "it is called):")
+    for label in order + ["exact mode (synthesize_batch)", "  IDW", "  m_T", "  neither IDW nor m_T"]:
+        print(f"  {label:<37}{best[label] * 1e3:8.2f} ms")
+    print(f"  exact mode besides IDW and m_T: {best['  neither IDW nor m_T'] / best['  IDW']:.2f}x IDW")
 
 
 def blender(reference, exact):

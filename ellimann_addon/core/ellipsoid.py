@@ -60,6 +60,13 @@ def bounds(rotation, center, semi_axes):
     return center - half, center + half
 
 
+def _shape_entry(r, d2, i, j):
+    """M[i, j] of the shape matrix from R and D^2, in a fixed order (a mannequin gets the same bits alone as in a
+    batch)."""
+    return r[..., i, 0] * r[..., j, 0] * d2[..., 0] + r[..., i, 1] * r[..., j, 1] * d2[..., 1] + \
+        r[..., i, 2] * r[..., j, 2] * d2[..., 2]
+
+
 def section_shape(rotation, semi_axes):
     """What every horizontal section of an ellipsoid shares: (M_zz (...), m = M[:2, 2] / M_zz (..., 2), the Schur
     complement M_xy - m m^T M_zz (..., 2, 2)), M the shape matrix, entry by entry in a fixed order (a mannequin
@@ -68,8 +75,7 @@ def section_shape(rotation, semi_axes):
     d2 = np.asarray(semi_axes, dtype=float) ** 2
 
     def entry(i, j):
-        return r[..., i, 0] * r[..., j, 0] * d2[..., 0] + r[..., i, 1] * r[..., j, 1] * d2[..., 1] + \
-            r[..., i, 2] * r[..., j, 2] * d2[..., 2]
+        return _shape_entry(r, d2, i, j)
 
     mzz = entry(2, 2)
     slope = np.stack([entry(0, 2), entry(1, 2)], axis=-1) / mzz[..., None]
@@ -95,6 +101,19 @@ def section_at_height(rotation, center, semi_axes, height, shape=None):
     centre2 = center[..., :2] + dz[..., None] * slope
     k = np.clip(shrink, 0.0, None)[..., None, None] * schur
     return centre2, k, hit
+
+
+def section_extent(rotation, center, semi_axes, height, axis):
+    """Middle and half-width along world x (``axis`` 0) or y (1) of each horizontal section z = height, and hit:
+    :func:`section_at_height`'s centre[..., axis], sqrt(K[axis, axis]) and hit, the same bits, without the rest."""
+    r = np.asarray(rotation, dtype=float)
+    d2 = np.asarray(semi_axes, dtype=float) ** 2
+    mzz = _shape_entry(r, d2, 2, 2)
+    slope = _shape_entry(r, d2, axis, 2) / mzz
+    schur = _shape_entry(r, d2, axis, axis) - slope ** 2 * mzz
+    dz = np.asarray(height) - center[..., 2]
+    shrink = 1.0 - dz * dz / mzz
+    return center[..., axis] + dz * slope, np.sqrt(np.clip(shrink, 0.0, None) * schur), shrink > 0.0
 
 
 def sample_surface(rotation, center, semi_axes, count=256):

@@ -74,15 +74,17 @@ def _axis_scale(rotation, horizontal, vertical):
     return vertical[..., None] ** v * horizontal[..., None] ** (1.0 - v)
 
 
-def interpolate(reference, requests, metric="raw", power=DEFAULT_POWER, normalize=DEFAULT_NORMALIZE):
+def interpolate(reference, requests, metric="raw", power=DEFAULT_POWER, normalize=DEFAULT_NORMALIZE, weights=None):
     """Segmented IDW for a batch (B, 5) cm -> rotation (B, n, 3, 3), center (B, n, 3), semi_axes (B, n, 3).
 
     ``normalize="none"`` is the paper's Eq. 2.1 on the RMs' geometry; "height" and "proportional"
     average the geometry divided by each RM's scales and multiply the mean by the request's
-    (module docstring). Rotations and weights are the same in all three.
+    (module docstring). Rotations and weights are the same in all three. ``weights``: the requests'
+    :func:`idw_weights` (same metric and power) when they are at hand, e.g. shared with the joints.
     """
     requests = np.atleast_2d(np.asarray(requests, dtype=float))
-    weights = idw_weights(reference, requests, metric, power)  # (B, s, k)
+    if weights is None:
+        weights = idw_weights(reference, requests, metric, power)  # (B, s, k)
     src = reference._source
     batch, n = requests.shape[0], len(reference.topology)
     rotation = np.empty((batch, n, 3, 3))

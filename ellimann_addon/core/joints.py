@@ -28,6 +28,7 @@ SECTION_VERSION = 1
 SKELETON = "smpl24"
 # A joint lies at most this far (m) outside the box of the pieces on its bone, its parent's and its children's.
 JOINT_REACH = 0.05
+_SIDES = tuple(joint_side(name) for name in JOINT_NAMES)  # 'L', 'R' or 'C' of each joint
 
 
 def joints_to_dict(joints):
@@ -113,9 +114,9 @@ def mirror_joints(joints, source="L"):
     joints on x = 0: as ``core.clean.symmetrize`` makes the pieces."""
     joints = np.array(joints, dtype=float)
     mirrored = joints[..., JOINT_TWINS, :] * np.array([-1.0, 1.0, 1.0])
-    other = [i for i, n in enumerate(JOINT_NAMES) if joint_side(n) not in ("C", source)]
+    other = [i for i, side in enumerate(_SIDES) if side not in ("C", source)]
     joints[..., other, :] = mirrored[..., other, :]
-    joints[..., [i for i, n in enumerate(JOINT_NAMES) if joint_side(n) == "C"], 0] = 0.0
+    joints[..., [i for i, side in enumerate(_SIDES) if side == "C"], 0] = 0.0
     return joints
 
 
@@ -149,10 +150,11 @@ def follow_pieces(joints, anchors, before, after):
             + r1[..., 2] * scaled[..., 2, None])
 
 
-def interpolate_joints(reference, requests, metric, power, normalize):
+def interpolate_joints(reference, requests, metric, power, normalize, weights=None):
     """(B, 24, 3) joints of synthesized mannequins, or None if some Reference Mannequin has none: each left and
     central joint with its anchor part's IDW weights and proportional scales (as that part's centre), the right
-    joints their mirror images. At an RM's measurements, that RM's joints."""
+    joints their mirror images. At an RM's measurements, that RM's joints. ``weights``: the requests'
+    ``idw.idw_weights`` (same metric and power) when they are at hand, e.g. shared with the pieces'."""
     if reference.joints is None:
         return None
     from .idw import _center_scale, idw_weights
@@ -160,20 +162,26 @@ def interpolate_joints(reference, requests, metric, power, normalize):
     topology = reference.topology
     anchors = anchor_indices(topology)
     source = {int(part): s for s, part in enumerate(reference._source)}
-    own = [j for j, n in enumerate(JOINT_NAMES) if joint_side(n) != "R"]
+    own = [j for j, side in enumerate(_SIDES) if side != "R"]
     missing = [JOINT_NAMES[j] for j in own if int(anchors[j]) not in source]
     if missing:
         raise MannequinError([Problem(JOINT_ANCHORS[missing[0]], "joints", "anchor of a left or central joint "
                                       "must be a left or central part")])
     slots = np.array([source[int(anchors[j])] for j in own])
-    weights = idw_weights(reference, requests, metric, power)[:, slots]  # (B, J, k)
+    if weights is None:
+        weights = idw_weights(reference, requests, metric, power)
+    weights = weights[:, slots]  # (B, J, k)
     rm_joints = reference.joints[:, own]  # (k, J, 3)
     if normalize != "none":
         horizontal, vertical = reference.size_scales(reference.measurements, normalize)  # (k, s)
         rm_joints = rm_joints / _center_scale(horizontal[:, slots], vertical[:, slots])
-    mean = np.zeros((len(weights), len(own), 3))
-    for k in range(len(rm_joints)):  # the weighted sum in a fixed order: a row gets the same bits in any batch
-        mean += weights[:, :, k, None] * rm_joints[k]
+    # The weighted sum in a fixed order (a row gets the same bits in any batch), over runs of J * 3 numbers.
+    each = np.repeat(np.moveaxis(weights, -1, 0), 3, axis=-1)  # (k, B, J * 3): RM k's weight of each coordinate
+    flat = rm_joints.reshape(len(rm_joints), -1)
+    mean = np.zeros(each.shape[1:])
+    for k in range(len(flat)):
+        mean += each[k] * flat[k]
+    mean = mean.reshape(len(weights), len(own), 3)
     if normalize != "none":
         horizontal, vertical = reference.size_scales(np.atleast_2d(requests), normalize)
         mean *= _center_scale(horizontal[:, slots], vertical[:, slots])

@@ -89,6 +89,9 @@ class Topology:
             raise MannequinError(problems)
         self.names = tuple(p.name for p in self.parts)
         self.index = {name: i for i, name in enumerate(self.names)}
+        # The masks, built once (synthesis asks for them on every call); the properties hand out copies.
+        self._girth = np.array([p.girth for p in self.parts], dtype=bool)
+        self._depends = np.array([[m in p.depends for m in MEASUREMENTS] for p in self.parts], dtype=bool)
 
     def __len__(self):
         return len(self.parts)
@@ -149,12 +152,12 @@ class Topology:
 
     @property
     def girth_mask(self):
-        return np.array([p.girth for p in self.parts], dtype=bool)
+        return self._girth.copy()
 
     @property
     def dependency_mask(self):
         """(n, 5) bool: which measurements each ellipsoid depends on, in MEASUREMENTS order."""
-        return np.array([[m in p.depends for m in MEASUREMENTS] for p in self.parts], dtype=bool)
+        return self._depends.copy()
 
     @property
     def twin_indices(self):

@@ -11,7 +11,7 @@ from .constants import (
     MEASUREMENTS,
     SECTION_FRACTIONS,
 )
-from .ellipsoid import axis_extent, section_at_height, section_shape
+from .ellipsoid import axis_extent, section_extent
 from .hull import HullStructure
 from .measure import followed_measurements, section_heights, tailor_measurements
 
@@ -51,6 +51,8 @@ class _DeformBasis:
     _SHARED = ("shoulder_scaled", "shoulder_carried", "fractions")  # per part or set, not per mannequin
 
     def take(self, rows):
+        if len(rows) == len(self.bottom) and np.array_equal(rows, np.arange(len(rows))):
+            return self  # every mannequin in order (deform only reads the basis)
         return _DeformBasis(**{f.name: getattr(self, f.name) if f.name in self._SHARED else getattr(self, f.name)[rows]
                                for f in fields(self)})
 
@@ -86,29 +88,29 @@ def _deform_basis(topology, rotation, center, semi_axes, measured, fractions=Non
     knots = _knots(fractions)
     bottom, height, z = section_heights(rotation, center, semi_axes, fractions)
     half_z = axis_extent(rotation, semi_axes, 2)  # (B, n)
-    span = center[..., 2, None] + half_z[..., None] * _SPAN  # (B, n, q)
-    fraction = (span - bottom[:, None, None]) / height[:, None, None]
     girth = topology.girth_mask
-    weight = np.stack([_dot(_hat(fraction, _GIRTH_KNOT[key], knots), _SPAN_WEIGHT) for key in GIRTHS], axis=-1)
-    weight = weight * girth[:, None]
+    parts = np.nonzero(girth)[0]
+    # The blend weights of the girth parts (the others have none).
+    span = center[:, parts, 2, None] + half_z[:, parts, None] * _SPAN  # (B, p, q)
+    fraction = (span - bottom[:, None, None]) / height[:, None, None]
+    weight = np.zeros(center.shape[:-1] + (len(GIRTHS),))
+    weight[:, parts] = np.stack([_dot(_hat(fraction, _GIRTH_KNOT[key], knots), _SPAN_WEIGHT) for key in GIRTHS],
+                                axis=-1)
     fraction = (center[..., 2] - bottom[:, None]) / height[:, None]
     # Each girth section's own centre in y (middle of its extent), interpolated between sections.
-    parts = np.nonzero(girth)[0]
-    shape = tuple(a[:, None] for a in section_shape(rotation[:, parts], semi_axes[:, parts]))
-    heights = np.stack([z[key] for key in GIRTHS], axis=1)[:, :, None]  # (B, 3, 1)
-    c2, k2, hit = section_at_height(rotation[:, None, parts], center[:, None, parts], semi_axes[:, None, parts],
-                                    heights, shape)
-    half = np.sqrt(k2[..., 1, 1])
-    top = np.where(hit, c2[..., 1] + half, -np.inf).max(axis=-1, initial=-np.inf)
-    low = np.where(hit, c2[..., 1] - half, np.inf).min(axis=-1, initial=np.inf)
+    sections = np.stack([z[key] for key in GIRTHS], axis=-1)  # (B, 3)
+    middle, half, hit = section_extent(rotation[:, None, parts], center[:, None, parts], semi_axes[:, None, parts],
+                                       sections[:, :, None], 1)
+    top = np.where(hit, middle + half, -np.inf).max(axis=-1, initial=-np.inf)
+    low = np.where(hit, middle - half, np.inf).min(axis=-1, initial=np.inf)
     centre_y = np.where(np.isfinite(top), 0.5 * (top + low), 0.0)  # (B, 3) in GIRTHS order: Br, Wa, Hi
     order = [GIRTHS.index(key) for key in ("Hi", "Wa", "Br")]
     heights = [fractions[key] for key in ("Hi", "Wa", "Br")]
     origin_y = _interp_rows(fraction, heights, centre_y[:, order])
     # Where each section cuts each girth part, relative to the part's middle (-1 bottom .. 1 top).
-    cut = np.stack([(z[key][:, None] - center[..., 2]) / half_z for key in GIRTHS], axis=-1)  # (B, n, 3)
-    crossing = (np.abs(cut) < 1.0) & girth[:, None]
-    taper = np.where(crossing, np.abs(cut), 0.0)
+    cut = (sections[:, None, :] - center[..., 2, None]) / half_z[..., None]  # (B, n, 3)
+    distance = np.abs(cut)
+    taper = np.where((distance < 1.0) & girth[:, None], distance, 0.0)
     anchor = center[..., 2, None] - np.sign(cut) * half_z[..., None]
     depends_sh = topology.dependency_mask[:, _INDEX["Sh"]]
     return _DeformBasis(
@@ -143,10 +145,12 @@ def deform(basis, center, semi_axes, factors):
     # from its far end, which widens or narrows it there much more than in its middle (a rib cage
     # ending higher narrows the waist, not the bust).
     for g in range(len(GIRTHS)):
-        v = girth_f[:, g, None] ** (_TAPER * basis.taper[..., g])  # (B, n)
+        taper = basis.taper[..., g]
+        v = girth_f[:, g, None] ** (_TAPER * taper)  # (B, n), exactly 1 where the section cuts no part
         anchor = basis.anchor[..., g]
         center[..., 2] = anchor + v * (center[..., 2] - anchor)
-        semi *= 1.0 + (v[..., None] - 1.0) * basis.vertical
+        cut = np.nonzero(taper.any(axis=0))[0]  # elsewhere the semi-axes would be multiplied by exactly 1
+        semi[:, cut] *= 1.0 + (v[:, cut, None] - 1.0) * basis.vertical[:, cut]
     # He: vertical stretch about the floor.
     he = f[:, _INDEX["He"], None]
     center[..., 2] = basis.bottom[:, None] + he * (center[..., 2] - basis.bottom[:, None])
@@ -158,11 +162,13 @@ def deform(basis, center, semi_axes, factors):
     semi *= 1.0 + (sigma[..., None] - 1.0) * (1.0 - basis.vertical)
     # Sh: the shoulders widen along x; the arms hanging from them move out with their edge.
     sh = f[:, _INDEX["Sh"], None]
-    scaled = basis.shoulder_scaled[None, :]
-    center[..., 0] = np.where(scaled, center[..., 0] * sh, center[..., 0])
-    semi = np.where(scaled[..., None], semi * (1.0 + (sh[..., None] - 1.0) * basis.lateral), semi)
-    shift = np.sign(center[..., 0]) * (sh - 1.0) * basis.shoulder_half[:, None]
-    center[..., 0] += np.where(basis.shoulder_carried[None, :], shift, 0.0)
+    scaled = np.nonzero(basis.shoulder_scaled)[0]
+    center[:, scaled, 0] *= sh
+    semi[:, scaled] *= 1.0 + (sh[..., None] - 1.0) * basis.lateral[:, scaled]
+    carried = np.nonzero(basis.shoulder_carried)[0]
+    shift = np.zeros(center.shape[:-1])  # added to every part, as 0 to the others (-0 becomes 0)
+    shift[:, carried] = np.sign(center[:, carried, 0]) * (sh - 1.0) * basis.shoulder_half[:, None]
+    center[..., 0] += shift
     return center, semi
 
 
@@ -289,10 +295,10 @@ def refine(topology, rotation, center, semi_axes, targets, measured=None, tolera
 
 
 def _dot(a, b):
-    """Sum over the last axis of a * b (broadcast), in a fixed order: unlike a matrix product or einsum, whose
-    order can depend on the array's size and alignment, a mannequin gets the same bits alone as in a batch."""
-    a, b = np.broadcast_arrays(a, b)
-    total = a[..., 0] * b[..., 0]
+    """Sum over the last axis (the same length in both) of a * b (the other axes broadcast), in a fixed order:
+    unlike a matrix product or einsum, whose order can depend on the array's size and alignment, a mannequin gets
+    the same bits alone as in a batch."""
+    total = a[..., 0] * b[..., 0]  # already of the broadcast shape
     for k in range(1, a.shape[-1]):
         total += a[..., k] * b[..., k]
     return total
@@ -303,10 +309,10 @@ def _solve_positive(system, rhs):
     order (LAPACK's pivoting and blocking could differ between a batch and one system alone)."""
     count = system.shape[-1]
     factor = np.zeros_like(system)
-    for i in range(count):
-        for j in range(i + 1):
-            total = system[:, i, j] - _dot(factor[:, i, :j], factor[:, j, :j]) if j else system[:, i, j].copy()
-            factor[:, i, j] = np.sqrt(total) if i == j else total / factor[:, j, j]
+    for j in range(count):  # column by column: each entry's sum in the same order as entry by entry
+        total = system[:, j:, j] - _dot(factor[:, j:, :j], factor[:, j, None, :j]) if j else system[:, j:, j].copy()
+        factor[:, j, j] = np.sqrt(total[:, 0])
+        factor[:, j + 1:, j] = total[:, 1:] / factor[:, j, j, None]
     y = np.zeros_like(rhs)
     for i in range(count):
         y[:, i] = (rhs[:, i] - (_dot(factor[:, i, :i], y[:, :i]) if i else 0.0)) / factor[:, i, i]

@@ -104,9 +104,16 @@ def validate_requests(requests, ranges=None, limits=None):
         raise MeasurementError("requests", "must be numbers (cm) in rows of He, Sh, Br, Wa, Hi") from None
     if requests.ndim != 2 or requests.shape[1] != len(MEASUREMENTS):
         raise MeasurementError("requests", f"must have shape (B, 5) (He, Sh, Br, Wa, Hi), got {requests.shape}")
-    for row, values in enumerate(requests):
+    # One vectorised test of what validate_request refuses (every value is a float here); the message is that of
+    # validate_request on the first bad row, as checking row by row would give.
+    limits = limits or ABSURD_LIMITS
+    low, high = (np.array([limits[key][i] for key in MEASUREMENTS], dtype=float) for i in (0, 1))
+    with np.errstate(invalid="ignore"):
+        good = np.isfinite(requests) & (requests > 0.0) & (requests >= low) & (requests <= high)
+    if not np.all(good):
+        row = int(np.argwhere(~good)[0][0])
         try:
-            validate_request([float(v) for v in values], ranges, limits)
+            validate_request([float(v) for v in requests[row]], ranges, limits)
         except MeasurementError as error:
             raise MeasurementError(error.field, f"row {row}: {str(error).partition(': ')[2]}") from None
     return requests

@@ -117,15 +117,17 @@ class Synthesis:
 def check_plausible(topology, requests, rotation, center, semi_axes):
     """Refuse synthesis results (B, n, ...) with a piece outside the plausibility limits (SEMI_AXIS_LIMITS,
     CENTER_LIMIT) or not finite, as a file or a collection holding them would be: ElliMannError naming the
-    request, the part, the field and the range. One vectorised test; the message comes from
-    ``Mannequin.problems`` of the first bad result."""
+    request, the part, the field and the range. A few whole-array reductions (NaN fails them all); only when one
+    fails, the test per piece and ``Mannequin.problems`` of the first bad result for the message."""
     low, high = SEMI_AXIS_LIMITS
     with np.errstate(invalid="ignore"):
+        if (np.min(semi_axes, initial=np.inf) >= low and np.max(semi_axes, initial=-np.inf) <= high
+                and np.max(np.abs(center), initial=0.0) <= CENTER_LIMIT
+                and np.isfinite(np.max(np.abs(rotation), initial=0.0))):
+            return
         good = (np.all(np.isfinite(semi_axes), axis=-1) & np.all((semi_axes >= low) & (semi_axes <= high), axis=-1)
                 & np.all(np.isfinite(center), axis=-1) & np.all(np.abs(center) <= CENTER_LIMIT, axis=-1)
                 & np.all(np.isfinite(rotation), axis=(-1, -2)))
-    if np.all(good):
-        return
     row = int(np.argwhere(~good)[0][0])
     mannequin = Mannequin(topology, rotation[row], center[row], semi_axes[row])
     problems = [p for p in mannequin.problems() if p.field in ("rotation", "center", "semi_axes")]
@@ -154,8 +156,10 @@ def synthesize_batch(reference, requests, options=None, *, measure=True, toleran
     options = options_of(options, **fields).checked()
     mode = options.mode
     requests = validate_requests(requests, reference.ranges, reference.absurd_limits)
-    rotation, center, semi_axes = interpolate(reference, requests, options.metric, options.power, options.normalize)
-    joints = interpolate_joints(reference, requests, options.metric, options.power, options.normalize)
+    weights = idw_weights(reference, requests, options.metric, options.power)  # for the pieces and the joints alike
+    rotation, center, semi_axes = interpolate(reference, requests, options.metric, options.power, options.normalize,
+                                              weights)
+    joints = interpolate_joints(reference, requests, options.metric, options.power, options.normalize, weights)
     girth = reference.topology.girth_mask
     fractions = reference.section_fractions
     measured, structure = None, None

@@ -14,7 +14,7 @@ from devkit import synthetic
 from devkit.poses import make_apose_toy
 from devkit.toy import make_toy_mannequin
 from ellimann_addon.core import garments, synthesis
-from ellimann_addon.core.constants import ABSURD_LIMITS, CENTER_LIMIT, SEMI_AXIS_LIMITS
+from ellimann_addon.core.constants import ABSURD_LIMITS, CENTER_LIMIT, MEASUREMENTS, SEMI_AXIS_LIMITS
 from ellimann_addon.core.errors import ElliMannError, MannequinError, ReferenceSetError
 from ellimann_addon.core.mannequin import FORMAT_VERSION, Mannequin
 from ellimann_addon.core.reference_manifest import MANIFEST_FILE
@@ -216,6 +216,31 @@ def test_synthesis_output_is_checked_against_the_same_limits():
     semi[0, 2, 1] = np.inf
     with pytest.raises(ElliMannError, match="semi_axes: contains NaN or infinity"):
         synthesis.check_plausible(reference.topology, result.requests, result.rotation, result.center, semi)
+
+
+@pytest.mark.parametrize("field, index, value, words", [
+    ("semi_axes", (2, 3, 0), np.nan, "semi_axes: contains NaN or infinity"),
+    ("semi_axes", (1, 0, 2), 1e-9, "semi_axes: 1e-09 m is not a plausible semi-axis"),
+    ("semi_axes", (3, 5, 1), 4.0, "semi_axes: 4 m is not a plausible semi-axis"),
+    ("semi_axes", (0, 1, 0), -1.0, "semi_axes: must be > 0"),
+    ("center", (2, 0, 2), np.nan, "center: contains NaN or infinity"),
+    ("center", (4, 3, 1), -np.inf, "center: contains NaN or infinity"),
+    ("center", (0, 2, 2), -101.0, "center: z = -101 m is too far from the origin"),
+    ("rotation", (1, 2, 0, 1), np.nan, "rotation: contains NaN or infinity"),
+    ("rotation", (3, 0, 2, 2), np.inf, "rotation: contains NaN or infinity"),
+])
+def test_every_kind_of_implausible_result_is_refused_at_its_request(field, index, value, words):
+    reference = synthetic.make_reference_set()
+    result = synthesis.synthesize_batch(reference, reference.measurements, mode="idw")
+    arrays = {name: getattr(result, name).copy() for name in ("rotation", "center", "semi_axes")}
+    arrays[field][index] = value
+    request = ", ".join(f"{k} {v:g}" for k, v in zip(MEASUREMENTS, reference.measurements[index[0]]))
+    with pytest.raises(ElliMannError) as info:
+        synthesis.check_plausible(reference.topology, result.requests, **arrays)
+    assert str(info.value).startswith(f"synthesis at {request} cm gives an implausible mannequin: ")
+    assert words in str(info.value)
+    arrays[field][index] = getattr(result, field)[index]
+    synthesis.check_plausible(reference.topology, result.requests, **arrays)  # the rest was plausible
 
 
 # ------------------------------------------------------------------------------------------------ reference sets

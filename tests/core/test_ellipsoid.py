@@ -64,6 +64,20 @@ def test_section_misses_above_and_below():
     assert not e.section(1.21)[2] and not e.section(0.79)[2] and e.section(1.19)[2]
 
 
+def test_section_extent_is_the_section_s_middle_and_half_width_bit_for_bit():
+    rng = np.random.default_rng(6)
+    rotation = np.stack([rotation_from_vector(v) for v in rng.normal(size=(50, 3))]).reshape(10, 5, 3, 3)
+    center, semi = rng.normal(0.0, 0.3, size=(10, 5, 3)), rng.uniform(0.02, 0.3, size=(10, 5, 3))
+    heights = rng.normal(0.0, 0.4, size=(10, 4, 1))  # several heights per stack, some missing the ellipsoids
+    centre, k, hit = el.section_at_height(rotation[:, None], center[:, None], semi[:, None], heights)
+    assert hit.any() and not hit.all()
+    for axis in (0, 1):
+        middle, half, hits = el.section_extent(rotation[:, None], center[:, None], semi[:, None], heights, axis)
+        assert middle.tobytes() == centre[..., axis].tobytes()
+        assert half.tobytes() == np.sqrt(k[..., axis, axis]).tobytes()
+        assert np.array_equal(hits, hit)
+
+
 def test_sphere_section_through_centre_is_a_circle_of_radius_r():
     centre, k, hit = el.Ellipsoid.sphere((0.3, -0.2, 1.0), 0.25).section(1.0)
     assert hit and np.allclose(centre, (0.3, -0.2)) and np.allclose(k, np.eye(2) * 0.25**2)

@@ -10,7 +10,8 @@ import pytest
 from ellimann_addon.core import skeleton
 from ellimann_addon.core.clean import register_to_world, symmetrize
 from ellimann_addon.core.errors import MannequinError
-from ellimann_addon.core.joints import anchor_indices, follow_pieces, joints_from_dict
+from ellimann_addon.core.idw import idw_weights, interpolate
+from ellimann_addon.core.joints import anchor_indices, follow_pieces, interpolate_joints, joints_from_dict
 from ellimann_addon.core.mannequin import Mannequin
 from ellimann_addon.core.reference_set import REFERENCE_FOLDER, REFERENCE_NAMES, load_reference_set
 from ellimann_addon.core.synthesis import synthesize, synthesize_batch
@@ -135,6 +136,22 @@ def test_a_request_alone_gets_the_joints_it_gets_in_a_batch(reference):
     batch = synthesize_batch(reference, requests)
     for i, request in enumerate(requests):
         assert np.array_equal(synthesize_batch(reference, [request]).joints[0], batch.joints[i])
+
+
+@pytest.mark.parametrize("metric, power, normalize", [("raw", 2.0, "proportional"), ("normalized", 1.0, "none"),
+                                                      ("normalized", 4.0, "height")])
+def test_a_batch_shares_its_idw_weights_with_the_same_results_as_each_part_alone(reference, metric, power, normalize):
+    requests = np.array([[165, 41.5, 101.25, 82.75, 117.5], [150, 35, 90, 70, 95], [170, 50, 140, 130, 140]])
+    batch = synthesize_batch(reference, requests, mode="idw", metric=metric, power=power, normalize=normalize)
+    alone = interpolate_joints(reference, requests, metric, power, normalize)
+    assert np.array_equal(batch.joints, alone)
+    weights = idw_weights(reference, requests, metric, power)
+    assert np.array_equal(interpolate_joints(reference, requests, metric, power, normalize, weights), alone)
+    pieces = interpolate(reference, requests, metric, power, normalize)
+    for field, value in zip(("rotation", "center", "semi_axes"), pieces):
+        assert np.array_equal(getattr(batch, field), value)
+    for shared, value in zip(interpolate(reference, requests, metric, power, normalize, weights), pieces):
+        assert np.array_equal(shared, value)
 
 
 def test_a_deformation_carries_each_joint_with_its_anchor_piece(average):

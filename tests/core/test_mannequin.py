@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from devkit.toy import TOY_PARTS, make_toy_mannequin
+from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.errors import MannequinError
 from ellimann_addon.core.mannequin import Mannequin, Part, Topology, stack, twin_name
 
@@ -30,6 +31,10 @@ def test_toy_topology_is_valid_and_indexed(toy):
     assert topo.single_parts(cushions=False) == list(range(12))
     assert topo.girth_mask.sum() == 9
     assert topo.dependency_mask.shape == (12, 5)
+    assert topo.dependency_mask.tolist() == [[m in p.depends for m in MEASUREMENTS] for p in topo.parts]
+    topo.girth_mask[:] = False  # the masks are built once; a caller changing its copy changes nothing
+    topo.dependency_mask[:] = False
+    assert topo.girth_mask.sum() == 9 and topo.dependency_mask.sum() == sum(len(p.depends) for p in topo.parts)
     assert twin_name("4.a Trapezius.L") == "4.a Trapezius.R"
 
 

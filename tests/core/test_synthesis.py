@@ -287,6 +287,65 @@ def test_refinement_responds_to_each_measurement_in_its_own_neighbourhood():
         assert np.abs(ratio - 1.0).max() == pytest.approx(abs(ratio[k] - 1.0)), key  # and moves most
 
 
+def test_exact_mode_gives_a_request_alone_the_bits_it_gets_in_a_batch(reference):
+    requests = np.concatenate([GRID[::20], random_requests(11, 6)])
+    batch = synthesis.synthesize_batch(reference, requests, mode="exact")
+    for i, request in enumerate(requests):
+        alone = synthesis.synthesize_batch(reference, [request], mode="exact")
+        for field in ("rotation", "center", "semi_axes", "measured", "factors", "converged", "joints"):
+            if getattr(batch, field) is not None:
+                assert getattr(alone, field)[0].tobytes() == getattr(batch, field)[i].tobytes(), (i, field)
+
+
+def _deform_every_part(basis, center, semi, f):
+    """deform's formula applied to every part (what deform skips multiplies by exactly 1)."""
+    center, semi = center.copy(), semi.copy()
+    girth_f = f[:, 2:]
+    for g in range(3):
+        v = girth_f[:, g, None] ** (1.0 * basis.taper[..., g])
+        center[..., 2] = basis.anchor[..., g] + v * (center[..., 2] - basis.anchor[..., g])
+        semi *= 1.0 + (v[..., None] - 1.0) * basis.vertical
+    he, sh = f[:, 0, None], f[:, 1, None]
+    center[..., 2] = basis.bottom[:, None] + he * (center[..., 2] - basis.bottom[:, None])
+    semi *= 1.0 + (he[..., None] - 1.0) * basis.vertical
+    sigma = 1.0 + refine._dot(basis.girth_weight, (girth_f - 1.0)[:, None, :])
+    center[..., 0] *= sigma
+    center[..., 1] = basis.origin_y + sigma * (center[..., 1] - basis.origin_y)
+    semi *= 1.0 + (sigma[..., None] - 1.0) * (1.0 - basis.vertical)
+    scaled = basis.shoulder_scaled[None, :]
+    center[..., 0] = np.where(scaled, center[..., 0] * sh, center[..., 0])
+    semi = np.where(scaled[..., None], semi * (1.0 + (sh[..., None] - 1.0) * basis.lateral), semi)
+    center[..., 0] += np.where(basis.shoulder_carried[None, :], np.sign(center[..., 0]) * (sh - 1.0)
+                               * basis.shoulder_half[:, None], 0.0)
+    return center, semi
+
+
+def test_deform_gives_the_bits_of_its_formula_applied_to_every_part(reference):
+    requests = np.concatenate([GRID[::10], random_requests(12, 8, widen=0.2)])
+    rotation, center, semi_axes = synthesis.interpolate(reference, requests)
+    measured = tailor_measurements(rotation, center, semi_axes, reference.topology.girth_mask,
+                                   reference.section_fractions)
+    basis = refine._deform_basis(reference.topology, rotation, center, semi_axes, measured,
+                                 reference.section_fractions)
+    assert basis.taper.any() and not basis.taper.all() and basis.shoulder_carried.any()
+    factors = np.exp(np.random.default_rng(4).normal(0.0, 0.05, size=(len(requests), 5)))
+    for f in (factors, np.ones_like(factors)):
+        for got, expected in zip(synthesis.deform(basis, center, semi_axes, f),
+                                 _deform_every_part(basis, center, semi_axes, f)):
+            assert got.tobytes() == expected.tobytes()
+
+
+def test_the_fixed_order_solver_solves_and_gives_a_system_alone_its_bits_in_a_stack():
+    rng = np.random.default_rng(8)
+    a = rng.normal(size=(30, 5, 5))
+    system = a @ np.swapaxes(a, -1, -2) + 0.1 * np.eye(5)
+    rhs = rng.normal(size=(30, 5))
+    x = refine._solve_positive(system, rhs)
+    np.testing.assert_allclose(x, np.linalg.solve(system, rhs[..., None])[..., 0], rtol=1e-9, atol=1e-12)
+    for i in range(len(system)):
+        assert refine._solve_positive(system[i:i + 1], rhs[i:i + 1])[0].tobytes() == x[i].tobytes()
+
+
 # ---------------------------------------------------------------------------------------------- requests
 
 
@@ -326,6 +385,42 @@ def test_missing_unknown_and_short_requests_are_refused():
     with pytest.raises(MeasurementError, match="row 1") as info:
         synthesis.validate_requests([list(GOOD.values()), [159.0, 43.0, float("nan"), 104.0, 117.0]])
     assert info.value.field == "Br"
+
+
+def _row_by_row(requests, limits=None):
+    """The batch check as validate_request on every row in turn: the first bad row's message, with its row."""
+    for row, values in enumerate(np.asarray(requests, dtype=float)):
+        try:
+            synthesis.validate_request([float(v) for v in values], None, limits)
+        except MeasurementError as error:
+            return error.field, f"{error.field}: row {row}: {str(error).partition(': ')[2]}"
+    return None
+
+
+@pytest.mark.parametrize("limits", [None, {**ABSURD_LIMITS, "He": (100.0, 200.0), "Hi": (60.0, 160.0)},
+                                    {**ABSURD_LIMITS, "Sh": (-10.0, 100.0)}])  # > 0 whatever the limits
+def test_a_batch_is_refused_at_its_first_bad_row_and_field_as_row_by_row(limits):
+    good = list(GOOD.values())
+    bad_values = [float("nan"), float("inf"), -float("inf"), -1.0, 0.0, -0.0, 1e-300, 2.0, 5.0, 300.0, 1e308]
+    for field, value, row in itertools.product(range(5), bad_values, range(3)):
+        requests = np.array([good] * 4)
+        requests[row, field] = value
+        requests[3, (field + 1) % 5] = -5.0  # a later bad row does not take the message
+        if row == 1:
+            requests[1, (field + 3) % 5] = 1e4  # nor does a later bad field of the same row, if that is later
+        expected = _row_by_row(requests, limits)
+        with pytest.raises(MeasurementError) as info:
+            synthesis.validate_requests(requests, None, limits)
+        assert (info.value.field, str(info.value)) == expected
+    with pytest.raises(MeasurementError, match=r"^Br: row 2: must be a finite number, got nan \(accepted") as info:
+        synthesis.validate_requests([good, good, [159.0, 43.0, float("nan"), 104.0, 117.0]])
+    assert info.value.field == "Br"
+    with pytest.raises(MeasurementError, match=r"^Hi: row 0: must be > 0, got -0 \(accepted range"):
+        synthesis.validate_requests([[159.0, 43.0, 117.0, 104.0, -0.0]])
+    with pytest.raises(MeasurementError, match=r"^He: row 1: 500 cm is not a plausible value \(accepted range 50-250"):
+        synthesis.validate_requests([good, [500.0, 43.0, 117.0, 104.0, 117.0]])
+    edge = [[ABSURD_LIMITS[k][0] for k in MEASUREMENTS], [ABSURD_LIMITS[k][1] for k in MEASUREMENTS]]
+    assert np.array_equal(synthesis.validate_requests(edge + [good]), edge + [good])  # the limits are accepted
 
 
 def test_values_outside_L_are_allowed_with_a_warning_saying_how_far():
