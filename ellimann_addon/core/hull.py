@@ -226,25 +226,23 @@ def hull_perimeter(centre, k, active, warm=None, structure=False):
     columns = np.take_along_axis(given, columns, axis=1)
     cold = np.ones(sections, dtype=bool)
     if warm is not None:
-        cold, perimeter, (warm_first, sec, theta, after) = _warm_perimeter(centre, k, used, mirrored,
-                                                                           _to_columns(warm, columns))
-        out[~cold], first[~cold] = perimeter[~cold], warm_first[~cold]
+        cold, (warm_first, sec, theta, after) = _follow(centre, k, used, mirrored, _to_columns(warm, columns))
+        first[~cold] = warm_first[~cold]
         kinks.append((sec[~cold[sec]], theta[~cold[sec]], after[~cold[sec]]))
     count = used.sum(axis=-1)
-    # Sections are independent: measured in groups of one arc and, from _GROUP_MIN_SECTIONS on, of equal ellipse
+    # Sections are independent: searched in groups of one arc and, from _GROUP_MIN_SECTIONS on, of equal ellipse
     # counts, so that none is padded with others' ellipses.
     group = 2 * count + mirrored if sections >= _GROUP_MIN_SECTIONS else mirrored.astype(int)
     for key in np.unique(group[cold]):
         rows = np.nonzero(cold & (group == key))[0]
-        arc = _RIGHT_HALF if mirrored[rows[0]] else _FULL
         width = max(int(count[rows].max()), 1)  # the sections' ellipses are in front: narrower groups drop the rest
-        out[rows], group_first, theta, sec, after = _arc_perimeter(centre[rows, :width], k[rows, :width],
-                                                                   used[rows, :width], arc)
-        first[rows] = group_first
+        first[rows], theta, sec, after = _search(centre[rows, :width], k[rows, :width], used[rows, :width],
+                                                 _RIGHT_HALF if mirrored[rows[0]] else _FULL)
         kinks.append((rows[sec], theta, after))
+    sec, theta, after = _sorted_kinks(*(np.concatenate(column) for column in zip(*kinks)))
+    out = _integrate(_Coefficients(centre, k), used, mirrored, first, theta, sec, after)
     if not structure:
         return out
-    sec, theta, after = _sorted_kinks(*(np.concatenate(column) for column in zip(*kinks)))
     return out, HullStructure(mirrored, np.where(first >= 0, columns[np.arange(sections), np.maximum(first, 0)], -1),
                               sec, theta, columns[sec, after])
 
@@ -274,9 +272,9 @@ def _to_columns(structure, columns):
                          structure.kink_theta, convert(structure.kink_section, structure.kink_after))
 
 
-def _warm_perimeter(centre, k, used, mirrored, warm):
-    """Perimeters from a former structure (:func:`hull_perimeter`'s ``warm``), all in compacted columns: (the
-    sections to measure from scratch (S,), perimeters (S,), the structure followed: (first, section, angle, after))."""
+def _follow(centre, k, used, mirrored, warm):
+    """The kinks of a former structure (:func:`hull_perimeter`'s ``warm``) solved again, all in compacted columns:
+    (the sections to search instead (S,), the structure followed: (first, section, angle, after))."""
     sections = len(mirrored)
     rows = np.arange(sections)
     sec, theta, after = warm.kink_section, warm.kink_theta, warm.kink_after
@@ -297,18 +295,7 @@ def _warm_perimeter(centre, k, used, mirrored, warm):
     ok[sec[miss]] = False
     swapped = (sec[1:] == sec[:-1]) & (theta[1:] < theta[:-1])
     ok[sec[1:][swapped]] = False
-    perimeter = np.zeros(sections)
-    for arc, mine in ((_FULL, ~mirrored), (_RIGHT_HALF, mirrored)):
-        chosen = np.nonzero(ok & mine)[0]
-        if not len(chosen):
-            continue
-        renumber = np.full(sections, -1)
-        renumber[chosen] = np.arange(len(chosen))
-        take = renumber[sec] >= 0
-        part_sec, part_theta, part_after = renumber[sec[take]], theta[take], after[take]
-        perimeter[chosen] = _integrate(_Coefficients(centre[chosen], k[chosen]), used[chosen], arc, warm.first[chosen],
-                                       part_theta, part_sec, part_after)
-    return ~ok, perimeter, (warm.first, sec, theta, after)
+    return ~ok, (warm.first, sec, theta, after)
 
 
 def _right_half(centre, k, active):
@@ -328,10 +315,9 @@ def _right_half(centre, k, active):
     return mirrored, np.where(mirrored[:, None], active & ((cx >= 0.0) | ~dominated), active)
 
 
-def _arc_perimeter(centre, k, active, arc):
-    """The integral of max_i h_i over ``arc`` (an :class:`_Arc`) times its copies, per section: (perimeter, the
-    ellipse outermost at the arc's start (-1 if none is active), and the kinks: angle, section, the ellipse outermost
-    after it)."""
+def _search(centre, k, active, arc):
+    """Where max_i h_i changes ellipse over ``arc`` (an :class:`_Arc`), per section: (the ellipse outermost at the
+    arc's start (-1 if none is active), and the kinks: angle, section, the ellipse outermost after it)."""
     sections = centre.shape[0]
     coefficients = _Coefficients(centre, k)
     largest, smallest = _curvature_radii(k)  # (S, n)
@@ -368,23 +354,24 @@ def _arc_perimeter(centre, k, active, arc):
     theta, sec, after = (np.concatenate(column) for column in zip(*kinks))
 
     first = np.where(active.any(axis=1), winner[:, 0], -1)
-    return _integrate(coefficients, active, arc, first, theta, sec, after), first, theta, sec, after
+    return first, theta, sec, after
 
 
-def _integrate(coefficients, active, arc, first, theta, sec, after):
-    """The perimeter of each section from its outermost ellipse at the arc's start (S,) and its kinks (angle,
-    section, the ellipse outermost after it): each piece between them is its ellipse's support integrated in closed
-    form, the linear part and the root, sqrt(q) = sqrt(alpha + beta) sqrt(1 - m sin^2(theta - phi)) with
-    alpha +- beta the squared semi-axes and m = 2 beta / (alpha + beta), by the elliptic integral E
-    (:func:`_elliptic_e`)."""
+def _integrate(coefficients, active, mirrored, first, theta, sec, after):
+    """The perimeter of each section from its outermost ellipse at its arc's start (S,) (the right half where
+    ``mirrored``, else the whole circle) and its kinks (angle, section, the ellipse outermost after it): each piece
+    between them is its ellipse's support integrated in closed form, the linear part and the root, sqrt(q) =
+    sqrt(alpha + beta) sqrt(1 - m sin^2(theta - phi)) with alpha +- beta the squared semi-axes and
+    m = 2 beta / (alpha + beta), by the elliptic integral E (:func:`_elliptic_e`)."""
     sections = len(first)
+    arc_start = np.where(mirrored, _RIGHT_HALF.cell_start[0], _FULL.cell_start[0])
     # Each piece from its start (the arc's, or a kink; the arc's first where they coincide) to the next.
     sec, start, winner = _sorted_kinks(np.concatenate([np.arange(sections), sec]),
-                                       np.concatenate([np.full(sections, arc.cell_start[0]), theta]),
+                                       np.concatenate([arc_start, theta]),
                                        np.concatenate([first, after]))
     last = np.ones(len(sec), dtype=bool)
     last[:-1] = sec[1:] != sec[:-1]
-    end = np.where(last, arc.end, np.roll(start, -1))
+    end = np.where(last, np.where(mirrored, _RIGHT_HALF.end, _FULL.end)[sec], np.roll(start, -1))
     index = (sec, np.maximum(winner, 0))
     a, b, d = coefficients.a[index], coefficients.b[index], coefficients.d[index]
     alpha, spread, turn = 0.5 * (a + d), 0.5 * (a - d), 0.5 * b
@@ -396,7 +383,7 @@ def _integrate(coefficients, active, arc, first, theta, sec, after):
     root = np.sqrt(top) * (e[len(m):] - e[:len(m)])
     linear = coefficients.centre_integral(index, np.cos(start), np.sin(start), np.cos(end), np.sin(end))
     piece = np.where((winner >= 0) & active[index], root + linear, 0.0)
-    return arc.copies * np.bincount(sec, weights=piece, minlength=sections)
+    return np.where(mirrored, _RIGHT_HALF.copies, _FULL.copies) * np.bincount(sec, weights=piece, minlength=sections)
 
 
 def _elliptic_e(u, m):
