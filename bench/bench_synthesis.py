@@ -224,6 +224,19 @@ def run():
     blender(reference, exact)
 
 
+def _searching_before(centre, k, active, warm=None, structure=False):
+    """devkit.hull_before's hull perimeter where m_T calls today's: it searches every time (``warm`` unused), and the
+    structure it hands back is empty, so the refinement's later steps search too."""
+    from ellimann_addon.core.hull import HullStructure
+
+    out = hull_perimeter_before(centre, k, active)
+    if not structure:
+        return out
+    empty = HullStructure(np.zeros(len(out), dtype=bool), np.full(len(out), -1), np.zeros(0, dtype=np.int64),
+                          np.zeros(0), np.zeros(0, dtype=np.int64))
+    return out, empty
+
+
 def population_scale(reference, requests, repeat=5):
     """Exact mode against proportional IDW on the same batch, with today's m_T and the one it replaced
     (``devkit.hull_before``), every variant timed in turn within each round (best of ``repeat`` rounds), in CPU
@@ -233,7 +246,7 @@ def population_scale(reference, requests, repeat=5):
     def previous_m_t(fn):
         def run():
             current = measure.hull_perimeter
-            measure.hull_perimeter = hull_perimeter_before
+            measure.hull_perimeter = _searching_before
             try:
                 return fn()
             finally:
