@@ -230,11 +230,7 @@ def _searching_before(centre, k, active, warm=None, structure=False):
     from ellimann_addon.core.hull import HullStructure
 
     out = hull_perimeter_before(centre, k, active)
-    if not structure:
-        return out
-    empty = HullStructure(np.zeros(len(out), dtype=bool), np.full(len(out), -1), np.zeros(0, dtype=np.int64),
-                          np.zeros(0), np.zeros(0, dtype=np.int64))
-    return out, empty
+    return (out, HullStructure.empty(len(out))) if structure else out
 
 
 def population_scale(reference, requests, repeat=5):

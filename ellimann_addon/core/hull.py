@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-CELLS = 32  # grid directions over the circle, which find the outermost ellipses and cut the quadrature's pieces
+CELLS = 32  # grid directions over the circle, which find the outermost ellipses
 DUPLICATIONS = 8  # Carlson's duplication steps for the elliptic integrals (7 reach rounding; one to spare)
 NEWTON_STEPS = 8  # from a secant start across a whole grid cell ...
 NEWTON_DONE = 1e-13  # ... until a kink moves less than this (radians)
@@ -104,10 +104,9 @@ def _directions(theta):
 
 
 class _Arc:
-    """The directions a group of sections is integrated over, cut into equal cells (each a cell of the grid that
-    finds the outermost ellipses and a fixed cut of the quadrature): the whole circle, or, for a section symmetric
-    about x = 0, the right half [-pi/2, pi/2] counted twice (its support H has H(pi - theta) = H(theta)), with the
-    poles' directions exact."""
+    """The directions a group of sections is integrated over, cut into the equal cells of the grid that finds the
+    outermost ellipses: the whole circle, or, for a section symmetric about x = 0, the right half [-pi/2, pi/2]
+    counted twice (its support H has H(pi - theta) = H(theta)), with the poles' directions exact."""
 
     def __init__(self, start, cells, copies):
         self.cells, self.copies = cells, copies
@@ -152,6 +151,12 @@ class HullStructure:
     kink_theta: np.ndarray  # (K,)
     kink_after: np.ndarray  # (K,) the ellipse outermost after the kink
 
+    @staticmethod
+    def empty(sections):
+        """The structure of ``sections`` sections with no ellipse and no kink."""
+        return HullStructure(np.zeros(sections, dtype=bool), np.full(sections, -1), np.zeros(0, dtype=np.int64),
+                             np.zeros(0), np.zeros(0, dtype=np.int64))
+
     def take(self, rows):
         """The structure of the sections ``rows``, numbered from 0 in that order."""
         rows = np.asarray(rows, dtype=np.int64)
@@ -176,20 +181,24 @@ class HullStructure:
             np.concatenate([self.kink_after[keep], other.kink_after])))
 
     def renamed(self, names):
-        """The same structure with every ellipse e called names[e] (-1 stays -1, and so does a name of -1)."""
+        """The same structure with every ellipse e called names[e], or names[section, e] when ``names`` is one row
+        per section (-1 stays -1, and so does a name of -1)."""
         names = np.asarray(names)
 
-        def rename(e):
-            return np.where(e >= 0, names[np.maximum(e, 0)], -1) if len(names) else np.full_like(e, -1)
+        def rename(sec, e):
+            if not names.size:
+                return np.full_like(e, -1)
+            picked = names[sec, np.maximum(e, 0)] if names.ndim == 2 else names[np.maximum(e, 0)]
+            return np.where(e >= 0, picked, -1)
 
-        return HullStructure(self.mirrored, rename(self.first), self.kink_section, self.kink_theta,
-                             rename(self.kink_after))
+        return HullStructure(self.mirrored, rename(np.arange(len(self.first)), self.first), self.kink_section,
+                             self.kink_theta, rename(self.kink_section, self.kink_after))
 
     @staticmethod
     def concatenate(parts):
         """One structure of the sections of ``parts``, in order."""
         if not parts:
-            return _empty_structure(0)
+            return HullStructure.empty(0)
         offsets = np.cumsum([0] + [len(part.first) for part in parts])
         return HullStructure(np.concatenate([part.mirrored for part in parts]),
                              np.concatenate([part.first for part in parts]),
@@ -216,7 +225,7 @@ def hull_perimeter(centre, k, active, warm=None, structure=False):
     sections = centre.shape[0]
     out, first = np.zeros(sections), np.full(sections, -1)
     if sections == 0 or centre.shape[1] == 0:
-        return (out, _empty_structure(sections)) if structure else out
+        return (out, HullStructure.empty(sections)) if structure else out
     kinks = [(np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(0, dtype=np.int64))]  # section, angle, after
     given = np.broadcast_to(np.arange(centre.shape[1]), active.shape)
     if centre.shape[1] > _PAIRED_WIDTH:  # _right_half compares every pair of columns: the unused ones go first
@@ -252,11 +261,6 @@ def _sorted_kinks(sec, theta, after):
     return sec[order], theta[order], after[order]
 
 
-def _empty_structure(sections):
-    return HullStructure(np.zeros(sections, dtype=bool), np.full(sections, -1), np.zeros(0, dtype=np.int64),
-                         np.zeros(0), np.zeros(0, dtype=np.int64))
-
-
 def _to_columns(structure, columns):
     """``structure`` (in the caller's ellipse columns) in the compacted ones, ``columns`` (S, width) the caller's
     column of each: -1 for an ellipse not among them."""
@@ -264,12 +268,7 @@ def _to_columns(structure, columns):
                 int(structure.kink_after.max(initial=0))) + 1
     inverse = np.full((len(columns), width), -1)
     np.put_along_axis(inverse, columns, np.broadcast_to(np.arange(columns.shape[1]), columns.shape), axis=1)
-
-    def convert(sec, column):
-        return np.where(column >= 0, inverse[sec, np.maximum(column, 0)], -1)
-
-    return HullStructure(structure.mirrored, convert(np.arange(len(columns)), structure.first), structure.kink_section,
-                         structure.kink_theta, convert(structure.kink_section, structure.kink_after))
+    return structure.renamed(inverse)
 
 
 def _follow(centre, k, used, mirrored, warm):

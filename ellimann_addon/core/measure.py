@@ -110,8 +110,9 @@ def _measure_chunk(rotation, center, semi_axes, girth, fractions, warm=None, fol
         column = np.full(len(girth), -1)
         column[parts] = np.arange(n)
         warm = warm.renamed(column)
-    perimeters, structure = hull_perimeter(centre.reshape(sections, n, 2), k.reshape(sections, n, 2, 2),
-                                           hit.reshape(sections, n), warm=warm, structure=True)
+    found = hull_perimeter(centre.reshape(sections, n, 2), k.reshape(sections, n, 2, 2), hit.reshape(sections, n),
+                           warm=warm, structure=follow)
+    perimeters, structure = found if follow else (found, None)
     for index, key in enumerate(GIRTHS):
         result[key] = perimeters.reshape(batch, len(GIRTHS))[:, index]
     values = np.stack([result[key] for key in MEASUREMENTS], axis=-1) * CM_PER_M
