@@ -292,25 +292,26 @@ def convex_mesh_signed_distance(points, vertices, faces, cutoff=np.inf):
     points = np.asarray(points, dtype=float).reshape(-1, 3)
     vertices = np.asarray(vertices, dtype=float)
     centre = vertices.mean(axis=0)
-    bound = np.linalg.norm(points - centre, axis=1) - np.linalg.norm(vertices - centre, axis=1).max()
+    distance = np.linalg.norm(points - centre, axis=1) - np.linalg.norm(vertices - centre, axis=1).max()
+    near = np.nonzero(~(distance > cutoff))[0]  # the far ones keep their bound (most points, for a small cutoff)
+    points = points[near]
     faces = np.asarray(faces)
     tri = vertices[faces]
     normal = face_normals(vertices, faces)
     normal /= np.linalg.norm(normal, axis=1, keepdims=True)
     height = points @ normal.T - np.einsum("ij,ij->i", normal, tri[:, 0])  # (P, F)
     best = np.argmax(height, axis=1)
-    distance = height[np.arange(len(points)), best]
-    foot = points - distance[:, None] * normal[best]
+    plane = height[np.arange(len(points)), best]
+    foot = points - plane[:, None] * normal[best]
     t = tri[best]
     edges = np.roll(t, -1, axis=1) - t  # edge k runs corner k -> k+1
     # Inside the face: on the inner side of all three edges (cross product along the normal).
     side = np.einsum("pkj,pj->pk", np.cross(edges, foot[:, None, :] - t), normal[best])
     projected = np.all(side >= 0.0, axis=1)
-    far = bound > cutoff
-    distance[far] = np.maximum(distance[far], bound[far])
-    rest = np.nonzero((distance > 0.0) & ~projected & ~far)[0]
+    rest = np.nonzero((plane > 0.0) & ~projected)[0]
     if len(rest):
-        distance[rest], _ = mesh_distance(points[rest], vertices, faces, signed=False)
+        plane[rest], _ = mesh_distance(points[rest], vertices, faces, signed=False)
+    distance[near] = plane
     return distance
 
 

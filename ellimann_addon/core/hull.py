@@ -378,8 +378,8 @@ def _integrate(coefficients, active, mirrored, first, theta, sec, after):
     phase = 0.5 * np.arctan2(turn, spread)
     top = alpha + beta
     m = np.divide(2.0 * beta, top, out=np.zeros_like(top), where=top > 0.0)
-    e = _elliptic_e(np.concatenate([start - phase, end - phase]), np.concatenate([m, m]))
-    root = np.sqrt(top) * (e[len(m):] - e[:len(m)])
+    e = _elliptic_e(np.stack([start - phase, end - phase]), m)
+    root = np.sqrt(top) * (e[1] - e[0])
     linear = coefficients.centre_integral(index, np.cos(start), np.sin(start), np.cos(end), np.sin(end))
     piece = np.where((winner >= 0) & active[index], root + linear, 0.0)
     return np.where(mirrored, _RIGHT_HALF.copies, _FULL.copies) * np.bincount(sec, weights=piece, minlength=sections)
@@ -388,14 +388,21 @@ def _integrate(coefficients, active, mirrored, first, theta, sec, after):
 def _elliptic_e(u, m):
     """The incomplete elliptic integral of the second kind E(u | m) = integral_0^u sqrt(1 - m sin^2 t) dt for any
     real u, 0 <= m < 1: E(k pi + r) = 2 k E(m) + E(r) with |r| <= pi / 2, E(r) = sin r R_F(cos^2 r, 1 - m sin^2 r, 1)
-    - m/3 sin^3 r R_D(cos^2 r, 1 - m sin^2 r, 1) and the complete E(m) with r = pi / 2 (Carlson 1995, eq. 4.5)."""
+    - m/3 sin^3 r R_D(cos^2 r, 1 - m sin^2 r, 1) and the complete E(m) with r = pi / 2 (Carlson 1995, eq. 4.5).
+    u (..., P) and m (P,): the angles of each m share its complete integral, computed only where a whole turn needs
+    it (each value elementwise: the same bits whatever else is computed with it)."""
+    u = np.asarray(u, dtype=float)
     turns = np.round(u / np.pi)
     r = u - turns * np.pi
     s, c = np.sin(r), np.cos(r)
-    count = len(u)
-    rf, rd = _carlson(np.concatenate([c * c, np.zeros(count)]), np.concatenate([1.0 - m * s * s, 1.0 - m]))
-    complete = rf[count:] - m / 3.0 * rd[count:]
-    return s * rf[:count] - m / 3.0 * s * s * s * rd[:count] + 2.0 * turns * complete
+    whole = np.nonzero((turns != 0.0).reshape(-1, len(m)).any(axis=0))[0]
+    count = r.size
+    rf, rd = _carlson(np.concatenate([(c * c).ravel(), np.zeros(len(whole))]),
+                      np.concatenate([(1.0 - m * s * s).ravel(), 1.0 - m[whole]]))
+    complete = np.zeros(len(m))
+    complete[whole] = rf[count:] - m[whole] / 3.0 * rd[count:]
+    rf, rd = rf[:count].reshape(r.shape), rd[:count].reshape(r.shape)
+    return s * rf - m / 3.0 * s * s * s * rd + 2.0 * turns * complete
 
 
 def _carlson(x, y):

@@ -72,9 +72,13 @@ def _knots(fractions):
     return (hi - (wa - hi), hi, wa, br, br + (br - wa))
 
 
-def _hat(fraction, knot, knots):
-    """Piecewise-linear hat over ``knots``, 1 at knots[knot], 0 at its neighbours and beyond."""
-    return np.interp(fraction, knots, np.eye(len(knots))[knot])
+def _hats(fraction, knots):
+    """The piecewise-linear hats over ``knots`` of Br, Wa and Hi (GIRTHS order) at ``fraction``, stacked last: each 1
+    at its knot, 0 at the neighbouring knots and beyond."""
+    knots = np.asarray(knots, dtype=float)
+    rising = [(fraction - knots[i]) * (1.0 / (knots[i + 1] - knots[i])) for i in range(len(knots) - 1)]
+    return np.stack([np.maximum(np.minimum(rising[_GIRTH_KNOT[key] - 1], 1.0 - rising[_GIRTH_KNOT[key]]), 0.0)
+                     for key in GIRTHS], axis=-1)
 
 
 # Points across an ellipsoid's height (in half-extents) and their weights, proportional to the area
@@ -94,8 +98,8 @@ def _deform_basis(topology, rotation, center, semi_axes, measured, fractions=Non
     span = center[:, parts, 2, None] + half_z[:, parts, None] * _SPAN  # (B, p, q)
     fraction = (span - bottom[:, None, None]) / height[:, None, None]
     weight = np.zeros(center.shape[:-1] + (len(GIRTHS),))
-    weight[:, parts] = np.stack([_dot(_hat(fraction, _GIRTH_KNOT[key], knots), _SPAN_WEIGHT) for key in GIRTHS],
-                                axis=-1)
+    hats = _hats(fraction, knots)  # (B, p, q, 3)
+    weight[:, parts] = sum(hats[:, :, q] * w for q, w in enumerate(_SPAN_WEIGHT))  # in a fixed order, as _dot
     fraction = (center[..., 2] - bottom[:, None]) / height[:, None]
     # Each girth section's own centre in y (middle of its extent), interpolated between sections.
     sections = np.stack([z[key] for key in GIRTHS], axis=-1)  # (B, 3)

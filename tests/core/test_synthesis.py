@@ -346,6 +346,18 @@ def test_the_fixed_order_solver_solves_and_gives_a_system_alone_its_bits_in_a_st
         assert refine._solve_positive(system[i:i + 1], rhs[i:i + 1])[0].tobytes() == x[i].tobytes()
 
 
+
+def test_the_girth_blend_hats_are_the_piecewise_linear_interpolation_of_their_knots():
+    """refine._hats against np.interp of each hat's 0-1-0 values (rising, at, and beyond the knots)."""
+    from ellimann_addon.core.constants import GIRTHS, SECTION_FRACTIONS
+    knots = refine._knots(SECTION_FRACTIONS)
+    x = np.concatenate([np.random.default_rng(9).uniform(knots[0] - 0.2, knots[-1] + 0.2, 2000), knots])
+    hats = refine._hats(x, knots)
+    for g, key in enumerate(GIRTHS):
+        expected = np.interp(x, knots, np.eye(len(knots))[refine._GIRTH_KNOT[key]])
+        np.testing.assert_allclose(hats[:, g], expected, rtol=0, atol=1e-15)
+        assert hats[-len(knots):, g].tolist() == np.eye(len(knots))[refine._GIRTH_KNOT[key]].tolist()
+
 # ---------------------------------------------------------------------------------------------- requests
 
 
