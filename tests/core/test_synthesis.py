@@ -13,7 +13,14 @@ from hypothesis import strategies as st
 from devkit import synthetic
 from ellimann_addon.core import idw, measure, refine, synthesis
 from ellimann_addon.core.clean import asymmetry
-from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, quartile_points
+from ellimann_addon.core.constants import (
+    ABSURD_LIMITS,
+    GIRTHS,
+    MEASUREMENTS,
+    RANGES,
+    SECTION_FRACTIONS,
+    quartile_points,
+)
 from ellimann_addon.core.ellipsoid import shape_matrix
 from ellimann_addon.core.errors import ElliMannError, MeasurementError, ReferenceSetError
 from ellimann_addon.core.frames import is_rotation
@@ -346,10 +353,8 @@ def test_the_fixed_order_solver_solves_and_gives_a_system_alone_its_bits_in_a_st
         assert refine._solve_positive(system[i:i + 1], rhs[i:i + 1])[0].tobytes() == x[i].tobytes()
 
 
-
 def test_the_girth_blend_hats_are_the_piecewise_linear_interpolation_of_their_knots():
     """refine._hats against np.interp of each hat's 0-1-0 values (rising, at, and beyond the knots)."""
-    from ellimann_addon.core.constants import GIRTHS, SECTION_FRACTIONS
     knots = refine._knots(SECTION_FRACTIONS)
     x = np.concatenate([np.random.default_rng(9).uniform(knots[0] - 0.2, knots[-1] + 0.2, 2000), knots])
     hats = refine._hats(x, knots)
@@ -357,6 +362,7 @@ def test_the_girth_blend_hats_are_the_piecewise_linear_interpolation_of_their_kn
         expected = np.interp(x, knots, np.eye(len(knots))[refine._GIRTH_KNOT[key]])
         np.testing.assert_allclose(hats[:, g], expected, rtol=0, atol=1e-15)
         assert hats[-len(knots):, g].tolist() == np.eye(len(knots))[refine._GIRTH_KNOT[key]].tolist()
+
 
 # ---------------------------------------------------------------------------------------------- requests
 
