@@ -32,7 +32,10 @@ ROUNDS = 60  # of the growth towards a maximal ellipsoid, at most
 # Relative growth below which the ascent has stopped: so small that stopping a round earlier or later
 # moves nothing, so the result does not hinge on rounding (a coarser test would).
 STALLED = 1e-12
-ENTRY_NEWTON = 30  # Newton steps to where a point enters the growing ellipsoid (converges from one side)
+ENTRY_NEWTON = 30  # Newton steps to where a point enters the growing ellipsoid (converges from one side), at most
+# Newton has converged when no entry time moves by more than this: the next step would be ~ its square, while the
+# last steps of a converged iteration only jitter by rounding (some 1e-16), which no fixed count should sample.
+ENTRY_SETTLED = 1e-10
 # A step stops where the point it meets is this far out (in sum (x_k / D_k)^2 - 1): far above rounding,
 # so that point is outside in every later test, not inside or outside by the last bit.
 CONTACT = 1e-12
@@ -114,11 +117,10 @@ def _grow(local, area, limit, start, allowed, up=None, reach=np.inf):
     up2 = np.zeros(3) if up is None else np.asarray(up) ** 2
     bounded = np.isfinite(reach) and np.any(up2 > 0.0)
     reach2 = reach ** 2 * (1.0 + 1e-12)
-    axes = np.arange(3)
 
     def feasible(sq, area, semis):  # (k, 3) candidates -> (k,) bool
-        inside = sq @ (1.0 / semis.T ** 2) < 1.0
-        return (area @ inside <= allowed) & (semis ** 2 @ up2 <= reach2)
+        inside = np.einsum("mk,kc->mc", sq, 1.0 / semis.T ** 2) < 1.0
+        return (np.einsum("m,mc->c", area, inside) <= allowed) & (semis ** 2 @ up2 <= reach2)
 
     semi = np.minimum(start, limit)
     if not feasible(sq, area, semi[None])[0]:
@@ -127,7 +129,7 @@ def _grow(local, area, limit, start, allowed, up=None, reach=np.inf):
     with np.errstate(divide="ignore", invalid="ignore"):
         for _ in range(ROUNDS):
             inv = 1.0 / semi ** 2
-            radius = all_sq @ inv
+            radius = np.einsum("mk,k->m", all_sq, inv)
             # a round grows no axis by more than GROWTH: points this far out stay out whatever it does
             near = radius < GROWTH ** 2
             sq, area, radius = all_sq[near], all_area[near], radius[near]
@@ -137,15 +139,15 @@ def _grow(local, area, limit, start, allowed, up=None, reach=np.inf):
                 # component along, rather than letting one creep on by a margin that rounding would set
                 on = np.where(radius < 1.0 + 2.0 * CONTACT, np.minimum(radius, 1.0), radius)
                 room = 1.0 - on[:, None] + sq * inv  # (m, 3): with the other two axes as they are
-                # a point with room > 0 stays outside while semi_i <= |p_i| / sqrt(room)
-                bound = np.where(room > 0.0, np.sqrt(sq / room), np.inf)
-                if allowed > 0.0:
-                    order = np.argsort(bound, axis=0)
-                    over = np.cumsum(area[order], axis=0) > allowed
-                    first = np.argmax(over, axis=0)
-                    cap = np.minimum(cap, np.where(over[first, axes], bound[order[first, axes], axes], np.inf))
-                else:
-                    cap = np.minimum(cap, bound.min(axis=0))
+                # A point with room > 0 stays outside while semi_i <= |p_i| / sqrt(room). Only bounds below
+                # what the round may propose anyway can cap it: those are few, and only they are sorted.
+                below = (room > 0.0) & (sq < np.minimum(limit, semi * GROWTH) ** 2 * room)
+                for k in np.nonzero(np.einsum("m,mk->k", area, below) > allowed)[0]:
+                    rows = np.nonzero(below[:, k])[0]
+                    bound = np.sqrt(sq[rows, k] / room[rows, k])
+                    order = np.argsort(bound)
+                    # the bound at which the points inside would exceed the allowed area
+                    cap[k] = min(cap[k], bound[order[np.argmax(np.cumsum(area[rows][order]) > allowed)]])
             if bounded:
                 rest = reach ** 2 - up2 @ semi ** 2 + up2 * semi ** 2
                 cap = np.where(up2 > 0.0, np.minimum(cap, np.sqrt(np.maximum(rest, 0.0) / up2)), cap)
@@ -172,7 +174,7 @@ def _furthest_feasible(scaled, area, rate, allowed):
     exp(-2 rate_k t) decreases, convex; Newton from t = 0 approaches g = 1 + CONTACT from below.
     """
     g0 = scaled.sum(axis=1)
-    g1 = scaled @ np.exp(-2.0 * rate)
+    g1 = np.einsum("mk,k->m", scaled, np.exp(-2.0 * rate))
     entering = (g0 >= 1.0) & (g1 < 1.0 + CONTACT)
     inside = area[g0 < 1.0].sum()
     if inside > allowed:
@@ -183,8 +185,12 @@ def _furthest_feasible(scaled, area, rate, allowed):
     t = np.zeros(len(a))
     for _ in range(ENTRY_NEWTON):
         terms = a * np.exp(-np.outer(t, b))
-        step = (terms.sum(axis=1) - 1.0 - CONTACT) / np.maximum(terms @ b, 1e-300)
-        t = np.clip(t + step, 0.0, 1.0)
+        step = (terms.sum(axis=1) - 1.0 - CONTACT) / np.maximum(np.einsum("mk,k->m", terms, b), 1e-300)
+        moved = np.clip(t + step, 0.0, 1.0)
+        settled = np.abs(moved - t).max() <= ENTRY_SETTLED
+        t = moved
+        if settled:
+            break
     order = np.argsort(t, kind="stable")
     over = inside + np.cumsum(area[entering][order]) > allowed
     return float(t[order][np.argmax(over)])

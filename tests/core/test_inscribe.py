@@ -7,7 +7,7 @@ import pytest
 from devkit.toy import rotation_from_vector
 from ellimann_addon.core.body_mesh import hidden_vertices, vertex_areas, vertex_normals
 from ellimann_addon.core.frames import is_rotation
-from ellimann_addon.core.inscribe import hull_surface, inscribed_ellipsoid, principal_frame
+from ellimann_addon.core.inscribe import _grow, hull_surface, inscribed_ellipsoid, principal_frame
 from ellimann_addon.core.mesh import icosphere
 
 ROTATION = rotation_from_vector([0.3, -0.2, 0.5])
@@ -46,6 +46,16 @@ def test_obstacles_moved_out_let_the_ellipsoid_reach_that_far():
     radius = np.linalg.norm(walls, axis=1).min()
     assert np.all(semi <= radius + 1e-9) and np.all(semi >= 0.0985 + 0.005 * 0.95)
     assert np.allclose(center, 0.0, atol=1e-3)
+
+
+@pytest.mark.parametrize("allowed, reach", [(0.0, 1.0), (0.5, 1.0), (1.5, 2.0), (2.5, 3.0), (3.5, 4.0)])
+def test_points_of_the_allowed_area_may_end_inside_and_the_next_one_stops_the_growth(allowed, reach):
+    # points on the x axis at 1, 2 and 3 (area 1 each): with a units of area allowed inside, the nearest
+    # floor(a) end inside and the next stops the x semi-axis on it; y and z grow to their limit
+    local = np.array([[1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [3.0, 0.0, 0.0]])
+    semi = _grow(local, np.ones(3), np.array([4.0, 0.5, 0.5]), np.full(3, 0.1), allowed)
+    assert semi[0] == pytest.approx(reach, rel=1e-9) and semi[0] <= reach
+    assert np.allclose(semi[1:], 0.5)
 
 
 def test_a_fixed_frame_is_the_reference_and_the_box_caps_the_size():
