@@ -288,14 +288,22 @@ def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=N
         shape[shaped] = np.exp(x[len(free):])
         return c, shape
 
+    solved = {}  # a move's way back is the point it came from, bit for bit more often than not
+
+    def solve_at(x):
+        key = x.tobytes()
+        if key not in solved:
+            solved[key] = solve(*unpack(x))
+        return solved[key]
+
     x = np.concatenate([centre[free], np.zeros(len(shaped))])
     step = np.concatenate([0.25 * (hi - lo)[free] / 2.0, np.full(len(shaped), SHAPE_STEP)])
-    best, semi = solve(*unpack(x))
+    best, semi = solve_at(x)
     for _ in range(PATTERN_STEPS):
         while True:
             # best of the moves (not the first improving one), so the search has no preferred axis or sign
             trials = [x + sign * step[k] * np.eye(len(x))[k] for k in range(len(x)) for sign in (1.0, -1.0)]
-            results = [solve(*unpack(trial)) for trial in trials]
+            results = [solve_at(trial) for trial in trials]
             values = np.array([value for value, _ in results])
             # Trials within TIE of the best are equal: different starting shapes often grow into the same
             # ellipsoid, equal up to rounding, and rounding must not pick one. The first of them is taken.
@@ -318,7 +326,8 @@ def cell_share(local, semi_axes, spacing):
     """
     scaled = local / semi_axes
     g = np.einsum("pk,pk->p", scaled, scaled)
-    gradient = 2.0 * np.linalg.norm(scaled / semi_axes, axis=1)
+    over = scaled / semi_axes
+    gradient = 2.0 * np.sqrt(np.einsum("pk,pk->p", over, over))
     with np.errstate(divide="ignore"):
         distance = (1.0 - g) / gradient  # +inf at the centre
     return np.clip(0.5 + distance / spacing, 0.0, 1.0)
