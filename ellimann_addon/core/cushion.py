@@ -9,9 +9,12 @@ bridge is nearly flat; they are flipped until every edge is convex.
 
 A closed, consistently wound surface that is locally convex at every edge and whose faces all
 face away from one interior point is the boundary of a convex body (it is star-shaped, so
-embedded, and a closed locally convex surface is convex). That is checked on every result. Very
-flat ellipsoids (axis ratios beyond about 6:1) can fold the direction triangulation; such meshes
-fail the check and are rebuilt by an exact incremental hull of the same points instead.
+embedded, and a closed locally convex surface is convex). That is checked on every result. Where
+the bridge is long and thin (an upper arm and forearm end to end, a foot and its toes), the flips can
+end locally convex but folded over themselves at a few faces: those faces and two rings around them
+are rebuilt from the exact hull of their few dozen vertices. Very flat ellipsoids (axis ratios beyond
+about 6:1) can fold the direction triangulation more widely; such meshes are rebuilt by an exact
+incremental hull of all the points instead.
 """
 
 import functools
@@ -21,7 +24,7 @@ import numpy as np
 
 from .constants import CUSHION_LEVEL
 from .ellipsoid import support_and_point
-from .mesh import directed_edges, face_normals, icosphere
+from .mesh import directed_edges, face_normals, icosphere, is_closed_manifold
 
 _MAX_FLIP_ROUNDS = 200
 
@@ -56,10 +59,56 @@ def cushion_meshes(pairs, subdivisions=CUSHION_LEVEL):
     interiors = 0.5 * (center[0] + center[1])
     meshes = []
     for v, faces, interior in zip(vertices, _flip_to_locally_convex(vertices, sphere), interiors):
-        if faces is None or not _faces_point_away(v, faces, interior):
+        if faces is not None and not _faces_point_away(v, faces, interior):
+            faces = _mend_fold(v, faces, interior)
+        if faces is None:
             faces = convex_hull_3d(v)
         meshes.append((v, faces))
     return meshes
+
+
+_FOLD_RINGS = 2  # rings of vertices around a fold whose faces are rebuilt with it
+
+
+def _mend_fold(vertices, faces, interior):
+    """A locally convex mesh folded over itself somewhere (a few faces face the interior point) mended: the
+    faces that are not supporting planes of the points, and those within _FOLD_RINGS rings of them, replaced by
+    the faces of the exact hull of their vertices that are supporting planes. Returns the faces, or None when
+    the result is not the boundary of the points' hull (closed, consistently wound, a sphere, every face a
+    supporting plane, facing away from ``interior``): the caller then builds the whole hull. A fold is small, so
+    this is much cheaper than the whole hull (tens of vertices instead of thousands)."""
+    tol = 1e-12 * (float(np.ptp(vertices, axis=0).max()) or 1.0)
+    region = np.zeros(len(vertices), dtype=bool)
+    region[faces[_max_height(vertices, faces) > tol]] = True
+    for _ in range(_FOLD_RINGS):
+        region[faces[region[faces].any(axis=1)]] = True
+    rebuilt = region[faces].any(axis=1)
+    patch = np.unique(faces[rebuilt])
+    if len(patch) < 4 or len(patch) > len(vertices) // 4:
+        return None
+    try:
+        local = patch[convex_hull_3d(vertices[patch])]
+    except ValueError:  # the patch is flat
+        return None
+    local = local[_max_height(vertices, local) <= tol]
+    kept = faces[~rebuilt]
+    known = {tuple(sorted(f)) for f in kept.tolist()}
+    new = np.array([f for f in local.tolist() if tuple(sorted(f)) not in known], dtype=faces.dtype).reshape(-1, 3)
+    mended = np.concatenate([kept, new])
+    if (not is_closed_manifold(mended) or len(np.unique(mended)) - len(mended) // 2 != 2
+            or not _faces_point_away(vertices, mended, interior)):
+        return None
+    return mended
+
+
+def _max_height(vertices, faces):
+    """(F,): how far the furthest vertex lies above each face's plane (outward normals); <= 0 for a supporting
+    plane."""
+    normal = face_normals(vertices, faces)
+    normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-300)
+    offset = np.einsum("ij,ij->i", normal, vertices[faces[:, 0]])
+    return np.concatenate([(vertices @ normal[start:start + 1024].T).max(axis=0) - offset[start:start + 1024]
+                           for start in range(0, len(faces), 1024)])
 
 
 def cushion_vertices(rotation, center, semi_axes, pairs, subdivisions=CUSHION_LEVEL):

@@ -8,6 +8,8 @@ from ellimann_addon.core import cushion, mesh
 from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS
 from ellimann_addon.core.ellipsoid import contains, support
 from ellimann_addon.core.errors import ElliMannError
+from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.reference_set import REFERENCE_FOLDER
 from ellimann_addon.core.synthesis import synthesize
 
 
@@ -101,6 +103,23 @@ def test_a_batch_builds_every_pair_as_if_alone(monkeypatch):
         alone_v, alone_f = cushion.cushion_mesh(*pair, 3)
         assert np.array_equal(v, alone_v) and np.array_equal(f, alone_f)
     assert len(exact_hulls) == 2 and cushion.cushion_meshes([], 3) == []
+
+
+def test_a_fold_left_by_the_flips_is_mended_into_the_exact_hull_from_a_small_patch(monkeypatch):
+    """The shipped Average's right foot and toes: the flips end locally convex but folded (a few faces face the
+    interior); the faces around the fold are rebuilt from the hull of a few of the points, not all of them."""
+    average = Mannequin.load(REFERENCE_FOLDER / "average.json")
+    pair = [tuple(a[average.topology.index[name]] for a in (average.rotation, average.center, average.semi_axes))
+            for name in ("7.a Foot.R", "7.b Toes.R")]
+    hulled = []
+    real_hull = cushion.convex_hull_3d
+    monkeypatch.setattr(cushion, "convex_hull_3d", lambda points: hulled.append(len(points)) or real_hull(points))
+    v, f = cushion.cushion_mesh(*pair)
+    assert len(hulled) == 1 and 4 <= hulled[0] < len(v) // 10, hulled  # the fold's patch only
+    check_convex_closed(v, f)
+    assert {tuple(sorted(face)) for face in f.tolist()} == {tuple(sorted(face)) for face in real_hull(v).tolist()}
+    # what cannot be mended is left to the whole hull: here every face is wrong
+    assert cushion._mend_fold(v, f[:, ::-1], 0.5 * (pair[0][1] + pair[1][1])) is None
 
 
 def test_mannequin_cushions_are_the_hulls_of_its_pairs(toy):
