@@ -101,3 +101,14 @@ def test_the_blender_lanes_do_not_start_without_the_gltf_validator(monkeypatch, 
     monkeypatch.setattr(gltf_validator, "module_dir", unavailable)
     assert matrix.main(["--setup-only", "--lanes", "4.2"]) == 1
     assert "matrix: npm is not on PATH" in capsys.readouterr().err
+
+
+def test_lanes_side_by_side_share_the_cores_blas_threads_unless_set(monkeypatch):
+    for name in matrix.BLAS_THREADS:
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv("PYTHONPATH", "/elsewhere")
+    env = matrix._lane_env(1)
+    assert all(env[name] == "1" for name in matrix.BLAS_THREADS) and "PYTHONPATH" not in env
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "4")  # the user's own choice stays
+    assert matrix._lane_env(1)["OPENBLAS_NUM_THREADS"] == "4"
+    assert "OMP_NUM_THREADS" not in matrix._lane_env()
