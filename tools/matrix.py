@@ -146,8 +146,8 @@ def _lane_env(threads=None):
     """The environment a lane's pytest runs in; ``threads``: the BLAS threads each lane may use (unless set already).
 
     Lanes run side by side, one per core: a BLAS that spreads a small product over every core then waits for a
-    thread the other lane has the core of (the reference build ran 1.7x slower beside a busy core than with one
-    thread)."""
+    thread the other lane has the core of (the Base Mannequin's fit ran 1.7x slower beside a busy core than with
+    one thread)."""
     env = dict(os.environ)
     env.pop("PYTHONPATH", None)  # the lane's venv and the repository root only
     env.pop("VIRTUAL_ENV", None)

@@ -24,7 +24,7 @@ import numpy as np
 
 from .constants import CUSHION_LEVEL
 from .ellipsoid import support_and_point
-from .mesh import directed_edges, face_normals, icosphere, is_closed_manifold
+from .mesh import directed_edges, face_normals, highest_above_faces, icosphere, is_closed_manifold
 
 _MAX_FLIP_ROUNDS = 200
 
@@ -79,7 +79,7 @@ def _mend_fold(vertices, faces, interior):
     this is much cheaper than the whole hull (tens of vertices instead of thousands)."""
     tol = 1e-12 * (float(np.ptp(vertices, axis=0).max()) or 1.0)
     region = np.zeros(len(vertices), dtype=bool)
-    region[faces[_max_height(vertices, faces) > tol]] = True
+    region[faces[highest_above_faces(vertices, faces) > tol]] = True
     for _ in range(_FOLD_RINGS):
         region[faces[region[faces].any(axis=1)]] = True
     rebuilt = region[faces].any(axis=1)
@@ -90,7 +90,7 @@ def _mend_fold(vertices, faces, interior):
         local = patch[convex_hull_3d(vertices[patch])]
     except ValueError:  # the patch is flat
         return None
-    local = local[_max_height(vertices, local) <= tol]
+    local = local[highest_above_faces(vertices, local) <= tol]
     kept = faces[~rebuilt]
     known = {tuple(sorted(f)) for f in kept.tolist()}
     new = np.array([f for f in local.tolist() if tuple(sorted(f)) not in known], dtype=faces.dtype).reshape(-1, 3)
@@ -99,16 +99,6 @@ def _mend_fold(vertices, faces, interior):
             or not _faces_point_away(vertices, mended, interior)):
         return None
     return mended
-
-
-def _max_height(vertices, faces):
-    """(F,): how far the furthest vertex lies above each face's plane (outward normals); <= 0 for a supporting
-    plane."""
-    normal = face_normals(vertices, faces)
-    normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-300)
-    offset = np.einsum("ij,ij->i", normal, vertices[faces[:, 0]])
-    return np.concatenate([(vertices @ normal[start:start + 1024].T).max(axis=0) - offset[start:start + 1024]
-                           for start in range(0, len(faces), 1024)])
 
 
 def cushion_vertices(rotation, center, semi_axes, pairs, subdivisions=CUSHION_LEVEL):

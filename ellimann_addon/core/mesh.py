@@ -100,14 +100,17 @@ def is_closed_manifold(faces):
 
 def convexity_defect(vertices, faces):
     """Largest distance of any vertex above any face plane (0 for a convex, outward-wound mesh)."""
+    return float(highest_above_faces(vertices, faces).max(initial=0.0))
+
+
+def highest_above_faces(vertices, faces):
+    """(F,): how far the furthest of ``vertices`` lies above each face's plane (outward normals); <= 0 where the
+    plane supports them all."""
     n = face_normals(vertices, faces)
     n = n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
     offsets = np.einsum("ij,ij->i", n, vertices[faces[:, 0]])
-    worst = 0.0
-    for start in range(0, len(faces), 2048):
-        heights = vertices @ n[start:start + 2048].T - offsets[start:start + 2048]
-        worst = max(worst, float(heights.max()))
-    return worst
+    return np.concatenate([(vertices @ n[start:start + 2048].T).max(axis=0) - offsets[start:start + 2048]
+                           for start in range(0, len(faces), 2048)] or [np.zeros(0)])
 
 
 def plane_section_points(vertices, faces, height):
