@@ -232,9 +232,10 @@ def main(argv=None):
 
     started = time.monotonic()
     results = []
-    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+    jobs = max(1, args.jobs)
+    threads = max(1, (os.cpu_count() or 1) // jobs)  # each lane's BLAS: its share of the cores
+    with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
         # The lanes with the most suites first, so that two lanes at once finish together.
-        threads = max(1, (os.cpu_count() or 1) // max(1, args.jobs))
         futures = [pool.submit(run_lane, lane, extra, threads) for lane in sorted(lanes, key=lambda x: -len(x.suites))]
         for future in concurrent.futures.as_completed(futures):
             lane, counts, seconds, log_path = future.result()

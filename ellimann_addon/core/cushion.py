@@ -95,6 +95,7 @@ def _mend_fold(vertices, faces, interior):
     known = {tuple(sorted(f)) for f in kept.tolist()}
     new = np.array([f for f in local.tolist() if tuple(sorted(f)) not in known], dtype=faces.dtype).reshape(-1, 3)
     mended = np.concatenate([kept, new])
+    # closed, so E = 3F/2 and the Euler characteristic of the vertices it uses is V - F/2
     if (not is_closed_manifold(mended) or len(np.unique(mended)) - len(mended) // 2 != 2
             or not _faces_point_away(vertices, mended, interior)):
         return None

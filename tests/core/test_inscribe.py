@@ -50,8 +50,8 @@ def test_obstacles_moved_out_let_the_ellipsoid_reach_that_far():
 
 @pytest.mark.parametrize("allowed, reach", [(0.0, 1.0), (0.5, 1.0), (1.5, 2.0), (2.5, 3.0), (3.5, 4.0)])
 def test_points_of_the_allowed_area_may_end_inside_and_the_next_one_stops_the_growth(allowed, reach):
-    # points on the x axis at 1, 2 and 3 (area 1 each): with a units of area allowed inside, the nearest
-    # floor(a) end inside and the next stops the x semi-axis on it; y and z grow to their limit
+    # points on the x axis at 1, 2 and 3 (area 1 each): with ``allowed`` units of area allowed inside, the
+    # floor(allowed) nearest end inside and the next stops the x semi-axis on it; y and z grow to their limit
     local = np.array([[1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [3.0, 0.0, 0.0]])
     semi = _grow(local, np.ones(3), np.array([4.0, 0.5, 0.5]), np.full(3, 0.1), allowed)
     assert semi[0] == pytest.approx(reach, rel=1e-9) and semi[0] <= reach
