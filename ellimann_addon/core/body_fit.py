@@ -15,6 +15,7 @@ import numpy as np
 
 from .body_mesh import vertex_areas, vertex_normals
 from .constants import GIRTHS, SECTION_FRACTIONS
+from .ellipsoid import to_frame
 from .frames import mirror_frame
 from .inscribe import cell_share, hull_surface, inscribed_ellipsoid
 from .mannequin import Mannequin
@@ -93,7 +94,7 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
     obstacles = {i: obstacle_indices(traces[topology.names[i]]) for i in fitted}
 
     def cover(i):
-        return cell_share((inside - center[i]) @ rotation[i], semi_axes[i], spacing)
+        return cell_share(to_frame(inside, center[i], rotation[i]), semi_axes[i], spacing)
 
     for round_ in range(constants.fill_passes):
         for i in fitted:

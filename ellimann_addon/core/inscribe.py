@@ -23,6 +23,7 @@ ellipsoids are inscribed" in the reference 3D model. Here that is an optimisatio
 import numpy as np
 
 from .cushion import convex_hull_3d
+from .ellipsoid import to_frame
 from .frames import relabel_to_reference
 from .mesh import face_normals
 
@@ -236,18 +237,18 @@ def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=N
     rotation, centroid, kept = principal_frame(selected, weights, reference, frame, match)
     if span and kept is None:
         raise ValueError("span needs an axis taken from the points (a 'limb', 'axis' or 'main' frame that finds one)")
-    local_sel = (selected - centroid) @ rotation
+    local_sel = to_frame(selected, centroid, rotation)
     lo, hi = local_sel.min(axis=0), local_sel.max(axis=0)
     half = 0.5 * (hi - lo)
     lo, hi = lo - margin * half, hi + margin * half
     up = int(np.argmax(np.abs(rotation[2])))
     box_centre = 0.5 * (lo + hi)
-    local_obs = (obstacles - centroid) @ rotation
+    local_obs = to_frame(obstacles, centroid, rotation)
     near = np.all((local_obs > lo) & (local_obs < hi), axis=1)
     local_obs, area = local_obs[near], obstacle_area[near]
     allowed = inside_fraction * area.sum()
     if fill is not None:
-        fill = (np.asarray(fill) - centroid) @ rotation
+        fill = to_frame(fill, centroid, rotation)
         # every cell the ellipsoid (inside the box) can share, however the box moves
         in_box = np.all((fill > lo - fill_spacing) & (fill < hi + fill_spacing), axis=1)
         fill = fill[in_box]
@@ -266,7 +267,7 @@ def inscribed_ellipsoid(selected, weights, obstacles, obstacle_area, reference=N
         if fill is None or not np.all(semi > 0.0):
             return float(np.prod(semi)), semi
         # covered volume; the ellipsoid's own volume (tiny weight) breaks ties
-        covered = fill_weight @ cell_share(fill - centre, semi, fill_spacing)
+        covered = np.einsum("p,p->", fill_weight, cell_share(fill - centre, semi, fill_spacing))
         return covered + 1e-3 * float(np.prod(semi)) / float(np.prod(half)), semi
 
     centre = box_centre.copy()

@@ -1,6 +1,6 @@
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from devkit.toy import rotation_from_vector
@@ -83,6 +83,15 @@ def test_sphere_section_through_centre_is_a_circle_of_radius_r():
     assert hit and np.allclose(centre, (0.3, -0.2)) and np.allclose(k, np.eye(2) * 0.25**2)
 
 
+def test_points_in_a_frame_are_their_offsets_along_its_axes():
+    rotation = rotation_from_vector((0, 0, np.pi / 2))  # local x along world y, local y along world -x
+    origin = np.array([1.0, 2.0, 3.0])
+    points = origin + np.array([[0.0, 0.5, 0.0], [-0.25, 0.0, 0.0], [0.0, 0.0, 2.0]])
+    assert np.allclose(el.to_frame(points, origin, rotation), [[0.5, 0, 0], [0, 0.25, 0], [0, 0, 2]], atol=1e-15)
+    mesh = np.random.default_rng(1).normal(size=(5000, 3))  # long enough that a BLAS product would thread
+    assert np.allclose(el.to_frame(mesh, origin, rotation), (mesh - origin) @ rotation, rtol=0, atol=1e-14)
+
+
 def test_bounds_and_volume_closed_forms():
     e = el.Ellipsoid((1, 2, 3), rotation_from_vector((0, 0, np.pi / 2)), (0.1, 0.2, 0.3))
     lo, hi = el.bounds(e.rotation, e.center, e.semi_axes)
@@ -146,6 +155,14 @@ def test_decomposing_a_stack_is_one_decomposition_per_matrix_or_none_if_any_is_n
     assert el.decompose_matrices_world(projective) is None
 
 
+def is_frame(matrix):
+    try:
+        el.decompose_matrix_world(matrix)
+    except FrameError:
+        return False
+    return True
+
+
 def same_set(matrix, repaired):
     """Two descriptions of one ellipsoid: same centre and same shape matrix L L^T."""
     rotation, center, semi = repaired
@@ -174,6 +191,7 @@ def test_repair_of_shear_gives_a_valid_frame_for_the_same_set(entries, c):
     linear = np.eye(3) * 0.3 + np.reshape(entries, (3, 3)) * 0.05  # singular values >= 0.15
     m = np.eye(4)
     m[:3, :3], m[:3, 3] = linear, c
+    assume(not is_frame(m))  # one within the frames' tolerance is a frame: projected, not repaired
     repaired = el.repair_matrix_world(m)
     assert same_set(m, repaired) and is_rotation(repaired[0]) and np.all(repaired[2] > 0)
     el.decompose_matrix_world(el.matrix_world(*repaired))
