@@ -78,6 +78,41 @@ def test_symmetrize_central_gives_a_symmetric_right_handed_ellipsoid(rv, c, d):
     assert abs(s[0, k]) == 1.0
 
 
+def nearest_rotation_by_svd(matrix):
+    u, _, vt = np.linalg.svd(matrix)
+    fix = np.ones(matrix.shape[:-1])
+    fix[..., 2] = np.linalg.det(u @ vt)
+    return (u * fix[..., None, :]) @ vt
+
+
+@settings(max_examples=60, deadline=None)
+@given(vectors, sizes)
+def test_the_nearest_rotation_to_a_rotation_times_a_stretch_is_that_rotation(rv, stretch):
+    r = rotation_from_vector(rv)
+    assert np.allclose(frames.project_to_rotation(r @ np.diag(stretch)), r, atol=1e-12)  # polar factor R
+    assert np.allclose(frames.project_to_rotation(0.3 * r), r, atol=1e-13)
+
+
+def test_the_nearest_rotation_is_the_svd_s_for_any_matrix_and_the_same_alone_as_in_a_batch():
+    rng = np.random.default_rng(3)
+    near = np.stack([rotation_from_vector(v) for v in rng.normal(size=(200, 3))]) + 0.2 * rng.normal(size=(200, 3, 3))
+    matrices = np.concatenate([near, rng.normal(size=(200, 3, 3))])  # about half of the random ones: det < 0
+    assert (np.linalg.det(matrices) < 0).sum() > 50
+    nearest = frames.project_to_rotation(matrices)
+    assert np.allclose(nearest, nearest_rotation_by_svd(matrices), rtol=0, atol=1e-12)
+    assert np.all(frames.is_rotation(nearest, tol=1e-13))
+    alone = np.stack([frames.project_to_rotation(m) for m in matrices])
+    assert np.array_equal(alone, nearest)
+    assert frames.project_to_rotation(matrices.reshape(20, 20, 3, 3)).shape == (20, 20, 3, 3)
+
+
+def test_a_rotation_is_its_own_nearest_rotation_bit_for_bit():
+    rotations = np.stack([rotation_from_vector(v) for v in np.random.default_rng(4).normal(size=(50, 3))])
+    settled = frames.project_to_rotation(rotations)  # rotation_from_vector's own rounding, settled once
+    assert np.array_equal(frames.project_to_rotation(settled), settled)
+    assert np.array_equal(frames.project_to_rotation(np.eye(3)), np.eye(3))
+
+
 @settings(max_examples=60, deadline=None)
 @given(vectors, st.lists(st.floats(0.01, 1.0), min_size=1, max_size=6))
 def test_rotation_mean_of_identical_rotations_is_that_rotation(rv, weights):

@@ -14,6 +14,7 @@ import bpy
 import numpy as np
 
 from ...core.errors import ElliMannError
+from ...core.frames import project_to_rotation
 from ...core.retarget import SourceMotion
 from .chatter import blender_output
 
@@ -84,16 +85,10 @@ def _sampled(source, scene, frame_time):
         scene.frame_set(frame)
         posed = np.array([np.array(b.matrix) for b in bones])
         motion = world @ posed @ rest_inverse  # rest -> posed, world space
-        rotations.append(_orthonormal(motion[:, :3, :3]))
+        rotations.append(project_to_rotation(motion[:, :3, :3]))  # an importer's global_scale leaves a scale
         roots.append((world @ posed[root])[:3, 3])
     heads = (rest[:, :3, 3] @ world[:3, :3].T) + world[:3, 3]
     return SourceMotion([b.name for b in bones], heads, np.array(rotations), np.array(roots), 1.0 / frame_time)
-
-
-def _orthonormal(matrices):
-    """The rotation part of each (k, 3, 3) (a BVH importer's global_scale leaves a uniform scale)."""
-    u, _, vt = np.linalg.svd(matrices)
-    return u @ vt
 
 
 def _remove_new(objects_before, actions_before):
