@@ -106,6 +106,26 @@ def test_the_nearest_rotation_is_the_svd_s_for_any_matrix_and_the_same_alone_as_
     assert frames.project_to_rotation(matrices.reshape(20, 20, 3, 3)).shape == (20, 20, 3, 3)
 
 
+def test_a_matrix_whose_iteration_would_overflow_is_projected_by_the_svd():
+    r = rotation_from_vector((0.3, -0.2, 0.1))
+    assert np.allclose(frames.project_to_rotation(1e103 * r), r, atol=1e-12)  # det overflows
+    assert np.allclose(frames.project_to_rotation(np.diag([1e200, 1e-200, 1.0])), np.eye(3))  # a step overflows
+    assert np.allclose(frames.project_to_rotation(np.diag([1.0, 1.0, 1e-300])), np.eye(3))
+
+
+def test_means_of_nearby_rotations_need_no_svd(monkeypatch):
+    rng = np.random.default_rng(5)
+    means = np.stack([rotation_from_vector(v) for v in rng.normal(size=(100, 3))]) * 0.9 + 0.02 * rng.normal(
+        size=(100, 3, 3))
+    expected = nearest_rotation_by_svd(means)
+
+    def refused(*args, **kwargs):
+        raise AssertionError("the SVD was called")
+
+    monkeypatch.setattr(frames.np.linalg, "svd", refused)
+    assert np.allclose(frames.project_to_rotation(means), expected, rtol=0, atol=1e-13)
+
+
 def test_a_rotation_is_its_own_nearest_rotation_bit_for_bit():
     rotations = np.stack([rotation_from_vector(v) for v in np.random.default_rng(4).normal(size=(50, 3))])
     settled = frames.project_to_rotation(rotations)  # rotation_from_vector's own rounding, settled once
