@@ -7,8 +7,18 @@ shows Blender's output too (on stderr).
 import importlib
 import sys
 
-BENCHES = ("bench_core", "bench_synthesis", "bench_male", "bench_pose", "bench_drape", "bench_walk_drape",
-           "bench_references", "bench_scan", "bench_scan_held_out", "bench_extra")
+BENCHES = (
+    "bench_core",
+    "bench_synthesis",
+    "bench_male",
+    "bench_pose",
+    "bench_drape",
+    "bench_walk_drape",
+    "bench_references",
+    "bench_scan",
+    "bench_scan_held_out",
+    "bench_extra",
+)
 
 
 def main(names=None, verbose=False):

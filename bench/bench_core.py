@@ -5,7 +5,8 @@ import time
 import numpy as np
 
 from devkit.reference import brute_force_measure, random_mannequin_arrays
-from ellimann_addon.core import cushion, measure
+from ellimann_addon.core.geometry import cushion
+from ellimann_addon.core.measure import tailor as measure
 
 
 def best_of(fn, repeat=5, number=1):
@@ -37,14 +38,17 @@ def run():
         err = rel_error(lambda *b, s=samples: brute_force_measure(*b, samples=s))
         t = best_of(lambda s=samples: [brute_force_measure(*b, samples=s) for b in bodies[:5]], repeat=3) / 5
         verdict = "worse" if err > closed_err else "equal or better"
-        print(f"  brute force, {samples:6d} samples    {t * 1e3:8.3f} ms   max rel error {err:.1e}  "
-              f"({verdict} accuracy; closed form is {t / closed_t:6.1f}x faster)")
+        print(
+            f"  brute force, {samples:6d} samples    {t * 1e3:8.3f} ms   max rel error {err:.1e}  "
+            f"({verdict} accuracy; closed form is {t / closed_t:6.1f}x faster)"
+        )
 
     batch = 1000
     stacked = [np.stack([bodies[i % len(bodies)][j] for i in range(batch)]) for j in range(3)]
     t = best_of(lambda: measure.tailor_measurements(*stacked, girth), repeat=3)
-    print(f"m_T batched over {batch} mannequins: {t:.3f} s = {t / batch * 1e3:.3f} ms each, "
-          f"{batch / t:,.0f} mannequins/s")
+    print(
+        f"m_T batched over {batch} mannequins: {t:.3f} s = {t / batch * 1e3:.3f} ms each, {batch / t:,.0f} mannequins/s"
+    )
 
     eye = np.eye(3)
     pair = ((eye, (0, 0, 0), (0.06, 0.07, 0.2)), (eye, (0.01, 0.02, -0.35), (0.045, 0.05, 0.18)))

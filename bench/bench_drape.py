@@ -26,12 +26,12 @@ import time
 
 import numpy as np
 
-from ellimann_addon.core import garments
-from ellimann_addon.core.body_mesh import read_obj
-from ellimann_addon.core.collision import collision_pieces, triangle_count
-from ellimann_addon.core.garment_fit import BodyPieces, fit_statistics, mesh_distance
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.synthesis import REFERENCE_FOLDER
+from ellimann_addon.core.drape import garments
+from ellimann_addon.core.drape.colliders import collision_pieces, triangle_count
+from ellimann_addon.core.drape.fit_metrics import BodyPieces, fit_statistics, mesh_distance
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.synthesize import REFERENCE_FOLDER
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 REFMODELS = ROOT.parent / "shared" / "refmodels"
@@ -69,14 +69,16 @@ def run(frames=FRAMES, repeat=REPEAT, sweep=SWEEP, kinds=("tube_dress", "t_shirt
     ellimann_addon.register()
     try:
         body = read_obj(body_path)
-        compare(Mannequin.load(source), body.vertices, body.faces, frames=frames, repeat=repeat, sweep=sweep,
-                kinds=kinds)
+        compare(
+            Mannequin.load(source), body.vertices, body.faces, frames=frames, repeat=repeat, sweep=sweep, kinds=kinds
+        )
     finally:
         ellimann_addon.unregister()
 
 
-def compare(mannequin, body_vertices, body_faces, frames=FRAMES, repeat=REPEAT, sweep=SWEEP,
-            kinds=("tube_dress", "t_shirt")):
+def compare(
+    mannequin, body_vertices, body_faces, frames=FRAMES, repeat=REPEAT, sweep=SWEEP, kinds=("tube_dress", "t_shirt")
+):
     """Drape each garment of ``kinds`` on every collider of ``sweep`` and on the dense body; print the table."""
     import bpy
 
@@ -90,12 +92,16 @@ def compare(mannequin, body_vertices, body_faces, frames=FRAMES, repeat=REPEAT, 
     def dense(points):
         return mesh_distance(points, body_vertices, body_faces)[0]
 
-    print(f"mannequin: {mannequin.name} ({len(mannequin)} ellipsoids, {len(mannequin.topology.cushion_pairs)} "
-          f"cushion pairs), m_T " + ", ".join(f"{k} {v:.2f}" for k, v in mannequin.measure().items()) + " cm")
+    print(
+        f"mannequin: {mannequin.name} ({len(mannequin)} ellipsoids, {len(mannequin.topology.cushion_pairs)} "
+        f"cushion pairs), m_T " + ", ".join(f"{k} {v:.2f}" for k, v in mannequin.measure().items()) + " cm"
+    )
     print(f"dense body: {BODY}.obj, {len(body_vertices):,} vertices, {len(body_faces):,} triangles")
     gap = dense(exact_samples(mannequin))
-    print(f"mannequin surface vs dense body: median {np.median(gap) * 1e3:.1f} mm, {np.mean(gap < 0) * 100:.0f}% of "
-          "it inside the body (the pieces are fitted mostly inside the skin)")
+    print(
+        f"mannequin surface vs dense body: median {np.median(gap) * 1e3:.1f} mm, {np.mean(gap < 0) * 100:.0f}% of "
+        "it inside the body (the pieces are fitted mostly inside the skin)"
+    )
     print(f"cloth: settings {drape.DrapeSettings(frames=frames, edge=EDGE)}")
 
     def simulate(garment, pieces):
@@ -111,9 +117,11 @@ def compare(mannequin, body_vertices, body_faces, frames=FRAMES, repeat=REPEAT, 
         garment = garments.make_garment(mannequin, kind, edge=EDGE)
         start = time.perf_counter()
         garment = garments.clear_of(garment, lambda p: np.minimum(exact.signed_distance(p, 0.05)[0], dense(p)))
-        print(f"\n== {garment.name}: {len(garment.vertices)} vertices, {len(garment.faces)} triangles, "
-              f"{len(garment.seams)} seams, {len(garment.pins)} pins; {garment.pattern['cleared']} vertices moved "
-              f"clear of both bodies ({time.perf_counter() - start:.1f} s)")
+        print(
+            f"\n== {garment.name}: {len(garment.vertices)} vertices, {len(garment.faces)} triangles, "
+            f"{len(garment.seams)} seams, {len(garment.pins)} pins; {garment.pattern['cleared']} vertices moved "
+            f"clear of both bodies ({time.perf_counter() - start:.1f} s)"
+        )
         rows = {}
         runs = [("dense body", None, 0, 0), *sweep]
         # The cloth alone (no collider: it falls freely) is the floor under every collider's cost.
@@ -122,11 +130,16 @@ def compare(mannequin, body_vertices, body_faces, frames=FRAMES, repeat=REPEAT, 
             pieces = body_piece if cushions is None else collision_pieces(mannequin, cushions, sphere, cushion)
             results = [simulate(garment, pieces) for _ in range(repeat)]
             vertices = results[0][2]
-            row = {"seconds": min(r[0] for r in results), "cpu": min(r[1] for r in results),
-                   "triangles": triangle_count(pieces), "vertices": vertices,
-                   "dense": fit_statistics(dense(vertices)),
-                   "own": None if cushions is None else fit_statistics(
-                       own[cushions].signed_distance(vertices, drape.FIT_CUTOFF)[0])}
+            row = {
+                "seconds": min(r[0] for r in results),
+                "cpu": min(r[1] for r in results),
+                "triangles": triangle_count(pieces),
+                "vertices": vertices,
+                "dense": fit_statistics(dense(vertices)),
+                "own": None
+                if cushions is None
+                else fit_statistics(own[cushions].signed_distance(vertices, drape.FIT_CUTOFF)[0]),
+            }
             if len(garment.seams):
                 gaps = np.linalg.norm(vertices[garment.seams[:, 0]] - vertices[garment.seams[:, 1]], axis=1)
                 row["seams"] = (float(np.median(gaps)), float(gaps.max()))
@@ -136,7 +149,7 @@ def compare(mannequin, body_vertices, body_faces, frames=FRAMES, repeat=REPEAT, 
 
 def exact_samples(mannequin, count=100):
     """Points on the mannequin's outer surface (ellipsoid samples not inside another piece)."""
-    from ellimann_addon.core.ellipsoid import sample_surface
+    from ellimann_addon.core.geometry.ellipsoid import sample_surface
 
     points = sample_surface(mannequin.rotation, mannequin.center, mannequin.semi_axes, count).reshape(-1, 3)
     return points[BodyPieces(mannequin).signed_distance(points)[0] > -1e-9]
@@ -145,27 +158,37 @@ def exact_samples(mannequin, count=100):
 def report(rows, garment, free):
     base = rows["dense body"]
     headline = HEADLINE if HEADLINE in rows else next(label for label in rows if label != "dense body")
-    print(f"cloth alone (no collider) {free:.3f} s/frame; above that, collisions cost "
-          f"{base['seconds'] - free:.3f} with the dense body and {rows[headline]['seconds'] - free:.3f} with "
-          f"{headline} ({(base['seconds'] - free) / max(rows[headline]['seconds'] - free, 1e-9):.1f}x)")
-    print("s/frame: wall (CPU); distances in mm; 'inside': garment vertices inside that surface; "
-          "speed-up = dense s/frame / this")
-    print(f"{'collider':<16}{'triangles':>10}{'s/frame':>15}{'speed-up':>9} | vs dense body: {'median':>6}{'p05':>6}"
-          f"{'p95':>6}{'inside':>7}{'deepest':>8} | vs own pieces: {'inside':>6}{'deepest':>8}"
-          + (" | seams median/max" if len(garment.seams) else ""))
+    print(
+        f"cloth alone (no collider) {free:.3f} s/frame; above that, collisions cost "
+        f"{base['seconds'] - free:.3f} with the dense body and {rows[headline]['seconds'] - free:.3f} with "
+        f"{headline} ({(base['seconds'] - free) / max(rows[headline]['seconds'] - free, 1e-9):.1f}x)"
+    )
+    print(
+        "s/frame: wall (CPU); distances in mm; 'inside': garment vertices inside that surface; "
+        "speed-up = dense s/frame / this"
+    )
+    print(
+        f"{'collider':<16}{'triangles':>10}{'s/frame':>15}{'speed-up':>9} | vs dense body: {'median':>6}{'p05':>6}"
+        f"{'p95':>6}{'inside':>7}{'deepest':>8} | vs own pieces: {'inside':>6}{'deepest':>8}"
+        + (" | seams median/max" if len(garment.seams) else "")
+    )
     for label, row in rows.items():
         d, own = row["dense"], row["own"]
-        cells = (f"{label:<16}{row['triangles']:>10,}{row['seconds']:>8.3f} ({row['cpu']:.3f})"
-                 f"{base['seconds'] / row['seconds']:>8.2f}x"
-                 f" | {'':14}{d['median'] * 1e3:>6.1f}{d['p05'] * 1e3:>6.1f}{d['p95'] * 1e3:>6.1f}"
-                 f"{d['penetrating']:>7}{d['max_depth'] * 1e3:>8.1f}")
+        cells = (
+            f"{label:<16}{row['triangles']:>10,}{row['seconds']:>8.3f} ({row['cpu']:.3f})"
+            f"{base['seconds'] / row['seconds']:>8.2f}x"
+            f" | {'':14}{d['median'] * 1e3:>6.1f}{d['p05'] * 1e3:>6.1f}{d['p95'] * 1e3:>6.1f}"
+            f"{d['penetrating']:>7}{d['max_depth'] * 1e3:>8.1f}"
+        )
         cells += f" | {'':14}{own['penetrating']:>6}{own['max_depth'] * 1e3:>8.1f}" if own else f" | {'(the same)':>28}"
         if "seams" in row:
             cells += f" | {row['seams'][0] * 1e3:6.1f} / {row['seams'][1] * 1e3:5.1f}"
         print(cells)
     shift = np.linalg.norm(rows[headline]["vertices"] - base["vertices"], axis=1)
-    print(f"same garment, {headline} vs dense body, per vertex: median {np.median(shift) * 1e3:.1f} mm, "
-          f"95th percentile {np.percentile(shift, 95) * 1e3:.1f} mm apart")
+    print(
+        f"same garment, {headline} vs dense body, per vertex: median {np.median(shift) * 1e3:.1f} mm, "
+        f"95th percentile {np.percentile(shift, 95) * 1e3:.1f} mm apart"
+    )
     for kind in ("cushions", "ellipsoids"):
         print(best_at_equal_fit({label: row for label, row in rows.items() if label.startswith(kind)}, kind))
 
@@ -176,19 +199,26 @@ def best_at_equal_fit(sweep, kind):
         return f"{kind}: fewer than two resolutions, no comparison"
     finest_label = max(sweep, key=lambda label: sweep[label]["triangles"])
     finest = sweep[finest_label]["dense"]
-    equal = [label for label, row in sweep.items()
-             if abs(row["dense"]["median"] - finest["median"]) <= FIT_TOLERANCE
-             and abs(row["dense"]["p95"] - finest["p95"]) <= 2 * FIT_TOLERANCE
-             and row["dense"]["penetrating"] <= finest["penetrating"] + PENETRATING_TOLERANCE * len(row["vertices"])
-             and row["own"]["max_depth"] <= FIT_TOLERANCE]
-    criteria = (f"median within {FIT_TOLERANCE * 1e3:g} mm, p95 within {2 * FIT_TOLERANCE * 1e3:g} mm and vertices "
-                f"inside the dense body within {PENETRATING_TOLERANCE:.0%} of the garment of {finest_label}'s, none "
-                f"over {FIT_TOLERANCE * 1e3:g} mm inside the exact pieces")
+    equal = [
+        label
+        for label, row in sweep.items()
+        if abs(row["dense"]["median"] - finest["median"]) <= FIT_TOLERANCE
+        and abs(row["dense"]["p95"] - finest["p95"]) <= 2 * FIT_TOLERANCE
+        and row["dense"]["penetrating"] <= finest["penetrating"] + PENETRATING_TOLERANCE * len(row["vertices"])
+        and row["own"]["max_depth"] <= FIT_TOLERANCE
+    ]
+    criteria = (
+        f"median within {FIT_TOLERANCE * 1e3:g} mm, p95 within {2 * FIT_TOLERANCE * 1e3:g} mm and vertices "
+        f"inside the dense body within {PENETRATING_TOLERANCE:.0%} of the garment of {finest_label}'s, none "
+        f"over {FIT_TOLERANCE * 1e3:g} mm inside the exact pieces"
+    )
     if not equal:
         return f"{kind}: no resolution fits as {finest_label} does ({criteria})"
     best = min(equal, key=lambda label: sweep[label]["seconds"])
-    return (f"{kind}, best speed at equal fit ({criteria}): {best}, {sweep[best]['seconds']:.3f} s/frame, "
-            f"{sweep[best]['triangles']:,} triangles (equal fit: {', '.join(equal)})")
+    return (
+        f"{kind}, best speed at equal fit ({criteria}): {best}, {sweep[best]['seconds']:.3f} s/frame, "
+        f"{sweep[best]['triangles']:,} triangles (equal fit: {', '.join(equal)})"
+    )
 
 
 if __name__ == "__main__":

@@ -1,12 +1,12 @@
-"""The extra measurements on a mannequin (``core.extra_measures.mannequin_extra_measurements``) and exact mode
-with them (``core.refine_extra.meet_extra``): now against main's code before they were made faster
+"""The extra measurements on a mannequin (``core.measure.extra.mannequin_extra_measurements``) and exact mode
+with them (``core.synthesis.extra_refine.meet_extra``): now against main's code before they were made faster
 (``devkit.extra_before``: golden section per band, one hull_perimeter call a step), in one run.
 
 Mannequins: the shipped female and male Reference Mannequins and mannequins synthesized (exact mode) on a grid
 of requests over each set's inner quartiles. Per mannequin: the best of three timings of each way, the ratio,
 and the largest difference of any extra measurement (cm). meet_extra: a few synthesized mannequins asked for
 their extra measurements moved by a few per cent, timed once each way (main's measurements patched into
-``core.refine_extra`` for the before), with the largest difference of what each measured at the end.
+``core.synthesis.extra_refine`` for the before), with the largest difference of what each measured at the end.
 """
 
 import itertools
@@ -20,11 +20,13 @@ import numpy as np
 
 from devkit.extra_before import MannequinLandmarksBefore, mannequin_extra_measurements_before
 from ellimann_addon.cli import main as ellimann
-from ellimann_addon.core import body_measure, refine_extra, synthesis
-from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
-from ellimann_addon.core.extra_measures import EXTRA_MEASUREMENTS, mannequin_extra_measurements
-from ellimann_addon.core.shipped_sets import FEMALE_SET, MALE_SET, named_reference_set
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.measure import body as body_measure
+from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS, mannequin_extra_measurements
+from ellimann_addon.core.synthesis import extra_refine as refine_extra
+from ellimann_addon.core.synthesis import synthesize as synthesis
+from ellimann_addon.core.synthesis.shipped import FEMALE_SET, MALE_SET, named_reference_set
 from tools.reference_sets import TRACING_FOLDER
 
 GRID_STEP = 27  # every 27th of the 243 inner-quartile requests: 9 per set
@@ -53,7 +55,7 @@ BODIES = ("reference_female", "small_slim", "tall_slim", "small_chubby", "tall_c
 
 @contextmanager
 def every_triangle_cut():
-    """core.body_measure cutting every triangle of the mesh at every height (main's way)."""
+    """core.measure.body cutting every triangle of the mesh at every height (main's way)."""
     saved = body_measure.StandingBody.crossed
     body_measure.StandingBody.crossed = lambda body, z, rows=None: np.arange(len(body.faces)) if rows is None else rows
     try:
@@ -64,7 +66,8 @@ def every_triangle_cut():
 
 @contextmanager
 def measured_as_before():
-    """core.refine_extra measuring with main's extra measurements (its landmarks too, for the deformations)."""
+    """core.synthesis.extra_refine measuring with main's extra measurements (its landmarks too, for the
+    deformations)."""
     saved = refine_extra.mannequin_extra_measurements, refine_extra.MannequinLandmarks
     refine_extra.mannequin_extra_measurements = mannequin_extra_measurements_before
     refine_extra.MannequinLandmarks = MannequinLandmarksBefore
@@ -88,10 +91,14 @@ def run():
                 difference = max(abs(new[key] - old[key]) for key in EXTRA_MEASUREMENTS)
                 worst[(set_name, label)] = max(worst.get((set_name, label), 0.0), difference)
                 ratios.append(before / now)
-                print(f"{set_name + ' ' + mannequin.name:<28} {1e3 * before:9.1f} {1e3 * now:7.1f} "
-                      f"{before / now:6.1f} {difference:13.1e}")
-    print(f"mannequin_extra_measurements: median {statistics.median(ratios):.1f}x faster (min {min(ratios):.1f}x); "
-          "largest difference: " + ", ".join(f"{s} {label} {d:.1e} cm" for (s, label), d in worst.items()))
+                print(
+                    f"{set_name + ' ' + mannequin.name:<28} {1e3 * before:9.1f} {1e3 * now:7.1f} "
+                    f"{before / now:6.1f} {difference:13.1e}"
+                )
+    print(
+        f"mannequin_extra_measurements: median {statistics.median(ratios):.1f}x faster (min {min(ratios):.1f}x); "
+        "largest difference: " + ", ".join(f"{s} {label} {d:.1e} cm" for (s, label), d in worst.items())
+    )
 
     print(f"\nmeet_extra (each extra measurement asked at x {', '.join(f'{c:g}' for c in EXTRA_CHANGE)}):")
     print(f"{'mannequin':<28} {'before s':>8} {'now s':>6} {'ratio':>6} {'max |diff| cm':>13}  misses now")
@@ -106,10 +113,14 @@ def run():
             totals[0] += before
             totals[1] += now
             difference = max(abs(new[key] - old[key]) for key in new)
-            print(f"{set_name + ' ' + mannequin.name:<28} {before:8.2f} {now:6.2f} {before / now:6.1f} "
-                  f"{difference:13.1e}  {misses or 'none'}")
-    print(f"meet_extra: {totals[0] / totals[1]:.1f}x faster over {2 * MEET_PER_SET} mannequins "
-          f"({totals[0] / (2 * MEET_PER_SET):.2f} s -> {totals[1] / (2 * MEET_PER_SET):.2f} s per mannequin)")
+            print(
+                f"{set_name + ' ' + mannequin.name:<28} {before:8.2f} {now:6.2f} {before / now:6.1f} "
+                f"{difference:13.1e}  {misses or 'none'}"
+            )
+    print(
+        f"meet_extra: {totals[0] / totals[1]:.1f}x faster over {2 * MEET_PER_SET} mannequins "
+        f"({totals[0] / (2 * MEET_PER_SET):.2f} s -> {totals[1] / (2 * MEET_PER_SET):.2f} s per mannequin)"
+    )
 
     bodies()
     population()
@@ -120,21 +131,40 @@ def population(rows=12):
         with tempfile.TemporaryDirectory() as folder:
             folder = pathlib.Path(folder)
             start = time.perf_counter()
-            code = ellimann(["population", "--stats", "ansur2_female", "--n", str(rows), "--seed", "1", "-q",
-                             "-o", str(folder / "people.csv"), "--extras", "--synthesize", str(folder / "out")])
+            code = ellimann(
+                [
+                    "population",
+                    "--stats",
+                    "ansur2_female",
+                    "--n",
+                    str(rows),
+                    "--seed",
+                    "1",
+                    "-q",
+                    "-o",
+                    str(folder / "people.csv"),
+                    "--extras",
+                    "--synthesize",
+                    str(folder / "out"),
+                ]
+            )
             assert code == 0
             return time.perf_counter() - start
 
     with measured_as_before():
         before = once()
     now = once()
-    print(f"\npopulation --n {rows} --extras --synthesize: before {before:.1f} s, now {now:.1f} s, "
-          f"{before / now:.1f}x faster")
+    print(
+        f"\npopulation --n {rows} --extras --synthesize: before {before:.1f} s, now {now:.1f} s, "
+        f"{before / now:.1f}x faster"
+    )
 
 
 def bodies():
-    print(f"\nmeasure_body_mesh:\n{'body':<17} {'triangles':>9} {'before s':>8} {'now s':>6} {'ratio':>6} "
-          f"{'max |diff| cm':>13}")
+    print(
+        f"\nmeasure_body_mesh:\n{'body':<17} {'triangles':>9} {'before s':>8} {'now s':>6} {'ratio':>6} "
+        f"{'max |diff| cm':>13}"
+    )
     totals = [0.0, 0.0]
     for name in BODIES:
         mesh = read_obj(TRACING_FOLDER / f"{name}.obj")

@@ -13,13 +13,15 @@ import time
 import numpy as np
 
 from bench.bench_synthesis import population_scale, table
-from ellimann_addon.core import synthesis
 from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
-from ellimann_addon.core.shipped_sets import MALE_SET, named_reference_set
+from ellimann_addon.core.synthesis import synthesize as synthesis
+from ellimann_addon.core.synthesis.shipped import MALE_SET, named_reference_set
 
-VARIANTS = (("the paper's IDW", {"mode": "idw", "normalize": "none"}),
-            ("proportional IDW (default)", {"mode": "idw", "normalize": "proportional"}),
-            ("exact mode (default)", {"mode": "exact"}))
+VARIANTS = (
+    ("the paper's IDW", {"mode": "idw", "normalize": "none"}),
+    ("proportional IDW (default)", {"mode": "idw", "normalize": "proportional"}),
+    ("exact mode (default)", {"mode": "exact"}),
+)
 
 
 def male_grid(reference):
@@ -29,10 +31,12 @@ def male_grid(reference):
 def run():
     reference = named_reference_set(MALE_SET)
     requests = male_grid(reference)
-    print(f"reference set: {reference.name} ({len(reference)} RMs), section heights "
-          + ", ".join(f"{k} {v:g}" for k, v in reference.section_fractions.items())
-          + f"; grid: {len(requests)} requests over the inner quartiles of "
-          + ", ".join(f"{k} {lo:g}-{hi:g}" for k, (lo, hi) in reference.ranges.items()))
+    print(
+        f"reference set: {reference.name} ({len(reference)} RMs), section heights "
+        + ", ".join(f"{k} {v:g}" for k, v in reference.section_fractions.items())
+        + f"; grid: {len(requests)} requests over the inner quartiles of "
+        + ", ".join(f"{k} {lo:g}-{hi:g}" for k, (lo, hi) in reference.ranges.items())
+    )
     for title, options in VARIANTS:
         start = time.perf_counter()
         result = synthesis.synthesize_batch(reference, requests, **options)
@@ -40,10 +44,17 @@ def run():
         table(f"\nTable 2.4 on the male set, {title}: {seconds:.2f} s", result.relative_error(), paper=False)
         if options["mode"] == "exact":
             spread = np.abs(result.factors - 1.0) * 100.0
-            refined = synthesis.refine(reference.topology, *synthesis.interpolate(reference, requests), requests,
-                                       jacobian=reference.refine_jacobian(), fractions=reference.section_fractions)
+            refined = synthesis.refine(
+                reference.topology,
+                *synthesis.interpolate(reference, requests),
+                requests,
+                jacobian=reference.refine_jacobian(),
+                fractions=reference.section_fractions,
+            )
             print(f"  iterations (slowest mannequin): {refined.iterations}")
-            print(f"  converged: {int(result.converged.sum())}/{len(requests)} within "
-                  f"{synthesis.EXACT_TOLERANCE * 100:g}% (largest error {result.relative_error().max():.1e}%); "
-                  f"largest |factor - 1|: {spread.max():.2f}%")
+            print(
+                f"  converged: {int(result.converged.sum())}/{len(requests)} within "
+                f"{synthesis.EXACT_TOLERANCE * 100:g}% (largest error {result.relative_error().max():.1e}%); "
+                f"largest |factor - 1|: {spread.max():.2f}%"
+            )
     population_scale(reference, requests)

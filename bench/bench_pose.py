@@ -7,11 +7,11 @@ import time
 import numpy as np
 
 from ellimann_addon.core.constants import CUSHION_LEVEL, LIVE_CUSHION_LEVEL, MJCF_CUSHION_LEVEL
-from ellimann_addon.core.cushion import cushion_vertices
-from ellimann_addon.core.posed import PosingRig
-from ellimann_addon.core.poses import standard_pose, walk
-from ellimann_addon.core.reference_set import load_reference_set
-from ellimann_addon.core.synthesis import synthesize_batch
+from ellimann_addon.core.geometry.cushion import cushion_vertices
+from ellimann_addon.core.pose.posed_pieces import PosingRig
+from ellimann_addon.core.pose.standard import standard_pose, walk
+from ellimann_addon.core.synthesis.reference_set import load_reference_set
+from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 
 TARGET_MS = 16.0  # a frame at 60 Hz: what following a dragged bone needs
 REQUEST = [165.0, 41.5, 101.25, 82.75, 117.5]
@@ -36,8 +36,10 @@ def run():
         cushion_vertices(result.rotation[0], result.center[0], result.semi_axes[0], pairs, LIVE_CUSHION_LEVEL)
 
     live, live_max = median_ms(live_step)
-    print(f"live synthesis step (exact mode + {len(pairs)} cushions' vertices at level {LIVE_CUSHION_LEVEL}): "
-          f"{live:7.2f} ms median, {live_max:.2f} max")
+    print(
+        f"live synthesis step (exact mode + {len(pairs)} cushions' vertices at level {LIVE_CUSHION_LEVEL}): "
+        f"{live:7.2f} ms median, {live_max:.2f} max"
+    )
     frames = walk(mannequin.joints)
     sitting = standard_pose("sit", mannequin.joints)
     for level in (MJCF_CUSHION_LEVEL, CUSHION_LEVEL):
@@ -48,7 +50,9 @@ def run():
         posing, posing_max = median_ms(lambda r=rig: r.pose(sitting))
         cycle, _ = median_ms(lambda r=rig: [r.pose(f) for f in frames], count=5)
         verdict = "under" if posing < TARGET_MS else "OVER"
-        print(f"pose 40 pieces + {len(rig.meshes)} cushion meshes (level {level}, {vertices:,} vertices): "
-              f"{posing:6.2f} ms median, {posing_max:.2f} max ({verdict} the {TARGET_MS:g} ms target; "
-              f"{posing / live:.2f}x the live synthesis step); rig built once in {built:.0f} ms; "
-              f"the 24-frame walk cycle {cycle:.0f} ms")
+        print(
+            f"pose 40 pieces + {len(rig.meshes)} cushion meshes (level {level}, {vertices:,} vertices): "
+            f"{posing:6.2f} ms median, {posing_max:.2f} max ({verdict} the {TARGET_MS:g} ms target; "
+            f"{posing / live:.2f}x the live synthesis step); rig built once in {built:.0f} ms; "
+            f"the 24-frame walk cycle {cycle:.0f} ms"
+        )

@@ -12,11 +12,12 @@ import time
 
 import numpy as np
 
-from ellimann_addon.core import body_fit, reference_build
-from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER
+from ellimann_addon.core.fitting import mannequin_fit as body_fit
+from ellimann_addon.core.fitting import reference_build
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
 REFMODELS = pathlib.Path(__file__).resolve().parents[2] / "shared" / "refmodels"
 
@@ -53,9 +54,15 @@ def run():
     read = time.perf_counter() - started
 
     watch = Stopwatch()
-    originals = [(module, name, watch.wrap(module, name, label)) for module, name, label in (
-        (body_fit, "inscribed_ellipsoid", "inscribe parts"), (reference_build, "fit_mannequin", "fit bodies"),
-        (reference_build, "adjust", "refine to targets"), (reference_build, "clean", "clean together"))]
+    originals = [
+        (module, name, watch.wrap(module, name, label))
+        for module, name, label in (
+            (body_fit, "inscribed_ellipsoid", "inscribe parts"),
+            (reference_build, "fit_mannequin", "fit bodies"),
+            (reference_build, "adjust", "refine to targets"),
+            (reference_build, "clean", "clean together"),
+        )
+    ]
     started = time.perf_counter()
     serial, report = reference_build.build_reference_set(base, bodies, REFERENCE_MEASUREMENTS, workers=1)
     one = time.perf_counter() - started
@@ -63,13 +70,15 @@ def run():
         setattr(module, name, original)
 
     fit = watch.seconds["fit bodies"]
-    rows = [("read 5 OBJ files", read),
-            ("fit 5 bodies (core.body_fit)", fit),
-            ("  of which: inscribe each part (core.inscribe pattern search)", watch.seconds["inscribe parts"]),
-            ("  of which: the rest (volume grid, normals, part covers)", fit - watch.seconds["inscribe parts"]),
-            ("refine to targets (core.refine)", watch.seconds["refine to targets"]),
-            ("clean together", watch.seconds["clean together"]),
-            ("check coverage (core.volume, 5 mm grid)", report.seconds.get("coverage check", 0.0))]
+    rows = [
+        ("read 5 OBJ files", read),
+        ("fit 5 bodies (core.fitting.mannequin_fit)", fit),
+        ("  of which: inscribe each part (core.fitting.inscribed pattern search)", watch.seconds["inscribe parts"]),
+        ("  of which: the rest (volume grid, normals, part covers)", fit - watch.seconds["inscribe parts"]),
+        ("refine to targets (core.synthesis.refine)", watch.seconds["refine to targets"]),
+        ("clean together", watch.seconds["clean together"]),
+        ("check coverage (core.geometry.volume, 5 mm grid)", report.seconds.get("coverage check", 0.0)),
+    ]
     print(f"five-body build, one process: {one:.1f} s")
     for label, seconds in rows:
         print(f"  {label:64s} {seconds:7.1f} s  {seconds / one:6.1%}")
@@ -78,7 +87,12 @@ def run():
     started = time.perf_counter()
     parallel, _ = reference_build.build_reference_set(base, bodies, REFERENCE_MEASUREMENTS, workers=workers)
     many = time.perf_counter() - started
-    diff = max(float(np.abs(getattr(serial[n], a) - getattr(parallel[n], a)).max())
-               for n in names for a in ("rotation", "center", "semi_axes"))
-    print(f"five-body build, {workers} processes: {many:.1f} s ({one / many:.2f}x faster on {os.cpu_count()} CPUs; "
-          f"largest difference from the one-process build {diff:.1g} m)")
+    diff = max(
+        float(np.abs(getattr(serial[n], a) - getattr(parallel[n], a)).max())
+        for n in names
+        for a in ("rotation", "center", "semi_axes")
+    )
+    print(
+        f"five-body build, {workers} processes: {many:.1f} s ({one / many:.2f}x faster on {os.cpu_count()} CPUs; "
+        f"largest difference from the one-process build {diff:.1g} m)"
+    )

@@ -1,9 +1,11 @@
 """Scan to mannequin: the time to measure a body mesh, and how much the extra measurements make a synthesized
-twin overlap its body (core.volume.voxel_iou of its ellipsoids, the twin stood as tools/overlap.py stands it), on
+twin overlap its body (core.geometry.volume.voxel_iou of its ellipsoids, the twin stood as tools/overlap.py stands
+it), on
 the six female reference bodies of ../shared/refmodels.
 
-Per body: measure the mesh (core.body_measure, no labels), synthesize in exact mode with the five it found, with
-the five and each extra measurement alone, and with all it found (core.refine_extra), and count the IoU of each
+Per body: measure the mesh (core.measure.body, no labels), synthesize in exact mode with the five it found, with
+the five and each extra measurement alone, and with all it found (core.synthesis.extra_refine), and count the IoU of
+each
 twin with the body. Also: the time to
 measure one 27k-triangle body (the median of three runs) and what the five's measurement differs from the
 README's table by.
@@ -12,13 +14,13 @@ README's table by.
 import statistics
 import time
 
-from ellimann_addon.core.body_measure import measure_body_mesh
-from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import MEASUREMENTS
-from ellimann_addon.core.extra_measures import split_measurements
-from ellimann_addon.core.refine_extra import synthesize_extra
-from ellimann_addon.core.shipped_sets import named_reference_set
-from ellimann_addon.core.volume import IOU_MARGIN, BodyVolume, voxel_iou
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.geometry.volume import IOU_MARGIN, BodyVolume, voxel_iou
+from ellimann_addon.core.measure.body import measure_body_mesh
+from ellimann_addon.core.measure.extra import split_measurements
+from ellimann_addon.core.synthesis.shipped import named_reference_set
+from ellimann_addon.core.synthesis.synthesize import synthesize_extra
 from tools.bodies import body_measurements, load_labels
 from tools.overlap import standing_in
 from tools.reference_sets import TRACING_FOLDER
@@ -47,8 +49,7 @@ def twin_overlaps(reference, body, found):
 def run():
     reference = named_reference_set("female")
     labels = load_labels(TRACING_FOLDER)
-    print(f"{'body':<17} {'measure s':>9} {'max |five - README| cm':>22} {'IoU five':>9} {'IoU all':>8} "
-          f"{'gain':>6}")
+    print(f"{'body':<17} {'measure s':>9} {'max |five - README| cm':>22} {'IoU five':>9} {'IoU all':>8} {'gain':>6}")
     gains = []
     for name in BODIES:
         body = read_obj(TRACING_FOLDER / f"{name}.obj")
@@ -66,9 +67,11 @@ def run():
         for key, value in extra.items():
             mannequin, _, _ = synthesize_extra(reference, five, {key: value})
             alone.append(f"{key} {overlap(mannequin, body) - five_iou:+.3f}")
-        print(f"{name:<17} {statistics.median(times):9.2f} {worst:22.3f} {five_iou:9.3f} {all_iou:8.3f} "
-              f"{all_iou - five_iou:+6.3f}  ({len(body.faces)} triangles; not measured: {result.missing or 'none'}; "
-              f"missed by the twin: {missed or 'none'})")
+        print(
+            f"{name:<17} {statistics.median(times):9.2f} {worst:22.3f} {five_iou:9.3f} {all_iou:8.3f} "
+            f"{all_iou - five_iou:+6.3f}  ({len(body.faces)} triangles; not measured: {result.missing or 'none'}; "
+            f"missed by the twin: {missed or 'none'})"
+        )
         print(f"{'':<17} IoU change with one extra measurement alone: {', '.join(alone)}")
     print(f"mean IoU gain with all measurements: {statistics.mean(gains):+.3f}")
 

@@ -13,7 +13,7 @@ import statistics
 import numpy as np
 
 from bench.bench_scan import twin_overlaps
-from ellimann_addon.core.body_measure import measure_body_mesh
+from ellimann_addon.core.measure.body import measure_body_mesh
 from tools.build_reference import DEFAULT_REFMODELS
 from tools.held_out import six_rms, subset_set
 
@@ -28,8 +28,10 @@ def run(workers=2):
         five_iou, all_iou, missed = twin_overlaps(others, body, found)
         gains.append(all_iou - five_iou)
         print(f"{held:<17} {five_iou:9.3f} {all_iou:8.3f} {all_iou - five_iou:+6.3f}  {', '.join(missed) or 'none'}")
-    print(f"mean IoU gain with all measurements, held out: {statistics.mean(gains):+.3f} "
-          f"(min {min(gains):+.3f}, max {max(gains):+.3f}; {int(np.sum(np.array(gains) > 0))} of {len(gains)} gain)")
+    print(
+        f"mean IoU gain with all measurements, held out: {statistics.mean(gains):+.3f} "
+        f"(min {min(gains):+.3f}, max {max(gains):+.3f}; {int(np.sum(np.array(gains) > 0))} of {len(gains)} gain)"
+    )
 
 
 if __name__ == "__main__":

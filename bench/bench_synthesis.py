@@ -24,11 +24,11 @@ import numpy as np
 from bench.bench_core import best_of
 from devkit.hull_before import hull_perimeter_before
 from devkit.synthetic import shipped_or_synthetic
-from ellimann_addon.core import synthesis
 from ellimann_addon.core.constants import MEASUREMENTS, PAPER_TABLE_2_4, SECTION_FRACTIONS, quartile_points
-from ellimann_addon.core.ellipsoid import section_at_height
-from ellimann_addon.core.measure import hull_perimeter, section_heights, tailor_measurements
-from ellimann_addon.core.writers import write_core_file
+from ellimann_addon.core.formats.core_writers import write_core_file
+from ellimann_addon.core.geometry.ellipsoid import section_at_height
+from ellimann_addon.core.measure.tailor import hull_perimeter, section_heights, tailor_measurements
+from ellimann_addon.core.synthesis import synthesize as synthesis
 
 VARIANTS = (  # label, synthesize_batch options
     ("paper IDW (Eq. 2.1: normalize none, raw cm, p = 2)", {"normalize": "none"}),
@@ -47,8 +47,10 @@ def table(title, error, paper=True):
     print(title)
     print("  relative error %   " + "".join(f"{k:>14}" for k in MEASUREMENTS))
     for label, values in (("mean", error.mean(axis=0)), ("max", error.max(axis=0)), ("min", error.min(axis=0))):
-        cells = "".join(f"{v:8.3f}" + (f" ({PAPER_TABLE_2_4[label][k]:3.1f})" if paper else " " * 6)
-                        for v, k in zip(values, MEASUREMENTS))
+        cells = "".join(
+            f"{v:8.3f}" + (f" ({PAPER_TABLE_2_4[label][k]:3.1f})" if paper else " " * 6)
+            for v, k in zip(values, MEASUREMENTS)
+        )
         print(f"  {label:<18} {cells}")
     if paper:
         print("  (in brackets: the paper's Table 2.4)")
@@ -63,9 +65,11 @@ def old_exact(reference, requests):
 
 def deformation(title, result, seconds):
     spread = np.abs(result.factors - 1.0) * 100.0
-    print(f"{title}: {result.converged.sum()}/{len(result.factors)} converged (tolerance "
-          f"{synthesis.EXACT_TOLERANCE * 100:g}%) in {seconds:.2f} s; |factor - 1| % mean / max: "
-          + ", ".join(f"{k} {m:.2f}/{x:.2f}" for k, m, x in zip(MEASUREMENTS, spread.mean(0), spread.max(0))))
+    print(
+        f"{title}: {result.converged.sum()}/{len(result.factors)} converged (tolerance "
+        f"{synthesis.EXACT_TOLERANCE * 100:g}%) in {seconds:.2f} s; |factor - 1| % mean / max: "
+        + ", ".join(f"{k} {m:.2f}/{x:.2f}" for k, m, x in zip(MEASUREMENTS, spread.mean(0), spread.max(0)))
+    )
 
 
 _err = synthesis.relative_error  # |a - b| / b in %
@@ -109,8 +113,10 @@ def diagnose(reference, requests):
     if he_only:
         implied = weights[:, he_only[0]] @ reference.measurements
         error = _err(implied[:, 0], requests[:, 0])
-        print(f"  He: paper IDW {_stat(_err(measured[:, 0], requests[:, 0]))}; "
-              f"the head (on He alone) is built for sum_j w_j He_j, off by {_stat(error)}")
+        print(
+            f"  He: paper IDW {_stat(_err(measured[:, 0], requests[:, 0]))}; "
+            f"the head (on He alone) is built for sum_j w_j He_j, off by {_stat(error)}"
+        )
     for index, key in enumerate(MEASUREMENTS[1:], start=1):
         own = topology.dependency_mask[:, index]
         rows = [row for row, part in enumerate(source) if own[part]]
@@ -124,21 +130,29 @@ def diagnose(reference, requests):
         foreign = np.abs(measured[:, index] - own_only) > 1e-9
         added = 100.0 * (measured[:, index] - own_only) / measured[:, index]  # share the foreign parts add
         target = requests[:, index]
-        print(f"  {key}: paper IDW {_stat(_err(measured[:, index], target))}; its parts are "
-              f"built for an He off by {_stat(_err(implied[:, 0], requests[:, 0]))} "
-              f"(section {_stat(np.abs(placed - z[key]) * 100.0)} cm off); with the section moved there "
-              f"{_stat(_err(moved, target))}\n"
-              f"      of which sum_j w_j {key}_j vs {key} {_stat(_err(implied[:, index], target))}"
-              f" + m_T non-linearity {_stat(_err(moved, implied[:, index]))}; "
-              f"parts of other measurements change it in {foreign.sum()} mannequins, by "
-              f"{_stat(added)}")
+        print(
+            f"  {key}: paper IDW {_stat(_err(measured[:, index], target))}; its parts are "
+            f"built for an He off by {_stat(_err(implied[:, 0], requests[:, 0]))} "
+            f"(section {_stat(np.abs(placed - z[key]) * 100.0)} cm off); with the section moved there "
+            f"{_stat(_err(moved, target))}\n"
+            f"      of which sum_j w_j {key}_j vs {key} {_stat(_err(implied[:, index], target))}"
+            f" + m_T non-linearity {_stat(_err(moved, implied[:, index]))}; "
+            f"parts of other measurements change it in {foreign.sum()} mannequins, by "
+            f"{_stat(added)}"
+        )
 
 
 def reference_version():
     """The last commit that changed reference_blends/ (the numbers depend on the RMs), + local changes."""
+
     def git(*args):
-        return subprocess.run(["git", *args, "--", "reference_blends"], capture_output=True, text=True, check=True,
-                              cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__)))).stdout.strip()
+        return subprocess.run(
+            ["git", *args, "--", "reference_blends"],
+            capture_output=True,
+            text=True,
+            check=True,
+            cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+        ).stdout.strip()
 
     try:
         commit = git("log", "-1", "--format=%h %cs") or "uncommitted"
@@ -161,8 +175,11 @@ def run():
         start = time.perf_counter()
         results[title] = synthesis.synthesize_batch(reference, requests, mode="idw", **options)
         seconds = time.perf_counter() - start
-        table(f"\nTable 2.4, {title}: synthesized + measured in {seconds:.2f} s", results[title].relative_error(),
-              paper=options.get("metric", "raw") == "raw")
+        table(
+            f"\nTable 2.4, {title}: synthesized + measured in {seconds:.2f} s",
+            results[title].relative_error(),
+            paper=options.get("metric", "raw") == "raw",
+        )
 
     start = time.perf_counter()
     exact = synthesis.synthesize_batch(reference, requests, mode="exact")
@@ -176,16 +193,21 @@ def run():
     print()
     deformation("exact after paper IDW       ", old, t_old)
     deformation("exact after proportional IDW", exact, t_exact)
-    now = synthesis.refine(reference.topology, *synthesis.interpolate(reference, requests), requests,
-                           jacobian=reference.refine_jacobian())
+    now = synthesis.refine(
+        reference.topology, *synthesis.interpolate(reference, requests), requests, jacobian=reference.refine_jacobian()
+    )
     print(f"  iterations (slowest mannequin): {old.iterations} after paper IDW, {now.iterations} after proportional")
-    for title, start, end in (("exact vs paper IDW       ", results[VARIANTS[0][0]], old),
-                              ("exact vs proportional IDW", results[VARIANTS[1][0]], exact)):
+    for title, start, end in (
+        ("exact vs paper IDW       ", results[VARIANTS[0][0]], old),
+        ("exact vs proportional IDW", results[VARIANTS[1][0]], exact),
+    ):
         ratio = np.abs(end.semi_axes / start.semi_axes - 1.0) * 100.0
         shift = np.linalg.norm(end.center - start.center, axis=-1) * 100.0
-        print(f"{title}, per ellipsoid: semi-axis change median {np.median(ratio):.2f}%, 99th percentile "
-              f"{np.percentile(ratio, 99):.1f}%, max {ratio.max():.1f}%; centre shift 99th percentile "
-              f"{np.percentile(shift, 99):.2f} cm, max {shift.max():.2f} cm")
+        print(
+            f"{title}, per ellipsoid: semi-axis change median {np.median(ratio):.2f}%, 99th percentile "
+            f"{np.percentile(ratio, 99):.1f}%, max {ratio.max():.1f}%; centre shift 99th percentile "
+            f"{np.percentile(shift, 99):.2f} cm, max {shift.max():.2f} cm"
+        )
     print("\nthroughput (core, one process, best of 3):")
     batch = len(requests)
     t_idw = best_of(lambda: synthesis.interpolate(reference, requests), repeat=3)
@@ -194,22 +216,30 @@ def run():
     t_mt = best_of(lambda: tailor_measurements(rotation, center, semi_axes, girth), repeat=3)
     t_exact = best_of(lambda: synthesis.synthesize_batch(reference, requests, mode="exact"), repeat=3)
     t_old = best_of(lambda: old_exact(reference, requests), repeat=3)
-    for name, seconds in ((f"paper IDW, batched {batch}", t_paper), (f"proportional IDW, batched {batch}", t_idw),
-                          (f"m_T, batched {batch}", t_mt), ("exact mode, before (paper IDW + FD)", t_old),
-                          ("exact mode, now", t_exact)):
+    for name, seconds in (
+        (f"paper IDW, batched {batch}", t_paper),
+        (f"proportional IDW, batched {batch}", t_idw),
+        (f"m_T, batched {batch}", t_mt),
+        ("exact mode, before (paper IDW + FD)", t_old),
+        ("exact mode, now", t_exact),
+    ):
         print(f"  {name:<37}{batch / seconds:10,.0f} mannequins/s  ({seconds * 1e3:7.1f} ms)")
     print(f"  exact mode batched: {t_old / t_exact:.1f}x faster than before")
-    print(f"  exact mode costs {t_exact / t_idw:.2f}x proportional IDW, m_T {t_mt / t_idw:.2f}x (wall time; the CPU "
-          f"time ratios below are steadier)")
+    print(
+        f"  exact mode costs {t_exact / t_idw:.2f}x proportional IDW, m_T {t_mt / t_idw:.2f}x (wall time; the CPU "
+        f"time ratios below are steadier)"
+    )
     population_scale(reference, requests)
     exact_parts(reference, requests)
     exact_parts(reference, requests[121:122], repeat=30)
     one = requests[121:122]
     t_one = {}
-    for name, fn in (("idw, paper", lambda: synthesis.synthesize_batch(reference, one, mode="idw", normalize="none")),
-                     ("idw, proportional", lambda: synthesis.synthesize_batch(reference, one, mode="idw")),
-                     ("exact, before", lambda: old_exact(reference, one)),
-                     ("exact, now", lambda: synthesis.synthesize_batch(reference, one, mode="exact"))):
+    for name, fn in (
+        ("idw, paper", lambda: synthesis.synthesize_batch(reference, one, mode="idw", normalize="none")),
+        ("idw, proportional", lambda: synthesis.synthesize_batch(reference, one, mode="idw")),
+        ("exact, before", lambda: old_exact(reference, one)),
+        ("exact, now", lambda: synthesis.synthesize_batch(reference, one, mode="exact")),
+    ):
         t_one[name] = best_of(fn, repeat=5, number=5)
         print(f"  one request, {name:<18} (with m_T) {t_one[name] * 1e3:8.2f} ms")
     print(f"  one request, exact: {t_one['exact, before'] / t_one['exact, now']:.1f}x faster than before")
@@ -218,8 +248,10 @@ def run():
         start = time.perf_counter()
         synthesis.synthesize_batch(reference, request[None], mode="exact")
         singles.append(time.perf_counter() - start)
-    print(f"  one request at a time, exact, over {len(singles)} grid requests: median "
-          f"{np.median(singles) * 1e3:.2f} ms, max {np.max(singles) * 1e3:.2f} ms")
+    print(
+        f"  one request at a time, exact, over {len(singles)} grid requests: median "
+        f"{np.median(singles) * 1e3:.2f} ms, max {np.max(singles) * 1e3:.2f} ms"
+    )
 
     blender(reference, exact)
 
@@ -227,7 +259,7 @@ def run():
 def _searching_before(centre, k, active, warm=None, structure=False):
     """devkit.hull_before's hull perimeter where m_T calls today's: it searches every time (``warm`` unused), and the
     structure it hands back is empty, so the refinement's later steps search too."""
-    from ellimann_addon.core.hull import HullStructure
+    from ellimann_addon.core.geometry.section_hull import HullStructure
 
     out = hull_perimeter_before(centre, k, active)
     return (out, HullStructure.empty(len(out))) if structure else out
@@ -237,7 +269,7 @@ def population_scale(reference, requests, repeat=5):
     """Exact mode against proportional IDW on the same batch, with today's m_T and the one it replaced
     (``devkit.hull_before``), every variant timed in turn within each round (best of ``repeat`` rounds), in CPU
     time (on a shared machine wall time mostly measures the other jobs): the ratios are the figures to read."""
-    from ellimann_addon.core import measure
+    from ellimann_addon.core.measure import tailor as measure
 
     def previous_m_t(fn):
         def run():
@@ -247,6 +279,7 @@ def population_scale(reference, requests, repeat=5):
                 return fn()
             finally:
                 measure.hull_perimeter = current
+
         return run
 
     rotation, center, semi_axes = synthesis.interpolate(reference, requests)
@@ -258,8 +291,9 @@ def population_scale(reference, requests, repeat=5):
         "m_T, now": lambda: tailor_measurements(rotation, center, semi_axes, girth, fractions),
         "m_T, before": previous_m_t(lambda: tailor_measurements(rotation, center, semi_axes, girth, fractions)),
         "exact, now": lambda: synthesis.synthesize_batch(reference, requests, mode="exact"),
-        "exact, with the m_T before": previous_m_t(lambda: synthesis.synthesize_batch(reference, requests,
-                                                                                         mode="exact")),
+        "exact, with the m_T before": previous_m_t(
+            lambda: synthesis.synthesize_batch(reference, requests, mode="exact")
+        ),
     }
     best = dict.fromkeys(variants, float("inf"))
     for _ in range(repeat):
@@ -274,16 +308,18 @@ def population_scale(reference, requests, repeat=5):
     idw, measured = best["proportional IDW (interpolation)"], best["IDW + m_T (mode idw)"]
     now, before = best["exact, now"], best["exact, with the m_T before"]
     print(f"  m_T {best['m_T, before'] / best['m_T, now']:.2f}x faster than before")
-    print(f"  ratios to proportional IDW (the interpolation): m_T {best['m_T, now'] / idw:.2f}x (before "
-          f"{best['m_T, before'] / idw:.2f}x), exact {now / idw:.2f}x (before {before / idw:.2f}x); exact / IDW with "
-          f"its m_T {now / measured:.2f}x (before {before / measured:.2f}x)")
+    print(
+        f"  ratios to proportional IDW (the interpolation): m_T {best['m_T, now'] / idw:.2f}x (before "
+        f"{best['m_T, before'] / idw:.2f}x), exact {now / idw:.2f}x (before {before / idw:.2f}x); exact / IDW with "
+        f"its m_T {now / measured:.2f}x (before {before / measured:.2f}x)"
+    )
 
 
 def exact_parts(reference, requests, repeat=5):
     """Where exact mode's CPU time goes, part by part: each function synthesize_batch and refine call, timed where
     it is called (time.process_time), best of ``repeat`` runs of synthesize_batch. What is neither IDW nor m_T is
     exact mode's own overhead (issue 14 asks for exact mode at about 2x IDW at most)."""
-    from ellimann_addon.core import refine as refine_module
+    from ellimann_addon.core.synthesis import refine as refine_module
 
     timed = {  # label: the (module, name) places where synthesize_batch and refine call it
         "validate_requests": [(synthesis, "validate_requests")],
@@ -293,7 +329,7 @@ def exact_parts(reference, requests, repeat=5):
         "m_T of the IDW result": [(synthesis, "tailor_measurements"), (synthesis, "followed_measurements")],
         "refine": [(synthesis, "refine")],
         "  m_T in refine": [(refine_module, "tailor_measurements"), (refine_module, "followed_measurements")],
-        "  _deform_basis": [(refine_module, "_deform_basis")],
+        "  _deform_basis": [(refine_module, "deform_basis")],
         "  deform": [(refine_module, "deform")],
         "follow_pieces": [(synthesis, "follow_pieces")],
         "check_plausible": [(synthesis, "check_plausible")],
@@ -307,6 +343,7 @@ def exact_parts(reference, requests, repeat=5):
                 return fn(*args, **kwargs)
             finally:
                 spent[label] += time.process_time() - start
+
         return run
 
     originals = [(module, name, getattr(module, name)) for places in timed.values() for module, name in places]
@@ -323,19 +360,29 @@ def exact_parts(reference, requests, repeat=5):
             total = time.process_time() - start
             idw = spent["IDW weights"] + spent["interpolate (IDW)"]
             m_t = spent["m_T of the IDW result"] + spent["  m_T in refine"]
-            run = dict(spent, **{
-                "  refine's own loop": spent["refine"] - spent["  m_T in refine"] - spent["  _deform_basis"]
-                - spent["  deform"],
-                "exact mode (synthesize_batch)": total, "  IDW": idw, "  m_T": m_t,
-                "  neither IDW nor m_T": total - idw - m_t})
+            run = dict(
+                spent,
+                **{
+                    "  refine's own loop": spent["refine"]
+                    - spent["  m_T in refine"]
+                    - spent["  _deform_basis"]
+                    - spent["  deform"],
+                    "exact mode (synthesize_batch)": total,
+                    "  IDW": idw,
+                    "  m_T": m_t,
+                    "  neither IDW nor m_T": total - idw - m_t,
+                },
+            )
             best = {k: min(v, best.get(k, float("inf"))) for k, v in run.items()}
     finally:
         for module, name, fn in originals:
             setattr(module, name, fn)
     order = list(timed)
     order.insert(order.index("  deform") + 1, "  refine's own loop")
-    print(f"\nexact mode part by part (batch {len(requests)}; CPU ms, best of {repeat} runs, each part timed where "
-          "it is called):")
+    print(
+        f"\nexact mode part by part (batch {len(requests)}; CPU ms, best of {repeat} runs, each part timed where "
+        "it is called):"
+    )
     for label in order + ["exact mode (synthesize_batch)", "  IDW", "  m_T", "  neither IDW nor m_T"]:
         print(f"  {label:<37}{best[label] * 1e3:8.2f} ms")
     print(f"  exact mode besides IDW and m_T: {best['  neither IDW nor m_T'] / best['  IDW']:.2f}x IDW")
@@ -365,8 +412,9 @@ def blender(reference, exact):
         print(f"  build a mannequin collection       {1 / t_build:10,.0f} mannequins/s  ({t_build * 1e3:7.2f} ms)")
         measure_in_blender(bpy, convert, collections)
         target = collections[0]
-        t_update = best_of(lambda: [convert.update_collection_geometry(target, m) for m in mannequins[1:11]],
-                           repeat=3) / 10
+        t_update = (
+            best_of(lambda: [convert.update_collection_geometry(target, m) for m in mannequins[1:11]], repeat=3) / 10
+        )
         print(f"  move one in place (live update)     {t_update * 1e3:8.2f} ms")
 
         with tempfile.TemporaryDirectory() as folder:
@@ -388,8 +436,10 @@ def blender(reference, exact):
                     props.he = float(value)
                     times.append(time.perf_counter() - start)
             times = np.array(times) * 1e3
-            print(f"  live update from the panel (exact) {np.median(times):8.2f} ms median, {times.max():.2f} ms max "
-                  f"over {len(times)} slider steps")
+            print(
+                f"  live update from the panel (exact) {np.median(times):8.2f} ms median, {times.max():.2f} ms max "
+                f"over {len(times)} slider steps"
+            )
             live_with_cushions(bpy, props)
             for kind in ("json", "blend", "glb", "obj"):
                 path = os.path.join(folder, f"m.{kind}")
@@ -407,10 +457,13 @@ def measure_in_blender(bpy, convert, collections):
     t_read = best_of(lambda: [convert.collection_to_mannequin(c) for c in collections], repeat=3) / len(collections)
     read = [convert.collection_to_mannequin(c) for c in collections]
     t_core = best_of(lambda: [m.measure() for m in read], repeat=3) / len(collections)
-    t_mt = best_of(lambda: [convert.collection_to_mannequin(c).measure() for c in collections],
-                   repeat=3) / len(collections)
-    print(f"  measure (read objects + m_T)       {1 / t_mt:10,.0f} mannequins/s  ({t_mt * 1e3:7.2f} ms: reading "
-          f"{t_read * 1e3:.2f} ms, m_T {t_core * 1e3:.2f} ms, best of 3 each)")
+    t_mt = best_of(lambda: [convert.collection_to_mannequin(c).measure() for c in collections], repeat=3) / len(
+        collections
+    )
+    print(
+        f"  measure (read objects + m_T)       {1 / t_mt:10,.0f} mannequins/s  ({t_mt * 1e3:7.2f} ms: reading "
+        f"{t_read * 1e3:.2f} ms, m_T {t_core * 1e3:.2f} ms, best of 3 each)"
+    )
 
     def operator():
         for collection in collections[:10]:
@@ -471,8 +524,10 @@ def live_with_cushions(bpy, props):
     start = time.perf_counter()
     with blender_output():
         rebuilt = live.settle_live(bpy.context.scene)
-    print(f"    exact rebuild once the slider stops ({rebuilt} cushions, "
-          f"{live.LIVE_SETTLE_SECONDS:g} s later): {(time.perf_counter() - start) * 1e3:.0f} ms")
+    print(
+        f"    exact rebuild once the slider stops ({rebuilt} cushions, "
+        f"{live.LIVE_SETTLE_SECONDS:g} s later): {(time.perf_counter() - start) * 1e3:.0f} ms"
+    )
     calls = []
     real = live.live_update
     live.live_update = lambda scene: calls.append(time.perf_counter()) or real(scene)

@@ -1,6 +1,6 @@
 """A tube dress on a walking body: the convex mannequin against the dense body mesh skinned to the same motion.
 
-The Average Reference Mannequin walks (``core.poses`` walk, after ``services.drape_motion.SETTLE_FRAMES``
+The Average Reference Mannequin walks (``core.pose.standard`` walk, after ``services.drape_motion.SETTLE_FRAMES``
 frames turning from rest into its first frame) with the dress draped on (a) its convex pieces (cushions
 and the ellipsoids not in one, the drape's default resolution), each bound rigidly to its bone, and (b)
 the dense body it stands for (``../shared/refmodels/average.obj``, 26,692 triangles), every vertex
@@ -19,14 +19,14 @@ import time
 
 import numpy as np
 
-from ellimann_addon.core import garments
-from ellimann_addon.core.collision import collision_pieces, triangle_count
-from ellimann_addon.core.garment_fit import BodyPieces, fit_statistics, mesh_distance
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.motion import clamped_motion
-from ellimann_addon.core.skeleton import JOINT_NAMES, RIG_NAME_MAPS
-from ellimann_addon.core.synthesis import REFERENCE_FOLDER
-from tools.bodies import load_obj
+from ellimann_addon.core.drape import garments
+from ellimann_addon.core.drape.colliders import collision_pieces, triangle_count
+from ellimann_addon.core.drape.fit_metrics import BodyPieces, fit_statistics, mesh_distance
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.skeleton import JOINT_NAMES, RIG_NAME_MAPS
+from ellimann_addon.core.pose.motion import clamped_motion
+from ellimann_addon.core.synthesis.synthesize import REFERENCE_FOLDER
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 REFMODELS = ROOT.parent / "shared" / "refmodels"
@@ -47,7 +47,8 @@ def run(frames=FRAMES):
     ellimann_addon.register()
     try:
         mannequin = Mannequin.load(source)
-        vertices, faces = load_obj(paths[0])
+        body = read_obj(paths[0])  # the refmodels' bodies are in ElliMann's axes (Z up)
+        vertices, faces = body.vertices, body.faces
         compare(mannequin, vertices, faces, dense_bones(paths[1], paths[2]), frames)
     finally:
         ellimann_addon.unregister()
@@ -83,12 +84,17 @@ def compare(mannequin, body_vertices, body_faces, bones, frames):
     settings = drape.DrapeSettings(frames=frames, edge=EDGE)
     exact = BodyPieces(mannequin, cushions=True, subdivisions=4)
     garment = garments.make_garment(mannequin, "tube_dress", edge=EDGE)
-    garment = garments.clear_of(garment, lambda p: np.minimum(exact.signed_distance(p, 0.05)[0],
-                                                              mesh_distance(p, body_vertices, body_faces)[0]))
-    print(f"mannequin: {mannequin.name}; dense body {BODY}.obj, {len(body_vertices):,} vertices, "
-          f"{len(body_faces):,} triangles, skinned rigidly to {len(set(bones.tolist()))} of the 24 SMPL bones")
-    print(f"walk: {frames} frames ({settle_frames(frames)} settling from rest), {len(walk)} frames a stride; "
-          f"{garment.name} {len(garment.vertices)} vertices, cloth edge {EDGE * 100:g} cm")
+    garment = garments.clear_of(
+        garment, lambda p: np.minimum(exact.signed_distance(p, 0.05)[0], mesh_distance(p, body_vertices, body_faces)[0])
+    )
+    print(
+        f"mannequin: {mannequin.name}; dense body {BODY}.obj, {len(body_vertices):,} vertices, "
+        f"{len(body_faces):,} triangles, skinned rigidly to {len(set(bones.tolist()))} of the 24 SMPL bones"
+    )
+    print(
+        f"walk: {frames} frames ({settle_frames(frames)} settling from rest), {len(walk)} frames a stride; "
+        f"{garment.name} {len(garment.vertices)} vertices, cloth edge {EDGE * 100:g} cm"
+    )
 
     def simulate(pieces, dense):
         with blender_output():
@@ -98,8 +104,13 @@ def compare(mannequin, body_vertices, body_faces, bones, frames):
                 rig = bare_armature("bench body", mannequin.joints, collection)
                 bind_weights(colliders[0], rig, {JOINT_NAMES[j]: (bones == j).astype(float) for j in set(bones)})
                 bind_weights(obj, rig, _pins(obj, mannequin))
-                bake_action(rig, JOINT_NAMES, np.stack([p.rotations for p in motion]),
-                            np.stack([p.translation for p in motion]), "bench motion")
+                bake_action(
+                    rig,
+                    JOINT_NAMES,
+                    np.stack([p.rotations for p in motion]),
+                    np.stack([p.translation for p in motion]),
+                    "bench motion",
+                )
             else:
                 animate_drape(collection, colliders, obj, mannequin, walk, True, frames)
             wall, _ = drape.bake(bpy.context.scene, obj, frames)
@@ -113,17 +124,24 @@ def compare(mannequin, body_vertices, body_faces, bones, frames):
     dense_piece = [drape.mesh_piece(f"{BODY}.obj", body_vertices, body_faces)]
     dense_seconds, dense_cloth, posed_body = simulate(dense_piece, dense=True)
     print(f"(both drapes and their set-up: {time.perf_counter() - start:.0f} s)")
-    print(f"{'collider':<18}{'triangles':>10}{'s/frame':>9} | vs the dense body at the last frame, mm: "
-          f"{'median':>6}{'p95':>6}{'inside':>7}{'deepest':>8}")
+    print(
+        f"{'collider':<18}{'triangles':>10}{'s/frame':>9} | vs the dense body at the last frame, mm: "
+        f"{'median':>6}{'p95':>6}{'inside':>7}{'deepest':>8}"
+    )
     for label, triangles, seconds, cloth in (
-            ("convex pieces", triangle_count(pieces), convex_seconds, convex_cloth),
-            ("dense body", len(body_faces), dense_seconds, dense_cloth)):
+        ("convex pieces", triangle_count(pieces), convex_seconds, convex_cloth),
+        ("dense body", len(body_faces), dense_seconds, dense_cloth),
+    ):
         fit = fit_statistics(mesh_distance(cloth, posed_body, body_faces)[0])
-        print(f"{label:<18}{triangles:>10,}{seconds:>9.3f} | {'':40}{fit['median'] * 1e3:>6.1f}"
-              f"{fit['p95'] * 1e3:>6.1f}{fit['penetrating']:>7}{fit['max_depth'] * 1e3:>8.1f}")
+        print(
+            f"{label:<18}{triangles:>10,}{seconds:>9.3f} | {'':40}{fit['median'] * 1e3:>6.1f}"
+            f"{fit['p95'] * 1e3:>6.1f}{fit['penetrating']:>7}{fit['max_depth'] * 1e3:>8.1f}"
+        )
     apart = np.linalg.norm(convex_cloth - dense_cloth, axis=1)
-    print(f"speed-up of the convex pieces: {dense_seconds / convex_seconds:.2f}x; the two dresses per vertex: median "
-          f"{np.median(apart) * 1e3:.1f} mm, 95th percentile {np.percentile(apart, 95) * 1e3:.1f} mm apart")
+    print(
+        f"speed-up of the convex pieces: {dense_seconds / convex_seconds:.2f}x; the two dresses per vertex: median "
+        f"{np.median(apart) * 1e3:.1f} mm, 95th percentile {np.percentile(apart, 95) * 1e3:.1f} mm apart"
+    )
 
 
 def _pins(garment_object, mannequin):

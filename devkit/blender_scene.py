@@ -5,8 +5,8 @@ import bpy
 import numpy as np
 from mathutils import Matrix
 
-from ellimann_addon.core.frames import rigid_matrix
-from ellimann_addon.core.mesh import icosphere
+from ellimann_addon.core.geometry.frames import rigid_matrix
+from ellimann_addon.core.geometry.mesh import icosphere
 
 PART_FIELDS = ("is_part", "kind", "part_name", "side", "region", "girth", "partner")
 
@@ -33,20 +33,31 @@ def state():
     for obj in bpy.data.objects:
         part = obj.ellimann
         objects[obj.name] = (
-            Matrix4(obj.matrix_world), obj.data.name if obj.data else None,
-            tuple(sorted(c.name for c in obj.users_collection)), obj.parent.name if obj.parent else None,
-            tuple(getattr(part, f) for f in PART_FIELDS), tuple(sorted(part.depends)),
+            Matrix4(obj.matrix_world),
+            obj.data.name if obj.data else None,
+            tuple(sorted(c.name for c in obj.users_collection)),
+            obj.parent.name if obj.parent else None,
+            tuple(getattr(part, f) for f in PART_FIELDS),
+            tuple(sorted(part.depends)),
         )
     collections = {
-        c.name: (tuple(sorted(ch.name for ch in c.children)), c.ellimann.is_mannequin, c.ellimann.role,
-                 c.ellimann.has_measured, tuple(c.ellimann.measured))
+        c.name: (
+            tuple(sorted(ch.name for ch in c.children)),
+            c.ellimann.is_mannequin,
+            c.ellimann.role,
+            c.ellimann.has_measured,
+            tuple(c.ellimann.measured),
+        )
         for c in bpy.data.collections
     }
     scene = bpy.context.scene
     armatures = {
-        obj.name: (tuple((b.name, Matrix4(b.matrix_basis)) for b in obj.pose.bones),
-                   obj.animation_data.action.name if obj.animation_data and obj.animation_data.action else None)
-        for obj in bpy.data.objects if obj.type == "ARMATURE"
+        obj.name: (
+            tuple((b.name, Matrix4(b.matrix_basis)) for b in obj.pose.bones),
+            obj.animation_data.action.name if obj.animation_data and obj.animation_data.action else None,
+        )
+        for obj in bpy.data.objects
+        if obj.type == "ARMATURE"
     }
     return {
         "objects": objects,

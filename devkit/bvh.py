@@ -16,16 +16,43 @@ CM_PER_M = 100.0
 # Bone names per rig style, for the SMPL joints they stand for (CMU clips as MotionBuilder-style BVH;
 # Mixamo with its "mixamorig:" prefix).
 STYLES = {
-    "cmu": {"Pelvis": "Hips", "L_Hip": "LeftUpLeg", "R_Hip": "RightUpLeg", "Spine1": "LowerBack",
-            "L_Knee": "LeftLeg", "R_Knee": "RightLeg", "Spine2": "Spine", "L_Ankle": "LeftFoot",
-            "R_Ankle": "RightFoot", "Spine3": "Spine1", "L_Foot": "LeftToeBase", "R_Foot": "RightToeBase",
-            "Neck": "Neck", "L_Collar": "LeftShoulder", "R_Collar": "RightShoulder", "Head": "Head",
-            "L_Shoulder": "LeftArm", "R_Shoulder": "RightArm", "L_Elbow": "LeftForeArm", "R_Elbow": "RightForeArm",
-            "L_Wrist": "LeftHand", "R_Wrist": "RightHand", "L_Hand": "LeftFingerBase", "R_Hand": "RightFingerBase"},
+    "cmu": {
+        "Pelvis": "Hips",
+        "L_Hip": "LeftUpLeg",
+        "R_Hip": "RightUpLeg",
+        "Spine1": "LowerBack",
+        "L_Knee": "LeftLeg",
+        "R_Knee": "RightLeg",
+        "Spine2": "Spine",
+        "L_Ankle": "LeftFoot",
+        "R_Ankle": "RightFoot",
+        "Spine3": "Spine1",
+        "L_Foot": "LeftToeBase",
+        "R_Foot": "RightToeBase",
+        "Neck": "Neck",
+        "L_Collar": "LeftShoulder",
+        "R_Collar": "RightShoulder",
+        "Head": "Head",
+        "L_Shoulder": "LeftArm",
+        "R_Shoulder": "RightArm",
+        "L_Elbow": "LeftForeArm",
+        "R_Elbow": "RightForeArm",
+        "L_Wrist": "LeftHand",
+        "R_Wrist": "RightHand",
+        "L_Hand": "LeftFingerBase",
+        "R_Hand": "RightFingerBase",
+    },
 }
 STYLES["mixamo"] = {joint: "mixamorig:" + name for joint, name in STYLES["cmu"].items()}
-STYLES["mixamo"].update({"Spine1": "mixamorig:Spine", "Spine2": "mixamorig:Spine1", "Spine3": "mixamorig:Spine2",
-                         "L_Hand": "mixamorig:LeftHandMiddle1", "R_Hand": "mixamorig:RightHandMiddle1"})
+STYLES["mixamo"].update(
+    {
+        "Spine1": "mixamorig:Spine",
+        "Spine2": "mixamorig:Spine1",
+        "Spine3": "mixamorig:Spine2",
+        "L_Hand": "mixamorig:LeftHandMiddle1",
+        "R_Hand": "mixamorig:RightHandMiddle1",
+    }
+)
 
 
 def zxy_degrees(rotation):

@@ -20,9 +20,14 @@ def run(args, capsys):
 
 def python_m(*args, cwd=ROOT):
     """``python -m ellimann_addon ARGS`` in a subprocess, with the test session's Blender user folders."""
-    return subprocess.run([sys.executable, "-m", "ellimann_addon", *args], cwd=cwd, capture_output=True, text=True,
-                          env=dict(os.environ, BLENDER_USER_RESOURCES=os.environ["BLENDER_USER_RESOURCES"]),
-                          timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "ellimann_addon", *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        env=dict(os.environ, BLENDER_USER_RESOURCES=os.environ["BLENDER_USER_RESOURCES"]),
+        timeout=300,
+    )
 
 
 def assert_one_line_error(code, err, *words):

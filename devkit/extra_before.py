@@ -1,12 +1,12 @@
-"""The extra measurements of a mannequin as ``core.extra_measures`` computed them before they were made faster
+"""The extra measurements of a mannequin as ``core.measure.extra`` computed them before they were made faster
 (each band searched apart by golden section, one hull_perimeter call per step; the arm's tip by a second
 bisection): tests check the two agree, ``bench.bench_extra`` times both in one run."""
 
 import numpy as np
 
 from ellimann_addon.core.constants import CM_PER_M
-from ellimann_addon.core.ellipsoid import axis_extent, section_at_height
-from ellimann_addon.core.extra_measures import (
+from ellimann_addon.core.geometry.ellipsoid import axis_extent, section_at_height
+from ellimann_addon.core.measure.extra import (
     CALF_BAND,
     CROTCH_FLOOR,
     EXTRA_MEASUREMENTS,
@@ -18,7 +18,7 @@ from ellimann_addon.core.extra_measures import (
     _permuted,
     extreme_over_band,
 )
-from ellimann_addon.core.measure import hull_perimeter, section_heights
+from ellimann_addon.core.measure.tailor import hull_perimeter, section_heights
 
 
 def _farthest_distance(rotation, center, semi_axes, point):
@@ -51,8 +51,9 @@ class MannequinLandmarksBefore:
         self.bottom, self.height, self.z_shoulder = float(bottom), float(height), float(z["Sh"])
         centre, k, hit = section_at_height(self.rotation, self.center, self.semi, self.at(MID_PLANE_HEIGHT))
         half = np.sqrt(k[:, 0, 0])
-        self.mid_x = 0.5 * (np.max(np.where(hit, centre[:, 0] + half, -np.inf))
-                            + np.min(np.where(hit, centre[:, 0] - half, np.inf)))
+        self.mid_x = 0.5 * (
+            np.max(np.where(hit, centre[:, 0] + half, -np.inf)) + np.min(np.where(hit, centre[:, 0] - half, np.inf))
+        )
 
     def at(self, fraction):
         return self.bottom + fraction * self.height
@@ -139,13 +140,23 @@ def mannequin_extra_measurements_before(mannequin):
         z_thigh = marks.bottom + crotch - THIGH_DROP * he
         out["thigh"] = float(np.mean([marks.girths_at([z_thigh], mask)[0] for mask in legs]))
         low, high = (marks.bottom + f * crotch for f in CALF_BAND)
-        out["calf"] = float(np.mean([extreme_over_band(lambda z, m=mask: marks.girths_at(z, m), low, high, True,
-                                                       marks.piece_ends(mask)) for mask in legs]))
+        out["calf"] = float(
+            np.mean(
+                [
+                    extreme_over_band(lambda z, m=mask: marks.girths_at(z, m), low, high, True, marks.piece_ends(mask))
+                    for mask in legs
+                ]
+            )
+        )
     else:
         out["thigh"] = out["calf"] = np.nan
     neck_mask = np.ones(len(marks.girth), bool)  # the whole section: no arm reaches the neck's band apart
-    out["neck"] = extreme_over_band(lambda z: marks.nonzero_girths_at(z, neck_mask), *(marks.at(f) for f in NECK_BAND),
-                                    False, marks.piece_ends(neck_mask))
+    out["neck"] = extreme_over_band(
+        lambda z: marks.nonzero_girths_at(z, neck_mask),
+        *(marks.at(f) for f in NECK_BAND),
+        False,
+        marks.piece_ends(neck_mask),
+    )
     out["neck"] = out["neck"] if np.isfinite(out["neck"]) else np.nan  # no piece in the neck's band: no neck
     if marks.arm.any() and all((marks.arm & (marks.side == side)).any() for side in SIDES):
         out["arm_length"] = float(np.mean([marks.arm_axis(side)[2] for side in SIDES]))
@@ -153,5 +164,3 @@ def mannequin_extra_measurements_before(mannequin):
     else:
         out["arm_length"] = out["upper_arm"] = np.nan
     return {key: out[key] * CM_PER_M for key in EXTRA_MEASUREMENTS}
-
-

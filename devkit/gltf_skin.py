@@ -19,9 +19,9 @@ def read_glb(path):
     with open(path, "rb") as stream:
         data = stream.read()
     length = struct.unpack_from("<I", data, 12)[0]
-    doc = json.loads(data[20:20 + length])
-    rest = data[20 + length:]
-    binary = rest[8:8 + struct.unpack_from("<I", rest, 0)[0]] if rest else b""
+    doc = json.loads(data[20 : 20 + length])
+    rest = data[20 + length :]
+    binary = rest[8 : 8 + struct.unpack_from("<I", rest, 0)[0]] if rest else b""
     return doc, binary
 
 
@@ -33,10 +33,13 @@ def accessor(doc, binary, index):
     width = COMPONENTS[info["type"]]
     start = view.get("byteOffset", 0) + info.get("byteOffset", 0)
     stride = view.get("byteStride", dtype.itemsize * width)
-    raw = np.frombuffer(binary, dtype=np.uint8, count=stride * (info["count"] - 1) + dtype.itemsize * width,
-                        offset=start)
-    rows = [np.frombuffer(raw[i * stride:i * stride + dtype.itemsize * width].tobytes(), dtype) for i in
-            range(info["count"])]
+    raw = np.frombuffer(
+        binary, dtype=np.uint8, count=stride * (info["count"] - 1) + dtype.itemsize * width, offset=start
+    )
+    rows = [
+        np.frombuffer(raw[i * stride : i * stride + dtype.itemsize * width].tobytes(), dtype)
+        for i in range(info["count"])
+    ]
     values = np.array(rows, dtype=float)
     if info.get("normalized"):
         values /= np.iinfo(dtype).max
@@ -47,9 +50,13 @@ def node_matrix(node):
     if "matrix" in node:
         return np.array(node["matrix"], float).reshape(4, 4).T
     x, y, z, w = node.get("rotation", (0.0, 0.0, 0.0, 1.0))
-    rotation = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                         [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                         [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    rotation = np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
     matrix = np.eye(4)
     matrix[:3, :3] = rotation * np.array(node.get("scale", (1.0, 1.0, 1.0)))
     matrix[:3, 3] = node.get("translation", (0.0, 0.0, 0.0))
@@ -88,5 +95,5 @@ def skinned_positions(doc, binary, node_name):
     homogeneous = np.c_[positions, np.ones(len(positions))]
     out = np.zeros((len(positions), 4))
     for k in range(joints.shape[1]):
-        out += weights[:, k:k + 1] * np.einsum("vij,vj->vi", joint_matrices[joints[:, k]], homogeneous)
+        out += weights[:, k : k + 1] * np.einsum("vij,vj->vi", joint_matrices[joints[:, k]], homogeneous)
     return out[:, :3]

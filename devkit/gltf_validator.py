@@ -31,17 +31,31 @@ def module_dir():
         return target
     npm = shutil.which("npm")
     if npm is None:
-        raise ValidatorUnavailableError("npm is not on PATH: install Node.js 18+ (the glTF tests run the Khronos "
-                                        "validator)")
+        raise ValidatorUnavailableError(
+            "npm is not on PATH: install Node.js 18+ (the glTF tests run the Khronos validator)"
+        )
     PREFIX.mkdir(parents=True, exist_ok=True)
     with open(PREFIX / ".install.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         if _installed_version(target) != VERSION:
-            done = subprocess.run([npm, "install", "--prefix", str(PREFIX), "--no-audit", "--no-fund",
-                                   "--loglevel=error", f"{PACKAGE}@{VERSION}"], capture_output=True, text=True)
+            done = subprocess.run(
+                [
+                    npm,
+                    "install",
+                    "--prefix",
+                    str(PREFIX),
+                    "--no-audit",
+                    "--no-fund",
+                    "--loglevel=error",
+                    f"{PACKAGE}@{VERSION}",
+                ],
+                capture_output=True,
+                text=True,
+            )
             if done.returncode != 0 or _installed_version(target) != VERSION:
-                raise ValidatorUnavailableError(f"npm could not install {PACKAGE}@{VERSION}: "
-                                                f"{done.stderr.strip()[-400:]}")
+                raise ValidatorUnavailableError(
+                    f"npm could not install {PACKAGE}@{VERSION}: {done.stderr.strip()[-400:]}"
+                )
     return target
 
 
@@ -56,8 +70,9 @@ def validate(path):
     """The validator's issues for a .glb / .gltf file (see the module docstring)."""
     node = shutil.which("node")
     if node is None:
-        raise ValidatorUnavailableError("node is not on PATH: install Node.js 18+ (the glTF tests run the Khronos "
-                                        "validator)")
+        raise ValidatorUnavailableError(
+            "node is not on PATH: install Node.js 18+ (the glTF tests run the Khronos validator)"
+        )
     done = subprocess.run([node, str(SCRIPT), str(module_dir()), str(path)], capture_output=True, text=True)
     if done.returncode != 0:
         raise ValidatorUnavailableError(f"the glTF validator failed on {path}: {done.stderr.strip()[-400:]}")

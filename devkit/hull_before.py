@@ -1,4 +1,4 @@
-"""The convex-hull perimeter of section ellipses as ``core.measure.hull_perimeter`` computed it before issue 14's
+"""The convex-hull perimeter of section ellipses as ``core.measure.tailor.hull_perimeter`` computed it before issue 14's
 speed-up (main at b43ba1d, verbatim but for the name): a 128-direction grid, every cell where the outermost
 ellipse changes or a hidden one seemed possible sampled 16 times finer, 12 Gauss-Legendre nodes per piece. Its
 bound on a hidden ellipse used that ellipse's curvature, not the outermost one's, so it can miss a small ellipse
@@ -152,8 +152,9 @@ def hull_perimeter_before(centre, k, active):
     h_r = coefficients.support(section, *(t[cell_r, :, None] for t in _FINE_DIRECTIONS))  # (R, F - 1, n)
     np.copyto(h_r, -np.inf, where=~active[sec_r, None, :])
     inside = np.argmax(h_r, axis=2)
-    winner_r = np.concatenate([winner[sec_r, cell_r, None], inside,
-                               winner[sec_r, (cell_r + 1) % DETECTION_SAMPLES, None]], axis=1)
+    winner_r = np.concatenate(
+        [winner[sec_r, cell_r, None], inside, winner[sec_r, (cell_r + 1) % DETECTION_SAMPLES, None]], axis=1
+    )
     row, at = np.nonzero(winner_r[:, :-1] != winner_r[:, 1:])
     sec = sec_r[row]
     lo, hi = theta_r[row, at], theta_r[row, at + 1]
@@ -169,7 +170,7 @@ def hull_perimeter_before(centre, k, active):
     half = 0.5 * (end - cut_theta)
     whole = (cell >= 0) & (next_cell >= 0)
     split = ~whole
-    cell_winner = winner[:, _GRID_PER_CELL // 2::_GRID_PER_CELL]  # (S, cells)
+    cell_winner = winner[:, _GRID_PER_CELL // 2 :: _GRID_PER_CELL]  # (S, cells)
     cells = (np.arange(sections)[:, None, None], cell_winner[:, :, None])
     cell_integral = _weighted_sum(coefficients.support(cells, *_CELL_NODE_DIRECTIONS), _GL_WEIGHTS)  # (S, cells)
     piece_winner = np.empty(len(cut_sec), dtype=np.int64)
@@ -178,8 +179,10 @@ def hull_perimeter_before(centre, k, active):
     nodes = (cut_theta[split] + half[split])[:, None] + half[split, None] * _GL_NODES
     integral = np.empty(len(cut_sec))
     integral[whole] = cell_integral[cut_sec[whole], cell[whole]]
-    integral[split] = _weighted_sum(coefficients.support((cut_sec[split, None], piece_winner[split, None]),
-                                                         np.cos(nodes), np.sin(nodes)), _GL_WEIGHTS)
+    integral[split] = _weighted_sum(
+        coefficients.support((cut_sec[split, None], piece_winner[split, None]), np.cos(nodes), np.sin(nodes)),
+        _GL_WEIGHTS,
+    )
     piece = np.where(active[cut_sec, piece_winner], half * integral, 0.0)
     return np.bincount(cut_sec, weights=piece, minlength=sections)
 

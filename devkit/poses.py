@@ -8,7 +8,7 @@ A-pose with the upper arms 35 degrees from vertical; this variant does the same.
 import numpy as np
 
 from devkit.toy import make_toy_mannequin, rotation_from_vector
-from ellimann_addon.core.frames import mirror_frame
+from ellimann_addon.core.geometry.frames import mirror_frame
 
 A_POSE_DEGREES = 35.0
 SHOULDER_JOINT = (0.19, 0.02, 1.31)  # upper end of the left arm's long axis (m)

@@ -3,20 +3,23 @@
 import numpy as np
 from scipy.spatial import ConvexHull
 
-from ellimann_addon.core import measure
 from ellimann_addon.core.constants import GIRTHS, MEASUREMENTS
-from ellimann_addon.core.ellipsoid import section_at_height
+from ellimann_addon.core.geometry.ellipsoid import section_at_height
+from ellimann_addon.core.measure import tailor as measure
 
 
 def random_rotations(rng, n):
     q = rng.normal(size=(n, 4))
     q /= np.linalg.norm(q, axis=1, keepdims=True)
     w, x, y, z = q.T
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
-        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
-        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
-    ], -2)
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+            np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+            np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
+        ],
+        -2,
+    )
 
 
 def random_mannequin_arrays(rng, n=40):

@@ -4,7 +4,7 @@ Stands in for the shipped ``reference_blends/`` until (and beside) the real RMs:
 small body, each shaped region by region (height, shoulders, chest, belly, pelvis and legs, with
 rotations that change with the body too) until m_T meets its row of Table 2.3 within 0.01%, then
 registered. Their ``measurements`` are the Table 2.3 targets, as for the real RMs. The shaping here
-is deliberately independent of ``core.synthesis``'s refinement.
+is deliberately independent of ``core.synthesis.synthesize``'s refinement.
 """
 
 import pathlib
@@ -13,10 +13,11 @@ import numpy as np
 
 from devkit.toy import TOY_PARTS, rotation_from_vector
 from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS
-from ellimann_addon.core.ellipsoid import axis_extent
-from ellimann_addon.core.frames import mirror_frame
-from ellimann_addon.core.mannequin import Mannequin, Topology
-from ellimann_addon.core.synthesis import REFERENCE_NAMES, ReferenceSet, load_reference_set
+from ellimann_addon.core.geometry.ellipsoid import axis_extent
+from ellimann_addon.core.geometry.frames import mirror_frame
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.topology import Topology
+from ellimann_addon.core.synthesis.synthesize import REFERENCE_NAMES, ReferenceSet, load_reference_set
 
 # Left and central parts of a ~1.6 m body: centre (m), rotation vector, semi-axes (m).
 BASE_GEOMETRY = {
@@ -29,8 +30,12 @@ BASE_GEOMETRY = {
     "6.a Thigh.L": ((0.085, 0.0, 0.60), (0.0, 0.06, 0.0), (0.075, 0.075, 0.24)),
     "6.b Shin.L": ((0.095, 0.01, 0.20), (0.05, 0.02, 0.0), (0.05, 0.05, 0.20)),
 }
-REGION_OF_MEASUREMENT = {"Sh": ("4.a Trapezius",), "Br": ("2.a Chest",), "Wa": ("2.b Belly",),
-                         "Hi": ("3.a Pelvis", "6.a Thigh")}
+REGION_OF_MEASUREMENT = {
+    "Sh": ("4.a Trapezius",),
+    "Br": ("2.a Chest",),
+    "Wa": ("2.b Belly",),
+    "Hi": ("3.a Pelvis", "6.a Thigh"),
+}
 
 
 def _normalised(me):

@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from ellimann_addon.core.mannequin import Mannequin, Part, Topology
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.topology import Part, Topology
 
 
 def rotation_from_vector(v):

@@ -1,5 +1,5 @@
 """The reference body meshes of ../shared/refmodels: per-vertex labels and mesh measurements (the meshes
-are read by core.body_mesh.read_obj).
+are read by core.fitting.body_mesh.read_obj).
 
 All six OBJ files share one topology (same vertex order), so labels and vertex selections made on
 the neutral reference body apply to every body.
@@ -12,8 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ellimann_addon.core.constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
-from ellimann_addon.core.joints import joints_from_makehuman
-from ellimann_addon.core.mesh import convex_hull_2d, plane_section_points, polygon_perimeter
+from ellimann_addon.core.geometry.mesh import convex_hull_2d, plane_section_points, polygon_perimeter
+from ellimann_addon.core.mannequin.joints import joints_from_makehuman
 
 REFERENCE_BODY = "reference_female"
 RM_BODIES = ("small_slim", "tall_slim", "small_chubby", "tall_chubby", "average")

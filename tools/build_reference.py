@@ -17,15 +17,16 @@ its body ``docs/images/base_mannequin_trace.png`` (with the bpy module), ``docs/
 Steps (paper, Sections 2.3.2-2.3.4):
 1. Trace: every part of tools/reference_topology.py selects its vertices on the neutral reference body
    (regions and bones of its labels); the selections and fit settings are recorded on the Base
-   Mannequin's parts (core/trace.py), as Fit Ellipsoid records them in Blender.
-2. Base Mannequin: the parts fitted over ``reference_female.obj`` (core/body_fit.py), registered and
+   Mannequin's parts (core/mannequin/traces.py), as Fit Ellipsoid records them in Blender.
+2. Base Mannequin: the parts fitted over ``reference_female.obj`` (core/fitting/mannequin_fit.py), registered and
    made symmetric.
-3. Reference Mannequins: the product's builder (core/reference_build.py, ``ellimann references
+3. Reference Mannequins: the product's builder (core/fitting/reference_build.py, ``ellimann references
    build``) on the five bodies and Table 2.3, the Average RM the one the others' axes are labelled
    against.
-4. Joints: each body's SMPL joints from its own rig (skeleton.json, core.joints.joints_from_makehuman) go through
+4. Joints: each body's SMPL joints from its own rig (skeleton.json, core.mannequin.joints.joints_from_makehuman) go
+through
    every step the pieces go through: mirrored with them, registered with them, and moved by the refinement as
-   points fixed in their anchor parts (core.joints.follow_pieces, in core/reference_build.py).
+   points fixed in their anchor parts (core.mannequin.joints.follow_pieces, in core/fitting/reference_build.py).
 Deterministic: no randomness, fixed iteration counts and orders.
 """
 
@@ -41,24 +42,24 @@ import zlib
 
 import numpy as np
 
-from ellimann_addon.core.body_fit import FitConstants, fit_mannequin
-from ellimann_addon.core.body_mesh import hidden_vertices, read_obj, vertex_normals
-from ellimann_addon.core.clean import register_to_world, registration_offset, symmetrize
 from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
-from ellimann_addon.core.ellipsoid import section_at_height
 from ellimann_addon.core.files import atomic_write_text
-from ellimann_addon.core.frames import axis_agreement
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.measure import section_heights
-from ellimann_addon.core.reference_build import (
+from ellimann_addon.core.fitting.body_mesh import hidden_vertices, read_obj, vertex_normals
+from ellimann_addon.core.fitting.mannequin_fit import FitConstants, fit_mannequin
+from ellimann_addon.core.fitting.reference_build import (
     BuildSettings,
     build_reference_set,
     cleanliness_problems,
     display_name,
     relative_errors,
 )
-from ellimann_addon.core.reference_manifest import MANIFEST_FILE, legacy_manifest, read_manifest
-from ellimann_addon.core.trace import PartTrace
+from ellimann_addon.core.geometry.ellipsoid import section_at_height
+from ellimann_addon.core.geometry.frames import axis_agreement
+from ellimann_addon.core.mannequin.clean import register_to_world, registration_offset, symmetrize
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.traces import PartTrace
+from ellimann_addon.core.measure.tailor import section_heights
+from ellimann_addon.core.synthesis.manifest import MANIFEST_FILE, legacy_manifest, read_manifest
 
 from . import coverage
 from . import reference_topology as rt
@@ -92,23 +93,27 @@ def trace_reference(reference_body, labels):
         if len(idx) < 8:
             raise ValueError(f"'{name}' selects only {len(idx)} vertices: widen its selection")
         cavity = np.nonzero(hidden)[0] if spec.cavities and not spec.mitten else np.zeros(0, dtype=np.int64)
-        traces[name] = PartTrace(reference_body.name, len(vertices), reference_body.edges_crc, idx,
-                                 rt.fit_settings(spec), cavity)
+        traces[name] = PartTrace(
+            reference_body.name, len(vertices), reference_body.edges_crc, idx, rt.fit_settings(spec), cavity
+        )
     return traces, hidden
 
 
 def trace_base(reference_body, traces, constants=None, joints=None):
     """The Base Mannequin fitted over the reference body: symmetric, registered, each part's trace
     recording the axis its frame took from the points, ``joints`` (the body's, or None) moved with it.
-    ``constants``: the fit's (core.body_fit.FitConstants; default the female set's section heights).
+    ``constants``: the fit's (core.fitting.mannequin_fit.FitConstants; default the female set's section heights).
     Returns (base, body -> base translation)."""
     topology = rt.topology()
-    base, kept = fit_mannequin(reference_body, topology, traces, constants=constants, name=DISPLAY_NAMES[BASE_FILE],
-                               role="base")
+    base, kept = fit_mannequin(
+        reference_body, topology, traces, constants=constants, name=DISPLAY_NAMES[BASE_FILE], role="base"
+    )
     base = symmetrize(base.copy(joints=joints))  # symmetric first: mirroring may move the lowest point
     shift = registration_offset(base)
-    traces = {name: dataclasses.replace(trace, fit=dataclasses.replace(trace.fit, kept=kept[topology.index[name]]))
-              for name, trace in traces.items()}
+    traces = {
+        name: dataclasses.replace(trace, fit=dataclasses.replace(trace.fit, kept=kept[topology.index[name]]))
+        for name, trace in traces.items()
+    }
     return register_to_world(base).copy(traces=traces), shift
 
 
@@ -134,9 +139,14 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
     base, base_shift = trace_base(reference_body, traces, joints=skeletons[REFERENCE_BODY])
     log(f"base mannequin fitted ({len(base)} parts)")
     bodies = [dataclasses.replace(load_body(name), joints=skeletons[name]) for name in RM_BODIES]
-    rms, built = build_reference_set(base, bodies, REFERENCE_MEASUREMENTS, settings=BuildSettings(check_spacing=None),
-                                     reference=REFERENCE_RM,
-                                     progress=lambda fraction, text: log(f"{fraction:4.0%} {text}"))
+    rms, built = build_reference_set(
+        base,
+        bodies,
+        REFERENCE_MEASUREMENTS,
+        settings=BuildSettings(check_spacing=None),
+        reference=REFERENCE_RM,
+        progress=lambda fraction, text: log(f"{fraction:4.0%} {text}"),
+    )
     base = built.base
     shifts = {BASE_FILE: base_shift, **built.shifts}
     fill = {}
@@ -178,15 +188,24 @@ def sections_crossed(mannequin):
 
 
 def shipped_manifest(refmodels):
-    """The shipped set's reference_set.json (core.reference_manifest): Table 2.3, today's constants, the bodies."""
-    bodies = {name: {"file": f"{name}.obj", "sha256": hashlib.sha256((pathlib.Path(refmodels) / f"{name}.obj")
-                                                                      .read_bytes()).hexdigest()}
-              for name in (REFERENCE_BODY, *RM_BODIES)}
+    """The shipped set's reference_set.json (core.synthesis.manifest): Table 2.3, today's constants, the bodies."""
+    bodies = {
+        name: {
+            "file": f"{name}.obj",
+            "sha256": hashlib.sha256((pathlib.Path(refmodels) / f"{name}.obj").read_bytes()).hexdigest(),
+        }
+        for name in (REFERENCE_BODY, *RM_BODIES)
+    }
     manifest = legacy_manifest()
     manifest.base = BASE_FILE
-    manifest.provenance = {"built_by": "python -m tools.build_reference", "bodies": "../shared/refmodels (Anny 0.6.2)",
-                           "traced_on": REFERENCE_BODY, "labelled_against": REFERENCE_RM, "files": bodies,
-                           "targets": "the paper's Table 2.3"}
+    manifest.provenance = {
+        "built_by": "python -m tools.build_reference",
+        "bodies": "../shared/refmodels (Anny 0.6.2)",
+        "traced_on": REFERENCE_BODY,
+        "labelled_against": REFERENCE_RM,
+        "files": bodies,
+        "targets": "the paper's Table 2.3",
+    }
     return manifest
 
 
@@ -232,8 +251,19 @@ def write_trace(mannequin_file, body_file, shift, path):
     from . import render
 
     path.parent.mkdir(parents=True, exist_ok=True)
-    render.main(["mannequins", str(mannequin_file), "--ghost", str(body_file), "--ghost-shift",
-                 *(f"{v:.9g}" for v in shift), "--side-too", "--out", str(path)])
+    render.main(
+        [
+            "mannequins",
+            str(mannequin_file),
+            "--ghost",
+            str(body_file),
+            "--ghost-shift",
+            *(f"{v:.9g}" for v in shift),
+            "--side-too",
+            "--out",
+            str(path),
+        ]
+    )
 
 
 def check_shipped(base, rms, folder, atol=CHECK_TOLERANCE):
@@ -253,7 +283,8 @@ def check_shipped(base, rms, folder, atol=CHECK_TOLERANCE):
             if diff > atol:
                 problems.append(f"{stem}: {attr} differs by up to {diff:.3g}")
         if {k: t.to_dict() for k, t in (shipped.traces or {}).items()} != {
-                k: t.to_dict() for k, t in (fresh.traces or {}).items()}:
+            k: t.to_dict() for k, t in (fresh.traces or {}).items()
+        }:
             problems.append(f"{stem}: the recorded selections (traces) differ")
     return problems
 
@@ -269,7 +300,7 @@ def docs_differ(shipped, fresh):
         return True
     for x, y in zip(_NUMBER.findall(shipped), _NUMBER.findall(fresh)):
         decimals = len(x.partition(".")[2])
-        if decimals != len(y.partition(".")[2]) or abs(float(x) - float(y)) > 1.5 * 10.0 ** -decimals:
+        if decimals != len(y.partition(".")[2]) or abs(float(x) - float(y)) > 1.5 * 10.0**-decimals:
             return True
     return False
 
@@ -278,9 +309,15 @@ def check(base, rms, docs, out, docs_folder, refmodels=DEFAULT_REFMODELS):
     """What --check reports: shipped JSON files, manifest and docs that differ from a build (empty: none)."""
     manifest = read_manifest(out)
     stale = manifest is None or manifest.to_dict() != shipped_manifest(refmodels).to_dict()
-    return check_shipped(base, rms, out) + [f"{MANIFEST_FILE} is not what the build writes"] * stale + [
-        f"docs/{name} is not what the build writes" for name, text in docs.items()
-        if not (docs_folder / name).is_file() or docs_differ((docs_folder / name).read_text(), text)]
+    return (
+        check_shipped(base, rms, out)
+        + [f"{MANIFEST_FILE} is not what the build writes"] * stale
+        + [
+            f"docs/{name} is not what the build writes"
+            for name, text in docs.items()
+            if not (docs_folder / name).is_file() or docs_differ((docs_folder / name).read_text(), text)
+        ]
+    )
 
 
 # ---------------------------------------------------------------- docs
@@ -311,7 +348,7 @@ def topology_doc(base):
         "paper's (10.a Trapezius, 13.a Rectus Abdominalis). Two ellipsoids with the same number and side "
         "form a cushion (letters a and b). `.L` parts are on the body's left (+X), `.R` parts are their "
         "mirror images, central parts are symmetric about x = 0. The `Trapezius` pair is the registration "
-        "landmark of `core/clean.py`.",
+        "landmark of `core/mannequin/clean.py`.",
         "",
         "- **girth**: takes part in the breast, waist and hip sections of m_T (arms and hands do not; the "
         "shoulder width is measured over every part).",
@@ -322,7 +359,8 @@ def topology_doc(base):
         "`refmodels/reference_female_regions.json`, heights `h` as fractions of the body's height, "
         "`x` lateral and `y` front(-)/back(+) bands in metres).",
         "",
-        "- **fit**: how the part is fitted (`ellimann_addon/core/inscribe.py`): an ellipsoid inside the body surface "
+        "- **fit**: how the part is fitted (`ellimann_addon/core/fitting/inscribed.py`): an ellipsoid inside the body "
+        "surface "
         f"moved out by `depth` (default {rt.Spec.depth * 1e3:g} mm, so a part may reach that far outside the skin "
         "rather than leave a gap) and within the selection's box enlarged by `margin` of its half-size (default "
         f"{rt.Spec.margin:g}); vertices of total area `inside` of the nearby surface (default {rt.Spec.inside:g}) "
@@ -343,11 +381,18 @@ def topology_doc(base):
     specs = dict((rt.part_name(spec, side), spec) for spec, side in rt.expanded())
     for part in base.topology:
         spec = specs[part.name]
-        lines.append(f"| {part.name} | {part.side} | {part.partner or '-'} | {part.region} | "
-                     f"{'yes' if part.girth else 'no'} | {', '.join(part.depends)} | {_describe(spec)} | "
-                     f"{_fit_notes(spec)} |")
-    lines += ["", "## Parts cut by each section of the Base Mannequin", "",
-              "| measurement | height (fraction of He) | parts |", "|---|---|---|"]
+        lines.append(
+            f"| {part.name} | {part.side} | {part.partner or '-'} | {part.region} | "
+            f"{'yes' if part.girth else 'no'} | {', '.join(part.depends)} | {_describe(spec)} | "
+            f"{_fit_notes(spec)} |"
+        )
+    lines += [
+        "",
+        "## Parts cut by each section of the Base Mannequin",
+        "",
+        "| measurement | height (fraction of He) | parts |",
+        "|---|---|---|",
+    ]
     for key, names in crossed.items():
         lines.append(f"| {key} | {SECTION_FRACTIONS[key]} | {', '.join(names)} |")
     return "\n".join(lines) + "\n"
@@ -480,9 +525,11 @@ def fill_doc(fill):
     ]
     for name, metrics in fill.items():
         e, c = metrics["ellipsoids"], metrics["cushions"]
-        lines.append(f"| {DISPLAY_NAMES[name]} | {e['coverage']:.1%} | {e['excess']:.1%} | {e['depth'] * 1e3:.1f} "
-                     f"({e['deepest']}) | {c['coverage']:.1%} | {c['excess']:.1%} | {c['depth'] * 1e3:.1f} "
-                     f"({c['deepest']}) |")
+        lines.append(
+            f"| {DISPLAY_NAMES[name]} | {e['coverage']:.1%} | {e['excess']:.1%} | {e['depth'] * 1e3:.1f} "
+            f"({e['deepest']}) | {c['coverage']:.1%} | {c['excess']:.1%} | {c['depth'] * 1e3:.1f} "
+            f"({c['deepest']}) |"
+        )
     chains = list(coverage.CHAINS)
     lines += [
         "",
@@ -496,8 +543,11 @@ def fill_doc(fill):
         "|---|" + "---|" * len(chains),
     ]
     for name, metrics in fill.items():
-        cells = [f"{max(metrics['ellipsoids']['gaps'][chain]) * 1e3:.0f} / "
-                 f"{max(metrics['cushions']['gaps'][chain]) * 1e3:.0f}" for chain in chains]
+        cells = [
+            f"{max(metrics['ellipsoids']['gaps'][chain]) * 1e3:.0f} / "
+            f"{max(metrics['cushions']['gaps'][chain]) * 1e3:.0f}"
+            for chain in chains
+        ]
         lines.append(f"| {DISPLAY_NAMES[name]} | " + " | ".join(cells) + " |")
     return lines + [""]
 
@@ -516,14 +566,23 @@ def summary(base, rms):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m tools.build_reference", description=__doc__.split("\n")[0])
-    parser.add_argument("--refmodels", type=pathlib.Path, default=DEFAULT_REFMODELS,
-                        help=f"folder of the reference bodies (default: {DEFAULT_REFMODELS})")
-    parser.add_argument("--out", type=pathlib.Path, default=REPO / "reference_blends",
-                        help="where the mannequins go (default: reference_blends/)")
+    parser.add_argument(
+        "--refmodels",
+        type=pathlib.Path,
+        default=DEFAULT_REFMODELS,
+        help=f"folder of the reference bodies (default: {DEFAULT_REFMODELS})",
+    )
+    parser.add_argument(
+        "--out",
+        type=pathlib.Path,
+        default=REPO / "reference_blends",
+        help="where the mannequins go (default: reference_blends/)",
+    )
     parser.add_argument("--docs", type=pathlib.Path, default=REPO / "docs", help="where the docs go (default: docs/)")
     parser.add_argument("--no-blend", action="store_true", help="skip the .blend files and the line-up (no bpy needed)")
-    parser.add_argument("--check", action="store_true",
-                        help="rebuild in memory and compare with the files in --out; write nothing")
+    parser.add_argument(
+        "--check", action="store_true", help="rebuild in memory and compare with the files in --out; write nothing"
+    )
     args = parser.parse_args(argv)
     if not (args.refmodels / f"{REFERENCE_BODY}.obj").is_file():
         print(f"error: no {REFERENCE_BODY}.obj in {args.refmodels} (use --refmodels)", file=sys.stderr)
@@ -535,18 +594,30 @@ def main(argv=None):
     print(f"smallest axis agreement with the {REFERENCE_RM} RM: {min(report['agreement'].values()):.4f}")
     for name, metrics in report["fill"].items():
         e, c = metrics["ellipsoids"], metrics["cushions"]
-        print(f"{name:15s} fill: coverage {e['coverage']:.1%} (cushions {c['coverage']:.1%}), excess {e['excess']:.1%} "
-              f"({c['excess']:.1%}), depth {e['depth'] * 1e3:.1f} mm at {e['deepest']} "
-              f"({c['depth'] * 1e3:.1f} at {c['deepest']})")
-        print(" " * 16 + "gaps (mm, ellipsoids / cushions): " + "; ".join(
-            f"{chain} " + " ".join(f"{a * 1e3:.0f}/{b * 1e3:.0f}" for a, b in zip(e["gaps"][chain], c["gaps"][chain]))
-            for chain in coverage.CHAINS))
+        print(
+            f"{name:15s} fill: coverage {e['coverage']:.1%} (cushions {c['coverage']:.1%}), excess {e['excess']:.1%} "
+            f"({c['excess']:.1%}), depth {e['depth'] * 1e3:.1f} mm at {e['deepest']} "
+            f"({c['depth'] * 1e3:.1f} at {c['deepest']})"
+        )
+        print(
+            " " * 16
+            + "gaps (mm, ellipsoids / cushions): "
+            + "; ".join(
+                f"{chain} "
+                + " ".join(f"{a * 1e3:.0f}/{b * 1e3:.0f}" for a, b in zip(e["gaps"][chain], c["gaps"][chain]))
+                for chain in coverage.CHAINS
+            )
+        )
     print(f"built in {report['seconds']:.1f} s")
     docs = generated_docs(base, rms, report)
     if args.check:
         problems = check(base, rms, docs, args.out, args.docs, args.refmodels)
-        print("\n".join(problems) if problems else f"identical to the files in {args.out} and {args.docs} "
-              f"(within {CHECK_TOLERANCE:g} m and the docs' printed precision)")
+        print(
+            "\n".join(problems)
+            if problems
+            else f"identical to the files in {args.out} and {args.docs} "
+            f"(within {CHECK_TOLERANCE:g} m and the docs' printed precision)"
+        )
         return 1 if problems else 0
 
     mannequins = {BASE_FILE: base, **rms}
@@ -557,8 +628,9 @@ def main(argv=None):
     print(f"{len(changed)} of {len(mannequins)} JSON files changed in {args.out}; docs written to {args.docs}")
     if not args.no_blend:
         # .blend and .png files are not byte-reproducible: rewrite only what changed (or is missing)
-        stale = {stem: m for stem, m in mannequins.items()
-                 if stem in changed or not (args.out / f"{stem}.blend").is_file()}
+        stale = {
+            stem: m for stem, m in mannequins.items() if stem in changed or not (args.out / f"{stem}.blend").is_file()
+        }
         if stale:
             write_blends(sorted(stale), args.out)
         print(f"{len(stale)} .blend files written")
@@ -567,8 +639,12 @@ def main(argv=None):
             write_lineup([args.out / f"{stem}.json" for stem in LINEUP_ORDER], lineup)
         trace = args.docs / "images" / "base_mannequin_trace.png"
         if BASE_FILE in changed or not trace.is_file():
-            write_trace(args.out / f"{BASE_FILE}.json", args.refmodels / f"{REFERENCE_BODY}.obj",
-                        report["shifts"][BASE_FILE], trace)
+            write_trace(
+                args.out / f"{BASE_FILE}.json",
+                args.refmodels / f"{REFERENCE_BODY}.obj",
+                report["shifts"][BASE_FILE],
+                trace,
+            )
     return 0
 
 

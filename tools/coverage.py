@@ -1,7 +1,7 @@
 """How well a mannequin fills the body it was traced from: the product's coverage and excess
-(core/volume.py), plus what only the build's docs print: depth and gaps along the limbs.
+(core/geometry/volume.py), plus what only the build's docs print: depth and gaps along the limbs.
 
-- **coverage**, **excess**: see ``ellimann_addon.core.volume``;
+- **coverage**, **excess**: see ``ellimann_addon.core.geometry.volume``;
 - **depth**: how far (m) a piece reaches outside the body surface at most (leaving out the mesh's open
   mouth and eye sockets, if given);
 - **gaps**: along each chain of CHAINS (e.g. thigh, knee, calf, ankle, foot, toes), the distance
@@ -11,11 +11,11 @@
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ellimann_addon.core import volume
-from ellimann_addon.core.ellipsoid import fibonacci_sphere, sample_surface, support
-from ellimann_addon.core.garment_fit import closest_points_on_triangles
-from ellimann_addon.core.mannequin import NAME_PATTERN
-from ellimann_addon.core.volume import GRID_SPACING, fill_shares, occupancy, pieces
+from ellimann_addon.core.drape.fit_metrics import closest_points_on_triangles
+from ellimann_addon.core.geometry import volume
+from ellimann_addon.core.geometry.ellipsoid import fibonacci_sphere, sample_surface, support
+from ellimann_addon.core.geometry.volume import GRID_SPACING, fill_shares, occupancy, pieces
+from ellimann_addon.core.mannequin.topology import NAME_PATTERN
 
 __all__ = ["GRID_SPACING", "BodyVolume", "CHAINS", "chain_gaps", "fill_metrics", "occupancy", "report", "separation"]
 
@@ -78,7 +78,7 @@ def _outside_depth(body, points, cavity=None):
 
 
 def fill_metrics(body, grid, mannequin, cavity=None):
-    """{"ellipsoids": ..., "cushions": ...}, each {"coverage", "excess" (shares of volume, core.volume),
+    """{"ellipsoids": ..., "cushions": ...}, each {"coverage", "excess" (shares of volume, core.geometry.volume),
     "depth" (m, largest outside the body but in its cavities, see :func:`_outside_depth`), "deepest" (the
     name of the piece that reaches that far)}."""
     hulls = volume.cushion_hulls(mannequin)
@@ -86,8 +86,10 @@ def fill_metrics(body, grid, mannequin, cavity=None):
     depth = {}  # piece name -> depth, for the ellipsoids and for the cushion pieces
     for name, indices in pieces(mannequin):
         depth[name] = _outside_depth(body, samples[indices[0]], cavity)
-    cushion_depth = {name: _outside_depth(body, hulls[indices][0], cavity) if len(indices) == 2 else depth[name]
-                     for name, indices in pieces(mannequin, True)}
+    cushion_depth = {
+        name: _outside_depth(body, hulls[indices][0], cavity) if len(indices) == 2 else depth[name]
+        for name, indices in pieces(mannequin, True)
+    }
     out = fill_shares(grid, mannequin, hulls)
     for key, depths in (("ellipsoids", depth), ("cushions", cushion_depth)):
         # mirror twins reach equally deep up to rounding: the first (the left one) within DEPTH_TIE is named
@@ -115,11 +117,14 @@ def separation(mannequin, first, second):
     support planes h_first(u) and -h_second(-u); support functions of a hull are the largest of
     its ellipsoids'. The best of ``_DIRECTIONS`` is refined by a local search.
     """
+
     def gap(u):
-        a = support(mannequin.rotation[first, None], mannequin.center[first, None],
-                    mannequin.semi_axes[first, None], u).max(axis=0)
-        b = support(mannequin.rotation[second, None], mannequin.center[second, None],
-                    mannequin.semi_axes[second, None], -u).max(axis=0)
+        a = support(
+            mannequin.rotation[first, None], mannequin.center[first, None], mannequin.semi_axes[first, None], u
+        ).max(axis=0)
+        b = support(
+            mannequin.rotation[second, None], mannequin.center[second, None], mannequin.semi_axes[second, None], -u
+        ).max(axis=0)
         return -a - b
 
     values = gap(_DIRECTIONS)
@@ -153,9 +158,14 @@ def _gap_between(mannequin, first, second, cushions):
 
 def chain_gaps(mannequin, cushions=False):
     """{chain: [gap (m) between each two consecutive links]} over CHAINS."""
-    return {name: [_gap_between(mannequin, first, second, cushions)
-                   for first, second in zip(links, links[1:]) if first and second]
-            for name, links in ((name, _links(mannequin, chain)) for name, chain in CHAINS.items())}
+    return {
+        name: [
+            _gap_between(mannequin, first, second, cushions)
+            for first, second in zip(links, links[1:])
+            if first and second
+        ]
+        for name, links in ((name, _links(mannequin, chain)) for name, chain in CHAINS.items())
+    }
 
 
 def report(mannequin, body_vertices, body_faces, cavity=None, spacing=GRID_SPACING):

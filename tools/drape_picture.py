@@ -15,13 +15,13 @@ from dataclasses import replace
 import numpy as np
 
 from bench.bench_drape import BODY, EDGE, REFMODELS
-from ellimann_addon.core import garments
-from ellimann_addon.core.body_mesh import read_obj
-from ellimann_addon.core.collision import collision_pieces
-from ellimann_addon.core.ellipsoid import bounds
-from ellimann_addon.core.garment_fit import BodyPieces, mesh_distance
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.synthesis import REFERENCE_FOLDER
+from ellimann_addon.core.drape import garments
+from ellimann_addon.core.drape.colliders import collision_pieces
+from ellimann_addon.core.drape.fit_metrics import BodyPieces, mesh_distance
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.geometry.ellipsoid import bounds
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.synthesize import REFERENCE_FOLDER
 
 SPACING = 1.05  # m between slots
 BODY_COLOR = (0.8, 0.78, 0.72, 1.0)
@@ -61,8 +61,9 @@ def main(argv=None):
             offset = np.array([slot * SPACING, 0.0, 0.0])
             moved = replace(garment, vertices=garment.vertices + offset)
             if on_body:
-                obj = bpy.data.objects.new(f"{BODY}.obj", mesh_from_arrays(f"{BODY}.obj", body_vertices + offset,
-                                                                            body_faces))
+                obj = bpy.data.objects.new(
+                    f"{BODY}.obj", mesh_from_arrays(f"{BODY}.obj", body_vertices + offset, body_faces)
+                )
                 obj.color = BODY_COLOR
                 scene.collection.objects.link(obj)
                 pieces = [drape.mesh_piece(f"{BODY}.obj", body_vertices + offset, body_faces)]

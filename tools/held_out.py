@@ -7,7 +7,7 @@ depends only on its own body: fitted, refined and cleaned alone; only its axis l
 reference RM, here the Average). Then, leaving each body out in turn, mannequins are synthesized
 (exact mode, default options) at the held-out body's measurements from every set of 3, 4 and 5 of
 the other bodies, and compared with the held-out body's mesh: volumetric IoU (intersection over
-union of the voxels, 5 mm grid: core.volume.voxel_iou) of the mannequin's cushions (its convex
+union of the voxels, 5 mm grid: core.geometry.volume.voxel_iou) of the mannequin's cushions (its convex
 pieces) and of its ellipsoids, the body moved by the registration its own RM got (so both stand in
 the same frame). The held-out body's own RM (traced on it) is the ceiling. With the reference body
 held out, the set of five is the shipped set. Prints a markdown table (and writes it with --out).
@@ -21,14 +21,14 @@ import sys
 
 import numpy as np
 
-from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.reference_build import display_name
-from ellimann_addon.core.reference_manifest import Manifest, targets_range
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER, ReferenceSet
-from ellimann_addon.core.synthesis import synthesize_batch
-from ellimann_addon.core.volume import IOU_MARGIN, IOU_SPACING, BodyVolume, voxel_iou
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.fitting.reference_build import display_name
+from ellimann_addon.core.geometry.volume import IOU_MARGIN, IOU_SPACING, BodyVolume, voxel_iou
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.manifest import Manifest, targets_range
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, ReferenceSet
+from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 
 from .bodies import REFERENCE_BODY, body_measurements, load_labels
 from .build_reference import DEFAULT_REFMODELS, REFERENCE_RM
@@ -38,16 +38,23 @@ SIZES = (3, 4, 5)
 
 def six_rms(refmodels, workers):
     """({stem: RM} of the six bodies, {stem: targets}, {stem: body -> RM shift}, {stem: BodyMesh})."""
-    from ellimann_addon.core.reference_build import build_reference_set
+    from ellimann_addon.core.fitting.reference_build import build_reference_set
 
-    bodies = {name: read_obj(pathlib.Path(refmodels) / f"{name}.obj") for name in (REFERENCE_BODY,
-                                                                                     *REFERENCE_MEASUREMENTS)}
+    bodies = {
+        name: read_obj(pathlib.Path(refmodels) / f"{name}.obj") for name in (REFERENCE_BODY, *REFERENCE_MEASUREMENTS)
+    }
     targets = {name: dict(row) for name, row in REFERENCE_MEASUREMENTS.items()}
     # the reference body's targets: its own measurements (measured as refmodels/README.md says)
     targets[REFERENCE_BODY] = body_measurements(bodies[REFERENCE_BODY], load_labels(refmodels))
     base = Mannequin.load(REFERENCE_FOLDER / "base_mannequin.json")
-    rms, report = build_reference_set(base, list(bodies.values()), targets, reference=REFERENCE_RM, workers=workers,
-                                      progress=lambda f, text: print(f"  {f:4.0%} {text}", file=sys.stderr))
+    rms, report = build_reference_set(
+        base,
+        list(bodies.values()),
+        targets,
+        reference=REFERENCE_RM,
+        workers=workers,
+        progress=lambda f, text: print(f"  {f:4.0%} {text}", file=sys.stderr),
+    )
     return rms, targets, report.shifts, bodies
 
 
@@ -74,8 +81,11 @@ def held_out_table(rms, targets, shifts, bodies):
                 mannequin = synthesize_batch(reference, request, mode="exact").mannequin(0)
                 row[size].append((voxel_iou(mannequin, grid=grid), voxel_iou(mannequin, cushions=False, grid=grid)))
         rows[held] = row
-        print(f"  {held}: own RM {row['own'][0]:.3f}, " + ", ".join(
-            f"N={size} {np.mean([v[0] for v in row[size]]):.3f}" for size in SIZES), file=sys.stderr)
+        print(
+            f"  {held}: own RM {row['own'][0]:.3f}, "
+            + ", ".join(f"N={size} {np.mean([v[0] for v in row[size]]):.3f}" for size in SIZES),
+            file=sys.stderr,
+        )
     return rows
 
 
@@ -88,12 +98,19 @@ def markdown(rows):
 
     lines = []
     for which, label in ((0, "cushions"), (1, "ellipsoids")):
-        lines += [f"Volumetric IoU of the {label} with the held-out body ({IOU_SPACING * 1e3:g} mm voxels); "
-                  "N = 3, 4: mean (min-max) over every set of that many of the other five bodies.", "",
-                  "| held-out body | own RM (ceiling) | N = 5 | N = 4 | N = 3 |", "|---|---|---|---|---|"]
+        lines += [
+            f"Volumetric IoU of the {label} with the held-out body ({IOU_SPACING * 1e3:g} mm voxels); "
+            "N = 3, 4: mean (min-max) over every set of that many of the other five bodies.",
+            "",
+            "| held-out body | own RM (ceiling) | N = 5 | N = 4 | N = 3 |",
+            "|---|---|---|---|---|",
+        ]
         for held, row in rows.items():
-            lines.append(f"| {display_name(held)} | {row['own'][which]:.3f} | " + " | ".join(
-                cell(row[size], which) for size in (5, 4, 3)) + " |")
+            lines.append(
+                f"| {display_name(held)} | {row['own'][which]:.3f} | "
+                + " | ".join(cell(row[size], which) for size in (5, 4, 3))
+                + " |"
+            )
         means = {size: np.mean([v[which] for row in rows.values() for v in row[size]]) for size in SIZES}
         own = np.mean([row["own"][which] for row in rows.values()])
         lines += [f"| **mean** | {own:.3f} | " + " | ".join(f"{means[size]:.3f}" for size in (5, 4, 3)) + " |", ""]

@@ -17,9 +17,9 @@ import sys
 
 import numpy as np
 
-from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import CM_PER_M
-from ellimann_addon.core.mesh import convex_hull_2d, plane_section_points, polygon_perimeter
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.geometry.mesh import convex_hull_2d, plane_section_points, polygon_perimeter
 
 from .bodies import RM_BODIES, load_labels
 from .reference_sets import BUILD_SETS, TRACING_FOLDER

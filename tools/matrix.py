@@ -73,14 +73,20 @@ def find_python(version):
         candidate = prefix / "bin" / f"python{version}"
         if candidate.is_file() and _runs(str(candidate), version):
             return str(candidate)
-    raise SystemExit(f"matrix: no Python {version} found (on PATH as python{version} or under {pyenv_root}/versions); "
-                     f"the Blender lanes that embed it need one")
+    raise SystemExit(
+        f"matrix: no Python {version} found (on PATH as python{version} or under {pyenv_root}/versions); "
+        f"the Blender lanes that embed it need one"
+    )
 
 
 def _runs(python, version):
     try:
-        out = subprocess.run([python, "-c", "import sys; print('%d.%d' % sys.version_info[:2])"],
-                             capture_output=True, text=True, timeout=30)
+        out = subprocess.run(
+            [python, "-c", "import sys; print('%d.%d' % sys.version_info[:2])"],
+            capture_output=True,
+            text=True,
+            timeout=30,
+        )
     except (OSError, subprocess.TimeoutExpired):
         return False
     # pyenv's shim for a version it does not serve exits non-zero.
@@ -106,8 +112,12 @@ def ensure_venv(lane, log):
     subprocess.run([interpreter, "-m", "venv", str(lane.venv)], check=True, stdout=log, stderr=log)
     # The pins go on the same command line as the tools so that pip resolves them together: scipy or
     # mujoco may not pull in a numpy other than the one Blender bundles.
-    subprocess.run([str(python), "-m", "pip", "install", "--quiet", "-r", str(REQUIREMENTS), *lane.pins],
-                   check=True, stdout=log, stderr=log)
+    subprocess.run(
+        [str(python), "-m", "pip", "install", "--quiet", "-r", str(REQUIREMENTS), *lane.pins],
+        check=True,
+        stdout=log,
+        stderr=log,
+    )
     stamp.touch()
     return python
 
@@ -125,12 +135,12 @@ def run_lane(lane, extra_args, threads=None):
             return lane, None, time.monotonic() - started, log_path
         paths = [SUITES[s] for s in lane.suites]
         # Each lane's Blender gets its own user folders (the Blender conftest makes a temp dir).
-        command = [str(python), "-m", "pytest", "-p", "no:cacheprovider", f"--junitxml={xml_path}", *paths,
-                   *extra_args]
+        command = [str(python), "-m", "pytest", "-p", "no:cacheprovider", f"--junitxml={xml_path}", *paths, *extra_args]
         log.write("$ " + " ".join(command) + "\n")
         log.flush()
-        code = subprocess.run(command, cwd=REPO, stdout=log, stderr=subprocess.STDOUT,
-                              env=_lane_env(threads)).returncode
+        code = subprocess.run(
+            command, cwd=REPO, stdout=log, stderr=subprocess.STDOUT, env=_lane_env(threads)
+        ).returncode
         counts = _counts(xml_path)
         if counts is not None and code != 0 and counts[1] == 0:
             # pytest said nothing failed but did not exit cleanly (a crash at exit, no test collected…)
@@ -173,8 +183,7 @@ def _counts(xml_path):
 def versions(lane):
     """What the lane really runs (read from its venv): Blender, Python and numpy versions."""
     python = lane.venv / "bin" / "python"
-    code = ("import sys, numpy, bpy; print(bpy.app.version_string, '%d.%d.%d' % sys.version_info[:3], "
-            "numpy.__version__)")
+    code = "import sys, numpy, bpy; print(bpy.app.version_string, '%d.%d.%d' % sys.version_info[:3], numpy.__version__)"
     out = subprocess.run([str(python), "-c", code], capture_output=True, text=True, env=_lane_env())
     return out.stdout.strip().splitlines()[-1] if out.returncode == 0 and out.stdout.strip() else "?"
 
@@ -194,9 +203,11 @@ def ensure_gltf_validator():
 
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python3 -m tools.matrix", description=__doc__.split("\n")[0])
-    parser.add_argument("--lanes", default=os.environ.get("LANES", ""),
-                        help="comma-separated Blender versions (default: all, or $LANES): "
-                             + ", ".join(lane.blender for lane in LANES))
+    parser.add_argument(
+        "--lanes",
+        default=os.environ.get("LANES", ""),
+        help="comma-separated Blender versions (default: all, or $LANES): " + ", ".join(lane.blender for lane in LANES),
+    )
     parser.add_argument("--jobs", type=int, default=2, help="lanes at once (default 2)")
     parser.add_argument("--list", action="store_true", help="print the lanes and exit")
     parser.add_argument("--setup-only", action="store_true", help="make the lanes' venvs, run no test")
@@ -249,8 +260,10 @@ def main(argv=None):
     print(f"\n{'lane':<8} {'Blender / Python / numpy':<32} {'suites':<20} {'passed':>6} {'failed':>6} {'skipped':>7}")
     for lane, counts, _, _ in results:
         p, f, s = counts if counts else ("-", "setup", "-")
-        print(f"{lane.blender:<8} {versions(lane) if counts else '?':<32} {','.join(lane.suites):<20} "
-              f"{p:>6} {f:>6} {s:>7}")
+        print(
+            f"{lane.blender:<8} {versions(lane) if counts else '?':<32} {','.join(lane.suites):<20} "
+            f"{p:>6} {f:>6} {s:>7}"
+        )
     passed = sum(c[0] for _, c, _, _ in results if c)
     failed = sum(c[1] for _, c, _, _ in results if c) + sum(1 for _, c, _, _ in results if c is None)
     skipped = sum(c[2] for _, c, _, _ in results if c)

@@ -6,7 +6,7 @@ For each of a set's six bodies (tools/reference_sets.py): measure the body as it
 set's section heights), synthesize a mannequin from those five numbers with the set's shipped Reference
 Mannequins (exact mode), stand it where the body stands (the floors at z = 0 and the volumes' centroids
 on one vertical line, since a synthesized mannequin is registered on its own landmark) and compare the
-voxels they fill: core.volume.voxel_iou, of the ellipsoids and of the cushions (the convex pieces).
+voxels they fill: core.geometry.volume.voxel_iou, of the ellipsoids and of the cushions (the convex pieces).
 """
 
 import argparse
@@ -14,11 +14,11 @@ import sys
 
 import numpy as np
 
-from ellimann_addon.core import volume
-from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import MEASUREMENTS
-from ellimann_addon.core.reference_set import load_reference_set
-from ellimann_addon.core.synthesis import synthesize_batch
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.geometry import volume
+from ellimann_addon.core.synthesis.reference_set import load_reference_set
+from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 
 from .bodies import RM_BODIES, body_measurements, load_labels
 from .reference_sets import BUILD_SETS, TRACING_FOLDER

@@ -19,8 +19,15 @@ os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="elliman
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 WIDTH, LINE, PAD = 560, 34, 14
-THEME = {"back": (48, 48, 48), "header": (61, 61, 61), "field": (29, 29, 29), "button": (84, 84, 84),
-         "text": (230, 230, 230), "dim": (160, 160, 160), "accent": (71, 114, 179)}
+THEME = {
+    "back": (48, 48, 48),
+    "header": (61, 61, 61),
+    "field": (29, 29, 29),
+    "button": (84, 84, 84),
+    "text": (230, 230, 230),
+    "dim": (160, 160, 160),
+    "accent": (71, 114, 179),
+}
 
 
 def _value(data, prop):
@@ -105,8 +112,11 @@ def draw(title, log, path):
             elif kind == "prop":
                 value = _value(kw["data"], kw["prop"])
                 label = kw.get("text", kw["data"].bl_rna.properties[kw["prop"]].name)
-                cells += [("field", v) for v in value] if isinstance(value, list) else [("field", f"{label}: {value}"
-                                                                                        if label else value)]
+                cells += (
+                    [("field", v) for v in value]
+                    if isinstance(value, list)
+                    else [("field", f"{label}: {value}" if label else value)]
+                )
             elif kind == "operator":
                 cells.append(("button", kw.get("text", _operator_label(kw["idname"])) or ICONS.get(kw.get("icon"), "")))
             elif kind == "label":
@@ -118,8 +128,9 @@ def draw(title, log, path):
             box = [x + 2, y + 3, x + width - 2, y + LINE - 5]
             if cell_kind == "bar":
                 pen.rounded_rectangle(box, radius=5, fill=THEME["field"])
-                pen.rounded_rectangle([box[0], box[1], box[0] + (box[2] - box[0]) * text, box[3]], radius=5,
-                                      fill=THEME["accent"])
+                pen.rounded_rectangle(
+                    [box[0], box[1], box[0] + (box[2] - box[0]) * text, box[3]], radius=5, fill=THEME["accent"]
+                )
                 text = f"{text:.0%}"
             elif cell_kind != "label":
                 pen.rounded_rectangle(box, radius=5, fill=THEME["field" if cell_kind == "field" else "button"])
@@ -142,14 +153,15 @@ def references_scene(refmodels):
     import bpy
 
     from ellimann_addon.blender.bridge.convert import mannequin_to_collection, mesh_from_arrays
-    from ellimann_addon.core.body_mesh import read_obj
     from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS
-    from ellimann_addon.core.mannequin import Mannequin
-    from ellimann_addon.core.reference_set import REFERENCE_FOLDER
+    from ellimann_addon.core.fitting.body_mesh import read_obj
+    from ellimann_addon.core.mannequin.model import Mannequin
+    from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
     props = bpy.context.scene.ellimann_references
-    props.base = mannequin_to_collection(Mannequin.load(REFERENCE_FOLDER / "base_mannequin.json"),
-                                         name="Base Mannequin")
+    props.base = mannequin_to_collection(
+        Mannequin.load(REFERENCE_FOLDER / "base_mannequin.json"), name="Base Mannequin"
+    )
     for name, targets in REFERENCE_MEASUREMENTS.items():
         body = read_obj(pathlib.Path(refmodels) / f"{name}.obj")
         obj = bpy.data.objects.new(name, mesh_from_arrays(name, body.vertices, body.faces))

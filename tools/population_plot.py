@@ -18,9 +18,9 @@ matplotlib.use("Agg")  # files only, no window
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ellimann_addon.core.batch_file import read_batch_file  # noqa: E402
 from ellimann_addon.core.constants import MEASUREMENTS  # noqa: E402
-from ellimann_addon.core.population import load_population  # noqa: E402
+from ellimann_addon.core.formats.npz_bundle import read_batch_file  # noqa: E402
+from ellimann_addon.core.synthesis.population import load_population  # noqa: E402
 
 NAMES = {"He": "height", "Sh": "shoulder width", "Br": "bust", "Wa": "waist", "Hi": "hips"}
 
@@ -46,11 +46,24 @@ def plot(people_count, requested, measured, population, path):
         mean, std = population.mean[index], math.sqrt(population.covariance[index, index])
         bins = np.linspace(mean - 4 * std, mean + 4 * std, 41)
         top.hist(requested[:, index], bins=bins, density=True, color="#9bb7d4", label="requested (sampled)")
-        top.hist(measured[:, index], bins=bins, density=True, histtype="step", color="#c0392b", linewidth=1.6,
-                 label="measured m_T")
+        top.hist(
+            measured[:, index],
+            bins=bins,
+            density=True,
+            histtype="step",
+            color="#c0392b",
+            linewidth=1.6,
+            label="measured m_T",
+        )
         x = np.linspace(bins[0], bins[-1], 200)
-        top.plot(x, np.exp(-0.5 * ((x - mean) / std) ** 2) / (std * math.sqrt(2 * math.pi)), color="black",
-                 linewidth=1.0, linestyle="--", label="the survey's normal (its mean and standard deviation)")
+        top.plot(
+            x,
+            np.exp(-0.5 * ((x - mean) / std) ** 2) / (std * math.sqrt(2 * math.pi)),
+            color="black",
+            linewidth=1.0,
+            linestyle="--",
+            label="the survey's normal (its mean and standard deviation)",
+        )
         top.set_title(f"{key} ({NAMES[key]}), cm")
         top.set_yticks([])
         bottom.hist(error[:, index], bins=np.linspace(-0.0012, 0.0012, 25), color="#7f8c8d")
@@ -59,11 +72,15 @@ def plot(people_count, requested, measured, population, path):
         bottom.set_xticks([-0.001, 0.0, 0.001], ["-0.001", "0", "+0.001"])
         bottom.set_xlabel("(m_T - request) / request, %")
         bottom.set_yticks([])
-    handles, labels = (sum(pair, []) for pair in zip(axes[0, 0].get_legend_handles_labels(),
-                                                      axes[1, 0].get_legend_handles_labels()))
+    handles, labels = (
+        sum(pair, []) for pair in zip(axes[0, 0].get_legend_handles_labels(), axes[1, 0].get_legend_handles_labels())
+    )
     figure.legend(handles, labels, loc="upper right", fontsize=8, frameon=False, ncol=2)
-    figure.suptitle(f"{len(requested):,} of {people_count:,} bodies sampled from {population.name} "
-                    f"(multivariate normal), synthesized in exact mode", fontsize=12)
+    figure.suptitle(
+        f"{len(requested):,} of {people_count:,} bodies sampled from {population.name} "
+        f"(multivariate normal), synthesized in exact mode",
+        fontsize=12,
+    )
     figure.tight_layout(rect=(0, 0, 1, 0.93))
     figure.savefig(path, dpi=110)
 

@@ -24,10 +24,10 @@ from ellimann_addon.blender.services.render import render_view
 from ellimann_addon.blender.services.rig import build_rig, pose_standard
 from ellimann_addon.blender.services.scene import add_mannequin, empty_scene
 from ellimann_addon.core.files import atomic_output
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.motion import clamped_motion
-from ellimann_addon.core.poses import POSE_NAMES
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.pose.motion import clamped_motion
+from ellimann_addon.core.pose.standard import POSE_NAMES
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
 SPACING = 1.3  # m between mannequins of the line-up
 WALK_FRAME = 7
@@ -76,8 +76,7 @@ def side_by_side(paths, out):
     """One PNG of equally sized PNGs in a row (through Blender's image API), written atomically."""
     images = [bpy.data.images.load(str(p)) for p in paths]
     width, height = images[0].size
-    row = np.concatenate([np.array(im.pixels[:], dtype=np.float32).reshape(height, width, 4) for im in images],
-                         axis=1)
+    row = np.concatenate([np.array(im.pixels[:], dtype=np.float32).reshape(height, width, 4) for im in images], axis=1)
     combined = bpy.data.images.new("side by side", width * len(images), height, alpha=True)
     combined.pixels.foreach_set(row.ravel())
     with atomic_output(out) as temp:

@@ -7,8 +7,8 @@ Each body of ``refmodels/`` (the five the Reference Mannequins are built from) i
 per-vertex bones (each vertex rides on its dominant skinning bone of ``reference_female_regions.json``;
 the shoulder01 vertices half way, a linear blend of the two transforms): the ``upperarm*`` vertices turn about
 the body's ``upperarm01`` joint so the upper arm is horizontal, the ``lowerarm*``, wrist and hand ones then also
-about ``lowerarm01`` so the forearm is horizontal, as ``core.poses.t_pose`` poses the mannequin. The mannequin
-is synthesized at the body's Table 2.3 measurements (its RM), posed with cushions (``core.posed``). The body
+about ``lowerarm01`` so the forearm is horizontal, as ``core.pose.standard.t_pose`` poses the mannequin. The mannequin
+is synthesized at the body's Table 2.3 measurements (its RM), posed with cushions (``core.pose.posed_pieces``). The body
 is moved onto the mannequin by the mean offset between their torso joints (the registration of the build).
 IoU = |body and mannequin| / |body or mannequin| over voxel centres (``--spacing``, default 6 mm).
 """
@@ -19,16 +19,16 @@ import pathlib
 
 import numpy as np
 
-from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS
-from ellimann_addon.core.joints import joints_from_makehuman
-from ellimann_addon.core.pose import rotation_between
-from ellimann_addon.core.posed import PosingRig, body_pieces, pieces_contain
-from ellimann_addon.core.poses import a_pose, t_pose
-from ellimann_addon.core.reference_set import load_reference_set
-from ellimann_addon.core.skeleton import JOINT_INDEX
-from ellimann_addon.core.synthesis import synthesize_batch
-from ellimann_addon.core.volume import BodyVolume
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.geometry.volume import BodyVolume
+from ellimann_addon.core.mannequin.joints import joints_from_makehuman
+from ellimann_addon.core.mannequin.skeleton import JOINT_INDEX
+from ellimann_addon.core.pose.kinematics import rotation_between
+from ellimann_addon.core.pose.posed_pieces import PosingRig, body_pieces, pieces_contain
+from ellimann_addon.core.pose.standard import a_pose, t_pose
+from ellimann_addon.core.synthesis.reference_set import load_reference_set
+from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 
 from .bodies import RM_BODIES, load_labels
 
@@ -66,15 +66,30 @@ def iou(body_vertices, faces, rig, pose, spacing):
     ellipsoids, meshes = body_pieces(rig.pose(pose))
     mannequin = np.zeros(len(centres), dtype=bool)
     for start in range(0, len(centres), 200_000):
-        mannequin[start:start + 200_000] = pieces_contain(ellipsoids, meshes, centres[start:start + 200_000])
+        mannequin[start : start + 200_000] = pieces_contain(ellipsoids, meshes, centres[start : start + 200_000])
     body = grid.inside.ravel()
     # The grid spans the body with a margin: how far the mannequin reaches beyond it (uncounted), in metres.
-    low = np.min([v.min(axis=0) for v, _ in meshes] + [(ellipsoids[1] - ellipsoids[2].max(axis=1)[:, None]).min(0)],
-                 axis=0)
-    high = np.max([v.max(axis=0) for v, _ in meshes] + [(ellipsoids[1] + ellipsoids[2].max(axis=1)[:, None]).max(0)],
-                  axis=0)
-    beyond = max(0.0, float(np.max(np.r_[axes[0][0] - low[0], axes[1][0] - low[1], axes[2][0] - low[2],
-                                         high[0] - axes[0][-1], high[1] - axes[1][-1], high[2] - axes[2][-1]])))
+    low = np.min(
+        [v.min(axis=0) for v, _ in meshes] + [(ellipsoids[1] - ellipsoids[2].max(axis=1)[:, None]).min(0)], axis=0
+    )
+    high = np.max(
+        [v.max(axis=0) for v, _ in meshes] + [(ellipsoids[1] + ellipsoids[2].max(axis=1)[:, None]).max(0)], axis=0
+    )
+    beyond = max(
+        0.0,
+        float(
+            np.max(
+                np.r_[
+                    axes[0][0] - low[0],
+                    axes[1][0] - low[1],
+                    axes[2][0] - low[2],
+                    high[0] - axes[0][-1],
+                    high[1] - axes[1][-1],
+                    high[2] - axes[2][-1],
+                ]
+            )
+        ),
+    )
     return float(np.sum(body & mannequin) / np.sum(body | mannequin)), beyond
 
 

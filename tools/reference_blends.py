@@ -51,8 +51,12 @@ def oldest_lane_python():
 
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python3 -m tools.reference_blends", description=__doc__.split("\n")[0])
-    parser.add_argument("--folder", type=pathlib.Path, default=FOLDER, help="where the JSON files are (default: "
-                        "reference_blends/); each STEM.json gets a STEM.blend beside it")
+    parser.add_argument(
+        "--folder",
+        type=pathlib.Path,
+        default=FOLDER,
+        help="where the JSON files are (default: reference_blends/); each STEM.json gets a STEM.blend beside it",
+    )
     parser.add_argument("stems", nargs="*", default=list(STEMS), help="which files (default: all six)")
     args = parser.parse_args(argv)
     missing = [s for s in args.stems if not (args.folder / f"{s}.json").is_file()]
@@ -64,7 +68,7 @@ def main(argv=None):
         command = [str(python), "-m", "tools.reference_blends", "--folder", str(args.folder), *args.stems]
         return subprocess.run(command, cwd=REPO).returncode
 
-    from ellimann_addon.core.mannequin import Mannequin
+    from ellimann_addon.core.mannequin.model import Mannequin
 
     write_blends({s: Mannequin.load(args.folder / f"{s}.json") for s in args.stems}, args.folder)
     import bpy

@@ -1,6 +1,6 @@
 """The reference sets the tools build (tools/build_reference.py the female, tools/build_male.py the male) and
 measure (tools/overlap.py, tools/landmarks.py): which bodies, which reference body, which targets and which
-section heights (the landmarks that travel with a set: core.reference_set).
+section heights (the landmarks that travel with a set: core.synthesis.reference_set).
 
 Every set is traced with the same selections, made once on the neutral female body: all bodies share one mesh
 topology and vertex order (../shared/refmodels_male/README.md), so the same vertices trace the same part on a
@@ -31,8 +31,17 @@ class BuildSet:
     lineup_name: str  # the line-up picture in docs/images/
 
 
-FEMALE = BuildSet("female", "female", SHARED / "refmodels", "reference_female", REFERENCE_MEASUREMENTS,
-                  SECTION_FRACTIONS, REPO / "reference_blends", "reference_mannequins.md", "reference_lineup.png")
+FEMALE = BuildSet(
+    "female",
+    "female",
+    SHARED / "refmodels",
+    "reference_female",
+    REFERENCE_MEASUREMENTS,
+    SECTION_FRACTIONS,
+    REPO / "reference_blends",
+    "reference_mannequins.md",
+    "reference_lineup.png",
+)
 
 # ../shared/refmodels_male: the male targets (its measurements.csv, read as `ellimann references build` reads a
 # targets CSV), chosen to span a male population, and the section heights the male bodies were fitted and
@@ -40,7 +49,16 @@ FEMALE = BuildSet("female", "female", SHARED / "refmodels", "reference_female", 
 # crotch at 0.477).
 MALE_TARGETS = read_targets(SHARED / "refmodels_male" / "measurements.csv")
 MALE_FRACTIONS = {"Sh": 0.800, "Br": 0.720, "Wa": 0.625, "Hi": 0.515}
-MALE = BuildSet("male", "male", SHARED / "refmodels_male", "reference_male", MALE_TARGETS, MALE_FRACTIONS,
-                REPO / "reference_blends" / "male", "reference_mannequins_male.md", "reference_lineup_male.png")
+MALE = BuildSet(
+    "male",
+    "male",
+    SHARED / "refmodels_male",
+    "reference_male",
+    MALE_TARGETS,
+    MALE_FRACTIONS,
+    REPO / "reference_blends" / "male",
+    "reference_mannequins_male.md",
+    "reference_lineup_male.png",
+)
 
 BUILD_SETS = {s.name: s for s in (FEMALE, MALE)}

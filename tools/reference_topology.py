@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ellimann_addon.core.mannequin import Part, Topology
-from ellimann_addon.core.trace import FitSettings
+from ellimann_addon.core.mannequin.topology import Part, Topology
+from ellimann_addon.core.mannequin.traces import FitSettings
 
 
 @dataclass(frozen=True)
@@ -34,7 +34,8 @@ class Select:
 
 @dataclass(frozen=True)
 class Spec:
-    """One part of the topology, its selection on the reference body and how to fit it (core.trace.FitSettings)."""
+    """One part of the topology, its selection on the reference body and how to fit it
+    (core.mannequin.traces.FitSettings)."""
 
     number: int
     letter: str
@@ -53,12 +54,13 @@ class Spec:
     mitten: bool = False  # kept inside the convex hull of its own vertices instead of the body surface
     level: str = None  # the section (Br, Wa) the part is centred on
     axis: tuple = None  # world direction of a limb, when its longest extent is not along it (a short neck)
-    clear: tuple = ()  # sections it keeps clear of, besides those core.body_fit.section_bounds finds (the neck: Sh)
+    # sections it keeps clear of, besides those core.fitting.mannequin_fit.section_bounds finds (the neck: Sh)
+    clear: tuple = ()
     cavities: bool = False  # the walls of the mesh's open eye sockets and mouth are no obstacles: the part
     # may fill them, as a solid head does
 
 
-# The waist's sides are centred on its section (see core.inscribe.inscribed_ellipsoid's ``level``); the
+# The waist's sides are centred on its section (see core.fitting.inscribed.inscribed_ellipsoid's ``level``); the
 # front is left to the belly, which on the chubby bodies bulges below a crease at the waist, and the
 # back free to reach down to the hips.
 WAIST_LEVEL = "Wa"
@@ -70,65 +72,275 @@ WAIST = ("He", "Wa")
 HIPS = ("He", "Hi")
 
 SPECS = (
-    Spec(1, "a", "Cranium", "C", "head", True, HEAD, Select(regions=("head",), h=(0.88, 1.01)), frame="fixed",
-         cavities=True),
-    Spec(1, "b", "Face", "C", "head", True, HEAD, Select(regions=("head",), h=(0.855, 0.91), y=(-1, -0.07)),
-         inward=(0.0, 0.03, 0.0), frame="fixed", cavities=True),
-    Spec(2, "a", "Neck", "C", "neck", True, HEAD,
-         Select(regions=("neck",), h=(0.83, 0.905), x=(0.0, 0.06), y=(-0.075, 1)), frame="axis", span=True,
-         axis=(0.0, 0.0, 1.0), margin=1.0, clear=("Sh",)),
-    Spec(3, "a", "Upper Arm", "L", "arms", False, SHOULDERS,
-         Select(bones=("upperarm01", "upperarm02"), h=(0, 0.84)), frame="limb", margin=0.15),
+    Spec(
+        1,
+        "a",
+        "Cranium",
+        "C",
+        "head",
+        True,
+        HEAD,
+        Select(regions=("head",), h=(0.88, 1.01)),
+        frame="fixed",
+        cavities=True,
+    ),
+    Spec(
+        1,
+        "b",
+        "Face",
+        "C",
+        "head",
+        True,
+        HEAD,
+        Select(regions=("head",), h=(0.855, 0.91), y=(-1, -0.07)),
+        inward=(0.0, 0.03, 0.0),
+        frame="fixed",
+        cavities=True,
+    ),
+    Spec(
+        2,
+        "a",
+        "Neck",
+        "C",
+        "neck",
+        True,
+        HEAD,
+        Select(regions=("neck",), h=(0.83, 0.905), x=(0.0, 0.06), y=(-0.075, 1)),
+        frame="axis",
+        span=True,
+        axis=(0.0, 0.0, 1.0),
+        margin=1.0,
+        clear=("Sh",),
+    ),
+    Spec(
+        3,
+        "a",
+        "Upper Arm",
+        "L",
+        "arms",
+        False,
+        SHOULDERS,
+        Select(bones=("upperarm01", "upperarm02"), h=(0, 0.84)),
+        frame="limb",
+        margin=0.15,
+    ),
     Spec(3, "b", "Forearm", "L", "arms", False, SHOULDERS, Select(bones=("lowerarm",)), frame="limb", span=True),
-    Spec(4, "a", "Hand", "L", "hands", False, SHOULDERS, Select(bones=("wrist", "metacarpal", "finger1-1")),
-         mitten=True, depth=0.0),
-    Spec(4, "b", "Fingers", "L", "hands", False, SHOULDERS,
-         Select(bones=("finger2", "finger3", "finger4", "finger5")), mitten=True, depth=0.0),
-    Spec(5, "a", "Thigh", "L", "legs", True, HIPS, Select(bones=("upperleg",), h=(0.30, 0.50)), frame="limb",
-         margin=0.15),
-    Spec(5, "b", "Knee", "L", "legs", True, HIPS, Select(bones=("upperleg02", "lowerleg01"), h=(0.20, 0.38)),
-         frame="limb", margin=0.15),
-    Spec(6, "a", "Calf", "L", "legs", True, HIPS, Select(bones=("lowerleg",), h=(0.09, 0.28)), frame="limb",
-         margin=0.15),
-    Spec(6, "b", "Ankle", "L", "legs", True, HIPS, Select(bones=("lowerleg02", "foot"), h=(0.035, 0.12)),
-         frame="limb", margin=0.15),
+    Spec(
+        4,
+        "a",
+        "Hand",
+        "L",
+        "hands",
+        False,
+        SHOULDERS,
+        Select(bones=("wrist", "metacarpal", "finger1-1")),
+        mitten=True,
+        depth=0.0,
+    ),
+    Spec(
+        4,
+        "b",
+        "Fingers",
+        "L",
+        "hands",
+        False,
+        SHOULDERS,
+        Select(bones=("finger2", "finger3", "finger4", "finger5")),
+        mitten=True,
+        depth=0.0,
+    ),
+    Spec(
+        5, "a", "Thigh", "L", "legs", True, HIPS, Select(bones=("upperleg",), h=(0.30, 0.50)), frame="limb", margin=0.15
+    ),
+    Spec(
+        5,
+        "b",
+        "Knee",
+        "L",
+        "legs",
+        True,
+        HIPS,
+        Select(bones=("upperleg02", "lowerleg01"), h=(0.20, 0.38)),
+        frame="limb",
+        margin=0.15,
+    ),
+    Spec(
+        6, "a", "Calf", "L", "legs", True, HIPS, Select(bones=("lowerleg",), h=(0.09, 0.28)), frame="limb", margin=0.15
+    ),
+    Spec(
+        6,
+        "b",
+        "Ankle",
+        "L",
+        "legs",
+        True,
+        HIPS,
+        Select(bones=("lowerleg02", "foot"), h=(0.035, 0.12)),
+        frame="limb",
+        margin=0.15,
+    ),
     Spec(7, "a", "Foot", "L", "feet", True, HIPS, Select(bones=("foot",), h=(0, 0.05)), frame="limb"),
-    Spec(7, "b", "Toes", "L", "feet", True, HIPS, Select(bones=("toe", "foot"), y=(-1, -0.09)), frame="limb",
-         mitten=True, depth=0.0),
-    Spec(8, "a", "Deltoid", "L", "shoulders", False, SHOULDERS,
-         Select(bones=("upperarm01", "shoulder01"), h=(0.765, 1.0))),
-    Spec(9, "a", "Breast", "L", "chest", True, BUST,
-         Select(regions=("chest",), h=(0.68, 0.77), x=(0.03, 0.13), y=(-1, -0.11)), margin=0.2,
-         inward=(0.0, 0.05, 0.0), frame="fixed", level="Br"),
-    Spec(10, "a", "Trapezius", "L", "shoulders", True, SHOULDERS,
-         Select(bones=("spine01", "clavicle", "shoulder01", "neck01"), h=(0.81, 0.88), x=(0.02, 0.14)),
-         inward=(0.0, 0.0, -0.04)),
-    Spec(11, "a", "Thorax", "C", "chest", True, BUST, Select(regions=("chest",), h=(0.685, 0.80), y=(-1, -0.02)),
-         inward=(0.0, 0.06, 0.0), frame="fixed"),
-    Spec(11, "b", "Upper Back", "C", "chest", True, BUST,
-         Select(regions=("chest",), h=(0.685, 0.83), x=(0, 0.11), y=(-0.04, 1)), inward=(0.0, -0.06, 0.0),
-         frame="fixed"),
-    Spec(12, "a", "Oblique", "L", "abdomen", True, WAIST,
-         Select(regions=("abdomen",), h=(0.56, 0.70), x=(0.03, 1)), frame="fixed", level=WAIST_LEVEL),
-    Spec(12, "b", "Hip", "L", "hips", True, HIPS,
-         Select(bones=("pelvis", "upperleg01"), h=(0.44, 0.60), x=(0.07, 1)), frame="fixed"),
-    Spec(13, "a", "Rectus Abdominalis", "C", "abdomen", True, WAIST,
-         Select(regions=("abdomen",), h=(0.56, 0.70), y=(-1, -0.03)), inward=(0.0, 0.05, 0.0), frame="fixed"),
-    Spec(13, "b", "Lower Back", "C", "abdomen", True, WAIST,
-         Select(regions=("abdomen",), h=(0.56, 0.70), y=(-0.03, 1)), inward=(0.0, -0.05, 0.0), frame="fixed"),
-    Spec(14, "a", "Pelvis", "C", "hips", True, HIPS, Select(regions=("pelvis",), h=(0.45, 0.62)), inside=0.001,
-         frame="fixed"),
-    Spec(15, "a", "Gluteus", "L", "hips", True, HIPS,
-         Select(bones=("pelvis", "upperleg01", "spine05"), h=(0.44, 0.56), x=(0.02, 1), y=(0.03, 1)),
-         inward=(0.0, -0.06, 0.0), frame="fixed"),
+    Spec(
+        7,
+        "b",
+        "Toes",
+        "L",
+        "feet",
+        True,
+        HIPS,
+        Select(bones=("toe", "foot"), y=(-1, -0.09)),
+        frame="limb",
+        mitten=True,
+        depth=0.0,
+    ),
+    Spec(
+        8,
+        "a",
+        "Deltoid",
+        "L",
+        "shoulders",
+        False,
+        SHOULDERS,
+        Select(bones=("upperarm01", "shoulder01"), h=(0.765, 1.0)),
+    ),
+    Spec(
+        9,
+        "a",
+        "Breast",
+        "L",
+        "chest",
+        True,
+        BUST,
+        Select(regions=("chest",), h=(0.68, 0.77), x=(0.03, 0.13), y=(-1, -0.11)),
+        margin=0.2,
+        inward=(0.0, 0.05, 0.0),
+        frame="fixed",
+        level="Br",
+    ),
+    Spec(
+        10,
+        "a",
+        "Trapezius",
+        "L",
+        "shoulders",
+        True,
+        SHOULDERS,
+        Select(bones=("spine01", "clavicle", "shoulder01", "neck01"), h=(0.81, 0.88), x=(0.02, 0.14)),
+        inward=(0.0, 0.0, -0.04),
+    ),
+    Spec(
+        11,
+        "a",
+        "Thorax",
+        "C",
+        "chest",
+        True,
+        BUST,
+        Select(regions=("chest",), h=(0.685, 0.80), y=(-1, -0.02)),
+        inward=(0.0, 0.06, 0.0),
+        frame="fixed",
+    ),
+    Spec(
+        11,
+        "b",
+        "Upper Back",
+        "C",
+        "chest",
+        True,
+        BUST,
+        Select(regions=("chest",), h=(0.685, 0.83), x=(0, 0.11), y=(-0.04, 1)),
+        inward=(0.0, -0.06, 0.0),
+        frame="fixed",
+    ),
+    Spec(
+        12,
+        "a",
+        "Oblique",
+        "L",
+        "abdomen",
+        True,
+        WAIST,
+        Select(regions=("abdomen",), h=(0.56, 0.70), x=(0.03, 1)),
+        frame="fixed",
+        level=WAIST_LEVEL,
+    ),
+    Spec(
+        12,
+        "b",
+        "Hip",
+        "L",
+        "hips",
+        True,
+        HIPS,
+        Select(bones=("pelvis", "upperleg01"), h=(0.44, 0.60), x=(0.07, 1)),
+        frame="fixed",
+    ),
+    Spec(
+        13,
+        "a",
+        "Rectus Abdominalis",
+        "C",
+        "abdomen",
+        True,
+        WAIST,
+        Select(regions=("abdomen",), h=(0.56, 0.70), y=(-1, -0.03)),
+        inward=(0.0, 0.05, 0.0),
+        frame="fixed",
+    ),
+    Spec(
+        13,
+        "b",
+        "Lower Back",
+        "C",
+        "abdomen",
+        True,
+        WAIST,
+        Select(regions=("abdomen",), h=(0.56, 0.70), y=(-0.03, 1)),
+        inward=(0.0, -0.05, 0.0),
+        frame="fixed",
+    ),
+    Spec(
+        14,
+        "a",
+        "Pelvis",
+        "C",
+        "hips",
+        True,
+        HIPS,
+        Select(regions=("pelvis",), h=(0.45, 0.62)),
+        inside=0.001,
+        frame="fixed",
+    ),
+    Spec(
+        15,
+        "a",
+        "Gluteus",
+        "L",
+        "hips",
+        True,
+        HIPS,
+        Select(bones=("pelvis", "upperleg01", "spine05"), h=(0.44, 0.56), x=(0.02, 1), y=(0.03, 1)),
+        inward=(0.0, -0.06, 0.0),
+        frame="fixed",
+    ),
 )
 
 
 def fit_settings(spec, kept=None):
-    """The fit settings a traced part records (core.trace.FitSettings) for ``spec``."""
-    return FitSettings(margin=spec.margin, depth=spec.depth, inside=spec.inside, span=spec.span, inward=spec.inward,
-                       frame=spec.frame, mitten=spec.mitten, level=spec.level, axis=spec.axis, clear=spec.clear,
-                       kept=kept)
+    """The fit settings a traced part records (core.mannequin.traces.FitSettings) for ``spec``."""
+    return FitSettings(
+        margin=spec.margin,
+        depth=spec.depth,
+        inside=spec.inside,
+        span=spec.span,
+        inward=spec.inward,
+        frame=spec.frame,
+        mitten=spec.mitten,
+        level=spec.level,
+        axis=spec.axis,
+        clear=spec.clear,
+        kept=kept,
+    )
 
 
 def _partners():

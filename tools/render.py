@@ -22,9 +22,9 @@ from mathutils import Matrix
 import ellimann_addon
 from ellimann_addon.blender.bridge.convert import SIDE_COLORS, mannequin_to_collection, mesh_from_arrays
 from ellimann_addon.blender.services.render import workbench, write_png
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.posed import PosingRig
-from ellimann_addon.core.poses import POSE_NAMES, standard_motion
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.pose.posed_pieces import PosingRig
+from ellimann_addon.core.pose.standard import POSE_NAMES, standard_motion
 
 GHOST_COLOR = (0.55, 0.55, 0.58, 0.22)
 VIEWS = {"FRONT": 0.0, "SIDE": 90.0, "THREE_QUARTER": 35.0}  # camera turn about Z, degrees
@@ -56,8 +56,12 @@ def _copy(obj, collection, placement, color=None):
 
 
 def _bounds(objects):
-    points = np.concatenate([np.array(obj.bound_box) @ np.array(obj.matrix_world)[:3, :3].T
-                             + np.array(obj.matrix_world)[:3, 3] for obj in objects])
+    points = np.concatenate(
+        [
+            np.array(obj.bound_box) @ np.array(obj.matrix_world)[:3, :3].T + np.array(obj.matrix_world)[:3, 3]
+            for obj in objects
+        ]
+    )
     return points.min(axis=0), points.max(axis=0)
 
 
@@ -77,8 +81,9 @@ def render(path, slots, resolution=(800, 1000), view="FRONT", spacing=None, marg
             centre = Matrix.Translation((-(lo[0] + hi[0]) / 2.0, -(lo[1] + hi[1]) / 2.0, 0.0))
             placement = Matrix.Rotation(math.radians(slot.turn), 4, "Z") @ centre
             copies = [_copy(o, scene.collection, placement) for item in slot.solid for o in _objects(item)]
-            copies += [_copy(o, scene.collection, placement, GHOST_COLOR) for item in slot.ghosts
-                       for o in _objects(item)]
+            copies += [
+                _copy(o, scene.collection, placement, GHOST_COLOR) for item in slot.ghosts for o in _objects(item)
+            ]
             placed.append(copies)
             made_objects += copies
         widths = [np.ptp(np.array(_bounds(copies))[:, 0]) for copies in placed]
@@ -99,8 +104,9 @@ def render(path, slots, resolution=(800, 1000), view="FRONT", spacing=None, marg
         height = hi[2] - lo[2]
         camera_data = bpy.data.cameras.new("ElliMann render camera")
         camera_data.type = "ORTHO"
-        camera_data.ortho_scale = margin * max(height, width * resolution[1] / resolution[0]) * (
-            max(resolution) / resolution[1])
+        camera_data.ortho_scale = (
+            margin * max(height, width * resolution[1] / resolution[0]) * (max(resolution) / resolution[1])
+        )
         camera_data.clip_end = 100.0
         camera = bpy.data.objects.new("ElliMann render camera", camera_data)
         made_data.append(camera_data)
@@ -172,7 +178,7 @@ def posed_objects(rig, pose):
 
 def poses(path, out, names=POSE_NAMES, view="FRONT", walk_frame=6):
     """One mannequin (a JSON with joints) in each pose of ``names`` side by side, cushions split at the joints
-    (``core.posed``); the walk cycle shown at frame ``walk_frame``."""
+    (``core.pose.posed_pieces``); the walk cycle shown at frame ``walk_frame``."""
     bpy.ops.wm.read_homefile(use_empty=True)
     mannequin = Mannequin.load(path)
     rig = PosingRig(mannequin)
@@ -191,8 +197,14 @@ def main(argv=None):
     lineup = sub.add_parser("mannequins", help="mannequin JSON files side by side")
     lineup.add_argument("files", nargs="+", type=Path)
     lineup.add_argument("--ghost", action="append", default=[], type=Path)
-    lineup.add_argument("--ghost-shift", nargs=3, type=float, default=(0.0, 0.0, 0.0), metavar=("X", "Y", "Z"),
-                        help="move the ghost meshes by this much (m), e.g. by the mannequin's registration")
+    lineup.add_argument(
+        "--ghost-shift",
+        nargs=3,
+        type=float,
+        default=(0.0, 0.0, 0.0),
+        metavar=("X", "Y", "Z"),
+        help="move the ghost meshes by this much (m), e.g. by the mannequin's registration",
+    )
     lineup.add_argument("--side-too", action="store_true", help="each mannequin also seen from the side")
     lineup.add_argument("--out", required=True, type=Path)
     lineup.add_argument("--view", default="FRONT", choices=sorted(VIEWS))

@@ -4,7 +4,7 @@
 
 The body (one of ../shared/refmodels) and the mannequin (a shipped female Reference Mannequin, measured through
 its pieces' mesh, the same code as a scan) are drawn semi-transparent, front and side, with every measurement's
-loop, the arm's shoulder-to-fingertip line and the crotch point in colour (core.body_measure's sections).
+loop, the arm's shoulder-to-fingertip line and the crotch point in colour (core.measure.body's sections).
 """
 
 import argparse
@@ -15,18 +15,27 @@ import numpy as np
 import ellimann_addon
 from ellimann_addon.blender.bridge.convert import mannequin_to_collection
 from ellimann_addon.blender.services.teardown import exit_with
-from ellimann_addon.core.body_measure import measure_body_mesh
-from ellimann_addon.core.body_mesh import read_obj
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.mesh import icosphere
-from ellimann_addon.core.shipped_sets import reference_folder
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.geometry.mesh import icosphere
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.measure.body import measure_body_mesh
+from ellimann_addon.core.synthesis.shipped import reference_folder
 
 from .reference_sets import TRACING_FOLDER
 from .render import Slot, render
 
-COLORS = {"Sh": (0.9, 0.6, 0.1, 1), "Br": (0.85, 0.2, 0.2, 1), "Wa": (0.2, 0.6, 0.2, 1), "Hi": (0.2, 0.35, 0.85, 1),
-          "neck": (0.7, 0.2, 0.7, 1), "upper_arm": (0.1, 0.7, 0.7, 1), "thigh": (0.95, 0.45, 0.6, 1),
-          "calf": (0.55, 0.35, 0.15, 1), "crotch_height": (0.05, 0.05, 0.05, 1), "arm_length": (0.95, 0.85, 0.1, 1)}
+COLORS = {
+    "Sh": (0.9, 0.6, 0.1, 1),
+    "Br": (0.85, 0.2, 0.2, 1),
+    "Wa": (0.2, 0.6, 0.2, 1),
+    "Hi": (0.2, 0.35, 0.85, 1),
+    "neck": (0.7, 0.2, 0.7, 1),
+    "upper_arm": (0.1, 0.7, 0.7, 1),
+    "thigh": (0.95, 0.45, 0.6, 1),
+    "calf": (0.55, 0.35, 0.15, 1),
+    "crotch_height": (0.05, 0.05, 0.05, 1),
+    "arm_length": (0.95, 0.85, 0.1, 1),
+}
 
 
 def pieces_mesh(mannequin, level=4):
@@ -72,17 +81,20 @@ def main(argv=None):
     ellimann_addon.register()
     mannequin = Mannequin.load(reference_folder("female") / f"{args.mannequin}.json")
     collection = mannequin_to_collection(mannequin)
-    mannequin_marks = marks(measure_body_mesh(*pieces_mesh(mannequin), mannequin.section_fractions).sections,
-                            "mannequin")
+    mannequin_marks = marks(
+        measure_body_mesh(*pieces_mesh(mannequin), mannequin.section_fractions).sections, "mannequin"
+    )
     body = read_obj(TRACING_FOLDER / f"{args.body}.obj")
     mesh = bpy.data.meshes.new(args.body)
     mesh.from_pydata(body.vertices.tolist(), [], body.faces.tolist())
     body_object = bpy.data.objects.new(args.body, mesh)
     bpy.context.scene.collection.objects.link(body_object)
     body_marks = marks(measure_body_mesh(body.vertices, body.faces).sections, "body")
-    slots = [Slot(solid=marks_, ghosts=[ghost], turn=turn) for marks_, ghost in ((mannequin_marks, collection),
-                                                                                  (body_marks, body_object))
-             for turn in (0, 90)]
+    slots = [
+        Slot(solid=marks_, ghosts=[ghost], turn=turn)
+        for marks_, ghost in ((mannequin_marks, collection), (body_marks, body_object))
+        for turn in (0, 90)
+    ]
     render(args.out, slots, resolution=(1800, 1100), spacing=0.25)
     print(f"wrote {args.out}")
 

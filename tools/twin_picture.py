@@ -8,12 +8,12 @@ import argparse
 import tempfile
 from pathlib import Path
 
-from ellimann_addon.core.body_measure import measure_body_mesh
-from ellimann_addon.core.body_mesh import read_obj
-from ellimann_addon.core.extra_measures import split_measurements
-from ellimann_addon.core.refine_extra import synthesize_extra
-from ellimann_addon.core.shipped_sets import named_reference_set
-from ellimann_addon.core.volume import IOU_MARGIN, BodyVolume
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.geometry.volume import IOU_MARGIN, BodyVolume
+from ellimann_addon.core.measure.body import measure_body_mesh
+from ellimann_addon.core.measure.extra import split_measurements
+from ellimann_addon.core.synthesis.shipped import named_reference_set
+from ellimann_addon.core.synthesis.synthesize import synthesize_extra
 from tools import render
 from tools.build_reference import DEFAULT_REFMODELS
 from tools.overlap import standing_in
@@ -33,8 +33,9 @@ def twins(name, reference):
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m tools.twin_picture", description=__doc__.splitlines()[0])
     parser.add_argument("--bodies", nargs="+", default=["small_chubby", "tall_slim"])
-    parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parent.parent / "docs" / "images"
-                        / "twin_five_vs_all.png")
+    parser.add_argument(
+        "--out", type=Path, default=Path(__file__).resolve().parent.parent / "docs" / "images" / "twin_five_vs_all.png"
+    )
     args = parser.parse_args(argv)
     reference = named_reference_set("female")
     with tempfile.TemporaryDirectory() as folder:
@@ -45,8 +46,16 @@ def main(argv=None):
                 twin.copy(name=f"{name}, {label}").save(path)
                 files.append(path)
                 ghosts.append(DEFAULT_REFMODELS / f"{name}.obj")
-        return render.main(["mannequins", *map(str, files), *sum((["--ghost", str(g)] for g in ghosts), []),
-                            "--side-too", "--out", str(args.out)])
+        return render.main(
+            [
+                "mannequins",
+                *map(str, files),
+                *sum((["--ghost", str(g)] for g in ghosts), []),
+                "--side-too",
+                "--out",
+                str(args.out),
+            ]
+        )
 
 
 if __name__ == "__main__":

@@ -45,8 +45,14 @@ PANEL_REFERENCES = "ELLIMANN_PT_references"
 # Sub-panels of PANEL_MAIN sort by bl_order. Room is left after Measure for the Synthesize (60),
 # Pose (65) and Drape (70) panels that other parts of the add-on add.
 # Building a reference set (55) comes before synthesizing from it.
-PANEL_ORDER = {PANEL_TRACE: 10, PANEL_PART: 20, PANEL_CLEAN: 30, PANEL_CUSHIONS: 40, PANEL_MEASURE: 50,
-               PANEL_REFERENCES: 55}
+PANEL_ORDER = {
+    PANEL_TRACE: 10,
+    PANEL_PART: 20,
+    PANEL_CLEAN: 30,
+    PANEL_CUSHIONS: 40,
+    PANEL_MEASURE: 50,
+    PANEL_REFERENCES: 55,
+}
 SYNTHESIZE_ORDER = 60
 POSE_ORDER = 65
 DRAPE_ORDER = 70

@@ -31,8 +31,7 @@ from .features import (
 FEATURES = (trace, part, clean, cushions, measure, references, synthesize, pose, drape, export)
 
 # Property groups first (pointers need them), the main panel before its sub-panels.
-CLASSES = (props.classes + main_panel.classes + tuple(c for feature in FEATURES for c in feature.classes)
-           + menus.classes)
+CLASSES = props.classes + main_panel.classes + tuple(c for feature in FEATURES for c in feature.classes) + menus.classes
 
 # (menu, draw function) appended to Blender's menus.
 MENU_ENTRIES = menus.MENU_ENTRIES + tuple(e for feature in FEATURES for e in getattr(feature, "MENU_ENTRIES", ()))
@@ -63,7 +62,9 @@ def _remove_menu_entries():
 
 
 # (register, unregister) pairs, run after the classes are registered (and in reverse before they go).
-HOOKS = ((props.register_hooks, props.unregister_hooks),
-         *((f.register_hooks, f.unregister_hooks) for f in FEATURES if hasattr(f, "register_hooks")),
-         (_add_menu_entries, _remove_menu_entries),
-         (cli_command.register, cli_command.unregister))
+HOOKS = (
+    (props.register_hooks, props.unregister_hooks),
+    *((f.register_hooks, f.unregister_hooks) for f in FEATURES if hasattr(f, "register_hooks")),
+    (_add_menu_entries, _remove_menu_entries),
+    (cli_command.register, cli_command.unregister),
+)

@@ -28,8 +28,10 @@ SUBCOMMANDS = (synth, batch, pose, measure, demo, drape, references, population)
 
 
 def build_parser():
-    parser = argparse.ArgumentParser(prog=PROG, description="ElliMann: measurement-driven mannequins from "
-                                     "convex ellipsoids and cushions (measurements in cm).")
+    parser = argparse.ArgumentParser(
+        prog=PROG,
+        description="ElliMann: measurement-driven mannequins from convex ellipsoids and cushions (measurements in cm).",
+    )
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for command in SUBCOMMANDS:
         command.add_parser(commands)

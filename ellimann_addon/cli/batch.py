@@ -12,50 +12,64 @@ import numpy as np
 
 from ..core.constants import MEASUREMENTS
 from ..core.errors import ElliMannError, MeasurementError, ReferenceSetError
-from ..core.extra_measures import EXTRA_MEASUREMENTS
 from ..core.files import atomic_write_text, incomplete
-from ..core.formats import FORMATS
-from ..core.measure import as_dict
-from ..core.refine import EXACT_TOLERANCE
-from ..core.refine_extra import extra_request_problems, meet_extra
-from ..core.request import validate_request
-from ..core.skeleton import JOINT_NAMES
+from ..core.formats.table import FORMATS
+from ..core.mannequin.skeleton import JOINT_NAMES
+from ..core.measure.extra import EXTRA_MEASUREMENTS
+from ..core.measure.tailor import as_dict
+from ..core.synthesis.batch import CHUNK, synthesize_chunk
+from ..core.synthesis.extra_refine import extra_request_problems, meet_extra
+from ..core.synthesis.refine import EXACT_TOLERANCE
+from ..core.synthesis.request import validate_request
 from . import common, distributed
 from .common import PROG, UsageError
 
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,99}$")
-CHUNK = 256  # rows synthesized per core batch (and per Dask task)
 MAX_WARNING_LINES = 20  # range warnings printed before the rest go to the report only (a population has thousands)
-NPZ = "npz"  # the batch's one-file format (core.batch_file), written once at the end
+NPZ = "npz"  # the batch's one-file format (core.formats.npz_bundle), written once at the end
 
 
 def add_parser(commands):
-    batch = commands.add_parser("batch", help="synthesize every row of a CSV",
-                                description="One mannequin per CSV row. The header names the columns "
-                                            "He,Sh,Br,Wa,Hi (cm) and optionally name and references (a row's "
-                                            "reference set: female, male or a folder; empty: --references) "
-                                            "and any of the extra measurements (neck, upper_arm, thigh, calf, "
-                                            "crotch_height, arm_length: the keys measure --json prints; an empty "
-                                            "cell leaves it to the reference set). Writes the files and "
-                                            "DIR/report.csv (requested vs measured), row by row into "
-                                            "DIR/report.partial.csv while it runs. Bad or failed rows are "
-                                            "reported and skipped; the exit code is 1 if any row failed, 3 if "
-                                            "exact mode missed a row's request, 130 if interrupted.")
+    batch = commands.add_parser(
+        "batch",
+        help="synthesize every row of a CSV",
+        description="One mannequin per CSV row. The header names the columns "
+        "He,Sh,Br,Wa,Hi (cm) and optionally name and references (a row's "
+        "reference set: female, male or a folder; empty: --references) "
+        "and any of the extra measurements (neck, upper_arm, thigh, calf, "
+        "crotch_height, arm_length: the keys measure --json prints; an empty "
+        "cell leaves it to the reference set). Writes the files and "
+        "DIR/report.csv (requested vs measured), row by row into "
+        "DIR/report.partial.csv while it runs. Bad or failed rows are "
+        "reported and skipped; the exit code is 1 if any row failed, 3 if "
+        "exact mode missed a row's request, 130 if interrupted.",
+    )
     batch.add_argument("csv", metavar="MEASUREMENTS.csv")
     batch.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
-    batch.add_argument("--format", default="json",
-                       help=f"comma-separated output formats among {','.join(FORMATS)},npz (default json; mjcf "
-                            "writes NAME.xml; npz writes every mannequin of the batch into one compressed file "
-                            "DIR/mannequins.npz, docs/batch_file.md)")
-    batch.add_argument("--dask", metavar="ADDRESS",
-                       help="synthesize on a Dask cluster: a scheduler's tcp://HOST:PORT, or local:N for N local "
-                            "worker processes (pip install ellimann[dask]); results identical to a serial run")
-    batch.add_argument("--shard", metavar="I/N",
-                       help="process only rows I, I+N, I+2N… (I from 1 to N), for a render farm; the report "
-                            "is DIR/report-I-of-N.csv")
-    batch.add_argument("--resume", action="store_true",
-                       help="skip rows whose files (every --format) are already in DIR and whole, e.g. after an "
-                            "interrupted run with the same CSV and options; without it every row is written again")
+    batch.add_argument(
+        "--format",
+        default="json",
+        help=f"comma-separated output formats among {','.join(FORMATS)},npz (default json; mjcf "
+        "writes NAME.xml; npz writes every mannequin of the batch into one compressed file "
+        "DIR/mannequins.npz, docs/batch_file.md)",
+    )
+    batch.add_argument(
+        "--dask",
+        metavar="ADDRESS",
+        help="synthesize on a Dask cluster: a scheduler's tcp://HOST:PORT, or local:N for N local "
+        "worker processes (pip install ellimann[dask]); results identical to a serial run",
+    )
+    batch.add_argument(
+        "--shard",
+        metavar="I/N",
+        help="process only rows I, I+N, I+2N… (I from 1 to N), for a render farm; the report is DIR/report-I-of-N.csv",
+    )
+    batch.add_argument(
+        "--resume",
+        action="store_true",
+        help="skip rows whose files (every --format) are already in DIR and whole, e.g. after an "
+        "interrupted run with the same CSV and options; without it every row is written again",
+    )
     common.add_synthesis_options(batch)
     common.add_pose_option(batch)
     batch.set_defaults(run=run, blender=needs_blender)
@@ -105,8 +119,9 @@ def read_rows(path, reference_of):
     columns = {}
     for index, title in enumerate(header):
         key = title.strip()
-        canonical = next((m for m in MEASUREMENTS + EXTRA_MEASUREMENTS + ("name", "references")
-                          if m.lower() == key.lower()), None)
+        canonical = next(
+            (m for m in MEASUREMENTS + EXTRA_MEASUREMENTS + ("name", "references") if m.lower() == key.lower()), None
+        )
         if canonical in columns:
             raise UsageError(f"{path}: column {canonical} appears twice in the header")
         if canonical:
@@ -118,8 +133,10 @@ def read_rows(path, reference_of):
     for line, record in enumerate(reader, start=2):
         if not any(cell.strip() for cell in record):
             continue
-        name, chosen = (record[columns[c]].strip() if c in columns and columns[c] < len(record) else ""
-                        for c in ("name", "references"))
+        name, chosen = (
+            record[columns[c]].strip() if c in columns and columns[c] < len(record) else ""
+            for c in ("name", "references")
+        )
         reference = None
         try:
             try:
@@ -220,37 +237,60 @@ def _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file):
                 common.say(f"{PROG} batch: line {line}: warning: {warning}")
         jobs.append((line, name, values, warnings, extra, reference))
     if shown > MAX_WARNING_LINES:
-        common.say(f"{PROG} batch: {shown - MAX_WARNING_LINES} more warning(s) of requests outside the reference "
-                   f"range; every row's are in {report.path}")
+        common.say(
+            f"{PROG} batch: {shown - MAX_WARNING_LINES} more warning(s) of requests outside the reference "
+            f"range; every row's are in {report.path}"
+        )
     progress = common.Progress(len(jobs), "batch", quiet=args.quiet)
     # one core batch per reference set (in the order the sets first appear), in chunks
     groups = {}
     for job in jobs:
         groups.setdefault(id(job[-1]), []).append(job)
-    chunks = [group[start:start + CHUNK] for group in groups.values() for start in range(0, len(group), CHUNK)]
+    chunks = [group[start : start + CHUNK] for group in groups.values() for start in range(0, len(group), CHUNK)]
     sets = [chunk[0][-1] for chunk in chunks]
     requests = [[job[2] for job in chunk] for chunk in chunks]
     bundles = {}  # one batch file per reference set: mannequins.npz, or mannequins-NAME.npz when a batch uses several
     if NPZ in formats:
         for reference in dict.fromkeys(sets):
             tag = f"-{reference.name}" if len(groups) > 1 else ""
-            bundles[id(reference)] = Bundle(os.path.join(args.output, f"mannequins{tag}{suffix}.npz"),
-                                            reference.topology, args.mode)
-    results = (cluster.map(sets, requests, options) if cluster is not None
-               else ((index, synthesize_chunk(sets[index], chunk, options)) for index, chunk in enumerate(requests)))
+            bundles[id(reference)] = Bundle(
+                os.path.join(args.output, f"mannequins{tag}{suffix}.npz"), reference.topology, args.mode
+            )
+    results = (
+        cluster.map(sets, requests, options)
+        if cluster is not None
+        else ((index, synthesize_chunk(sets[index], chunk, options)) for index, chunk in enumerate(requests))
+    )
     try:
         for index, result in results:
             for i, (line, name, values, warnings, extra, reference) in enumerate(chunks[index]):
-                report.add(_row(args, formats, result, i, line, name, values, warnings, reference.name,
-                                bundles.get(id(reference)), index, pose_file, extra))
+                report.add(
+                    _row(
+                        args,
+                        formats,
+                        result,
+                        i,
+                        line,
+                        name,
+                        values,
+                        warnings,
+                        reference.name,
+                        bundles.get(id(reference)),
+                        index,
+                        pose_file,
+                        extra,
+                    )
+                )
                 progress.step(name)
         for bundle in bundles.values():
             bundle.write()
     except KeyboardInterrupt:
         progress.done()
         report.finish()
-        common.say(f"{PROG} batch: interrupted: {report.count('ok', 'missed')} of {len(mine)} rows done, report "
-             f"{report.path}; run it again with --resume to finish")
+        common.say(
+            f"{PROG} batch: interrupted: {report.count('ok', 'missed')} of {len(mine)} rows done, report "
+            f"{report.path}; run it again with --resume to finish"
+        )
         return common.INTERRUPTED
     except BaseException:
         report._close()  # the partial report stays for --resume; its file is not left open
@@ -258,93 +298,28 @@ def _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file):
     progress.done()
     report.finish()
     done, failed, missed = report.count("ok", "missed"), report.count("error"), report.count("missed")
-    common.say(f"{PROG} batch: {done} of {len(mine)} mannequins written to {args.output}"
-         + (f" ({report.count('kept')} already complete, kept)" if args.resume else "")
-         + (f" (shard {shard}/{shards} of {len(rows)} rows)" if shards > 1 else "") + f"; report {report.path}",
-         file=sys.stdout)
+    common.say(
+        f"{PROG} batch: {done} of {len(mine)} mannequins written to {args.output}"
+        + (f" ({report.count('kept')} already complete, kept)" if args.resume else "")
+        + (f" (shard {shard}/{shards} of {len(rows)} rows)" if shards > 1 else "")
+        + f"; report {report.path}",
+        file=sys.stdout,
+    )
     if failed:
         common.say(f"{PROG} batch: error: {failed} row(s) failed; see {report.path}")
         return 1
     if missed:
-        common.say(f"{PROG} batch: warning: exact mode missed the request of {missed} row(s) by more than "
-             f"{EXACT_TOLERANCE * 100:g}%; see {report.path}")
+        common.say(
+            f"{PROG} batch: warning: exact mode missed the request of {missed} row(s) by more than "
+            f"{EXACT_TOLERANCE * 100:g}%; see {report.path}"
+        )
         return common.MISSED
     return 0
 
 
-def synthesize_chunk(reference, requests, options):
-    """A chunk of requests synthesized in one core batch (what a Dask task runs). If the batch refuses a row
-    (an implausible body), every row is synthesized alone, so only that row fails: batched and one-at-a-time
-    results are the same bits. Returns a ChunkResult."""
-    from ..core.synthesis import synthesize_batch
-
-    try:
-        return ChunkResult.of(synthesize_batch(reference, requests, options), [None] * len(requests))
-    except ElliMannError:
-        pass
-    parts, errors = [], []
-    for values in requests:
-        try:
-            parts.append(synthesize_batch(reference, [values], options))
-            errors.append(None)
-        except ElliMannError as error:
-            parts.append(None)
-            errors.append(common.one_line(error))
-    return ChunkResult.joined(parts, errors)
-
-
-def _landmarks(synthesis):
-    """What each mannequin of a Synthesis records of its reference set (Mannequin keywords)."""
-    return {"reference_set": synthesis.reference_set, "section_fractions": synthesis.section_fractions}
-
-
-class ChunkResult:
-    """A chunk's synthesis as plain arrays (what a Dask worker sends back): ``errors[i]`` is None or why row i
-    failed (its arrays are then NaN)."""
-
-    FIELDS = ("rotation", "center", "semi_axes", "measured", "factors", "converged")
-
-    def __init__(self, topology, errors, joints=None, landmarks=None, **arrays):
-        self.topology, self.errors = topology, errors
-        self.joints = joints  # (B, 24, 3) or None: the reference set has no joints
-        self.landmarks = landmarks or {}  # the set's name and section heights, which each mannequin records
-        for key in self.FIELDS:
-            setattr(self, key, arrays[key])
-
-    @classmethod
-    def of(cls, synthesis, errors):
-        return cls(synthesis.topology, errors, synthesis.joints, _landmarks(synthesis),
-                   **{key: getattr(synthesis, key) for key in cls.FIELDS})
-
-    @classmethod
-    def joined(cls, parts, errors):
-        good = next((p for p in parts if p is not None), None)
-        if good is None:
-            return cls(None, errors, **{key: [None] * len(parts) for key in cls.FIELDS})
-        arrays = {key: np.concatenate([getattr(p if p is not None else good, key) for p in parts])
-                  for key in cls.FIELDS}
-        joints = (None if good.joints is None
-                  else np.concatenate([(p if p is not None else good).joints for p in parts]))
-        for i, part in enumerate(parts):
-            if part is None:
-                for key in cls.FIELDS:
-                    if key != "converged":
-                        arrays[key][i] = np.nan
-                arrays["converged"][i] = False
-                if joints is not None:
-                    joints[i] = np.nan
-        return cls(good.topology, errors, joints, _landmarks(good), **arrays)
-
-    def mannequin(self, i, name, request):
-        from ..core.mannequin import Mannequin
-
-        return Mannequin(self.topology, self.rotation[i], self.center[i], self.semi_axes[i], name=name,
-                         role="synthesized", measurements=as_dict(request),
-                         joints=None if self.joints is None else self.joints[i], **self.landmarks)
-
-
-def _row(args, formats, result, i, line, name, values, warnings, references, bundle=None, chunk=0, pose_file=None,
-         extra=None):
+def _row(
+    args, formats, result, i, line, name, values, warnings, references, bundle=None, chunk=0, pose_file=None, extra=None
+):
     """Write (or, with --resume, keep) the files of one synthesized row, and add it to the batch file; its report
     row. A failure is that row's: one line on stderr and status "error", and the batch goes on. A row with extra
     measurements is deformed to meet them too (exact mode; the report's message gives what they came to; the
@@ -371,8 +346,9 @@ def _row(args, formats, result, i, line, name, values, warnings, references, bun
     if bundle is not None:
         bundle.add(chunk, name, values, result, i)
     if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths) and paths:
-        row = common.report_row(line, name, status, "; ".join(notes + ["kept (--resume)"]), values, measured,
-                                listed, references)
+        row = common.report_row(
+            line, name, status, "; ".join(notes + ["kept (--resume)"]), values, measured, listed, references
+        )
         row["kept"] = True
         return row
     try:
@@ -389,7 +365,7 @@ def _row(args, formats, result, i, line, name, values, warnings, references, bun
 
 class Bundle:
     """The rows of ``--format npz``, gathered by chunk (a Dask run finishes chunks in any order) and written
-    once, in the CSV's order, when the batch ends (``core.batch_file``)."""
+    once, in the CSV's order, when the batch ends (``core.formats.npz_bundle``)."""
 
     def __init__(self, path, topology, mode):
         self.path, self.topology, self.mode = path, topology, mode
@@ -402,22 +378,39 @@ class Bundle:
         self.rows[chunk] = [row for row in self.rows.get(chunk, []) if row[0] != name]
 
     def write(self):
-        from ..core.batch_file import batch_arrays, write_batch_file
+        from ..core.formats.npz_bundle import batch_arrays, write_batch_file
 
         rows = [row for chunk in sorted(self.rows) for row in self.rows[chunk]]
         parts = len(self.topology)
-        shapes = {"rotation": (parts, 3, 3), "center": (parts, 3), "semi_axes": (parts, 3), "measured": (5,),
-                  "factors": (5,), "converged": ()}
-        arrays = {key: np.array([getattr(result, key)[i] for _, _, result, i in rows]).reshape((len(rows),) + shape)
-                  for key, shape in shapes.items()}
+        shapes = {
+            "rotation": (parts, 3, 3),
+            "center": (parts, 3),
+            "semi_axes": (parts, 3),
+            "measured": (5,),
+            "factors": (5,),
+            "converged": (),
+        }
+        arrays = {
+            key: np.array([getattr(result, key)[i] for _, _, result, i in rows]).reshape((len(rows),) + shape)
+            for key, shape in shapes.items()
+        }
         requests = np.array([values for _, values, _, _ in rows], dtype=float).reshape(len(rows), 5)
         joints = None
         if rows and all(result.joints is not None for _, _, result, _ in rows):
             joints = np.array([result.joints[i] for _, _, result, i in rows]).reshape(len(rows), len(JOINT_NAMES), 3)
         with common.writing(self.path):
-            write_batch_file(self.path, batch_arrays(self.topology, [row[0] for row in rows], requests,
-                                                     mode=self.mode, joints=joints, joint_names=JOINT_NAMES,
-                                                     **arrays))
+            write_batch_file(
+                self.path,
+                batch_arrays(
+                    self.topology,
+                    [row[0] for row in rows],
+                    requests,
+                    mode=self.mode,
+                    joints=joints,
+                    joint_names=JOINT_NAMES,
+                    **arrays,
+                ),
+            )
 
 
 class Report:
@@ -431,8 +424,9 @@ class Report:
         self.partial = f"{root}.partial{extension}"
         with common.writing(self.partial):
             self.stream = open(self.partial, "w", newline="", encoding="utf-8")
-        self.writer = csv.DictWriter(self.stream, fieldnames=common.REPORT_COLUMNS, lineterminator="\n",
-                                     extrasaction="ignore")
+        self.writer = csv.DictWriter(
+            self.stream, fieldnames=common.REPORT_COLUMNS, lineterminator="\n", extrasaction="ignore"
+        )
         self._append(self.writer.writeheader)
 
     def add(self, row):

@@ -16,14 +16,14 @@ import tempfile
 import time
 
 from ..core.constants import MEASUREMENTS
-from ..core.errors import ElliMannError, ReferenceSetError
+from ..core.errors import ElliMannError, ReferenceSetError, one_line  # noqa: F401  (one_line: common.one_line)
 from ..core.files import atomic_write_text, clean_stale_temporaries
-from ..core.formats import FORMATS, format_of
-from ..core.measure import measurement_line
-from ..core.options import SYNTHESIS, SynthesisOptions
-from ..core.refine import EXACT_TOLERANCE
-from ..core.request import relative_error
-from ..core.writers import core_format, write_core_file
+from ..core.formats.core_writers import core_format, write_core_file
+from ..core.formats.table import FORMATS, format_of
+from ..core.measure.tailor import measurement_line
+from ..core.synthesis.options import SYNTHESIS, SynthesisOptions
+from ..core.synthesis.refine import EXACT_TOLERANCE
+from ..core.synthesis.request import relative_error
 
 PROG = "ellimann"
 MISSED = 3  # exit code: written, but exact mode missed a requested measurement by more than its tolerance
@@ -35,12 +35,6 @@ class UsageError(ElliMannError):
 
 
 # ------------------------------------------------------------------------------------------------ printing
-
-
-def one_line(error):
-    if isinstance(error, OSError) and error.filename:
-        return f"{error.strerror or error}: {error.filename}"
-    return " ".join(str(error).split())
 
 
 _UNPRINTABLE = re.compile(r"[\x00-\x1f\x7f-\x9f\u061c\u200e\u200f\u2028-\u202e\u2066-\u2069]")
@@ -57,7 +51,7 @@ def say(text, file=None, end="\n"):
 
 
 def format_me(values):
-    """The m_T line (``core.measure.measurement_line``)."""
+    """The m_T line (``core.measure.tailor.measurement_line``)."""
     return measurement_line(values)
 
 
@@ -73,70 +67,92 @@ def number(text):
 
 
 def add_verbose(parser):
-    parser.add_argument("-v", "--verbose", action="store_true",
-                        help="also show what Blender prints (on stderr); without it only ElliMann's lines show")
-    parser.add_argument("-q", "--quiet", action="store_true",
-                        help="no progress line (errors, warnings and the result still show)")
+    parser.add_argument(
+        "-v",
+        "--verbose",
+        action="store_true",
+        help="also show what Blender prints (on stderr); without it only ElliMann's lines show",
+    )
+    parser.add_argument(
+        "-q", "--quiet", action="store_true", help="no progress line (errors, warnings and the result still show)"
+    )
 
 
 def add_synthesis_options(parser):
-    """--mode, --metric, --power, --normalize from ``core.options.SYNTHESIS``; --cushions, --references."""
+    """--mode, --metric, --power, --normalize from ``core.synthesis.options.SYNTHESIS``; --cushions, --references."""
     add_verbose(parser)
     for name, option in SYNTHESIS.items():
         if option.choices:
-            parser.add_argument(f"--{name}", choices=option.values, default=option.default,
-                                help=option.help.format(default=option.default))
+            parser.add_argument(
+                f"--{name}",
+                choices=option.values,
+                default=option.default,
+                help=option.help.format(default=option.default),
+            )
         else:
-            parser.add_argument(f"--{name}", type=number, default=option.default,
-                                help=option.help.format(default=option.default))
-    parser.add_argument("--cushions", action="store_true",
-                        help="cushions (convex hulls of the cushion pairs) instead of their ellipsoids: shown in "
-                             ".blend/.glb/.obj outputs, convex mesh geoms in MJCF")
+            parser.add_argument(
+                f"--{name}", type=number, default=option.default, help=option.help.format(default=option.default)
+            )
+    parser.add_argument(
+        "--cushions",
+        action="store_true",
+        help="cushions (convex hulls of the cushion pairs) instead of their ellipsoids: shown in "
+        ".blend/.glb/.obj outputs, convex mesh geoms in MJCF",
+    )
     add_references(parser, "the reference set to synthesize from")
 
 
 def add_references(parser, what, shipped="female (the default) or male"):
-    parser.add_argument("--references", metavar="NAME_OR_DIR",
-                        help=f"{what}: a shipped set, {shipped}, or a folder of Reference Mannequin .json files "
-                             "(with its reference_set.json manifest)")
+    parser.add_argument(
+        "--references",
+        metavar="NAME_OR_DIR",
+        help=f"{what}: a shipped set, {shipped}, or a folder of Reference Mannequin .json files "
+        "(with its reference_set.json manifest)",
+    )
 
 
 def add_pose_option(parser):
     """--pose NAME (a standard pose, or a pose .json) and --fps."""
-    from ..core.poses import POSE_NAMES, WALK_FPS
+    from ..core.pose.standard import POSE_NAMES, WALK_FPS
 
-    parser.add_argument("--pose", metavar="NAME", help=f"write the mannequin posed: {', '.join(POSE_NAMES)} (walk: "
-                        "an animation, in .json and .xml as its frames), or a pose .json file; measurements stay "
-                        "the rest pose's")
+    parser.add_argument(
+        "--pose",
+        metavar="NAME",
+        help=f"write the mannequin posed: {', '.join(POSE_NAMES)} (walk: "
+        "an animation, in .json and .xml as its frames), or a pose .json file; measurements stay "
+        "the rest pose's",
+    )
     parser.add_argument("--fps", type=number, default=WALK_FPS, help=f"frames per second of walk (default {WALK_FPS})")
 
 
 def check_pose_argument(args, kinds):
     """Refuse, before any work is done, an unknown pose name, a pose file that cannot be read and an animation
     for a format of ``kinds`` that holds none. Returns the frames of a pose file (None otherwise)."""
-    from ..core.poses import MOTIONS, check_pose_name
+    from ..core.pose.standard import MOTIONS, check_pose_name
 
     if args.pose is None:
         return None
     frames = None
     if args.pose.lower().endswith(".json"):
-        from ..core.posed_files import read_pose
+        from ..core.formats.posed_files import read_pose
 
         frames = read_pose(args.pose)
     else:
         check_pose_name(args.pose)
     still = [FORMATS[k] for k in kinds if k in FORMATS and not FORMATS[k].animated]  # (npz: batch's own bundle)
     if still and (args.pose in MOTIONS or (frames is not None and len(frames) > 1)):
-        raise UsageError(f"--pose {args.pose} is an animation and a .{still[0].extension} file holds none; write "
-                         f"{', '.join('.' + f.extension for f in FORMATS.values() if f.animated)}")
+        raise UsageError(
+            f"--pose {args.pose} is an animation and a .{still[0].extension} file holds none; write "
+            f"{', '.join('.' + f.extension for f in FORMATS.values() if f.animated)}"
+        )
     return frames
 
 
 def pose_frames(args, mannequin, frames=None):
     """The frames of ``--pose`` for ``mannequin`` (None without --pose): ``frames`` read from a pose file, or the
     standard pose made on its joints; ElliMannError naming the joint (and frame) of one beyond its limits."""
-    from ..core.pose import check_limits, require_joints
-    from ..core.poses import standard_motion
+    from ..core.pose.kinematics import check_limits, require_joints
+    from ..core.pose.standard import standard_motion
 
     if args.pose is None:
         return None
@@ -149,14 +165,13 @@ def pose_frames(args, mannequin, frames=None):
 
 def synthesis_options(args, name=None):
     """The SynthesisOptions of the command line (built once per command)."""
-    return SynthesisOptions(mode=args.mode, metric=args.metric, power=args.power, normalize=args.normalize,
-                            name=name)
+    return SynthesisOptions(mode=args.mode, metric=args.metric, power=args.power, normalize=args.normalize, name=name)
 
 
 def references(args, name_or_dir=None):
     """The reference set of ``name_or_dir`` (default: --references; a shipped set's name or a folder)."""
-    from ..core.reference_set import load_reference_set
-    from ..core.shipped_sets import reference_folder
+    from ..core.synthesis.reference_set import load_reference_set
+    from ..core.synthesis.shipped import reference_folder
 
     chosen = name_or_dir or args.references
     try:
@@ -164,8 +179,9 @@ def references(args, name_or_dir=None):
     except ReferenceSetError as error:
         if chosen:
             raise
-        raise UsageError(f"{error} (the shipped Reference Mannequins; use --references NAME_OR_DIR for "
-                         "others)") from None
+        raise UsageError(
+            f"{error} (the shipped Reference Mannequins; use --references NAME_OR_DIR for others)"
+        ) from None
 
 
 # ------------------------------------------------------------------------------------------------ Blender
@@ -182,8 +198,10 @@ def blender_available():
 
 
 def no_blender(what):
-    return UsageError(f"{what} needs Blender: the bpy module is not installed (pip install bpy, or run "
-                      f"blender --background --command {PROG} …)")
+    return UsageError(
+        f"{what} needs Blender: the bpy module is not installed (pip install bpy, or run "
+        f"blender --background --command {PROG} …)"
+    )
 
 
 def ensure_registered(what="this"):
@@ -219,7 +237,7 @@ def extension(kind):
 
 def write(mannequin, paths, measured, cushions, frames=None, fps=None):
     """Write every path (format from the extension); Blender is loaded only for .blend/.glb/.obj (posed: .blend
-    and .glb). ``frames``: the pose (a list of core.pose.Pose) to write the mannequin in, if any.
+    and .glb). ``frames``: the pose (a list of core.pose.kinematics.Pose) to write the mannequin in, if any.
 
     A path that cannot be written raises UsageError naming it (not the temporary file behind it).
     """
@@ -244,9 +262,10 @@ def write(mannequin, paths, measured, cushions, frames=None, fps=None):
 
 
 def write_posed(mannequin, paths, cushions, frames, fps):
-    """:func:`write` of a posed mannequin: .json, .xml and .obj by the core (core.posed_files), .blend and .glb by
+    """:func:`write` of a posed mannequin: .json, .xml and .obj by the core (core.formats.posed_files), .blend and
+    .glb by
     the Blender rig (``blender.services.posing.write_posed``)."""
-    from ..core.posed_files import write_posed as write_core_posed
+    from ..core.formats.posed_files import write_posed as write_core_posed
 
     blender = [p for p in paths if format_of(p).needs_blender_for(True)]
     for path in [p for p in paths if p not in blender]:
@@ -257,8 +276,10 @@ def write_posed(mannequin, paths, cushions, frames, fps):
         try:
             from ..blender.services.posing import write_posed as write_blender_posed
         except ImportError:
-            raise UsageError(f"writing a posed {blender[0]} needs ElliMann's Blender rig, which this build lacks; "
-                             "write .json, .xml or .obj") from None
+            raise UsageError(
+                f"writing a posed {blender[0]} needs ElliMann's Blender rig, which this build lacks; "
+                "write .json, .xml or .obj"
+            ) from None
         write_blender_posed(mannequin, frames, blender, cushions)
     return paths
 
@@ -316,29 +337,44 @@ def output_folder(folder, command):
 def misses(measured, requested):
     """The requested measurements exact mode missed by more than its tolerance (EXACT_TOLERANCE, the
     criterion it stops at): [(key, m_T cm, requested cm, error %)]."""
-    return [(key, float(m), float(r), abs(m - r) / r * 100.0) for key, m, r in zip(MEASUREMENTS, measured, requested)
-            if abs(math.log(max(float(m), 1e-12) / float(r))) > EXACT_TOLERANCE]
+    return [
+        (key, float(m), float(r), abs(m - r) / r * 100.0)
+        for key, m, r in zip(MEASUREMENTS, measured, requested)
+        if abs(math.log(max(float(m), 1e-12) / float(r))) > EXACT_TOLERANCE
+    ]
 
 
 def missed_text(missed):
-    return ("exact mode missed " + ", ".join(f"{key} by {error:.2f}% (m_T {m:.2f} cm for {r:g} cm)"
-                                             for key, m, r, error in missed)
-            + f" (tolerance {EXACT_TOLERANCE * 100:g}%; the file is the closest it found)")
+    return (
+        "exact mode missed "
+        + ", ".join(f"{key} by {error:.2f}% (m_T {m:.2f} cm for {r:g} cm)" for key, m, r, error in missed)
+        + f" (tolerance {EXACT_TOLERANCE * 100:g}%; the file is the closest it found)"
+    )
 
 
 # ------------------------------------------------------------------------------------------------ report CSV
 
 
-REPORT_COLUMNS = (["line", "name", "status", "message"] + list(MEASUREMENTS)
-                  + [f"{k}_measured" for k in MEASUREMENTS] + [f"{k}_error_pct" for k in MEASUREMENTS] + ["files",
-                                                                                                     "references"])
+REPORT_COLUMNS = (
+    ["line", "name", "status", "message"]
+    + list(MEASUREMENTS)
+    + [f"{k}_measured" for k in MEASUREMENTS]
+    + [f"{k}_error_pct" for k in MEASUREMENTS]
+    + ["files", "references"]
+)
 
 
 def report_row(line, name, status, message, requested=None, measured=None, paths=(), references=""):
     """One report row; text from the CSV or messages is made safe for spreadsheets and terminals (:func:`cell`).
     ``references``: the reference set the row was synthesized from (its name)."""
-    row = {"line": line, "name": cell(name), "status": status, "message": cell(message or ""),
-           "files": cell(" ".join(paths)), "references": cell(references)}
+    row = {
+        "line": line,
+        "name": cell(name),
+        "status": status,
+        "message": cell(message or ""),
+        "files": cell(" ".join(paths)),
+        "references": cell(references),
+    }
     error = relative_error(measured, requested) if measured is not None else None
     for i, key in enumerate(MEASUREMENTS):
         row[key] = f"{requested[i]:g}" if requested is not None else ""
@@ -388,16 +424,20 @@ class Progress:
         if self.quiet:
             return
         now = time.perf_counter()
-        due = (now - self.shown >= 0.1 or self.count == self.total) if self.tty else (
-            self.count // self.every > previous // self.every or self.count == self.total)
+        due = (
+            (now - self.shown >= 0.1 or self.count == self.total)
+            if self.tty
+            else (self.count // self.every > previous // self.every or self.count == self.total)
+        )
         if due:
             self.shown = now
             text = printable(f"{PROG} {self.command}: {self.line(now)} {name}")
-            print(f"\r{text[:100]:<100}" if self.tty else text, end="" if self.tty else "\n", file=self.stream,
-                  flush=True)
+            print(
+                f"\r{text[:100]:<100}" if self.tty else text, end="" if self.tty else "\n", file=self.stream, flush=True
+            )
 
     def line(self, now):
-        """"120/2000 (41.5/s, 45 s left)": count, rate and the time left at that rate."""
+        """ "120/2000 (41.5/s, 45 s left)": count, rate and the time left at that rate."""
         elapsed = max(now - self.start, 1e-9)
         rate = self.count / elapsed
         left = (self.total - self.count) / rate if rate > 0 else 0.0
@@ -409,7 +449,7 @@ class Progress:
 
 
 def duration(seconds):
-    """"45 s", "12 min 5 s", "2 h 3 min": a time left, to the second below a minute."""
+    """ "45 s", "12 min 5 s", "2 h 3 min": a time left, to the second below a minute."""
     seconds = int(round(seconds))
     if seconds < 60:
         return f"{seconds} s"

@@ -5,16 +5,19 @@ import os
 import sys
 
 from ..core.constants import MEASUREMENTS, TABLE_2_5
-from ..core.measure import as_dict
-from ..core.options import PAPER
+from ..core.measure.tailor import as_dict
+from ..core.synthesis.options import PAPER
 from . import common
 from .common import PROG
 
 
 def add_parser(commands):
-    demo = commands.add_parser("demo", help="the paper's ten Table 2.5 mannequins, a report and a line-up",
-                               description="Synthesize the ten mannequins of the paper's Table 2.5 into DIR: "
-                                           ".blend and .json files, report.csv, report.md and lineup.png.")
+    demo = commands.add_parser(
+        "demo",
+        help="the paper's ten Table 2.5 mannequins, a report and a line-up",
+        description="Synthesize the ten mannequins of the paper's Table 2.5 into DIR: "
+        ".blend and .json files, report.csv, report.md and lineup.png.",
+    )
     demo.add_argument("-o", "--output", required=True, metavar="DIR")
     demo.add_argument("--no-picture", dest="picture", action="store_false", help="skip the line-up render")
     common.add_synthesis_options(demo)
@@ -27,7 +30,7 @@ def needs_blender(args):
 
 
 def run(args):
-    from ..core.synthesis import synthesize_batch
+    from ..core.synthesis.synthesize import synthesize_batch
 
     reference = common.references(args)
     out = args.output
@@ -43,29 +46,46 @@ def run(args):
         if misses:
             missed += 1
             common.say(f"{PROG} demo: {name}: warning: {common.missed_text(misses)}")
-        rows.append(common.report_row(i + 1, name, "missed" if misses else "ok",
-                                "; ".join([mannequin.name] + ([common.missed_text(misses)] if misses else [])),
-                                result.requests[i], result.measured[i], paths))
+        rows.append(
+            common.report_row(
+                i + 1,
+                name,
+                "missed" if misses else "ok",
+                "; ".join([mannequin.name] + ([common.missed_text(misses)] if misses else [])),
+                result.requests[i],
+                result.measured[i],
+                paths,
+            )
+        )
         mannequins.append(mannequin)
         common.say(f"{PROG} demo: wrote {name} ({mannequin.name})")
-    for name, text in (("report.csv", common.report_csv(rows)),
-                       ("report.md", report_markdown(result, reference, args))):
+    for name, text in (
+        ("report.csv", common.report_csv(rows)),
+        ("report.md", report_markdown(result, reference, args)),
+    ):
         common.write_text(os.path.join(out, name), text)
     if args.picture:
         from ..blender.services.render import render_lineup
 
         with common.writing(os.path.join(out, "lineup.png")):
-            render_lineup(mannequins, os.path.join(out, "lineup.png"),
-                          labels=[f"({i + 1})" for i in range(len(rows))], cushions=args.cushions)
+            render_lineup(
+                mannequins,
+                os.path.join(out, "lineup.png"),
+                labels=[f"({i + 1})" for i in range(len(rows))],
+                cushions=args.cushions,
+            )
     error = result.relative_error()
-    common.say(f"{PROG} demo: {len(rows)} mannequins in {out} ({args.mode}); m_T error mean {error.mean():.3f}%, "
-         f"max {error.max():.3f}%; see {os.path.join(out, 'report.md')}", file=sys.stdout)
+    common.say(
+        f"{PROG} demo: {len(rows)} mannequins in {out} ({args.mode}); m_T error mean {error.mean():.3f}%, "
+        f"max {error.max():.3f}%; see {os.path.join(out, 'report.md')}",
+        file=sys.stdout,
+    )
     return common.MISSED if missed else 0
 
 
 def report_markdown(result, reference, args):
     """Requested vs m_T per mannequin, and the error summary beside the paper's IDW."""
-    from ..core.synthesis import synthesize_batch
+    from ..core.synthesis.synthesize import synthesize_batch
 
     paper = common.synthesis_options(args) == PAPER
     idw = result if paper else synthesize_batch(reference, result.requests, PAPER)
@@ -80,7 +100,10 @@ def report_markdown(result, reference, args):
         "Requested measurements and m_T of the synthesized mannequin (cm); largest relative error (%) of this "
         "mode and of the paper's IDW (normalize `none`, distance `raw`, p = 2).",
         "",
-        "| # | " + " | ".join(MEASUREMENTS) + " | " + " | ".join(f"m_T {k}" for k in MEASUREMENTS)
+        "| # | "
+        + " | ".join(MEASUREMENTS)
+        + " | "
+        + " | ".join(f"m_T {k}" for k in MEASUREMENTS)
         + f" | max error % ({args.mode}) | max error % (paper IDW) |",
         "|---|" + "---:|" * (2 * len(MEASUREMENTS) + 2),
     ]
@@ -88,10 +111,19 @@ def report_markdown(result, reference, args):
         cells = [f"{v:g}" for v in result.requests[i]] + [f"{v:.2f}" for v in result.measured[i]]
         cells += [f"{error[i].max():.3f}", f"{idw_error[i].max():.3f}"]
         lines.append(f"| {i + 1} | " + " | ".join(cells) + " |")
-    lines += ["", "Relative error (%) over the ten:", "", "| | " + " | ".join(MEASUREMENTS) + " |",
-              "|---|" + "---:|" * len(MEASUREMENTS)]
-    for label, values in ((f"mean, {args.mode}", error.mean(axis=0)), (f"max, {args.mode}", error.max(axis=0)),
-                          ("mean, paper IDW", idw_error.mean(axis=0)), ("max, paper IDW", idw_error.max(axis=0))):
+    lines += [
+        "",
+        "Relative error (%) over the ten:",
+        "",
+        "| | " + " | ".join(MEASUREMENTS) + " |",
+        "|---|" + "---:|" * len(MEASUREMENTS),
+    ]
+    for label, values in (
+        (f"mean, {args.mode}", error.mean(axis=0)),
+        (f"max, {args.mode}", error.max(axis=0)),
+        ("mean, paper IDW", idw_error.mean(axis=0)),
+        ("max, paper IDW", idw_error.max(axis=0)),
+    ):
         if paper and label.endswith("IDW"):
             continue
         lines.append(f"| {label} | " + " | ".join(f"{v:.3f}" for v in values) + " |")

@@ -24,8 +24,9 @@ def connect(address):
     text = address.strip()
     local = _LOCAL.fullmatch(text)
     if not local and not re.fullmatch(r"(tcp|tls)://\S+", text):
-        raise UsageError(f"--dask takes a scheduler address tcp://HOST:PORT or local:N (N workers here), got "
-                         f"{address!r}")
+        raise UsageError(
+            f"--dask takes a scheduler address tcp://HOST:PORT or local:N (N workers here), got {address!r}"
+        )
     if local and not 1 <= int(local.group(1)) <= MAX_LOCAL_WORKERS:
         raise UsageError(f"--dask local:N takes 1 to {MAX_LOCAL_WORKERS} workers, got {local.group(1)}")
     try:
@@ -37,16 +38,22 @@ def connect(address):
         logging.getLogger(name).setLevel(quiet)
     if local:
         try:
-            cluster = distributed.LocalCluster(n_workers=int(local.group(1)), threads_per_worker=1, processes=True,
-                                               dashboard_address=None, silence_logs=quiet)
+            cluster = distributed.LocalCluster(
+                n_workers=int(local.group(1)),
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                silence_logs=quiet,
+            )
         except Exception as error:  # noqa: BLE001 - any failure to start workers is the user's one line
             raise UsageError(f"--dask {address}: cannot start a local cluster: {one_line(error)}") from None
         return Cluster(distributed.Client(cluster), cluster)
     try:
         client = distributed.Client(text, timeout=CONNECT_TIMEOUT)
     except Exception as error:  # noqa: BLE001 - OSError, TimeoutError, CommClosedError...: one line, nothing written
-        raise UsageError(f"--dask {address}: cannot reach the scheduler: {one_line(error) or type(error).__name__}"
-                         ) from None
+        raise UsageError(
+            f"--dask {address}: cannot reach the scheduler: {one_line(error) or type(error).__name__}"
+        ) from None
     return Cluster(client, None)
 
 
@@ -62,14 +69,16 @@ class Cluster:
         chunk that failed every attempt comes back with every row's error set."""
         from distributed import as_completed
 
-        from .batch import ChunkResult, synthesize_chunk
+        from ..core.synthesis.batch import ChunkResult, synthesize_chunk
 
         shared = {}  # each reference set is sent once, not with every task
         for reference in references:
             if id(reference) not in shared:
                 shared[id(reference)] = self.client.scatter(reference, broadcast=True)
-        futures = [self.client.submit(synthesize_chunk, shared[id(reference)], chunk, options, retries=RETRIES,
-                                      pure=False) for reference, chunk in zip(references, requests)]
+        futures = [
+            self.client.submit(synthesize_chunk, shared[id(reference)], chunk, options, retries=RETRIES, pure=False)
+            for reference, chunk in zip(references, requests)
+        ]
         index = {future.key: i for i, future in enumerate(futures)}
         for future in as_completed(futures):
             i = index[future.key]
@@ -77,8 +86,7 @@ class Cluster:
                 result = future.result()
             except Exception as error:  # noqa: BLE001 - the chunk's rows are reported, the other chunks go on
                 reason = f"its chunk failed on the Dask cluster after {RETRIES + 1} attempts: {one_line(error)}"
-                result = ChunkResult(None, [reason] * len(requests[i]),
-                                     **dict.fromkeys(ChunkResult.FIELDS))
+                result = ChunkResult(None, [reason] * len(requests[i]), **dict.fromkeys(ChunkResult.FIELDS))
             future.release()
             yield i, result
 

@@ -1,5 +1,5 @@
 """``ellimann drape``: a garment sized from a mannequin, draped with Blender's cloth (Blender), saved as a .blend;
-its options and defaults are the Drape panel's (``core.options.DRAPE`` and ``DrapeSettings``)."""
+its options and defaults are the Drape panel's (``core.drape.settings.DRAPE`` and ``DrapeSettings``)."""
 
 import argparse
 import dataclasses
@@ -7,13 +7,13 @@ import os
 import sys
 
 from ..core.constants import CM_PER_M
-from ..core.ellipsoid import bounds
+from ..core.drape.garments import EDGE_RANGE
+from ..core.drape.settings import DRAPE, DrapeSettings, garment_help
 from ..core.files import atomic_output
-from ..core.garments import EDGE_RANGE
-from ..core.motion import clamped_motion
-from ..core.options import DRAPE, DrapeSettings, garment_help
-from ..core.pose import require_joints
-from ..core.poses import POSE_NAMES
+from ..core.geometry.ellipsoid import bounds
+from ..core.pose.kinematics import require_joints
+from ..core.pose.motion import clamped_motion
+from ..core.pose.standard import POSE_NAMES
 from . import common
 from .common import PROG, UsageError
 from .measure import load_blend_mannequin, load_json_mannequin
@@ -21,24 +21,34 @@ from .measure import load_blend_mannequin, load_json_mannequin
 
 def add_parser(commands):
     defaults = DrapeSettings()
-    drape = commands.add_parser("drape", help="drape a garment on a mannequin with Blender's cloth simulation",
-                                description="Build a garment sized from the mannequin's m_T, drape it with "
-                                            "Blender cloth (the mannequin's convex pieces as colliders), bake the "
-                                            "frames and save the scene as a .blend; prints the fit (garment-to-"
-                                            "body distances, vertices inside the body). Defaults are the Drape "
-                                            "panel's (DrapeSettings).")
+    drape = commands.add_parser(
+        "drape",
+        help="drape a garment on a mannequin with Blender's cloth simulation",
+        description="Build a garment sized from the mannequin's m_T, drape it with "
+        "Blender cloth (the mannequin's convex pieces as colliders), bake the "
+        "frames and save the scene as a .blend; prints the fit (garment-to-"
+        "body distances, vertices inside the body). Defaults are the Drape "
+        "panel's (DrapeSettings).",
+    )
     drape.add_argument("mannequin", metavar="MANNEQUIN", help="a .json or .blend mannequin")
     garment = DRAPE["garment"]
     drape.add_argument("--garment", choices=garment.values, default=garment.default, help=garment_help())
     drape.add_argument("--frames", type=int, help=DRAPE["frames"].help.format(default=defaults.frames))
-    drape.add_argument("--cushions", action=argparse.BooleanOptionalAction,
-                       help=DRAPE["cushions"].help.format(
-                           default_text="cushions" if defaults.cushions else "every ellipsoid"))
-    drape.add_argument("--edge", type=common.number, metavar="CM",
-                       help=DRAPE["edge"].help.format(default_cm=defaults.edge * CM_PER_M))
-    drape.add_argument("--pose", choices=POSE_NAMES, metavar="POSE",
-                       help=f"drape on a moving body: from rest into a standard pose (held), or walking (the cloth "
-                            f"follows the stride); one of {', '.join(POSE_NAMES)}; needs a mannequin with joints")
+    drape.add_argument(
+        "--cushions",
+        action=argparse.BooleanOptionalAction,
+        help=DRAPE["cushions"].help.format(default_text="cushions" if defaults.cushions else "every ellipsoid"),
+    )
+    drape.add_argument(
+        "--edge", type=common.number, metavar="CM", help=DRAPE["edge"].help.format(default_cm=defaults.edge * CM_PER_M)
+    )
+    drape.add_argument(
+        "--pose",
+        choices=POSE_NAMES,
+        metavar="POSE",
+        help=f"drape on a moving body: from rest into a standard pose (held), or walking (the cloth "
+        f"follows the stride); one of {', '.join(POSE_NAMES)}; needs a mannequin with joints",
+    )
     drape.add_argument("--collection", help="the mannequin collection in a .blend holding several (.blend only)")
     drape.add_argument("-o", "--output", required=True, metavar="OUT.blend")
     drape.add_argument("--render", metavar="OUT.png", help="also a Workbench picture of the last frame")
@@ -59,8 +69,10 @@ def run(args):
     if kind not in (".json", ".blend"):
         raise UsageError(f"MANNEQUIN must be a .json or .blend mannequin, got {args.mannequin!r}")
     if kind == ".json" and args.collection is not None:
-        raise UsageError(f"--collection picks one of the mannequins in a .blend; {args.mannequin} is a .json file "
-                         "holding one mannequin (leave --collection out)")
+        raise UsageError(
+            f"--collection picks one of the mannequins in a .blend; {args.mannequin} is a .json file "
+            "holding one mannequin (leave --collection out)"
+        )
     if not os.path.isfile(args.mannequin):
         raise UsageError(f"{args.mannequin}: no such file")
     if kind == ".json":
@@ -82,17 +94,26 @@ def run(args):
         motion, loop = motion_of(args, mannequin)
     vertices, size = check_cloth_size(mannequin, args.garment, settings)  # refuses a cloth too large to drape
     if vertices > WARN_CLOTH_VERTICES:
-        common.say(f"{PROG} drape: warning: the cloth will have about {vertices:,} vertices and need about "
-             f"{size / 1e9:.1f} GB; it is slow (a larger --edge is faster)")
+        common.say(
+            f"{PROG} drape: warning: the cloth will have about {vertices:,} vertices and need about "
+            f"{size / 1e9:.1f} GB; it is slow (a larger --edge is faster)"
+        )
     moving = f" ({args.pose})" if motion else ""
-    common.say(f"{PROG} drape: {args.garment} on '{mannequin.name}'{moving}, {settings.frames} frames, cloth edge "
-         f"{settings.edge * CM_PER_M:g} cm, colliding with {'cushions' if settings.cushions else 'ellipsoids'}")
-    progress = common.Progress(settings.frames, "drape", every=max(10, settings.frames // 20),  # 10 frames, 5% past 200
-                               quiet=args.quiet)
+    common.say(
+        f"{PROG} drape: {args.garment} on '{mannequin.name}'{moving}, {settings.frames} frames, cloth edge "
+        f"{settings.edge * CM_PER_M:g} cm, colliding with {'cushions' if settings.cushions else 'ellipsoids'}"
+    )
+    progress = common.Progress(
+        settings.frames,
+        "drape",
+        every=max(10, settings.frames // 20),  # 10 frames, 5% past 200
+        quiet=args.quiet,
+    )
 
     def frame_done(frame):
-        progress.step("frames simulated" + ("; baking and measuring the fit" if frame == settings.frames else ""),
-                      frame)
+        progress.step(
+            "frames simulated" + ("; baking and measuring the fit" if frame == settings.frames else ""), frame
+        )
 
     with blender_output():
         try:
@@ -126,6 +147,9 @@ def settings_of(args):
     low, high = (bound * CM_PER_M for bound in EDGE_RANGE)
     if args.edge is not None and not low <= args.edge <= high:  # in the flag's unit, not DrapeSettings' metres
         raise UsageError(f"--edge: the cloth's edge length must be from {low:g} to {high:g} cm, got {args.edge:g} cm")
-    given = {"frames": args.frames, "edge": None if args.edge is None else args.edge / CM_PER_M,
-             "cushions": args.cushions}
+    given = {
+        "frames": args.frames,
+        "edge": None if args.edge is None else args.edge / CM_PER_M,
+        "cushions": args.cushions,
+    }
     return dataclasses.replace(DrapeSettings(), **{k: v for k, v in given.items() if v is not None}).checked()

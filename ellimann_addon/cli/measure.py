@@ -6,12 +6,12 @@ import math
 import os
 import sys
 
-from ..core.body_measure import ALL_MEASUREMENTS, measure_body_mesh
-from ..core.body_mesh import MESH_EXTENSIONS, UNITS, UP_AXES, BodyMeshError, read_body_mesh
 from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS
 from ..core.errors import MannequinError
-from ..core.extra_measures import EXTRA_LABELS, mannequin_extra_measurements
-from ..core.mannequin import Mannequin
+from ..core.fitting.body_mesh import MESH_EXTENSIONS, UNITS, UP_AXES, BodyMeshError, read_body_mesh
+from ..core.mannequin.model import Mannequin
+from ..core.measure.body import ALL_MEASUREMENTS, measure_body_mesh
+from ..core.measure.extra import EXTRA_LABELS, mannequin_extra_measurements
 from . import common
 from .common import UsageError
 
@@ -19,21 +19,33 @@ LABELS = {**MEASUREMENT_LABELS, **EXTRA_LABELS}
 
 
 def add_parser(commands):
-    measure = commands.add_parser("measure", help="measurements of a mannequin file or a body mesh",
-                                  description="Tailor measurements (m_T and the extra ones, docs/measurements.md) of a "
-                                              ".json or .blend mannequin or of an upright A-pose body mesh "
-                                              "(.obj, .ply, .stl), in cm.")
+    measure = commands.add_parser(
+        "measure",
+        help="measurements of a mannequin file or a body mesh",
+        description="Tailor measurements (m_T and the extra ones, docs/measurements.md) of a "
+        ".json or .blend mannequin or of an upright A-pose body mesh "
+        "(.obj, .ply, .stl), in cm.",
+    )
     measure.add_argument("file", metavar="FILE")
-    measure.add_argument("--json", action="store_true",
-                         help='print {"He": …, "Sh": …, "Br": …, "Wa": …, "Hi": …, "neck": …, …} (a body mesh: '
-                              'only the measurements that could be taken)')
-    measure.add_argument("--up", choices=UP_AXES, help="a body mesh's up axis (default: y for .obj, as Blender "
-                                                       "imports it; z for .ply and .stl)")
+    measure.add_argument(
+        "--json",
+        action="store_true",
+        help='print {"He": …, "Sh": …, "Br": …, "Wa": …, "Hi": …, "neck": …, …} (a body mesh: '
+        "only the measurements that could be taken)",
+    )
+    measure.add_argument(
+        "--up",
+        choices=UP_AXES,
+        help="a body mesh's up axis (default: y for .obj, as Blender imports it; z for .ply and .stl)",
+    )
     measure.add_argument("--unit", choices=tuple(UNITS), default="m", help="a body mesh's length unit (default m)")
     measure.add_argument("--collection", help="the mannequin collection to measure in a .blend holding several")
-    common.add_references(measure, "measure at the section heights of this reference set instead of those the "
-                                   "mannequin records (its own set's; female for files that record none)",
-                          shipped="female or male")
+    common.add_references(
+        measure,
+        "measure at the section heights of this reference set instead of those the "
+        "mannequin records (its own set's; female for files that record none)",
+        shipped="female or male",
+    )
     common.add_verbose(measure)
     measure.set_defaults(run=run, blender=needs_blender)
 
@@ -61,8 +73,9 @@ def run(args):
     elif kind == ".blend":
         mannequin = load_blend_mannequin(path, args.collection)
     else:
-        raise UsageError(f"FILE must be a .json or .blend mannequin or a {'/'.join(MESH_EXTENSIONS)} body mesh, "
-                         f"got {path!r}")
+        raise UsageError(
+            f"FILE must be a .json or .blend mannequin or a {'/'.join(MESH_EXTENSIONS)} body mesh, got {path!r}"
+        )
     if args.references:
         reference = common.references(args)
         mannequin = mannequin.copy(reference_set=reference.name, section_fractions=reference.section_fractions)

@@ -3,21 +3,30 @@
 import sys
 
 from ..core.errors import MannequinError
-from ..core.formats import FORMATS, format_of
+from ..core.formats.table import FORMATS, format_of
 from . import common
 from .common import PROG, UsageError
 
 
 def add_parser(commands):
-    pose = commands.add_parser("pose", help="write a mannequin in a pose",
-                               description="Write a mannequin (a .json with joints) in a standard pose or a pose "
-                                           "file; its measurements stay the rest pose's.")
+    pose = commands.add_parser(
+        "pose",
+        help="write a mannequin in a pose",
+        description="Write a mannequin (a .json with joints) in a standard pose or a pose "
+        "file; its measurements stay the rest pose's.",
+    )
     pose.add_argument("input", metavar="IN.json", help="the mannequin (ElliMann's JSON, with joints)")
-    pose.add_argument("-o", "--output", required=True, metavar="OUT",
-                      help="output file: .json (rest mannequin, joints and the pose), .xml (MJCF: an articulated "
-                           "body, the pose as keyframes), .obj (the posed pieces), .glb or .blend (Blender's rig)")
-    pose.add_argument("--cushions", action="store_true",
-                      help="cushions instead of their ellipsoids (split at the joints they cross)")
+    pose.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        metavar="OUT",
+        help="output file: .json (rest mannequin, joints and the pose), .xml (MJCF: an articulated "
+        "body, the pose as keyframes), .obj (the posed pieces), .glb or .blend (Blender's rig)",
+    )
+    pose.add_argument(
+        "--cushions", action="store_true", help="cushions instead of their ellipsoids (split at the joints they cross)"
+    )
     common.add_verbose(pose)
     common.add_pose_option(pose)
     pose.set_defaults(run=run, blender=needs_blender)
@@ -29,7 +38,7 @@ def needs_blender(args):
 
 
 def run(args):
-    from ..core.mannequin import Mannequin
+    from ..core.mannequin.model import Mannequin
 
     kind = common.output_kind(args.output)
     if args.pose is None:

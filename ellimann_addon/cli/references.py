@@ -8,12 +8,12 @@ import os
 import pathlib
 import sys
 
-from ..core.body_mesh import BodyMeshError, read_obj
-from ..core.clean import asymmetry
 from ..core.constants import ABSURD_LIMITS, MEASUREMENTS
-from ..core.reference_build import build_reference_set, cleanliness_problems, relative_errors, validate_inputs
-from ..core.reference_manifest import STEM, Manifest, read_manifest, targets_range, write_reference_set
-from ..core.reference_set import load_reference_set
+from ..core.fitting.body_mesh import BodyMeshError, read_obj
+from ..core.fitting.reference_build import build_reference_set, cleanliness_problems, relative_errors, validate_inputs
+from ..core.mannequin.clean import asymmetry
+from ..core.synthesis.manifest import STEM, Manifest, read_manifest, targets_range, write_reference_set
+from ..core.synthesis.reference_set import load_reference_set
 from . import common
 from .common import PROG, UsageError
 from .measure import load_json_mannequin
@@ -22,34 +22,63 @@ ACCEPT = 5e-3  # what ``check`` lets an RM's m_T differ from its targets by (the
 
 
 def add_parser(commands):
-    references = commands.add_parser("references", help="build or check a reference set",
-                                     description="Reference sets: the Reference Mannequins synthesis interpolates.")
+    references = commands.add_parser(
+        "references",
+        help="build or check a reference set",
+        description="Reference sets: the Reference Mannequins synthesis interpolates.",
+    )
     actions = references.add_subparsers(dest="action", metavar="ACTION", required=True)
     build = actions.add_parser(
-        "build", help="Reference Mannequins from a traced Base Mannequin and N >= 3 bodies",
+        "build",
+        help="Reference Mannequins from a traced Base Mannequin and N >= 3 bodies",
         description="Fit the Base Mannequin's traced parts in every body (OBJ meshes of the traced mesh's "
-                    "topology), refine each until m_T meets its targets, clean them together and write a "
-                    "reference-set folder (the RMs' JSON, the base and reference_set.json).")
-    build.add_argument("--base", required=True, metavar="BASE.json", help="the Base Mannequin, with its recorded "
-                       "selections (traced with Fit Ellipsoid); the set is measured at the section heights it "
-                       "records (its own set's)")
-    build.add_argument("--bodies", required=True, nargs="+", metavar="BODY.obj",
-                       help="N >= 3 body meshes; each file's stem names its Reference Mannequin")
-    build.add_argument("--targets", required=True, metavar="TARGETS.csv",
-                       help="a 'name' column (the bodies' file stems) and a column per measurement: "
-                            f"{', '.join(MEASUREMENTS)} in cm (or target_He, ...)")
+        "topology), refine each until m_T meets its targets, clean them together and write a "
+        "reference-set folder (the RMs' JSON, the base and reference_set.json).",
+    )
+    build.add_argument(
+        "--base",
+        required=True,
+        metavar="BASE.json",
+        help="the Base Mannequin, with its recorded "
+        "selections (traced with Fit Ellipsoid); the set is measured at the section heights it "
+        "records (its own set's)",
+    )
+    build.add_argument(
+        "--bodies",
+        required=True,
+        nargs="+",
+        metavar="BODY.obj",
+        help="N >= 3 body meshes; each file's stem names its Reference Mannequin",
+    )
+    build.add_argument(
+        "--targets",
+        required=True,
+        metavar="TARGETS.csv",
+        help="a 'name' column (the bodies' file stems) and a column per measurement: "
+        f"{', '.join(MEASUREMENTS)} in cm (or target_He, ...)",
+    )
     build.add_argument("-o", "--out", required=True, metavar="DIR", help="the reference-set folder to write")
     build.add_argument("--name", help="the set's name (default: the folder's name)")
     build.add_argument("--sex", choices=("female", "male"), help="the set's sex, if it has one")
-    build.add_argument("--workers", type=int, default=os.cpu_count() or 1, metavar="N",
-                       help="processes fitting bodies at once (default: the CPUs, %(default)s here; the result is "
-                            "the same for any N)")
-    build.add_argument("--reference", metavar="STEM", help="the body whose RM the others' axes are labelled "
-                       "against (default: the one nearest the targets' mean)")
+    build.add_argument(
+        "--workers",
+        type=int,
+        default=os.cpu_count() or 1,
+        metavar="N",
+        help="processes fitting bodies at once (default: the CPUs, %(default)s here; the result is the same for any N)",
+    )
+    build.add_argument(
+        "--reference",
+        metavar="STEM",
+        help="the body whose RM the others' axes are labelled against (default: the one nearest the targets' mean)",
+    )
     common.add_verbose(build)
     build.set_defaults(run=run_build, blender=lambda args: None)
-    check = actions.add_parser("check", help="check a reference-set folder",
-                               description="Validity, ranges, symmetry and how each RM meets its targets.")
+    check = actions.add_parser(
+        "check",
+        help="check a reference-set folder",
+        description="Validity, ranges, symmetry and how each RM meets its targets.",
+    )
     check.add_argument("folder", metavar="DIR")
     common.add_verbose(check)
     check.set_defaults(run=run_check, blender=lambda args: None)
@@ -118,22 +147,35 @@ def run_build(args):
     def progress(fraction, text):
         common.say(f"{PROG} references build: {fraction:4.0%} {text}", file=sys.stderr)
 
-    rms, report = build_reference_set(base, bodies, targets, progress=progress, reference=args.reference,
-                                      workers=args.workers)
+    rms, report = build_reference_set(
+        base, bodies, targets, progress=progress, reference=args.reference, workers=args.workers
+    )
     fractions = dict(base.section_fractions)  # what the build measured at: the base's own set's
     name = args.name or out.resolve().name
     rms = {stem: rm.copy(reference_set=name) for stem, rm in rms.items()}
     first = next(iter(base.traces.values()))
     manifest = Manifest(
-        name=name, mannequins=stems, sex=args.sex, base=base_stem,
-        section_fractions=fractions, ranges_cm=targets_range({s: targets[s] for s in stems}),
+        name=name,
+        mannequins=stems,
+        sex=args.sex,
+        base=base_stem,
+        section_fractions=fractions,
+        ranges_cm=targets_range({s: targets[s] for s in stems}),
         absurd_limits_cm={k: list(v) for k, v in ABSURD_LIMITS.items()},
         targets_cm={s: dict(targets[s]) for s in stems},
-        provenance={"built_by": f"{PROG} references build", "base": {"file": pathlib.Path(args.base).name,
-                    "traced_mesh": first.mesh, "vertex_count": first.vertex_count},
-                    "bodies": {b.name: {"file": pathlib.Path(p).name, "sha256": _sha256(p)}
-                               for b, p in zip(bodies, args.bodies)},
-                    "labelled_against": report.reference})
+        provenance={
+            "built_by": f"{PROG} references build",
+            "base": {
+                "file": pathlib.Path(args.base).name,
+                "traced_mesh": first.mesh,
+                "vertex_count": first.vertex_count,
+            },
+            "bodies": {
+                b.name: {"file": pathlib.Path(p).name, "sha256": _sha256(p)} for b, p in zip(bodies, args.bodies)
+            },
+            "labelled_against": report.reference,
+        },
+    )
     with common.writing(str(out), folder=True):
         write_reference_set(out, rms, manifest, base=report.base.copy(reference_set=name))
     for stem in stems:
@@ -173,8 +215,10 @@ def check_folder(folder):
         if not a_lo <= lo <= hi <= a_hi:
             problems.append(f"ranges_cm {key} [{lo:g}, {hi:g}] is not within absurd_limits_cm [{a_lo:g}, {a_hi:g}]")
         if values.min() < lo - 1e-9 or values.max() > hi + 1e-9:
-            problems.append(f"ranges_cm {key} [{lo:g}, {hi:g}] does not hold the RMs' {key} "
-                            f"({values.min():g} to {values.max():g} cm)")
+            problems.append(
+                f"ranges_cm {key} [{lo:g}, {hi:g}] does not hold the RMs' {key} "
+                f"({values.min():g} to {values.max():g} cm)"
+            )
     targets = manifest.targets_cm if manifest else {}
     for name, rm in zip(reference.names, reference.mannequins):
         wanted = targets.get(name) or rm.measurements

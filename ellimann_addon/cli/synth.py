@@ -3,38 +3,58 @@ own measurements (``--from body.obj``), written as .json/.xml (no Blender) or .b
 
 import sys
 
-from ..core.body_mesh import UNITS, UP_AXES
 from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS, RANGES
 from ..core.errors import ElliMannError
-from ..core.extra_measures import EXTRA_ABSURD_LIMITS, EXTRA_LABELS, EXTRA_MEASUREMENTS
-from ..core.formats import FORMATS
-from ..core.request import relative_error, validate_request
+from ..core.fitting.body_mesh import UNITS, UP_AXES
+from ..core.formats.table import FORMATS
+from ..core.measure.extra import EXTRA_ABSURD_LIMITS, EXTRA_LABELS, EXTRA_MEASUREMENTS
+from ..core.synthesis.request import relative_error, validate_request
 from . import common
 from .common import PROG, UsageError
 
 
 def add_parser(commands):
-    synth = commands.add_parser("synth", help="synthesize one mannequin",
-                                description="Synthesize one mannequin from five measurements (cm), any of the extra "
-                                            "ones (docs/measurements.md), or a body mesh's own (--from).")
+    synth = commands.add_parser(
+        "synth",
+        help="synthesize one mannequin",
+        description="Synthesize one mannequin from five measurements (cm), any of the extra "
+        "ones (docs/measurements.md), or a body mesh's own (--from).",
+    )
     for key in MEASUREMENTS:
         low, high = RANGES[key]
-        synth.add_argument(f"--{key.lower()}", dest=key, type=common.number, metavar="CM",
-                           help=f"{MEASUREMENT_LABELS[key]} (the female set's reference range {low:g}-{high:g}; "
-                                "required unless --from)")
+        synth.add_argument(
+            f"--{key.lower()}",
+            dest=key,
+            type=common.number,
+            metavar="CM",
+            help=f"{MEASUREMENT_LABELS[key]} (the female set's reference range {low:g}-{high:g}; "
+            "required unless --from)",
+        )
     for key in EXTRA_MEASUREMENTS:
         low, high = EXTRA_ABSURD_LIMITS[key]
-        synth.add_argument(f"--{key.replace('_', '-')}", dest=key, type=common.number, metavar="CM",
-                           help=f"{EXTRA_LABELS[key]} ({low:g}-{high:g}; optional: met in exact mode, otherwise the "
-                                "reference set's)")
-    synth.add_argument("--from", dest="from_mesh", metavar="BODY",
-                       help="a body mesh (.obj, .ply, .stl; upright A-pose): measure it and synthesize with every "
-                            "measurement found (a measurement given as an option wins)")
+        synth.add_argument(
+            f"--{key.replace('_', '-')}",
+            dest=key,
+            type=common.number,
+            metavar="CM",
+            help=f"{EXTRA_LABELS[key]} ({low:g}-{high:g}; optional: met in exact mode, otherwise the reference set's)",
+        )
+    synth.add_argument(
+        "--from",
+        dest="from_mesh",
+        metavar="BODY",
+        help="a body mesh (.obj, .ply, .stl; upright A-pose): measure it and synthesize with every "
+        "measurement found (a measurement given as an option wins)",
+    )
     synth.add_argument("--up", choices=UP_AXES, help="--from's up axis (default: y for .obj, z for .ply/.stl)")
     synth.add_argument("--unit", choices=tuple(UNITS), default="m", help="--from's length unit (default m)")
-    synth.add_argument("-o", "--output", required=True, metavar="OUT",
-                       help="output file: .blend, .glb, .obj, .json (ElliMann's mannequin JSON) or .xml (MJCF, "
-                            "for MuJoCo)")
+    synth.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        metavar="OUT",
+        help="output file: .blend, .glb, .obj, .json (ElliMann's mannequin JSON) or .xml (MJCF, for MuJoCo)",
+    )
     synth.add_argument("--name", help="mannequin name (default: 'ElliMann He-Sh-Br-Wa-Hi')")
     common.add_synthesis_options(synth)
     common.add_pose_option(synth)
@@ -65,20 +85,24 @@ def _wanted(args):
             raise UsageError(f"{args.from_mesh}: {problems[0]}")
         for problem in problems:
             common.say(f"{PROG} synth: warning: {args.from_mesh}: {problem}")
-        common.say(f"{args.from_mesh}: measured " + ", ".join(f"{key} {value:.2f}" for key, value in found.items()),
-                   file=sys.stdout)
+        common.say(
+            f"{args.from_mesh}: measured " + ", ".join(f"{key} {value:.2f}" for key, value in found.items()),
+            file=sys.stdout,
+        )
     given = {key: getattr(args, key) for key in MEASUREMENTS + EXTRA_MEASUREMENTS if getattr(args, key) is not None}
     wanted = {**found, **given}
     missing = [key for key in MEASUREMENTS if key not in wanted]
     if missing:
         where = f" ({args.from_mesh} gave none)" if args.from_mesh else ""
         raise UsageError(f"missing {', '.join('--' + key.lower() for key in missing)}{where}")
-    return ({key: wanted[key] for key in MEASUREMENTS},
-            {key: wanted[key] for key in EXTRA_MEASUREMENTS if key in wanted})
+    return (
+        {key: wanted[key] for key in MEASUREMENTS},
+        {key: wanted[key] for key in EXTRA_MEASUREMENTS if key in wanted},
+    )
 
 
 def run(args):
-    from ..core.refine_extra import synthesize_extra
+    from ..core.synthesis.synthesize import synthesize_extra
 
     kind = common.output_kind(args.output)
     pose_file = common.check_pose_argument(args, [kind])
@@ -98,12 +122,20 @@ def run(args):
     for warning in warnings + ([common.missed_text(misses)] if misses else []):
         common.say(f"{PROG} synth: warning: {warning}")
     frames = common.pose_frames(args, mannequin, pose_file)
-    common.write(mannequin, [args.output], {key: measured[key] for key in MEASUREMENTS},
-                 args.cushions and kind != "json", frames, args.fps)
+    common.write(
+        mannequin,
+        [args.output],
+        {key: measured[key] for key in MEASUREMENTS},
+        args.cushions and kind != "json",
+        frames,
+        args.fps,
+    )
     error = relative_error(achieved, request).max()
     posed = f" in pose {args.pose}" if args.pose else ""
-    extra_line = ("; " + ", ".join(f"{key} {measured[key]:.2f}" for key in EXTRA_MEASUREMENTS) + " cm"
-                  if extra else "")
-    common.say(f"wrote {args.output}: '{mannequin.name}'{posed} ({args.mode}), m_T {common.format_me(achieved)} cm, "
-               f"max error {error:.3f}%{extra_line}", file=sys.stdout)
+    extra_line = "; " + ", ".join(f"{key} {measured[key]:.2f}" for key in EXTRA_MEASUREMENTS) + " cm" if extra else ""
+    common.say(
+        f"wrote {args.output}: '{mannequin.name}'{posed} ({args.mode}), m_T {common.format_me(achieved)} cm, "
+        f"max error {error:.3f}%{extra_line}",
+        file=sys.stdout,
+    )
     return common.MISSED if misses or missed_extra else 0

@@ -15,7 +15,7 @@ MEASUREMENT_LABELS = {
 
 # Section heights as fractions of He above the lowest point of the feet (the paper's Section 2.3.5; the
 # sections and the parts they cut: docs/topology.md); the tools in ../shared/refmodels use the same numbers.
-# These are the female reference set's; another set carries its own in its manifest (core.reference_set).
+# These are the female reference set's; another set carries its own in its manifest (core.synthesis.reference_set).
 SECTION_FRACTIONS = {"Sh": 0.790, "Br": 0.720, "Wa": 0.645, "Hi": 0.500}
 FEMALE_SET = "female"  # the name of the shipped default reference set, whose landmarks are the constants here
 GIRTHS = ("Br", "Wa", "Hi")
@@ -89,7 +89,7 @@ PAPER_TABLE_2_4 = {
     "min": {"He": 0.0, "Sh": 0.1, "Br": 0.0, "Wa": 0.0, "Hi": 0.1},
 }
 
-# Icosphere levels (core.mesh.icosphere: 10 * 4^n + 2 vertices, 20 * 4^n triangles), one name per use.
+# Icosphere levels (core.geometry.mesh.icosphere: 10 * 4^n + 2 vertices, 20 * 4^n triangles), one name per use.
 UNIT_SPHERE_LEVEL = 3  # the unit-sphere mesh every ellipsoid object shares (642 vertices)
 CUSHION_LEVEL = 4  # cushion hulls by default (Build Cushions, Synthesize): 2,562 vertices, capsule volume within 0.5%
 CUSHION_LEVELS = (1, 6)  # cushion hulls one may ask for (Build Cushions, MJCF): 42 to 40,962 vertices

@@ -58,3 +58,11 @@ class ReferenceSetError(ElliMannError):
         self.source = source
         self.field = field
         super().__init__(f"{source}: {field} {message}" if source else f"{field} {message}")
+
+
+def one_line(error):
+    """An error as one line of text (a message's own line breaks and runs of spaces folded; an OSError with its
+    file)."""
+    if isinstance(error, OSError) and error.filename:
+        return f"{error.strerror or error}: {error.filename}"
+    return " ".join(str(error).split())

@@ -37,8 +37,11 @@ def atomic_write_bytes(path, data):
             stream.write(data)
             stream.flush()
             os.fsync(stream.fileno())
-        problem = (f"{os.path.getsize(temp)} of {len(data)} bytes reached the disk"
-                   if os.path.getsize(temp) != len(data) else incomplete(temp, kind_of(path)))
+        problem = (
+            f"{os.path.getsize(temp)} of {len(data)} bytes reached the disk"
+            if os.path.getsize(temp) != len(data)
+            else incomplete(temp, kind_of(path))
+        )
         if problem:
             raise OSError(errno.EIO, f"the file written is incomplete: {problem}", path)
         os.chmod(temp, 0o666 & ~_umask())  # mkstemp makes 0600; give the file the usual permissions
@@ -342,8 +345,9 @@ def atomic_output(path):
             # A whole file is kept even where the folder reports no free blocks (some network and FUSE
             # file systems always do); a cut-short one on a full disk is named as such.
             if problem and disk_full(folder):
-                raise OSError(errno.ENOSPC, f"No space left on device (the file Blender wrote is incomplete: "
-                                            f"{problem})", target)
+                raise OSError(
+                    errno.ENOSPC, f"No space left on device (the file Blender wrote is incomplete: {problem})", target
+                )
             if problem:
                 raise OSError(errno.EIO, f"the file Blender wrote is incomplete: {problem}", target)
             os.replace(temp, path)

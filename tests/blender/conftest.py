@@ -35,7 +35,6 @@ def toy_collection(toy):
     return collection
 
 
-
 _exit_status = {}
 
 

@@ -3,9 +3,9 @@
 import pytest
 
 from bench import bench_drape
-from ellimann_addon.core.body_mesh import read_obj
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.synthesis import REFERENCE_FOLDER
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.synthesize import REFERENCE_FOLDER
 
 BODY = bench_drape.REFMODELS / f"{bench_drape.BODY}.obj"  # ../shared/refmodels, beside the repository (CI too)
 
@@ -14,8 +14,15 @@ BODY = bench_drape.REFMODELS / f"{bench_drape.BODY}.obj"  # ../shared/refmodels,
 def test_drape_bench_prints_its_table_and_the_resolution_verdict(capsys):
     sweep = tuple(s for s in bench_drape.SWEEP if s[0] in ("cushions L1/L1", "cushions L2/L2", "ellipsoids L1"))
     body = read_obj(BODY)
-    bench_drape.compare(Mannequin.load(REFERENCE_FOLDER / "average.json"), body.vertices, body.faces, frames=3,
-                        repeat=1, sweep=sweep, kinds=("tube_dress",))
+    bench_drape.compare(
+        Mannequin.load(REFERENCE_FOLDER / "average.json"),
+        body.vertices,
+        body.faces,
+        frames=3,
+        repeat=1,
+        sweep=sweep,
+        kinds=("tube_dress",),
+    )
     out = capsys.readouterr().out
     rows = [line[:16].strip() for line in out.splitlines() if " | " in line and "triangles" not in line]
     assert rows == ["dense body", "cushions L1/L1", "cushions L2/L2", "ellipsoids L1"]

@@ -9,10 +9,10 @@ import pytest
 from devkit.blender_scene import state
 from devkit.toy import make_toy_mannequin
 from ellimann_addon.blender.features.measure.body import RESULT_PROPERTY
-from ellimann_addon.core.body_measure import measure_body_mesh
-from ellimann_addon.core.body_mesh import read_obj
-from ellimann_addon.core.extra_measures import EXTRA_MEASUREMENTS
-from ellimann_addon.core.mesh import icosphere
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.geometry.mesh import icosphere
+from ellimann_addon.core.measure.body import measure_body_mesh
+from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
 from tools.reference_sets import TRACING_FOLDER
 
 
@@ -82,7 +82,7 @@ def test_a_mannequins_exported_obj_measures_as_the_mannequin(tmp_path, capsys):
     measurements within ISO 20685's allowances (the pieces are level-3 icospheres, inscribed: girths read a
     little short)."""
     from devkit.cli_runs import run
-    from ellimann_addon.core.extra_measures import ISO_ALLOWANCE
+    from ellimann_addon.core.measure.extra import ISO_ALLOWANCE
 
     request = ["--he", "160", "--sh", "42", "--br", "100", "--wa", "80", "--hi", "100"]
     for kind in ("json", "obj"):

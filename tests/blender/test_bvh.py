@@ -12,10 +12,10 @@ from ellimann_addon.blender.bridge.convert import rig_object
 from ellimann_addon.blender.features.pose.bvh import motion_onto
 from ellimann_addon.blender.services.bvh import bvh_header, sample_bvh
 from ellimann_addon.blender.services.scene import add_mannequin
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.pose import Pose, axis_angle, forward_kinematics, limit_reports
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER
-from ellimann_addon.core.skeleton import JOINT_INDEX, JOINT_NAMES, PARENTS, RIG_NAME_MAPS, joint_frames
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.skeleton import JOINT_INDEX, JOINT_NAMES, PARENTS, RIG_NAME_MAPS, joint_frames
+from ellimann_addon.core.pose.kinematics import Pose, axis_angle, forward_kinematics, limit_reports
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
 STEPS = np.array([[0.0, 0.0, 0.0], [0.0, -0.1, 0.0], [0.0, -0.2, 0.01], [0.0, -0.3, 0.0], [0.0, -0.4, 0.0]])
 
@@ -36,8 +36,10 @@ def rigged(average):
 def bends(average):
     """Rotations within the limits: a 60 degree elbow flexion about its hinge, a hip flexed and abducted."""
     hinge = joint_frames(average.joints)[JOINT_INDEX["L_Elbow"]][:, 0]
-    return {("L_Elbow", 2): axis_angle(hinge, np.radians(60.0)),
-            ("R_Hip", 3): axis_angle([1.0, 0.0, 0.0], np.radians(-30.0)) @ axis_angle([0.0, 1.0, 0.0], np.radians(10))}
+    return {
+        ("L_Elbow", 2): axis_angle(hinge, np.radians(60.0)),
+        ("R_Hip", 3): axis_angle([1.0, 0.0, 0.0], np.radians(-30.0)) @ axis_angle([0.0, 1.0, 0.0], np.radians(10)),
+    }
 
 
 def write_clip(path, average, style, frames=5, extra=None):
@@ -108,16 +110,24 @@ def _with(index, rotation):
 
 def test_a_clip_with_no_known_bone_changes_nothing(rigged, tmp_path):
     names = ["Wurzel", "Bein", "Fuss"]
-    path = bvh.write_bvh(tmp_path / "unknown.bvh", names, [-1, 0, 1], np.array([[0, 0, 1], [0, 0, 0.5], [0, 0, 0.1]]),
-                         np.broadcast_to(np.eye(3), (2, 3, 3, 3)), np.zeros((2, 3)))
+    path = bvh.write_bvh(
+        tmp_path / "unknown.bvh",
+        names,
+        [-1, 0, 1],
+        np.array([[0, 0, 1], [0, 0, 0.5], [0, 0, 0.1]]),
+        np.broadcast_to(np.eye(3), (2, 3, 3, 3)),
+        np.zeros((2, 3)),
+    )
     before = state()
     with pytest.raises(RuntimeError, match="none of the 3 bones of unknown.bvh"):
         bpy.ops.ellimann.import_bvh(filepath=str(path))
     assert state() == before
 
 
-@pytest.mark.parametrize("text, message", [("not a clip\n", "is not a BVH clip"),
-                                           ("HIERARCHY\nMOTION\nFrames: 0\nFrame Time: 0.04\n", "has no bones")])
+@pytest.mark.parametrize(
+    "text, message",
+    [("not a clip\n", "is not a BVH clip"), ("HIERARCHY\nMOTION\nFrames: 0\nFrame Time: 0.04\n", "has no bones")],
+)
 def test_a_file_that_is_no_clip_is_refused_in_one_line(tmp_path, text, message):
     path = tmp_path / "bad.bvh"
     path.write_text(text)
@@ -131,8 +141,10 @@ def test_mixamo_names_with_and_without_their_prefix_and_makehuman_names_are_know
     assert RIG_NAME_MAPS["mixamo"]["LeftForeArm"] == "L_Elbow"
     from ellimann_addon.blender.features.pose.bvh import name_map
 
-    assert name_map(["mixamorig:Hips", "mixamorig:LeftForeArm"])[1] == {"mixamorig:Hips": "Pelvis",
-                                                                       "mixamorig:LeftForeArm": "L_Elbow"}
+    assert name_map(["mixamorig:Hips", "mixamorig:LeftForeArm"])[1] == {
+        "mixamorig:Hips": "Pelvis",
+        "mixamorig:LeftForeArm": "L_Elbow",
+    }
     assert name_map(["root", "lowerarm01.L", "upperleg01.R"])[0] == "makehuman"
 
 

@@ -9,9 +9,9 @@ from devkit.toy import rotation_from_vector
 from devkit.ui_recorder import draw_operator
 from ellimann_addon.blender.bridge.convert import collection_to_mannequin, ellipsoid_frame, mannequin_to_collection
 from ellimann_addon.blender.features.clean.operators import ELLIMANN_OT_relabel_axes
-from ellimann_addon.core.clean import register_to_world
-from ellimann_addon.core.ellipsoid import shape_matrix
-from ellimann_addon.core.frames import axis_agreement
+from ellimann_addon.core.geometry.ellipsoid import shape_matrix
+from ellimann_addon.core.geometry.frames import axis_agreement
+from ellimann_addon.core.mannequin.clean import register_to_world
 
 # Turns that relabel axes: (x, y, z) -> (y, z, x) and a half turn about z.
 CYCLE = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
@@ -37,8 +37,9 @@ def test_relabel_mannequin_restores_the_reference_labels_without_moving_anything
     after = collection_to_mannequin(target).reordered(toy.topology)
     assert np.allclose(axis_agreement(after.rotation, toy.rotation), 1.0, atol=1e-6)
     assert np.allclose(after.semi_axes, toy.semi_axes, rtol=1e-6)
-    assert np.allclose(shape_matrix(after.rotation, after.semi_axes),
-                       shape_matrix(before.rotation, before.semi_axes), atol=1e-7)
+    assert np.allclose(
+        shape_matrix(after.rotation, after.semi_axes), shape_matrix(before.rotation, before.semi_axes), atol=1e-7
+    )
     assert np.allclose(after.center, before.center)
 
 

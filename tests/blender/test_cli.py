@@ -22,10 +22,10 @@ from ellimann_addon.blender.services.files import EXTRAS_KEY, read_glb_json
 from ellimann_addon.cli import common
 from ellimann_addon.cli import drape as drape_cli
 from ellimann_addon.core.constants import MEASUREMENTS
-from ellimann_addon.core.extra_measures import EXTRA_MEASUREMENTS
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.options import DrapeSettings
-from ellimann_addon.core.synthesis import relative_error
+from ellimann_addon.core.drape.settings import DrapeSettings
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
+from ellimann_addon.core.synthesis.synthesize import relative_error
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]
@@ -46,8 +46,10 @@ def five(printed):
 
 
 def test_python_m_help_is_fast_and_does_not_load_blender():
-    code = ("import sys\nfrom ellimann_addon.cli import main\ncode = main(['--help'])\n"
-            "print('bpy loaded' if 'bpy' in sys.modules else 'bpy not loaded', code)")
+    code = (
+        "import sys\nfrom ellimann_addon.cli import main\ncode = main(['--help'])\n"
+        "print('bpy loaded' if 'bpy' in sys.modules else 'bpy not loaded', code)"
+    )
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True).stdout
     assert "synth" in out and "batch" in out and "measure" in out and "demo" in out
     assert out.strip().endswith("bpy not loaded 0")
@@ -111,8 +113,9 @@ def test_synth_json_meets_the_request_in_exact_mode(tmp_path, capsys, references
 
 def test_synth_idw_reports_its_error(tmp_path, capsys, references):
     out = tmp_path / "m.json"
-    code, stdout, _ = run(["synth", *REQUEST, "--mode", "idw", "--normalize", "none", "-o", str(out),
-                           "--references", references], capsys)
+    code, stdout, _ = run(
+        ["synth", *REQUEST, "--mode", "idw", "--normalize", "none", "-o", str(out), "--references", references], capsys
+    )
     assert code == 0
     error = float(stdout.rsplit("max error ", 1)[1].rstrip("%\n"))
     measured = Mannequin.load(out).measure()
@@ -120,12 +123,15 @@ def test_synth_idw_reports_its_error(tmp_path, capsys, references):
     assert error > 0.1  # the paper's IDW misses: the point of exact mode
 
 
-@pytest.mark.parametrize("args, words", [
-    (["--he", "nan"], ("He", "finite")),
-    (["--sh", "-3"], ("Sh", "> 0")),
-    (["--br", "1000"], ("Br", "30-300 cm")),
-    (["--he", "abc"], None),  # argparse: exit 2
-])
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["--he", "nan"], ("He", "finite")),
+        (["--sh", "-3"], ("Sh", "> 0")),
+        (["--br", "1000"], ("Br", "30-300 cm")),
+        (["--he", "abc"], None),  # argparse: exit 2
+    ],
+)
 def test_synth_refuses_bad_measurements(tmp_path, capsys, references, args, words):
     request = REQUEST.copy()
     index = request.index(args[0])
@@ -142,8 +148,9 @@ def test_synth_refuses_bad_measurements(tmp_path, capsys, references, args, word
 def test_synth_refuses_unknown_outputs_and_missing_references(tmp_path, capsys, references):
     code, _, err = run(["synth", *REQUEST, "-o", str(tmp_path / "m.stl"), "--references", references], capsys)
     assert_one_line_error(code, err, ".blend, .glb, .obj, .json or .xml (MJCF)")
-    code, _, err = run(["synth", *REQUEST, "-o", str(tmp_path / "m.json"), "--references", str(tmp_path / "no")],
-                       capsys)
+    code, _, err = run(
+        ["synth", *REQUEST, "-o", str(tmp_path / "m.json"), "--references", str(tmp_path / "no")], capsys
+    )
     assert_one_line_error(code, err, "does not exist")
 
 
@@ -187,15 +194,18 @@ def test_synth_mjcf_loads_in_mujoco_without_blender(tmp_path, references):
     pairs = len(reference.topology.cushion_pairs)
     singles = sum(1 for p in reference.topology if not p.partner)
     out = tmp_path / "m.xml"
-    code = ("import sys\nfrom ellimann_addon.cli import main\n"
-            f"code = main(['synth', *{REQUEST!r}, '--cushions', '-o', {str(out)!r}, '--references', {references!r}])\n"
-            "print('bpy loaded' if 'bpy' in sys.modules else 'bpy not loaded', code)")
+    code = (
+        "import sys\nfrom ellimann_addon.cli import main\n"
+        f"code = main(['synth', *{REQUEST!r}, '--cushions', '-o', {str(out)!r}, '--references', {references!r}])\n"
+        "print('bpy loaded' if 'bpy' in sys.modules else 'bpy not loaded', code)"
+    )
     done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert done.stdout.strip().endswith("bpy not loaded 0"), done.stderr
     model = mujoco.MjModel.from_xml_path(str(out))
     kinds = [int(model.geom_type[i]) for i in range(model.ngeom) if model.geom(i).name != "floor"]
-    assert sorted(kinds) == sorted([int(mujoco.mjtGeom.mjGEOM_MESH)] * pairs
-                                   + [int(mujoco.mjtGeom.mjGEOM_ELLIPSOID)] * singles)
+    assert sorted(kinds) == sorted(
+        [int(mujoco.mjtGeom.mjGEOM_MESH)] * pairs + [int(mujoco.mjtGeom.mjGEOM_ELLIPSOID)] * singles
+    )
     measured = {key: float(model.numeric(f"measured_{key}").data[0]) for key in MEASUREMENTS}
     assert measured == pytest.approx(VALUES, rel=1e-4)
 
@@ -261,8 +271,9 @@ def test_drape_refuses_collection_for_a_json_mannequin(tmp_path, capsys, toy):
 def test_drape_prints_progress_while_it_simulates(tmp_path, capsys, toy):
     toy.save(tmp_path / "toy.json")
     out = tmp_path / "x.blend"
-    code, stdout, err = run(["drape", str(tmp_path / "toy.json"), "--frames", "12", "--edge", "6", "--no-cushions",
-                             "-o", str(out)], capsys)
+    code, stdout, err = run(
+        ["drape", str(tmp_path / "toy.json"), "--frames", "12", "--edge", "6", "--no-cushions", "-o", str(out)], capsys
+    )
     assert code == 0, err
     assert stdout.startswith(f"wrote {out}: ")
     lines = [line for line in err.splitlines() if line.startswith("ellimann drape: ")]
@@ -324,12 +335,21 @@ def read_report(path):
 
 
 def test_batch_skips_bad_rows_and_reports_everything(tmp_path, capsys, references):
-    rows = GOOD_ROWS[:2] + [(160, 40, "abc", 90, 100, "bad_number"), (500, 40, 100, 90, 100, "absurd"),
-                            (160, 40, 100, 90, 100, "t1"), (160, 40, 100, 90, 100, "no/slash")] + GOOD_ROWS[2:]
+    rows = (
+        GOOD_ROWS[:2]
+        + [
+            (160, 40, "abc", 90, 100, "bad_number"),
+            (500, 40, 100, 90, 100, "absurd"),
+            (160, 40, 100, 90, 100, "t1"),
+            (160, 40, 100, 90, 100, "no/slash"),
+        ]
+        + GOOD_ROWS[2:]
+    )
     source = write_csv(tmp_path / "in.csv", rows)
     out = tmp_path / "out"
-    code, stdout, err = run(["batch", source, "-o", str(out), "--format", "json,blend", "--references", references],
-                            capsys)
+    code, stdout, err = run(
+        ["batch", source, "-o", str(out), "--format", "json,blend", "--references", references], capsys
+    )
     assert code == 1
     assert "line 4: skipped: Br: 'abc' is not a number" in err
     assert "line 5: skipped: He: 500 cm is not a plausible value" in err
@@ -357,8 +377,10 @@ def test_batch_shards_partition_the_rows(tmp_path, capsys, references):
     out = tmp_path / "out"
     seen = []
     for shard in (1, 2, 3):
-        code, stdout, _ = run(["batch", source, "-o", str(out), "--shard", f"{shard}/3", "--mode", "idw",
-                               "--references", references], capsys)
+        code, stdout, _ = run(
+            ["batch", source, "-o", str(out), "--shard", f"{shard}/3", "--mode", "idw", "--references", references],
+            capsys,
+        )
         assert code == 0 and f"shard {shard}/3 of 10 rows" in stdout
         seen.append({r["name"] for r in read_report(out / f"report-{shard}-of-3.csv")})
     assert set().union(*seen) == {r[-1] for r in rows}
@@ -368,34 +390,47 @@ def test_batch_shards_partition_the_rows(tmp_path, capsys, references):
 
 def test_batch_shards_agree_on_duplicate_names_across_the_whole_csv(tmp_path, capsys, references):
     """Rows 1 and 2 share a name but land in different shards: only the first may write DIR/same.json."""
-    rows = [(150, 40, 110, 95, 110, "same"), (160, 40, 110, 95, 110, "same"), (155, 40, 110, 95, 110, "SAME"),
-            (158, 40, 110, 95, 110, "other")]
+    rows = [
+        (150, 40, 110, 95, 110, "same"),
+        (160, 40, 110, 95, 110, "same"),
+        (155, 40, 110, 95, 110, "SAME"),
+        (158, 40, 110, 95, 110, "other"),
+    ]
     source = write_csv(tmp_path / "in.csv", rows)
     out = tmp_path / "out"
     errors = {}
     for shard in (1, 2):
-        code, _, err = run(["batch", source, "-o", str(out), "--shard", f"{shard}/2", "--mode", "idw",
-                            "--references", references], capsys)
+        code, _, err = run(
+            ["batch", source, "-o", str(out), "--shard", f"{shard}/2", "--mode", "idw", "--references", references],
+            capsys,
+        )
         assert code == 1  # each shard holds one of the duplicates
         errors[shard] = err
     assert "line 4: skipped: name: 'SAME' is already used on line 2 (as 'same'" in errors[1]
     assert "line 3: skipped: name: 'same' is already used on line 2" in errors[2]
     assert Mannequin.load(out / "same.json").measurements["He"] == 150.0  # not overwritten by line 3
-    assert sorted(p.name for p in out.iterdir()) == ["other.json", "report-1-of-2.csv", "report-2-of-2.csv",
-                                                     "same.json"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        "other.json",
+        "report-1-of-2.csv",
+        "report-2-of-2.csv",
+        "same.json",
+    ]
     statuses = {}
     for shard in (1, 2):
         statuses.update({r["line"]: r["status"] for r in read_report(out / f"report-{shard}-of-2.csv")})
     assert statuses == {"2": "ok", "3": "error", "4": "error", "5": "ok"}
 
 
-@pytest.mark.parametrize("header, extra, words", [
-    (("He", "Sh", "Br", "Hi"), [], ("lacks column(s) Wa",)),
-    (("He", "Sh", "Br", "Wa", "Hi"), ["--shard", "4/3"], ("--shard must be I/N",)),
-    (("He", "Sh", "Br", "Wa", "Hi"), ["--format", "blend,stl"], ("--format",)),
-])
+@pytest.mark.parametrize(
+    "header, extra, words",
+    [
+        (("He", "Sh", "Br", "Hi"), [], ("lacks column(s) Wa",)),
+        (("He", "Sh", "Br", "Wa", "Hi"), ["--shard", "4/3"], ("--shard must be I/N",)),
+        (("He", "Sh", "Br", "Wa", "Hi"), ["--format", "blend,stl"], ("--format",)),
+    ],
+)
 def test_batch_refuses_bad_files_and_options(tmp_path, capsys, references, header, extra, words):
-    source = write_csv(tmp_path / "in.csv", [(159, 43, 117, 104, 117)[:len(header)]], header)
+    source = write_csv(tmp_path / "in.csv", [(159, 43, 117, 104, 117)[: len(header)]], header)
     code, _, err = run(["batch", source, "-o", str(tmp_path / "out"), *extra, "--references", references], capsys)
     assert_one_line_error(code, err, *words)
     code, _, err = run(["batch", str(tmp_path / "missing.csv"), "-o", str(tmp_path / "out")], capsys)
@@ -469,8 +504,7 @@ def test_batch_in_every_blender_format_prints_only_ellimann_lines(tmp_path, refe
     assert done.stdout.count("\n") == 1 and done.stdout.startswith("ellimann batch: 2 of 2 mannequins written")
     assert all(line.startswith("ellimann batch: ") for line in done.stderr.splitlines()), done.stderr
     assert_no_blender_lines(done.stdout + done.stderr)
-    verbose = python_m("batch", source, "-o", str(out), "--format", "blend,glb,obj", "--references", references,
-                       "-v")
+    verbose = python_m("batch", source, "-o", str(out), "--format", "blend,glb,obj", "--references", references, "-v")
     assert verbose.returncode == 0 and verbose.stdout == done.stdout
     # Blender 4.x says 'Info: Saved "average.blend"', 5.x 'Info: Saved copy as "average.blend"'.
     assert re.search(r'^Info: Saved (copy as )?"average\.blend"$', verbose.stderr, re.MULTILINE), verbose.stderr
@@ -522,8 +556,13 @@ def test_a_write_cut_short_is_one_line_exit_1_and_the_old_file_stays(tmp_path, r
     out = tmp_path / f"m.{kind}"
     out.write_bytes(b"the user's")
     argv = ["synth", *REQUEST, "-o", str(out), "--references", references]
-    done = subprocess.run([sys.executable, "-c", FSIZE_RUN.format(limit=4096, argv=argv)], cwd=ROOT,
-                          capture_output=True, text=True, timeout=300)
+    done = subprocess.run(
+        [sys.executable, "-c", FSIZE_RUN.format(limit=4096, argv=argv)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert_one_line_error(done.returncode, done.stderr, f"cannot write {out}: ")
     assert done.stdout == "" and ".ellimann-" not in done.stderr
     assert any(words in done.stderr for words in ("incomplete", "File too large")), done.stderr
@@ -535,14 +574,14 @@ def test_a_write_cut_short_is_one_line_exit_1_and_the_old_file_stays(tmp_path, r
 def test_a_full_disk_is_caught_on_a_64k_tmpfs(tmp_path, references):
     full = tmp_path / "full"
     full.mkdir()
-    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(full)],
-                      capture_output=True).returncode:
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(full)], capture_output=True).returncode:
         pytest.skip("cannot mount a tmpfs here")
     try:
         for kind in ("blend", "obj"):
             done = python_m("synth", *REQUEST, "-o", str(full / f"m.{kind}"), "--references", references)
-            assert_one_line_error(done.returncode, done.stderr, f"cannot write {full / f'm.{kind}'}: ",
-                                  "No space left on device")
+            assert_one_line_error(
+                done.returncode, done.stderr, f"cannot write {full / f'm.{kind}'}: ", "No space left on device"
+            )
             assert not list(full.iterdir())
     finally:
         subprocess.run(["umount", str(full)], check=True)
@@ -560,8 +599,10 @@ def test_blender_write_errors_become_one_line_os_errors():
     from ellimann_addon.core.files import blender_write_error
 
     temp, target = "/out/.ellimann-1@h-abcdefgh/m.glb", "out/m.glb"
-    gltf = RuntimeError("Error: Python: Traceback (most recent call last):\n  File \"x.py\", line 85, in save_gltf\n"
-                        f"OSError: [Errno 28] No space left on device: '{temp}'\nLocation: ops.py:109\n")
+    gltf = RuntimeError(
+        'Error: Python: Traceback (most recent call last):\n  File "x.py", line 85, in save_gltf\n'
+        f"OSError: [Errno 28] No space left on device: '{temp}'\nLocation: ops.py:109\n"
+    )
     error = blender_write_error(gltf, temp, target)
     assert (error.errno, error.strerror, error.filename) == (28, "No space left on device", target)
     blend = RuntimeError(f"Error: Cannot open file {temp}@ for writing: File name too long\n")
@@ -573,8 +614,9 @@ def test_blender_write_errors_become_one_line_os_errors():
 # ------------------------------------------------------------------------------------------------ batch: failures
 
 
-def test_a_batch_row_blender_fails_to_write_is_reported_and_the_batch_goes_on(tmp_path, capsys, references,
-                                                                             monkeypatch):
+def test_a_batch_row_blender_fails_to_write_is_reported_and_the_batch_goes_on(
+    tmp_path, capsys, references, monkeypatch
+):
     from ellimann_addon.blender.services import files
 
     real = files.export_gltf
@@ -582,15 +624,18 @@ def test_a_batch_row_blender_fails_to_write_is_reported_and_the_batch_goes_on(tm
     def full_disk_for_t1(collection, path):
         if os.path.basename(path) == "t1.glb":
             with files.atomic_output(path) as temp:  # what a bpy.ops call raises when the disk is full
-                raise RuntimeError(f"Error: Python: Traceback (most recent call last):\nOSError: [Errno 28] No "
-                                   f"space left on device: '{temp}'\nLocation: ops.py:109\n")
+                raise RuntimeError(
+                    f"Error: Python: Traceback (most recent call last):\nOSError: [Errno 28] No "
+                    f"space left on device: '{temp}'\nLocation: ops.py:109\n"
+                )
         return real(collection, path)
 
     monkeypatch.setattr(files, "export_gltf", full_disk_for_t1)
     source = write_csv(tmp_path / "in.csv", GOOD_ROWS)
     out = tmp_path / "out"
-    code, stdout, err = run(["batch", source, "-o", str(out), "--format", "json,glb", "--references", references],
-                            capsys)
+    code, stdout, err = run(
+        ["batch", source, "-o", str(out), "--format", "json,glb", "--references", references], capsys
+    )
     assert code == 1 and "Traceback" not in err
     assert f"line 3: failed: cannot write {out / 't1.glb'}: No space left on device" in err
     assert "2 of 3 mannequins written" in stdout
@@ -599,8 +644,7 @@ def test_a_batch_row_blender_fails_to_write_is_reported_and_the_batch_goes_on(tm
     assert not [p for p in out.iterdir() if p.name.startswith(".") or "partial" in p.name]
 
 
-def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_path, capsys, references,
-                                                                           monkeypatch):
+def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_path, capsys, references, monkeypatch):
     real, calls = common.write, []
 
     def interrupted_on_the_second_row(*args):
@@ -614,8 +658,10 @@ def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_
     out = tmp_path / "out"
     code, stdout, err = run(["batch", source, "-o", str(out), "--references", references], capsys)
     assert code == 130 and stdout == ""
-    assert err.strip().splitlines()[-1] == (f"ellimann batch: interrupted: 1 of 4 rows done, report "
-                                            f"{out / 'report.csv'}; run it again with --resume to finish")
+    assert err.strip().splitlines()[-1] == (
+        f"ellimann batch: interrupted: 1 of 4 rows done, report "
+        f"{out / 'report.csv'}; run it again with --resume to finish"
+    )
     assert [(r["line"], r["status"]) for r in read_report(out / "report.csv")] == [("2", "ok"), ("5", "error")]
     assert sorted(p.name for p in out.iterdir()) == ["average.json", "report.csv"]
     first = (out / "average.json").stat()
@@ -650,8 +696,9 @@ def test_a_killed_batch_leaves_a_partial_report_and_resume_cleans_up_and_finishe
     source = write_csv(tmp_path / "in.csv", rows)
     out = tmp_path / "out"
     argv = ["batch", source, "-o", str(out), "--references", references]
-    done = subprocess.run([sys.executable, "-c", KILLED_RUN.format(argv=argv)], cwd=ROOT, capture_output=True,
-                          text=True, timeout=300)
+    done = subprocess.run(
+        [sys.executable, "-c", KILLED_RUN.format(argv=argv)], cwd=ROOT, capture_output=True, text=True, timeout=300
+    )
     assert done.returncode == -9
     assert [r["name"] for r in read_report(out / "report.partial.csv")] == ["m0", "m1"]
     assert len([p for p in out.iterdir() if p.name.startswith(".ellimann-")]) == 1
@@ -680,8 +727,10 @@ def test_batch_without_resume_writes_every_row_again(tmp_path, capsys, reference
 
 
 def test_names_from_a_csv_cannot_become_formulas_or_terminal_escapes(tmp_path, capsys, references):
-    rows = [(159, 43, 117, 104, 117, name) for name in
-            ('=HYPERLINK("http://evil","x")', "+1+2", "-2+3", "@SUM(A1)", "\x1b[2J\x1b[31mred", "ok\u202eevil")]
+    rows = [
+        (159, 43, 117, 104, 117, name)
+        for name in ('=HYPERLINK("http://evil","x")', "+1+2", "-2+3", "@SUM(A1)", "\x1b[2J\x1b[31mred", "ok\u202eevil")
+    ]
     source = write_csv(tmp_path / "in.csv", rows + [GOOD_ROWS[1]])
     out = tmp_path / "out"
     code, _, err = run(["batch", source, "-o", str(out), "--references", references], capsys)
@@ -697,8 +746,9 @@ def test_names_from_a_csv_cannot_become_formulas_or_terminal_escapes(tmp_path, c
 
 def test_text_from_the_command_line_and_files_is_printed_without_control_characters(tmp_path, capsys, references):
     out = tmp_path / "m.json"
-    code, stdout, _ = run(["synth", *REQUEST, "--name", "\x1b]0;owned\x07\rx", "-o", str(out),
-                           "--references", references], capsys)
+    code, stdout, _ = run(
+        ["synth", *REQUEST, "--name", "\x1b]0;owned\x07\rx", "-o", str(out), "--references", references], capsys
+    )
     assert code == 0 and "\x1b" not in stdout and "\\x1b]0;owned\\x07\\rx" in stdout
     code, stdout, _ = run(["measure", str(out)], capsys)
     assert code == 0 and "\x1b" not in stdout and stdout.startswith("\\x1b]0;owned")

@@ -17,10 +17,10 @@ from devkit.cli_runs import assert_one_line_error, python_m, run
 from ellimann_addon.blender.bridge.convert import collection_to_mannequin
 from ellimann_addon.blender.services import drape as drape_module
 from ellimann_addon.blender.services.drape import MAX_CLOTH_VERTICES, DrapeSettings, check_cloth_size, drape
-from ellimann_addon.core import garments
+from ellimann_addon.core.drape import garments
 from ellimann_addon.core.errors import ElliMannError, MannequinError
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.synthesis import REFERENCE_FOLDER
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.synthesize import REFERENCE_FOLDER
 
 AVERAGE = REFERENCE_FOLDER / "average.json"
 REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]
@@ -44,14 +44,22 @@ BAD_FILES = {
     "latin-1": (_edited(lambda d: d.update(name="Zoë")).encode("latin-1"), ["not UTF-8"]),
     "nested": ("[" * 100_000 + "]" * 100_000, ["nested too deeply"]),
     "top level list": ("[]", ["holds a list"]),
-    "semi-axes 1e300": (_edited(lambda d: d["ellipsoids"][0]["semi_axes"].__setitem__(0, 1e300)),
-                        ["semi_axes", "1e+300 m", "accepted range 1e-05 to 3 m"]),
-    "semi-axes 1e-300": (_edited(lambda d: d["ellipsoids"][0]["semi_axes"].__setitem__(0, 1e-300)),
-                         ["semi_axes", "1e-300 m", "accepted range 1e-05 to 3 m"]),
-    "centre 1e308": (_edited(lambda d: d["ellipsoids"][0]["center"].__setitem__(0, 1e308)),
-                     ["center", "x = 1e+308 m", "accepted range -100 to 100 m"]),
-    "duplicate names": (_edited(lambda d: d["ellipsoids"].append(copy.deepcopy(d["ellipsoids"][0]))),
-                        ["name: is used twice"]),
+    "semi-axes 1e300": (
+        _edited(lambda d: d["ellipsoids"][0]["semi_axes"].__setitem__(0, 1e300)),
+        ["semi_axes", "1e+300 m", "accepted range 1e-05 to 3 m"],
+    ),
+    "semi-axes 1e-300": (
+        _edited(lambda d: d["ellipsoids"][0]["semi_axes"].__setitem__(0, 1e-300)),
+        ["semi_axes", "1e-300 m", "accepted range 1e-05 to 3 m"],
+    ),
+    "centre 1e308": (
+        _edited(lambda d: d["ellipsoids"][0]["center"].__setitem__(0, 1e308)),
+        ["center", "x = 1e+308 m", "accepted range -100 to 100 m"],
+    ),
+    "duplicate names": (
+        _edited(lambda d: d["ellipsoids"].append(copy.deepcopy(d["ellipsoids"][0]))),
+        ["name: is used twice"],
+    ),
 }
 
 
@@ -86,7 +94,8 @@ def test_python_m_reports_a_list_of_measurements_without_a_traceback(tmp_path):
     assert done.returncode == 1 and done.stdout == "" and "Traceback" not in done.stderr
     assert done.stderr.strip().splitlines() == [
         f"ellimann measure: error: {path}: measurements_cm: must be an object of He, Sh, Br, Wa, Hi in cm (or null), "
-        "got a list"]
+        "got a list"
+    ]
 
 
 @pytest.mark.parametrize("case", ["measurements list", "utf-16"])
@@ -128,8 +137,9 @@ def test_drape_refuses_a_cloth_too_fine_at_once_with_the_figures(tmp_path, capsy
     start = time.perf_counter()
     code, stdout, err = run(["drape", str(AVERAGE), "--edge", "0.2", "-o", str(out)], capsys)
     assert time.perf_counter() - start < 20  # it used to run out of memory building the garment
-    assert_one_line_error(code, err, "tube_dress", "0.2 cm edges", "vertices", "GB",
-                          f"limit {MAX_CLOTH_VERTICES:,} vertices")
+    assert_one_line_error(
+        code, err, "tube_dress", "0.2 cm edges", "vertices", "GB", f"limit {MAX_CLOTH_VERTICES:,} vertices"
+    )
     assert stdout == "" and not out.exists()
     vertices = int(re.search(r"about ([\d,]+) vertices", err).group(1).replace(",", ""))
     assert vertices > 3 * MAX_CLOTH_VERTICES
@@ -149,8 +159,20 @@ def test_edge_errors_quote_the_flag_in_cm(tmp_path, capsys, edge):
 def test_drape_warns_about_a_large_cloth(tmp_path, capsys, toy, monkeypatch):
     monkeypatch.setattr(drape_module, "WARN_CLOTH_VERTICES", 10)
     toy.save(tmp_path / "toy.json")
-    code, _, err = run(["drape", str(tmp_path / "toy.json"), "--frames", "2", "--edge", "6", "--no-cushions",
-                        "-o", str(tmp_path / "x.blend")], capsys)
+    code, _, err = run(
+        [
+            "drape",
+            str(tmp_path / "toy.json"),
+            "--frames",
+            "2",
+            "--edge",
+            "6",
+            "--no-cushions",
+            "-o",
+            str(tmp_path / "x.blend"),
+        ],
+        capsys,
+    )
     assert code == 0, err
     warning = [line for line in err.splitlines() if "warning" in line]
     assert len(warning) == 1 and re.search(r"about [\d,]+ vertices and need about [\d.]+ GB", warning[0])
@@ -172,9 +194,13 @@ def test_drape_refuses_before_building_anything(toy):
 # ------------------------------------------------------------------------------------------------ collections
 
 
-@pytest.mark.parametrize("scale, words", [(1e-6, ["semi_axes: 1e-06 m is not a plausible semi-axis",
-                                                  "accepted range 1e-05 to 3 m"]),
-                                          (50.0, ["semi_axes: 50 m", "accepted range 1e-05 to 3 m"])])
+@pytest.mark.parametrize(
+    "scale, words",
+    [
+        (1e-6, ["semi_axes: 1e-06 m is not a plausible semi-axis", "accepted range 1e-05 to 3 m"]),
+        (50.0, ["semi_axes: 50 m", "accepted range 1e-05 to 3 m"]),
+    ],
+)
 def test_a_collection_with_an_implausible_scale_is_refused_like_a_file(toy_collection, scale, words):
     obj = parts(toy_collection)["3.a Pelvis"]
     obj.scale = (scale, 0.1, 0.1)
@@ -189,8 +215,11 @@ def test_a_collection_far_from_the_origin_is_refused(toy_collection):
     obj = parts(toy_collection)["1.a Head"]
     obj.matrix_world = Matrix.Translation((0.0, 500.0, 1.6)) @ Matrix.Diagonal((0.1, 0.1, 0.12, 1.0))
     bpy.context.view_layer.update()
-    with pytest.raises(MannequinError, match=r"'1.a Head' center: y = 500 m is too far from the origin "
-                                             r"\(accepted range -100 to 100 m\)"):
+    with pytest.raises(
+        MannequinError,
+        match=r"'1.a Head' center: y = 500 m is too far from the origin "
+        r"\(accepted range -100 to 100 m\)",
+    ):
         collection_to_mannequin(toy_collection)
     obj.matrix_world = Matrix.Translation((0.0, 99.0, 1.6)) @ Matrix.Diagonal((0.1, 0.1, 0.12, 1.0))
     bpy.context.view_layer.update()

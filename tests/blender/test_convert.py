@@ -70,8 +70,8 @@ def test_update_geometry_moves_objects_in_place(toy):
 
 
 def test_joints_go_into_the_collection_and_back():
-    from ellimann_addon.core.mannequin import Mannequin
-    from ellimann_addon.core.reference_set import REFERENCE_FOLDER
+    from ellimann_addon.core.mannequin.model import Mannequin
+    from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
     average = Mannequin.load(REFERENCE_FOLDER / "average.json")
     back = convert.collection_to_mannequin(convert.mannequin_to_collection(average))

@@ -7,18 +7,23 @@ import pytest
 from devkit.blender_scene import parts, select, state
 from ellimann_addon.blender.bridge.built import BUILT_KEY, built_objects
 from ellimann_addon.blender.bridge.convert import mannequin_to_collection, world_triangles
-from ellimann_addon.core import mesh
 from ellimann_addon.core.constants import MEASUREMENTS
-from ellimann_addon.core.cushion import cushion_mesh
-from ellimann_addon.core.ellipsoid import volume
-from ellimann_addon.core.mannequin import Mannequin, Part, Topology
-from ellimann_addon.core.measure import measure_meshes, section_heights
+from ellimann_addon.core.geometry import mesh
+from ellimann_addon.core.geometry.cushion import cushion_mesh
+from ellimann_addon.core.geometry.ellipsoid import volume
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.topology import Part, Topology
+from ellimann_addon.core.measure.tailor import measure_meshes, section_heights
 
 
 def capsule_mannequin(radius=0.1, length=0.5):
     """Two equal spheres one above the other: their cushion is a capsule (closed-form volume)."""
-    topology = Topology([Part("1.a Upper", "C", "torso", True, ("He",), "1.b Lower"),
-                         Part("1.b Lower", "C", "torso", True, ("He",), "1.a Upper")])
+    topology = Topology(
+        [
+            Part("1.a Upper", "C", "torso", True, ("He",), "1.b Lower"),
+            Part("1.b Lower", "C", "torso", True, ("He",), "1.a Upper"),
+        ]
+    )
     center = np.array([(0.0, 0.0, radius + length), (0.0, 0.0, radius)])
     return Mannequin(topology, np.stack([np.eye(3)] * 2), center, np.full((2, 3), radius), name="Capsule")
 
@@ -38,7 +43,7 @@ def test_cushion_is_a_closed_convex_mesh_of_the_capsule_volume():
     vertices, faces = world_triangles(obj)
     assert mesh.is_closed_manifold(faces) and mesh.euler_characteristic(vertices, faces) == 2
     assert mesh.convexity_defect(vertices, faces) < 1e-6
-    exact = np.pi * r * r * length + 4.0 / 3.0 * np.pi * r ** 3
+    exact = np.pi * r * r * length + 4.0 / 3.0 * np.pi * r**3
     assert mesh.volume(vertices, faces) == pytest.approx(exact, rel=5e-3)
     # The object sits in the first ellipsoid's rigid frame, its vertices are local to it.
     assert np.allclose(np.array(obj.matrix_world), [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, r + length], [0, 0, 0, 1]])

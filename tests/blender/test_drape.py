@@ -44,8 +44,7 @@ def test_tube_dress_falls_on_the_ellipsoids_held_by_its_pins(body):
     scene.frame_start, scene.frame_end = 3, 7  # the user's range, shorter than the drape: left alone
     before = state()
     frames_done = []
-    result = drape(body, "tube_dress", DrapeSettings(frames=12, cushions=False, **COARSE),
-                   progress=frames_done.append)
+    result = drape(body, "tube_dress", DrapeSettings(frames=12, cushions=False, **COARSE), progress=frames_done.append)
     garment, obj = result.garment, result.garment_object
     moved = result.vertices - garment.vertices
     hem = garment.vertices[:, 2] < garment.vertices[:, 2].min() + 1e-6
@@ -93,9 +92,11 @@ def test_t_shirt_seams_close_on_the_cushions(body):
 def test_bad_settings_and_garments_change_nothing(body):
     mannequin_to_collection(body)
     before = state()
-    for settings, words in ((DrapeSettings(frames=1), "frames: must be an integer from 2"),
-                            (DrapeSettings(edge=0.0), "edge"),
-                            (DrapeSettings(sphere_subdivisions=9), "sphere_subdivisions")):
+    for settings, words in (
+        (DrapeSettings(frames=1), "frames: must be an integer from 2"),
+        (DrapeSettings(edge=0.0), "edge"),
+        (DrapeSettings(sphere_subdivisions=9), "sphere_subdivisions"),
+    ):
         with pytest.raises(ElliMannError, match=words):
             drape(body, "tube_dress", settings)
     with pytest.raises(ElliMannError, match="garment: must be one of"):
@@ -281,8 +282,9 @@ def test_cli_drapes_a_json_mannequin_into_a_blend_and_a_picture(body, tmp_path, 
     source = tmp_path / "body.json"
     body.save(source)
     out, picture = tmp_path / "out" / "dress.blend", tmp_path / "out" / "dress.png"
-    code, stdout, err = run(["drape", str(source), "--frames", "6", "--edge", "5", "-o", str(out),
-                             "--render", str(picture)], capsys)
+    code, stdout, err = run(
+        ["drape", str(source), "--frames", "6", "--edge", "5", "-o", str(out), "--render", str(picture)], capsys
+    )
     assert code == 0, err
     assert stdout.splitlines()[0].startswith(f"wrote {out}: Tube dress on 'toy (A-pose)', 6 frames")
     assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -302,18 +304,36 @@ def test_cli_drapes_a_mannequin_in_a_blend(body, tmp_path, capsys):
     out = tmp_path / "draped.blend"
     code, _, err = run(["drape", str(source), "--frames", "4", "--edge", "5", "-o", str(out)], capsys)
     assert code == 1 and "choose one with --collection" in err and not out.exists()
-    code, stdout, err = run(["drape", str(source), "--collection", "Body", "--frames", "4", "--edge", "5",
-                             "--garment", "t_shirt", "-o", str(out)], capsys)
+    code, stdout, err = run(
+        [
+            "drape",
+            str(source),
+            "--collection",
+            "Body",
+            "--frames",
+            "4",
+            "--edge",
+            "5",
+            "--garment",
+            "t_shirt",
+            "-o",
+            str(out),
+        ],
+        capsys,
+    )
     assert code == 0, err
     assert "T-shirt on 'Body'" in stdout and out.is_file()
 
 
-@pytest.mark.parametrize("args, words", [
-    (["-o", "x.obj"], "-o must end in .blend"),
-    (["-o", "x.blend", "--render", "x.jpg"], "--render must end in .png"),
-    (["-o", "x.blend", "--frames", "1"], "frames: must be an integer from 2 to 2000"),
-    (["-o", "x.blend", "--edge", "0"], "edge"),
-])
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["-o", "x.obj"], "-o must end in .blend"),
+        (["-o", "x.blend", "--render", "x.jpg"], "--render must end in .png"),
+        (["-o", "x.blend", "--frames", "1"], "frames: must be an integer from 2 to 2000"),
+        (["-o", "x.blend", "--edge", "0"], "edge"),
+    ],
+)
 def test_cli_refuses_bad_options(body, tmp_path, capsys, args, words):
     source = tmp_path / "body.json"
     body.save(source)

@@ -10,11 +10,11 @@ from ellimann_addon.blender.services.drape import CLOTH_NAME, PIN_GROUP, DrapeSe
 from ellimann_addon.blender.services.drape_motion import PIECE_KEY, TORSO_JOINTS, body_motion
 from ellimann_addon.blender.services.scene import add_mannequin
 from ellimann_addon.core.errors import ElliMannError
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.motion import clamped_motion
-from ellimann_addon.core.pose import forward_kinematics
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER
-from ellimann_addon.core.skeleton import JOINT_INDEX, part_bones
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.skeleton import JOINT_INDEX, part_bones
+from ellimann_addon.core.pose.kinematics import forward_kinematics
+from ellimann_addon.core.pose.motion import clamped_motion
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
 FRAMES = 9
 
@@ -41,8 +41,10 @@ def test_the_dress_walks_with_the_body(average):
         if piece not in average.topology.index:
             continue
         bone = bones[average.topology.index[piece]]
-        rest = np.array([v.co[:] for v in obj.data.vertices]) @ np.array(obj.matrix_world)[:3, :3].T \
+        rest = (
+            np.array([v.co[:] for v in obj.data.vertices]) @ np.array(obj.matrix_world)[:3, :3].T
             + np.array(obj.matrix_world)[:3, 3]
+        )
         assert np.abs(evaluated_vertices(obj) - (rest @ world[bone].T + offset[bone])).max() < 1e-4
     garment = result.garment_object
     assert PIN_GROUP in garment.vertex_groups and garment.modifiers[1].name == CLOTH_NAME
@@ -60,8 +62,12 @@ def test_the_dress_walks_with_the_body(average):
 def test_a_motion_needs_joints_and_nothing_is_built_without(average):
     before = state()
     with pytest.raises(ElliMannError, match="has no joints"):
-        drape(average.copy(joints=None), "tube_dress", DrapeSettings(frames=4, edge=0.05),
-              motion=clamped_motion("sit", average.joints)[0])
+        drape(
+            average.copy(joints=None),
+            "tube_dress",
+            DrapeSettings(frames=4, edge=0.05),
+            motion=clamped_motion("sit", average.joints)[0],
+        )
     assert state() == before
 
 

@@ -12,8 +12,8 @@ from ellimann_addon.blender.services.files import EXTRAS_KEY, export_gltf, read_
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.errors import ElliMannError, MannequinError
 from ellimann_addon.core.files import atomic_output
-from ellimann_addon.core.quaternion import quaternion_to_rotation
-from ellimann_addon.core.writers import write_core_file
+from ellimann_addon.core.formats.core_writers import write_core_file
+from ellimann_addon.core.geometry.quaternion import quaternion_to_rotation
 
 # glTF is Y-up: Blender's exporter maps (x, y, z) -> (x, z, -y).
 Z_UP_FROM_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
@@ -38,7 +38,12 @@ def test_pieces_keep_names_parts_and_frames(mannequin, tmp_path):
         node = nodes[part.name]
         extras = node["extras"][EXTRAS_KEY]
         assert (extras["part"], extras["side"], extras["region"], extras["girth"], extras["partner"]) == (
-            part.name, part.side, part.region, part.girth, part.partner)
+            part.name,
+            part.side,
+            part.region,
+            part.girth,
+            part.partner,
+        )
         assert extras["depends"] == [m for m in MEASUREMENTS if m in part.depends]
         assert np.allclose(extras["center_m"], mannequin.center[i], atol=1e-6)
         assert np.allclose(np.array(extras["axes"]).T, mannequin.rotation[i], atol=1e-6)
@@ -125,8 +130,10 @@ def test_a_failed_write_names_its_target_not_the_temporary_file(mannequin, tmp_p
     with pytest.raises(OSError) as raised:
         write_mannequin(mannequin, paths)
     assert raised.value.filename == str(blocked) and ".ellimann-" not in str(raised.value)
-    for target, error in ((str(tmp_path / "a_file" / "m.blend"), "File exists"),  # a file where its folder should be
-                          (str(tmp_path / "empty.png"), "Blender wrote nothing")):
+    for target, error in (
+        (str(tmp_path / "a_file" / "m.blend"), "File exists"),  # a file where its folder should be
+        (str(tmp_path / "empty.png"), "Blender wrote nothing"),
+    ):
         (tmp_path / "a_file").touch()
         with pytest.raises(OSError, match=error) as raised, atomic_output(target):
             pass

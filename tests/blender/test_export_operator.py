@@ -42,8 +42,9 @@ def test_the_extension_or_the_format_chooses_mjcf(toy, toy_collection, tmp_path,
     assert bpy.ops.ellimann.export_mannequin(filepath=str(tmp_path / "toy.xml")) == {"FINISHED"}
     assert sorted(g.get("name") for g in geoms(tmp_path / "toy.xml")) == sorted(toy.topology.names)
     assert all(g.get("type") == "ellipsoid" for g in geoms(tmp_path / "toy.xml"))
-    assert bpy.ops.ellimann.export_mannequin(filepath=str(tmp_path / "hulls"), format="MJCF",
-                                             cushions=True) == {"FINISHED"}
+    assert bpy.ops.ellimann.export_mannequin(filepath=str(tmp_path / "hulls"), format="MJCF", cushions=True) == {
+        "FINISHED"
+    }
     shapes = [g.get("type") for g in geoms(tmp_path / "hulls.xml")]
     assert shapes.count("mesh") == len(toy.topology.cushion_pairs) == 3
     assert shapes.count("ellipsoid") == len(toy) - 6
@@ -52,8 +53,11 @@ def test_the_extension_or_the_format_chooses_mjcf(toy, toy_collection, tmp_path,
 
 def test_a_name_without_glb_or_xml_gets_the_formats_extension_as_in_the_file_browser(toy_collection, tmp_path):
     """A dot in a mannequin's name ("ElliMann 159.5-43") is no extension; execute() and check() agree."""
-    cases = (("ElliMann 159.5-43", "GLB", "ElliMann 159.5-43.glb"),
-             ("ElliMann 159.5-43", "MJCF", "ElliMann 159.5-43.xml"), ("toy.obj", "GLB", "toy.obj.glb"))
+    cases = (
+        ("ElliMann 159.5-43", "GLB", "ElliMann 159.5-43.glb"),
+        ("ElliMann 159.5-43", "MJCF", "ElliMann 159.5-43.xml"),
+        ("toy.obj", "GLB", "toy.obj.glb"),
+    )
     for i, (name, kind, written) in enumerate(cases):
         assert with_extension(name, kind) == written  # what check() makes of the name
         path = tmp_path / str(i) / name
@@ -84,8 +88,11 @@ def test_refuses_a_glb_of_out_of_date_cushions_until_they_are_built_again(toy_co
     bpy.context.view_layer.update()
     before = state()
     path = tmp_path / "toy.glb"
-    with pytest.raises(RuntimeError, match=r"Cannot export 'toy': the cushions of 'toy' are out of date "
-                                           r"\('6.a Thigh.L \+ 6.b Shin.L': .*\): Build Cushions first"):
+    with pytest.raises(
+        RuntimeError,
+        match=r"Cannot export 'toy': the cushions of 'toy' are out of date "
+        r"\('6.a Thigh.L \+ 6.b Shin.L': .*\): Build Cushions first",
+    ):
         bpy.ops.ellimann.export_mannequin(filepath=str(path))
     assert state() == before and not path.exists()
     # MJCF takes its cushion meshes from the ellipsoids, not from the built objects: nothing out of date.

@@ -38,10 +38,18 @@ def test_zip_passes_blenders_validator_and_ships_only_the_add_on(built_zip):
     assert validate.returncode == 0 and "Success" in validate.stdout, validate.stdout + validate.stderr
     names = zipfile.ZipFile(built_zip).namelist()
     assert "blender_manifest.toml" in names and "__init__.py" in names
-    assert "ellimann_addon/blender/features/trace/operators.py" in names and "ellimann_addon/core/measure.py" in names
+    assert "ellimann_addon/blender/features/trace/operators.py" in names
+    assert "ellimann_addon/core/measure/tailor.py" in names
+    assert "ellimann_addon/core/synthesis/populations/ansur2_female.json" in names
     shipped_tops = {name.split("/")[0] for name in names}
-    assert shipped_tops <= {"blender_manifest.toml", "__init__.py", "README.md", "LICENSE", "ellimann_addon",
-                            "reference_blends"}, shipped_tops
+    assert shipped_tops <= {
+        "blender_manifest.toml",
+        "__init__.py",
+        "README.md",
+        "LICENSE",
+        "ellimann_addon",
+        "reference_blends",
+    }, shipped_tops
     assert not [n for n in names if "__pycache__" in n or n.endswith(".pyc")]
 
 

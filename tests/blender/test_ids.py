@@ -47,8 +47,11 @@ def test_operators_have_poll_tooltip_and_undo_when_they_change_data(cls):
 def test_sub_panels_hang_under_the_main_panel_in_their_order():
     subs = [cls for cls in PANELS if cls.bl_idname != ids.PANEL_MAIN]
     assert all(cls.bl_parent_id == ids.PANEL_MAIN for cls in subs)
-    assert [cls.bl_order for cls in subs] == sorted(ids.PANEL_ORDER.values()) + [ids.SYNTHESIZE_ORDER, ids.POSE_ORDER,
-                                                                                 ids.DRAPE_ORDER]
+    assert [cls.bl_order for cls in subs] == sorted(ids.PANEL_ORDER.values()) + [
+        ids.SYNTHESIZE_ORDER,
+        ids.POSE_ORDER,
+        ids.DRAPE_ORDER,
+    ]
     assert max(ids.PANEL_ORDER.values()) < ids.SYNTHESIZE_ORDER < ids.POSE_ORDER < ids.DRAPE_ORDER  # they come last
 
 
@@ -58,8 +61,10 @@ def test_the_other_modules_use_the_ids_of_ids_py():
     assert synthesize_presets.ELLIMANN_OT_add_measurement_preset.bl_idname == ids.ADD_MEASUREMENT_PRESET
     assert synthesize_presets.ELLIMANN_MT_measurement_presets.bl_idname == ids.MENU_MEASUREMENT_PRESETS
     assert synthesize_presets.ELLIMANN_OT_add_measurement_preset.preset_menu == ids.MENU_MEASUREMENT_PRESETS
-    for panel, order in ((synthesize_panel.ELLIMANN_PT_synthesize, ids.SYNTHESIZE_ORDER),
-                         (drape_panel.ELLIMANN_PT_drape, ids.DRAPE_ORDER)):
+    for panel, order in (
+        (synthesize_panel.ELLIMANN_PT_synthesize, ids.SYNTHESIZE_ORDER),
+        (drape_panel.ELLIMANN_PT_drape, ids.DRAPE_ORDER),
+    ):
         assert panel.__name__ == panel.bl_idname and panel.bl_idname in (ids.PANEL_SYNTHESIZE, ids.PANEL_DRAPE)
         assert (panel.bl_parent_id, panel.bl_order) == (ids.PANEL_MAIN, order)
 
@@ -79,8 +84,9 @@ def missing_tooltips(rna):
         if not prop.description.strip():
             missing.append(prop.identifier)
         if prop.type == "ENUM":
-            missing += [f"{prop.identifier}['{item.identifier}']" for item in prop.enum_items
-                        if not item.description.strip()]
+            missing += [
+                f"{prop.identifier}['{item.identifier}']" for item in prop.enum_items if not item.description.strip()
+            ]
     return missing
 
 
@@ -90,8 +96,11 @@ def test_every_property_and_enum_item_has_a_tooltip(cls):
 
 
 def test_tooltips_cover_everything_registered():
-    groups = {c.__name__ for c in bpy.types.PropertyGroup.__subclasses__()
-              if c.__name__.startswith("ELLIMANN_") and c.is_registered}
+    groups = {
+        c.__name__
+        for c in bpy.types.PropertyGroup.__subclasses__()
+        if c.__name__.startswith("ELLIMANN_") and c.is_registered
+    }
     assert {"ELLIMANN_PG_part", "ELLIMANN_PG_mannequin", "ELLIMANN_PG_synthesis", "ELLIMANN_PG_drape"} <= groups
     operator_classes = {ids.class_name(f"ellimann.{name}") for name in registered_operator_names()}
     assert {c.__name__ for c in TOOLTIP_OWNERS} == groups | operator_classes
@@ -100,8 +109,9 @@ def test_tooltips_cover_everything_registered():
 def test_missing_tooltips_finds_properties_and_items_without_one():
     class ELLIMANN_PG_tooltip_probe(bpy.types.PropertyGroup):
         bare: bpy.props.IntProperty(name="Bare")
-        told: bpy.props.EnumProperty(name="Told", description="Has one",
-                                     items=(("A", "A", "Item with a tooltip"), ("B", "B", "")))
+        told: bpy.props.EnumProperty(
+            name="Told", description="Has one", items=(("A", "A", "Item with a tooltip"), ("B", "B", ""))
+        )
         hidden: bpy.props.BoolProperty(options={"HIDDEN"})
 
     bpy.utils.register_class(ELLIMANN_PG_tooltip_probe)

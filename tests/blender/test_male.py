@@ -14,10 +14,10 @@ from devkit.cli_runs import assert_one_line_error, run
 from ellimann_addon.blender.bridge import convert
 from ellimann_addon.blender.services.files import EXTRAS_KEY, read_glb_json
 from ellimann_addon.core.constants import MEASUREMENTS, SECTION_FRACTIONS
-from ellimann_addon.core.garments import make_garment
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.reference_set import load_reference_set
-from ellimann_addon.core.shipped_sets import SHIPPED_SETS
+from ellimann_addon.core.drape.garments import make_garment
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.reference_set import load_reference_set
+from ellimann_addon.core.synthesis.shipped import SHIPPED_SETS
 
 REQUEST = dict(He=180.0, Sh=52.0, Br=108.0, Wa=96.0, Hi=104.0)  # inside the male ranges L
 
@@ -65,8 +65,11 @@ def test_the_command_line_chooses_the_set_by_name_and_per_batch_row(tmp_path, ca
     code, _, err = run(["synth", *args, "-o", str(out), "--references", "mael"], capsys)
     assert_one_line_error(code, err, "references", "neither a shipped set")
     table = tmp_path / "rows.csv"
-    table.write_text("name,He,Sh,Br,Wa,Hi,references\nhim,180,52,108,96,104,male\nher,159,43,117,104,117,\n"
-                     "typo,159,43,117,104,117,mael\n", encoding="utf-8")
+    table.write_text(
+        "name,He,Sh,Br,Wa,Hi,references\nhim,180,52,108,96,104,male\nher,159,43,117,104,117,\n"
+        "typo,159,43,117,104,117,mael\n",
+        encoding="utf-8",
+    )
     code, _, err = run(["batch", str(table), "-o", str(tmp_path / "out")], capsys)
     assert code == 1 and "line 4" in err and "references" in err
     with open(tmp_path / "out" / "report.csv", encoding="utf-8") as stream:
@@ -79,8 +82,9 @@ def test_the_command_line_chooses_the_set_by_name_and_per_batch_row(tmp_path, ca
         assert max(abs(float(rows[name][f"{k}_error_pct"])) for k in MEASUREMENTS) < 1e-3
     code, stdout, _ = run(["measure", str(tmp_path / "out" / "him.json"), "--json"], capsys)
     printed = json.loads(stdout)  # the five, then the extra measurements
-    assert {key: printed[key] for key in MEASUREMENTS} == pytest.approx(dict(zip(MEASUREMENTS, (180, 52, 108, 96,
-                                                                                               104))), rel=1e-5)
+    assert {key: printed[key] for key in MEASUREMENTS} == pytest.approx(
+        dict(zip(MEASUREMENTS, (180, 52, 108, 96, 104))), rel=1e-5
+    )
     code, stdout, _ = run(["measure", str(tmp_path / "out" / "him.json"), "--json", "--references", "female"], capsys)
     assert json.loads(stdout)["Hi"] != pytest.approx(104.0, rel=1e-3)  # cut at the female hip height
 

@@ -6,8 +6,8 @@ import pytest
 
 from devkit.blender_scene import parts, select, state
 from ellimann_addon.blender.bridge.convert import collection_to_mannequin, ellipsoid_frame
-from ellimann_addon.core.clean import asymmetry
-from ellimann_addon.core.frames import is_rotation
+from ellimann_addon.core.geometry.frames import is_rotation
+from ellimann_addon.core.mannequin.clean import asymmetry
 
 
 def symmetric(collection):

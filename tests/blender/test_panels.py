@@ -94,21 +94,28 @@ def test_menus_reach_every_operator():
     # Adding and removing a reference set's bodies belongs in its panel's list of bodies.
     bodies = bpy.context.scene.ellimann_references.bodies
     bodies.add()
-    assert {ids.ADD_REFERENCE_BODIES, ids.REMOVE_REFERENCE_BODY} <= set(draw_panel(
-        references_panel.ELLIMANN_PT_references).operators())
+    assert {ids.ADD_REFERENCE_BODIES, ids.REMOVE_REFERENCE_BODY} <= set(
+        draw_panel(references_panel.ELLIMANN_PT_references).operators()
+    )
     bodies.clear()
-    assert reached == everything - {ids.ADD_MEASUREMENT_PRESET, ids.APPLY_MEASUREMENT_PRESET, ids.ADD_REFERENCE_BODIES,
-                                    ids.REMOVE_REFERENCE_BODY}
+    assert reached == everything - {
+        ids.ADD_MEASUREMENT_PRESET,
+        ids.APPLY_MEASUREMENT_PRESET,
+        ids.ADD_REFERENCE_BODIES,
+        ids.REMOVE_REFERENCE_BODY,
+    }
 
 
 def test_recorder_refuses_misspelt_icons():
     recorder = Recorder()
     recorder.label(text="fine", icon="MOD_CLOTH")
     recorder.operator(ids.NEW_MANNEQUIN, icon="NONE")
-    for draw in (lambda: recorder.label(text="x", icon="MOD_CLOTHES"),
-                 lambda: recorder.operator(ids.NEW_MANNEQUIN, icon="outliner_collection"),
-                 lambda: recorder.prop(bpy.context.scene.ellimann_drape, "garment", icon="CLOTH"),
-                 lambda: recorder.menu(menus.ELLIMANN_MT_object.bl_idname, icon="ELLIMANN")):
+    for draw in (
+        lambda: recorder.label(text="x", icon="MOD_CLOTHES"),
+        lambda: recorder.operator(ids.NEW_MANNEQUIN, icon="outliner_collection"),
+        lambda: recorder.prop(bpy.context.scene.ellimann_drape, "garment", icon="CLOTH"),
+        lambda: recorder.menu(menus.ELLIMANN_MT_object.bl_idname, icon="ELLIMANN"),
+    ):
         with pytest.raises(ValueError, match="is not a Blender icon name"):
             draw()
     assert [kind for kind, _ in recorder.log] == ["label", "operator"]

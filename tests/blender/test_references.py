@@ -9,10 +9,10 @@ from devkit.blender_scene import edit_with_selection, reference_mesh, select, st
 from ellimann_addon.blender.bridge.bodies import body_mesh, mesh_fingerprint
 from ellimann_addon.blender.bridge.convert import collection_to_mannequin, mannequin_to_collection
 from ellimann_addon.blender.features.references import operators
-from ellimann_addon.core.body_mesh import connectivity_fingerprint
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.reference_manifest import read_manifest
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER, load_reference_set
+from ellimann_addon.core.fitting.body_mesh import connectivity_fingerprint
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.manifest import read_manifest
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, load_reference_set
 
 
 def _fitted_part(chosen, name="4.a Half"):
@@ -60,8 +60,10 @@ def _scene_for_build(tmp_path, bodies=3):
     props = bpy.context.scene.ellimann_references
     base = mannequin_to_collection(Mannequin.load(REFERENCE_FOLDER / "base_mannequin.json"), name="Base")
     props.base = base
-    meshes = [reference_mesh(np.eye(3), (0.5 * i, 0.0, 1.0), np.array((0.2, 0.2, 0.5)), name=f"body{i}")
-              for i in range(bodies)]
+    meshes = [
+        reference_mesh(np.eye(3), (0.5 * i, 0.0, 1.0), np.array((0.2, 0.2, 0.5)), name=f"body{i}")
+        for i in range(bodies)
+    ]
     select(*meshes)
     assert bpy.ops.ellimann.add_reference_bodies() == {"FINISHED"}
     for i, row in enumerate(props.bodies):
@@ -70,11 +72,14 @@ def _scene_for_build(tmp_path, bodies=3):
     return props
 
 
-@pytest.mark.parametrize("case, words", [
-    ("fewer bodies", "at least 3 bodies, got 2"),
-    ("other mesh", "642 vertices, the base was traced on 'reference_female' with 13348"),
-    ("no folder", "Choose the folder"),
-])
+@pytest.mark.parametrize(
+    "case, words",
+    [
+        ("fewer bodies", "at least 3 bodies, got 2"),
+        ("other mesh", "642 vertices, the base was traced on 'reference_female' with 13348"),
+        ("no folder", "Choose the folder"),
+    ],
+)
 def test_build_refuses_bad_input_and_changes_nothing(tmp_path, case, words):
     props = _scene_for_build(tmp_path)
     if case == "fewer bodies":
@@ -97,7 +102,7 @@ def test_a_build_is_written_as_a_set_and_loaded_into_a_new_collection(tmp_path, 
     base = Mannequin.load(REFERENCE_FOLDER / "base_mannequin.json")
 
     def build(self, progress=None, cancel_flag=None):
-        from ellimann_addon.core.reference_build import BuildReport
+        from ellimann_addon.core.fitting.reference_build import BuildReport
 
         rms = {name: rm.copy(name=name) for name, rm in zip(names, shipped.mannequins)}
         report = BuildReport(base=base, reference=names[0])

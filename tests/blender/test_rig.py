@@ -11,11 +11,11 @@ from ellimann_addon.blender.bridge.convert import objects_recursive, read_joints
 from ellimann_addon.blender.services.rig import MODIFIER_NAME, action_fcurves, apply_pose
 from ellimann_addon.blender.services.scene import add_mannequin
 from ellimann_addon.core.errors import ElliMannError
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.pose import Pose, axis_angle, clamp_pose, forward_kinematics
-from ellimann_addon.core.poses import WALK_FPS, standard_motion, standard_pose
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER
-from ellimann_addon.core.skeleton import JOINT_INDEX, JOINT_NAMES, bone_name, joint_frames, limits
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.skeleton import JOINT_INDEX, JOINT_NAMES, bone_name, joint_frames, limits
+from ellimann_addon.core.pose.kinematics import Pose, axis_angle, clamp_pose, forward_kinematics
+from ellimann_addon.core.pose.standard import WALK_FPS, standard_motion, standard_pose
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
 TOLERANCE = 2e-5  # m: Blender evaluates in single precision
 
@@ -96,21 +96,36 @@ def test_a_piece_follows_its_rotated_bone(rigged, average):
     posed_wrist = np.array(rig.matrix_world @ rig.pose.bones["L_Wrist"].head)
     assert np.abs(posed_wrist - (joint + rotation @ (wrist - joint))).max() < TOLERANCE
     # The objects' own matrices stay the rest pose: m_T is the rest pose's.
-    assert np.abs(np.array(forearm.matrix_world)[:3, 3] - average.center[average.topology.index["3.b Forearm.L"]]
-                  ).max() < 1e-6
+    assert (
+        np.abs(np.array(forearm.matrix_world)[:3, 3] - average.center[average.topology.index["3.b Forearm.L"]]).max()
+        < 1e-6
+    )
 
 
-@pytest.mark.parametrize("joint, angles", [("L_Knee", (-30.0, 0.0, 0.0)), ("L_Knee", (175.0, 10.0, 0.0)),
-                                           ("R_Hip", (40.0, -60.0, 70.0)), ("L_Elbow", (10.0, 5.0, 0.0))])
+@pytest.mark.parametrize(
+    "joint, angles",
+    [
+        ("L_Knee", (-30.0, 0.0, 0.0)),
+        ("L_Knee", (175.0, 10.0, 0.0)),
+        ("R_Hip", (40.0, -60.0, 70.0)),
+        ("L_Elbow", (10.0, 5.0, 0.0)),
+    ],
+)
 def test_limits_are_enforced_as_the_core_clamps(rigged, average, joint, angles):
-    """A rotation beyond a joint's range, typed into the bone, is shown clamped exactly as core.pose.clamp_pose
+    """A rotation beyond a joint's range, typed into the bone, is shown clamped exactly as
+    core.pose.kinematics.clamp_pose
     clamps it (the Limit Rotation constraint works in the bone's axes, the limit frame relabelled)."""
     rig = rig_object(rigged)
     index = JOINT_INDEX[joint]
     frame = joint_frames(average.joints)[index]
     a, b, c = np.radians(angles)
-    local = frame @ axis_angle([1.0, 0.0, 0.0], a) @ axis_angle([0.0, 1.0, 0.0], b) @ axis_angle([0.0, 0.0, 1.0], c) \
+    local = (
+        frame
+        @ axis_angle([1.0, 0.0, 0.0], a)
+        @ axis_angle([0.0, 1.0, 0.0], b)
+        @ axis_angle([0.0, 0.0, 1.0], c)
         @ frame.T
+    )
     pose = Pose()
     pose.rotations[index] = local
     clamped, reports = clamp_pose(pose, average.joints)
@@ -189,7 +204,8 @@ def test_rebuilding_replaces_the_armature(rigged, average):
     assert bpy.ops.ellimann.add_armature() == {"FINISHED"}
     assert len([o for o in bpy.data.objects if o.type == "ARMATURE"]) == 1
     assert len([m for m in bpy.data.meshes if m.get("ellimann_unit_sphere_bone")]) == len(
-        {bone_name(p) for p in average.topology})
+        {bone_name(p) for p in average.topology}
+    )
 
 
 def test_a_bone_typed_into_directly_moves_its_pieces(rigged):
@@ -220,8 +236,13 @@ def test_the_pose_panel_shows_the_poses_and_the_active_bones_limits(rigged, aver
     from ellimann_addon.blender.features.pose.panel import ELLIMANN_PT_pose
 
     rig = rig_object(rigged)
-    context = SimpleNamespace(scene=bpy.context.scene, active_object=rig, collection=rigged, mode="POSE",
-                              active_pose_bone=rig.pose.bones["L_Knee"])
+    context = SimpleNamespace(
+        scene=bpy.context.scene,
+        active_object=rig,
+        collection=rigged,
+        mode="POSE",
+        active_pose_bone=rig.pose.bones["L_Knee"],
+    )
     recorder = draw_panel(ELLIMANN_PT_pose, context)
     assert {ids.APPLY_POSE, ids.REST_POSE, ids.IMPORT_BVH, ids.ADD_ARMATURE} <= set(recorder.operators())
     labels = recorder.labels()

@@ -11,11 +11,11 @@ from ellimann_addon.blender.bridge.convert import objects_recursive, rig_object
 from ellimann_addon.blender.services.posing import write_posed
 from ellimann_addon.blender.services.rig import action_fcurves
 from ellimann_addon.core.errors import ElliMannError
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.motion import clamped_motion
-from ellimann_addon.core.poses import standard_motion
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER
-from ellimann_addon.core.skeleton import JOINT_NAMES, bone_name
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.skeleton import JOINT_NAMES, bone_name
+from ellimann_addon.core.pose.motion import clamped_motion
+from ellimann_addon.core.pose.standard import standard_motion
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
 Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # glTF (x, y, z) -> Blender
 
@@ -106,15 +106,21 @@ def test_the_blend_holds_the_armature_bound_pieces_and_the_walk(average, tmp_pat
 def test_a_posed_obj_holds_the_posed_pieces(average, tmp_path):
     path = tmp_path / "t.obj"
     write_mannequin(average, [path], pose="t_pose")
-    vertices = np.array([[float(v) for v in line.split()[1:4]] for line in path.read_text().splitlines()
-                         if line.startswith("v ")])
+    vertices = np.array(
+        [[float(v) for v in line.split()[1:4]] for line in path.read_text().splitlines() if line.startswith("v ")]
+    )
     width = vertices[:, 0].max() - vertices[:, 0].min()  # OBJ is Y-up; x is still the body's left
     assert width > 1.2 * (average.center[:, 0].max() - average.center[:, 0].min())  # arms out: wider than at rest
 
 
-@pytest.mark.parametrize("change, message", [({"pose": "dance"}, "unknown pose 'dance'"),
-                                             ({"joints": None}, "has no joints"),
-                                             ({"path": "x.fbx"}, "is not a .blend, .glb or .obj file")])
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        ({"pose": "dance"}, "unknown pose 'dance'"),
+        ({"joints": None}, "has no joints"),
+        ({"path": "x.fbx"}, "is not a .blend, .glb or .obj file"),
+    ],
+)
 def test_refused_before_anything_is_written(average, tmp_path, change, message):
     pose = change.get("pose", "sit")
     mannequin = average.copy(joints=None) if "joints" in change else average

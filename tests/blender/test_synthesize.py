@@ -25,11 +25,11 @@ from ellimann_addon.core.constants import (
     REFERENCE_MEASUREMENTS,
     TABLE_2_5,
 )
-from ellimann_addon.core.cushion import cushion_vertices
-from ellimann_addon.core.mesh import convexity_defect, is_closed_manifold
-from ellimann_addon.core.reference_set import load_reference_set
-from ellimann_addon.core.shipped_sets import SHIPPED_SETS
-from ellimann_addon.core.synthesis import synthesize as core_synthesize
+from ellimann_addon.core.geometry.cushion import cushion_vertices
+from ellimann_addon.core.geometry.mesh import convexity_defect, is_closed_manifold
+from ellimann_addon.core.synthesis.reference_set import load_reference_set
+from ellimann_addon.core.synthesis.shipped import SHIPPED_SETS
+from ellimann_addon.core.synthesis.synthesize import synthesize as core_synthesize
 
 
 @pytest.fixture(scope="module")
@@ -95,8 +95,14 @@ def test_idw_mode_and_cushions(props):
     cushions = [o for o in bpy.data.objects if o.ellimann.kind == "CUSHION"]
     reference = synthetic.make_reference_set()
     assert len(cushions) == len(reference.topology.cushion_pairs)
-    expected, _, _ = core_synthesize(reference, dict(zip(MEASUREMENTS, collection.ellimann.target)), mode="idw",
-                                     metric="normalized", power=3.0, normalize="none")
+    expected, _, _ = core_synthesize(
+        reference,
+        dict(zip(MEASUREMENTS, collection.ellimann.target)),
+        mode="idw",
+        metric="normalized",
+        power=3.0,
+        normalize="none",
+    )
     got = convert.collection_to_mannequin(collection).reordered(expected.topology)
     np.testing.assert_allclose(got.center, expected.center, atol=1e-6)
 
@@ -125,8 +131,10 @@ def test_live_updates_the_last_mannequin_in_place(props):
         start = time.perf_counter()
         props.he = value  # the property's update callback does the work
         times.append(time.perf_counter() - start)
-    print(f"\nlive update (exact mode, {len(objects)} ellipsoids): "
-          f"{1e3 * min(times):.1f}-{1e3 * max(times):.1f} ms per change")
+    print(
+        f"\nlive update (exact mode, {len(objects)} ellipsoids): "
+        f"{1e3 * min(times):.1f}-{1e3 * max(times):.1f} ms per change"
+    )
     assert props.target == collection and {o.name: o for o in collection.objects} == objects
     assert collection.name == "ElliMann 168-43-117-104-117"
     assert collection.ellimann.measured[0] == pytest.approx(168.0, rel=1e-4)
@@ -160,8 +168,9 @@ def test_live_moves_the_cushions_in_place_then_rebuilds_them_exactly(props):
     names = mannequin.topology.names
     for obj in cushions:  # vertices: the support points of the moved ellipsoids, in the first one's frame
         first, second = names.index(obj.ellimann.part_name), names.index(obj.ellimann.partner)
-        expected = cushion_vertices(mannequin.rotation, mannequin.center, mannequin.semi_axes, [(first, second)],
-                                    CUSHION_LEVEL)[0]
+        expected = cushion_vertices(
+            mannequin.rotation, mannequin.center, mannequin.semi_axes, [(first, second)], CUSHION_LEVEL
+        )[0]
         np.testing.assert_allclose(local_vertices(obj), expected, atol=1e-6)
         assert np.abs(local_vertices(obj) - before[obj.name][1]).max() > 1e-4
         np.testing.assert_allclose(np.array(obj.matrix_world)[:3, 3], mannequin.center[first], atol=1e-6)
@@ -320,7 +329,12 @@ def test_a_preset_is_one_undo_step_with_its_live_update(props):
     assert bpy.ops.ed.undo() == {"FINISHED"}
     assert state() == before
     assert [getattr(bpy.context.scene.ellimann_synthesis, m.lower()) for m in MEASUREMENTS] == [
-        159.0, 43.0, 117.0, 104.0, 117.0]
+        159.0,
+        43.0,
+        117.0,
+        104.0,
+        117.0,
+    ]
     assert bpy.ops.ed.redo() == {"FINISHED"}
     assert state() == after
 
@@ -361,12 +375,15 @@ def shipped_presets():
 
 def test_shipped_presets_hold_the_reference_and_table_2_5_measurements_and_choose_their_set(props):
     """Female presets leave a folder chosen (the user's own set) but leave the male set; male ones choose it."""
-    expected = {f"RM {k.replace('_', ' ').title()}": ([v[m] for m in MEASUREMENTS], "FEMALE")
-                for k, v in REFERENCE_MEASUREMENTS.items()}
+    expected = {
+        f"RM {k.replace('_', ' ').title()}": ([v[m] for m in MEASUREMENTS], "FEMALE")
+        for k, v in REFERENCE_MEASUREMENTS.items()
+    }
     expected.update({f"Table 2.5 ({i})": (list(row), "FEMALE") for i, row in enumerate(TABLE_2_5, 1)})
     male = load_reference_set(SHIPPED_SETS["male"])
-    expected.update({f"Male RM {k.replace('_', ' ').title()}": (list(v), "MALE")
-                     for k, v in zip(male.names, male.measurements)})
+    expected.update(
+        {f"Male RM {k.replace('_', ' ').title()}": (list(v), "MALE") for k, v in zip(male.names, male.measurements)}
+    )
     assert {p.stem for p in shipped_presets()} == set(expected)
     for path in shipped_presets():
         values, chosen = expected[path.stem]

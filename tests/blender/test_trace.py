@@ -8,8 +8,8 @@ from devkit.blender_scene import edit_with_selection, parts, reference_mesh, sta
 from devkit.toy import rotation_from_vector
 from ellimann_addon.blender.bridge.convert import collection_to_mannequin, ellipsoid_frame
 from ellimann_addon.blender.features.trace.operators import FIT_MODE_ITEMS, next_part_name
-from ellimann_addon.core.fit import FIT_MODES, fit_ellipsoid
-from ellimann_addon.core.frames import is_rotation
+from ellimann_addon.core.fitting.point_fit import FIT_MODES, fit_ellipsoid
+from ellimann_addon.core.geometry.frames import is_rotation
 
 
 def test_fit_mode_items_are_the_core_modes():

@@ -14,8 +14,8 @@ from devkit.poses import make_apose_toy
 from devkit.toy import rotation_from_vector
 from ellimann_addon.blender.bridge.convert import mannequin_to_collection
 from ellimann_addon.blender.services.scene import add_mannequin
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
 CYCLE = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])  # relabels axes (x, y, z) -> (y, z, x)
 

@@ -7,8 +7,8 @@ import pytest
 from devkit.blender_scene import parts, select, state
 from ellimann_addon.blender.bridge.checks import frame_issue
 from ellimann_addon.blender.bridge.convert import UNIT_SPHERE_NAME, ellipsoid_frame, is_unit_sphere, mesh_vertices
-from ellimann_addon.core.ellipsoid import shape_matrix
-from ellimann_addon.core.frames import is_rotation
+from ellimann_addon.core.geometry.ellipsoid import shape_matrix
+from ellimann_addon.core.geometry.frames import is_rotation
 
 
 def world_set(obj):
@@ -17,8 +17,8 @@ def world_set(obj):
     vertices = mesh_vertices(obj.data)
     if not is_unit_sphere(obj.data):
         from ellimann_addon.core.constants import UNIT_SPHERE_LEVEL
-        from ellimann_addon.core.fit import fit_affine
-        from ellimann_addon.core.mesh import icosphere
+        from ellimann_addon.core.fitting.point_fit import fit_affine
+        from ellimann_addon.core.geometry.mesh import icosphere
 
         matrix = matrix @ fit_affine(icosphere(UNIT_SPHERE_LEVEL)[0], vertices)[0]
     linear = matrix[:3, :3]

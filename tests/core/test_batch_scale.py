@@ -17,12 +17,12 @@ import pytest
 from devkit import synthetic
 from devkit.cli_runs import assert_one_line_error, run
 from ellimann_addon.cli import common, distributed
-from ellimann_addon.core.batch_file import BatchFileError, load_batch_file, read_batch_file
 from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER, REFERENCE_NAMES, load_reference_set
-from ellimann_addon.core.refine import EXACT_TOLERANCE, FACTOR_LIMITS
-from ellimann_addon.core.synthesis import synthesize_batch
+from ellimann_addon.core.formats.npz_bundle import BatchFileError, load_batch_file, read_batch_file
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, REFERENCE_NAMES, load_reference_set
+from ellimann_addon.core.synthesis.refine import EXACT_TOLERANCE, FACTOR_LIMITS
+from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 
 
 @pytest.fixture(scope="module")
@@ -32,8 +32,13 @@ def references(tmp_path_factory):
 
 def requests_csv(path, count):
     """``count`` requests spread over the reference range (a grid walk), named r0…"""
-    levels = [np.linspace(150, 170, 4), np.linspace(36, 44, 3), np.linspace(88, 110, 3), np.linspace(70, 95, 3),
-              np.linspace(95, 118, 2)]
+    levels = [
+        np.linspace(150, 170, 4),
+        np.linspace(36, 44, 3),
+        np.linspace(88, 110, 3),
+        np.linspace(70, 95, 3),
+        np.linspace(95, 118, 2),
+    ]
     rows = itertools.islice(itertools.cycle(itertools.product(*levels)), count)
     lines = ["name,He,Sh,Br,Wa,Hi"] + [f"r{i}," + ",".join(f"{v:.2f}" for v in row) for i, row in enumerate(rows)]
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
@@ -42,8 +47,9 @@ def requests_csv(path, count):
 
 def test_npz_holds_what_the_json_files_hold(tmp_path, capsys, references):
     source = requests_csv(tmp_path / "in.csv", 7)
-    code, _, err = run(["batch", source, "-o", str(tmp_path / "out"), "--format", "json,npz", "--references",
-                        references, "-q"], capsys)
+    code, _, err = run(
+        ["batch", source, "-o", str(tmp_path / "out"), "--format", "json,npz", "--references", references, "-q"], capsys
+    )
     assert code == 0, err
     loaded = load_batch_file(tmp_path / "out" / "mannequins.npz")
     assert [m.name for m in loaded] == [f"r{i}" for i in range(7)]
@@ -57,8 +63,9 @@ def test_npz_holds_what_the_json_files_hold(tmp_path, capsys, references):
     assert [f"{v:.4f}" for v in arrays["measured_cm"][:, 2]] == [row["Br_measured"] for row in report]
     assert "joints" not in arrays and arrays["converged"].all() and str(arrays["mode"]) == "exact"
     first = (tmp_path / "out" / "mannequins.npz").read_bytes()
-    code, _, _ = run(["batch", source, "-o", str(tmp_path / "out"), "--format", "npz", "--references", references,
-                      "-q"], capsys)
+    code, _, _ = run(
+        ["batch", source, "-o", str(tmp_path / "out"), "--format", "npz", "--references", references, "-q"], capsys
+    )
     assert code == 0 and (tmp_path / "out" / "mannequins.npz").read_bytes() == first  # no time stamps inside
 
 
@@ -71,13 +78,18 @@ def test_a_file_that_is_not_a_batch_is_refused_naming_the_field(tmp_path):
         load_batch_file(tmp_path / "cut.npz")
 
 
-
-
 def test_the_command_line_imports_dask_only_for_dask():
-    code = ("import sys, ellimann_addon.cli as cli; cli.build_parser(); "
-            "print(sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')))")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                          cwd=os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+    code = (
+        "import sys, ellimann_addon.cli as cli; cli.build_parser(); "
+        "print(sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')))"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+    )
     assert done.stdout.strip() == "[]"
 
 
@@ -88,8 +100,9 @@ def test_dask_local_cluster_writes_the_serial_files_byte_for_byte(tmp_path, caps
         here = os.getcwd()
         os.chdir(tmp_path / name)
         try:
-            code, _, err = run(["batch", source, "-o", "out", "--format", "json,npz", "--references", references,
-                                *extra], capsys)
+            code, _, err = run(
+                ["batch", source, "-o", "out", "--format", "json,npz", "--references", references, *extra], capsys
+            )
         finally:
             os.chdir(here)
         assert code == 0, err
@@ -134,16 +147,17 @@ def test_a_failed_chunk_is_reported_row_by_row_and_the_others_kept(monkeypatch, 
     import distributed as dask_distributed
 
     monkeypatch.setattr(dask_distributed, "as_completed", lambda futures: list(reversed(futures)))
-    from ellimann_addon.core.reference_set import load_reference_set
-    from ellimann_addon.core.synthesis import SynthesisOptions
+    from ellimann_addon.core.synthesis.reference_set import load_reference_set
+    from ellimann_addon.core.synthesis.synthesize import SynthesisOptions
 
     reference = load_reference_set(references)
     chunks = [[[160, 40, 95, 80, 105]] * 2, [[165, 41, 100, 82, 110]] * 3, [[170, 42, 100, 85, 110]]]
     results = dict(distributed.Cluster(FakeClient(), None).map([reference] * 3, chunks, SynthesisOptions()))
     assert sorted(results) == [0, 1, 2]
     assert results[0].errors == [None, None] and results[2].errors == [None]
-    assert len(results[1].errors) == 3 and all("failed on the Dask cluster" in e and "worker lost" in e
-                                               for e in results[1].errors)
+    assert len(results[1].errors) == 3 and all(
+        "failed on the Dask cluster" in e and "worker lost" in e for e in results[1].errors
+    )
 
 
 def test_an_unreachable_scheduler_is_one_line_and_nothing_written(tmp_path, capsys, monkeypatch, references):
@@ -152,8 +166,10 @@ def test_an_unreachable_scheduler_is_one_line_and_nothing_written(tmp_path, caps
         port = probe.getsockname()[1]
     monkeypatch.setattr(distributed, "CONNECT_TIMEOUT", "1s")
     source = requests_csv(tmp_path / "in.csv", 3)
-    code, out, err = run(["batch", source, "-o", str(tmp_path / "out"), "--dask", f"tcp://127.0.0.1:{port}",
-                          "--references", references], capsys)
+    code, out, err = run(
+        ["batch", source, "-o", str(tmp_path / "out"), "--dask", f"tcp://127.0.0.1:{port}", "--references", references],
+        capsys,
+    )
     assert_one_line_error(code, err, f"--dask tcp://127.0.0.1:{port}: cannot reach the scheduler")
     assert not (tmp_path / "out").exists() and out == ""
 
@@ -188,8 +204,7 @@ def test_progress_shows_count_rate_and_time_left_and_is_quiet_with_q(monkeypatch
 
 
 GRID = np.array(list(itertools.product(*[quartile_points(key) for key in MEASUREMENTS])))
-SETS = ["synthetic"] + (["shipped"] if all((REFERENCE_FOLDER / f"{n}.json").is_file() for n in REFERENCE_NAMES)
-                        else [])
+SETS = ["synthetic"] + (["shipped"] if all((REFERENCE_FOLDER / f"{n}.json").is_file() for n in REFERENCE_NAMES) else [])
 
 
 @pytest.mark.parametrize("which", SETS)
@@ -200,16 +215,16 @@ def test_exact_mode_converges_on_the_whole_grid_and_one_at_a_time_is_the_batch_b
     assert np.abs(np.log(batch.measured / GRID)).max() <= EXACT_TOLERANCE
     assert np.all((batch.factors >= FACTOR_LIMITS[0]) & (batch.factors <= FACTOR_LIMITS[1]))
     for i in range(0, len(GRID), 5):  # what a chunk of a serial or Dask batch gives is what a request alone gives
-        alone = synthesize_batch(reference, GRID[i:i + 1], mode="exact")
+        alone = synthesize_batch(reference, GRID[i : i + 1], mode="exact")
         for key in ("center", "semi_axes", "measured", "factors"):
             np.testing.assert_array_equal(getattr(alone, key)[0], getattr(batch, key)[i])
 
 
 def test_a_row_the_core_refuses_fails_alone_and_its_chunk_keeps_the_others(monkeypatch, references):
-    from ellimann_addon.cli import batch
-    from ellimann_addon.core import synthesis
     from ellimann_addon.core.errors import ElliMannError
-    from ellimann_addon.core.reference_set import load_reference_set
+    from ellimann_addon.core.synthesis import batch as chunking
+    from ellimann_addon.core.synthesis import synthesize as synthesis
+    from ellimann_addon.core.synthesis.reference_set import load_reference_set
 
     real = synthesis.synthesize_batch
 
@@ -218,10 +233,10 @@ def test_a_row_the_core_refuses_fails_alone_and_its_chunk_keeps_the_others(monke
             raise ElliMannError("synthesis at He 161 cm gives an implausible mannequin")
         return real(reference, requests, options, **fields)
 
-    monkeypatch.setattr(synthesis, "synthesize_batch", refusing)
+    monkeypatch.setattr(chunking, "synthesize_batch", refusing)
     reference = load_reference_set(references)
     chunk = [[160.0, 40, 95, 80, 105], [161.0, 40, 95, 80, 105], [162.0, 41, 96, 81, 106]]
-    result = batch.synthesize_chunk(reference, chunk, synthesis.SynthesisOptions())
+    result = chunking.synthesize_chunk(reference, chunk, synthesis.SynthesisOptions())
     assert result.errors[0] is None and result.errors[2] is None and "implausible" in result.errors[1]
     alone = real(reference, [chunk[0], chunk[2]])
     np.testing.assert_array_equal(result.center[[0, 2]], alone.center)

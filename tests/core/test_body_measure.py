@@ -8,16 +8,18 @@ import pytest
 
 from devkit.cli_runs import assert_one_line_error, run
 from devkit.toy import make_toy_mannequin
-from ellimann_addon.core.body_measure import (
+from ellimann_addon.core.constants import MEASUREMENTS, SECTION_FRACTIONS
+from ellimann_addon.core.fitting.body_mesh import BodyMeshError, read_body_mesh
+from ellimann_addon.core.geometry.mesh import icosphere, in_plane, section_segments
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.measure.body import (
     ALL_MEASUREMENTS,
     StandingBody,
     hull_girth,
     measure_body_mesh,
     section_blobs,
 )
-from ellimann_addon.core.body_mesh import BodyMeshError, read_body_mesh
-from ellimann_addon.core.constants import MEASUREMENTS, SECTION_FRACTIONS
-from ellimann_addon.core.extra_measures import (
+from ellimann_addon.core.measure.extra import (
     EXTRA_MEASUREMENTS,
     ISO_ALLOWANCE,
     MannequinLandmarks,
@@ -25,23 +27,32 @@ from ellimann_addon.core.extra_measures import (
     extreme_over_band,
     mannequin_extra_measurements,
 )
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.mesh import icosphere, in_plane, section_segments
-from ellimann_addon.core.refine_extra import ExtraRequestError, extra_request_problems, synthesize_extra
-from ellimann_addon.core.shipped_sets import named_reference_set, reference_folder
+from ellimann_addon.core.synthesis.extra_refine import ExtraRequestError, extra_request_problems
+from ellimann_addon.core.synthesis.shipped import named_reference_set, reference_folder
+from ellimann_addon.core.synthesis.synthesize import synthesize_extra
 
 
 def cylinder(radius, length, sides, axis=(0.0, 0.0, 1.0), centre=(0.0, 0.0, 0.0)):
     """A closed prism of ``sides`` around ``axis`` (vertices, faces)."""
     angle = 2.0 * np.pi * np.arange(sides) / sides
     ring = np.stack([radius * np.cos(angle), radius * np.sin(angle)], axis=1)
-    v = np.concatenate([np.c_[ring, np.full(sides, -0.5 * length)], np.c_[ring, np.full(sides, 0.5 * length)],
-                        [[0, 0, -0.5 * length], [0, 0, 0.5 * length]]])
+    v = np.concatenate(
+        [
+            np.c_[ring, np.full(sides, -0.5 * length)],
+            np.c_[ring, np.full(sides, 0.5 * length)],
+            [[0, 0, -0.5 * length], [0, 0, 0.5 * length]],
+        ]
+    )
     i = np.arange(sides)
     j = (i + 1) % sides
-    faces = np.concatenate([np.c_[i, j, sides + j], np.c_[i, sides + j, sides + i],
-                            np.c_[np.full(sides, 2 * sides), j, i], np.c_[np.full(sides, 2 * sides + 1), sides + i,
-                                                                           sides + j]])
+    faces = np.concatenate(
+        [
+            np.c_[i, j, sides + j],
+            np.c_[i, sides + j, sides + i],
+            np.c_[np.full(sides, 2 * sides), j, i],
+            np.c_[np.full(sides, 2 * sides + 1), sides + i, sides + j],
+        ]
+    )
     axis = np.asarray(axis, float) / np.linalg.norm(axis)
     _, frame = in_plane(np.zeros((1, 3)), np.zeros(3), axis)
     return v @ frame + centre, faces
@@ -55,6 +66,7 @@ def mesh_of(mannequin, level=4):
 
 
 # ------------------------------------------------------------------------------------------------ closed forms
+
 
 @pytest.mark.parametrize("sides", [8, 64])
 def test_prism_section_is_its_polygon(sides):
@@ -113,6 +125,7 @@ def test_spheroid_limbs_closed_forms():
 
 # ------------------------------------------------------------------------------------------------ mannequin vs mesh
 
+
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["average", "small_slim"])
 def test_mesh_of_a_mannequin_measures_as_its_closed_forms(name):
@@ -125,6 +138,7 @@ def test_mesh_of_a_mannequin_measures_as_its_closed_forms(name):
 
 
 # ------------------------------------------------------------------------------------------------ bad meshes
+
 
 def body():
     return mesh_of(make_toy_mannequin(), 3)
@@ -179,16 +193,26 @@ def test_arms_against_the_torso():
 
 def test_readers_agree(tmp_path):
     v, f = cylinder(0.1, 1.6, 12, centre=(0, 0, 0.8))
-    (tmp_path / "b.obj").write_text("".join(f"v {x} {z} {-y}\n" for x, y, z in v)
-                                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in f))
-    (tmp_path / "b.ply").write_text(f"ply\nformat ascii 1.0\nelement vertex {len(v)}\nproperty float x\n"
-                                    f"property float y\nproperty float z\nelement face {len(f)}\n"
-                                    "property list uchar int vertex_indices\nend_header\n"
-                                    + "".join(f"{x} {y} {z}\n" for x, y, z in v)
-                                    + "".join(f"3 {a} {b} {c}\n" for a, b, c in f))
-    (tmp_path / "b.stl").write_text("solid b\n" + "".join(
-        "facet normal 0 0 0\nouter loop\n" + "".join(f"vertex {x} {y} {z}\n" for x, y, z in v[t])
-        + "endloop\nendfacet\n" for t in f) + "endsolid b\n")
+    (tmp_path / "b.obj").write_text(
+        "".join(f"v {x} {z} {-y}\n" for x, y, z in v) + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in f)
+    )
+    (tmp_path / "b.ply").write_text(
+        f"ply\nformat ascii 1.0\nelement vertex {len(v)}\nproperty float x\n"
+        f"property float y\nproperty float z\nelement face {len(f)}\n"
+        "property list uchar int vertex_indices\nend_header\n"
+        + "".join(f"{x} {y} {z}\n" for x, y, z in v)
+        + "".join(f"3 {a} {b} {c}\n" for a, b, c in f)
+    )
+    (tmp_path / "b.stl").write_text(
+        "solid b\n"
+        + "".join(
+            "facet normal 0 0 0\nouter loop\n"
+            + "".join(f"vertex {x} {y} {z}\n" for x, y, z in v[t])
+            + "endloop\nendfacet\n"
+            for t in f
+        )
+        + "endsolid b\n"
+    )
     for kind in ("obj", "ply", "stl"):
         read, faces = read_body_mesh(str(tmp_path / f"b.{kind}"))
         assert np.allclose(np.sort(read, axis=0), np.sort(v, axis=0), atol=1e-6) and len(faces) == len(f), kind
@@ -197,6 +221,7 @@ def test_readers_agree(tmp_path):
 
 
 # ------------------------------------------------------------------------------------------------ exact mode
+
 
 def test_contradictions_are_refused_with_the_amount():
     request = {"He": 160.0, "Sh": 40.0, "Br": 100.0, "Wa": 80.0, "Hi": 100.0}
@@ -208,8 +233,10 @@ def test_contradictions_are_refused_with_the_amount():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("request_five", [(150.0, 35.0, 90.0, 70.0, 90.0), (165.0, 45.0, 120.0, 105.0, 120.0)])
-@pytest.mark.parametrize("extra", [{"neck": 33.0, "thigh": None, "crotch_height": None},
-                                   {"upper_arm": None, "calf": None, "arm_length": None}])
+@pytest.mark.parametrize(
+    "extra",
+    [{"neck": 33.0, "thigh": None, "crotch_height": None}, {"upper_arm": None, "calf": None, "arm_length": None}],
+)
 def test_exact_mode_meets_every_given_measurement(request_five, extra):
     reference = named_reference_set("female")
     five = dict(zip(MEASUREMENTS, request_five))
@@ -224,11 +251,13 @@ def test_exact_mode_meets_every_given_measurement(request_five, extra):
 
 # ------------------------------------------------------------------------------------------------ command line
 
+
 def test_measure_a_body_mesh_on_the_command_line(tmp_path, capsys):
     v, f = body()
     path = tmp_path / "toy.obj"
-    path.write_text("".join(f"v {x} {z} {-y}\n" for x, y, z in v) + "".join(f"f {a + 1} {b + 1} {c + 1}\n"
-                                                                             for a, b, c in f))
+    path.write_text(
+        "".join(f"v {x} {z} {-y}\n" for x, y, z in v) + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in f)
+    )
     code, out, err = run(["measure", str(path), "--json"], capsys)
     assert code == 0, err
     values = json.loads(out)

@@ -1,12 +1,13 @@
-"""core.bones (an armature's layout for a skeleton) and core.retarget (motion from another rig), without Blender."""
+"""core.pose.bones (an armature's layout for a skeleton) and core.pose.retarget (motion from another rig), without
+Blender."""
 
 import numpy as np
 import pytest
 
-from ellimann_addon.core.bones import bone_axes, bone_limit, bone_rotations, layout_bones, root_location
 from ellimann_addon.core.errors import ElliMannError
-from ellimann_addon.core.pose import axis_angle
-from ellimann_addon.core.retarget import SourceMotion, retarget, shortest_rotation
+from ellimann_addon.core.pose.bones import bone_axes, bone_limit, bone_rotations, layout_bones, root_location
+from ellimann_addon.core.pose.kinematics import axis_angle
+from ellimann_addon.core.pose.retarget import SourceMotion, retarget, shortest_rotation
 
 AXES = np.eye(3)
 
@@ -14,9 +15,13 @@ AXES = np.eye(3)
 def random_rotation(rng):
     q = rng.normal(size=4)
     w, x, y, z = q / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def blender_euler(order, angles_by_axis):
@@ -49,8 +54,13 @@ def test_a_limit_in_the_limit_frame_is_a_box_in_the_bones_axes(seed):
     bone = layout_bones(["A", "B"], joints, [-1, 0], limit_frames=np.stack([frame, frame]))[0]
     angles = rng.uniform(-1.2, 1.2, size=3)
     limit = bone_limit(bone, frame, [(a - 0.1, a + 0.1) for a in angles])
-    local = frame @ axis_angle(AXES[0], angles[0]) @ axis_angle(AXES[1], angles[1]) @ axis_angle(AXES[2], angles[2]) \
+    local = (
+        frame
+        @ axis_angle(AXES[0], angles[0])
+        @ axis_angle(AXES[1], angles[1])
+        @ axis_angle(AXES[2], angles[2])
         @ frame.T
+    )
     basis = bone_rotations(bone.frame[None], local[None])[0]
     centres = np.array([(lo + hi) / 2.0 for lo, hi in limit.ranges])
     assert np.allclose(blender_euler(limit.euler_order, centres), basis, atol=1e-12)
@@ -72,8 +82,9 @@ def test_root_location_and_bone_rotations_invert_the_bone_frame():
     assert np.allclose(frame @ bone_rotations(frame[None], rotation[None])[0] @ frame.T, rotation)
 
 
-@pytest.mark.parametrize("a, b", [((1, 0, 0), (0, 1, 0)), ((0, 0, 1), (0, 0, -1)), ((1, 2, 3), (-3, 1, 0.5)),
-                                  ((1, 0, 0), (1, 0, 0))])
+@pytest.mark.parametrize(
+    "a, b", [((1, 0, 0), (0, 1, 0)), ((0, 0, 1), (0, 0, -1)), ((1, 2, 3), (-3, 1, 0.5)), ((1, 0, 0), (1, 0, 0))]
+)
 def test_shortest_rotation(a, b):
     rotation = shortest_rotation(a, b)
     assert np.allclose(rotation @ (np.array(a) / np.linalg.norm(a)), np.array(b) / np.linalg.norm(b))
@@ -90,8 +101,9 @@ def test_a_source_resting_elsewhere_is_followed_by_bone_directions():
     """A source whose rest bends the chain 90 degrees: at its own rest frame the target takes that bend."""
     names, joints, parents = chain()
     heads = np.array([[0.0, 0.0, 2.0], [0.0, 0.0, 1.0], [0.0, -1.0, 1.0]])  # Mid -> Tip points forward
-    motion = SourceMotion(["r", "m", "t"], heads, np.broadcast_to(np.eye(3), (1, 3, 3, 3)).copy(),
-                          heads[:1].copy(), 24.0)
+    motion = SourceMotion(
+        ["r", "m", "t"], heads, np.broadcast_to(np.eye(3), (1, 3, 3, 3)).copy(), heads[:1].copy(), 24.0
+    )
     local, translation = retarget(motion, names, joints, parents, {"r": "Root", "m": "Mid", "t": "Tip"})
     mid_direction = local[0, 0] @ local[0, 1] @ (joints[2] - joints[1])
     assert np.allclose(mid_direction / np.linalg.norm(mid_direction), [0.0, -1.0, 0.0])
@@ -115,8 +127,8 @@ def test_no_known_bone_is_refused_naming_the_clips_bones():
 
 
 def test_a_drape_motion_starts_at_rest_reaches_the_pose_and_loops_with_the_drift():
-    from ellimann_addon.core.motion import arms_out, drape_motion, rotation_fraction
-    from ellimann_addon.core.pose import Pose
+    from ellimann_addon.core.pose.kinematics import Pose
+    from ellimann_addon.core.pose.motion import arms_out, drape_motion, rotation_fraction
 
     rng = np.random.default_rng(3)
     poses = [Pose(np.stack([random_rotation(rng) for _ in range(24)]), rng.normal(size=3)) for _ in range(3)]

@@ -2,9 +2,9 @@ import numpy as np
 import pytest
 
 from devkit.toy import rotation_from_vector
-from ellimann_addon.core import clean
-from ellimann_addon.core.ellipsoid import axis_extent, shape_matrix
-from ellimann_addon.core.frames import SIGNED_PERMUTATIONS, axis_agreement, is_rotation
+from ellimann_addon.core.geometry.ellipsoid import axis_extent, shape_matrix
+from ellimann_addon.core.geometry.frames import SIGNED_PERMUTATIONS, axis_agreement, is_rotation
+from ellimann_addon.core.mannequin import clean
 
 
 def disturbed(toy, seed):
@@ -43,8 +43,11 @@ def test_clean_gives_consistent_labels_and_keeps_each_ellipsoid(toy):
         assert clean.asymmetry(after) < 1e-12
         left = after.topology.indices("L")
         # the left side is only moved (registration) and relabelled, not reshaped
-        assert np.allclose(shape_matrix(after.rotation[left], after.semi_axes[left]),
-                           shape_matrix(before.rotation[left], before.semi_axes[left]), atol=1e-12)
+        assert np.allclose(
+            shape_matrix(after.rotation[left], after.semi_axes[left]),
+            shape_matrix(before.rotation[left], before.semi_axes[left]),
+            atol=1e-12,
+        )
         assert axis_agreement(after.rotation, cleaned[0].rotation).min() > 0.95
 
 

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from devkit.cli_runs import assert_one_line_error, run
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.posed_files import read_pose
-from ellimann_addon.core.poses import standard_pose, walk
+from ellimann_addon.core.formats.posed_files import read_pose
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.pose.standard import standard_pose, walk
 
 REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]
 
@@ -47,8 +47,9 @@ def test_synth_with_a_pose_writes_the_pose_of_the_synthesized_mannequin(tmp_path
 def test_batch_with_a_pose_writes_each_row_posed(tmp_path, capsys):
     source = tmp_path / "in.csv"
     source.write_text("He,Sh,Br,Wa,Hi,name\n160,40,95,80,105,a\n170,42,100,85,110,b\n", encoding="utf-8")
-    code, _, _ = run(["batch", str(source), "-o", str(tmp_path / "out"), "--format", "json,mjcf,obj", "--pose",
-                      "t_pose"], capsys)
+    code, _, _ = run(
+        ["batch", str(source), "-o", str(tmp_path / "out"), "--format", "json,mjcf,obj", "--pose", "t_pose"], capsys
+    )
     assert code == 0
     for name in "ab":
         assert read_pose(tmp_path / "out" / f"{name}.json")[0].name == "t_pose"
@@ -81,15 +82,18 @@ def _beyond(tmp_path, rest):
     return pose
 
 
-@pytest.mark.parametrize("argv, words", [
-    (["pose", "{rest}", "--pose", "dance", "-o", "{tmp}/x.json"], ["unknown pose 'dance'", "t_pose"]),
-    (["synth", *REQUEST, "--pose", "dance", "-o", "{tmp}/x.json"], ["unknown pose 'dance'"]),
-    (["pose", "{old}", "--pose", "sit", "-o", "{tmp}/x.json"], ["has no joints"]),
-    (["pose", "{rest}", "--pose", "{kick}", "-o", "{tmp}/x.xml"], ["L_Hip", "-170.0", "range -140 to 20"]),
-    (["pose", "{rest}", "--pose", "walk", "-o", "{tmp}/x.obj"], ["walk is an animation", ".obj"]),
-    (["batch", "{tmp}/in.csv", "-o", "{tmp}/out", "--format", "obj", "--pose", "walk"], ["animation"]),
-    (["pose", "{rest}", "-o", "{tmp}/x.json"], ["--pose is required"]),
-])
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        (["pose", "{rest}", "--pose", "dance", "-o", "{tmp}/x.json"], ["unknown pose 'dance'", "t_pose"]),
+        (["synth", *REQUEST, "--pose", "dance", "-o", "{tmp}/x.json"], ["unknown pose 'dance'"]),
+        (["pose", "{old}", "--pose", "sit", "-o", "{tmp}/x.json"], ["has no joints"]),
+        (["pose", "{rest}", "--pose", "{kick}", "-o", "{tmp}/x.xml"], ["L_Hip", "-170.0", "range -140 to 20"]),
+        (["pose", "{rest}", "--pose", "walk", "-o", "{tmp}/x.obj"], ["walk is an animation", ".obj"]),
+        (["batch", "{tmp}/in.csv", "-o", "{tmp}/out", "--format", "obj", "--pose", "walk"], ["animation"]),
+        (["pose", "{rest}", "-o", "{tmp}/x.json"], ["--pose is required"]),
+    ],
+)
 def test_bad_poses_are_refused_in_one_line_and_nothing_is_written(tmp_path, rest, capsys, argv, words):
     (tmp_path / "in.csv").write_text("He,Sh,Br,Wa,Hi\n165,41.5,101.25,82.75,117.5\n", encoding="utf-8")
     fields = dict(rest=rest, tmp=tmp_path, old=_no_joints(tmp_path, rest), kick=_beyond(tmp_path, rest))

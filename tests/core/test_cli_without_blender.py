@@ -11,7 +11,7 @@ import sys
 import pytest
 
 from devkit import synthetic
-from ellimann_addon.core.extra_measures import EXTRA_MEASUREMENTS
+from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]
@@ -41,16 +41,20 @@ def references(tmp_path_factory):
 
 
 def without_blender(*args):
-    done = subprocess.run([sys.executable, "-c", WITHOUT_BLENDER, *args], cwd=ROOT, capture_output=True, text=True,
-                          timeout=120)
+    done = subprocess.run(
+        [sys.executable, "-c", WITHOUT_BLENDER, *args], cwd=ROOT, capture_output=True, text=True, timeout=120
+    )
     *lines, loaded = done.stderr.strip().splitlines()
     assert loaded == "LOADED []", done.stderr
     return done.returncode, done.stdout, "\n".join(lines)
 
 
 def test_the_blocker_blocks():
-    code = "import sys\n" + WITHOUT_BLENDER.split("sys.meta_path.insert(0, NoBlender())")[0] + (
-        "sys.meta_path.insert(0, NoBlender())\ntry:\n    import bpy\nexcept ImportError:\n    print('blocked')\n")
+    code = (
+        "import sys\n"
+        + WITHOUT_BLENDER.split("sys.meta_path.insert(0, NoBlender())")[0]
+        + ("sys.meta_path.insert(0, NoBlender())\ntry:\n    import bpy\nexcept ImportError:\n    print('blocked')\n")
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "blocked"
 
@@ -58,8 +62,7 @@ def test_the_blocker_blocks():
 @pytest.mark.parametrize("kind", ["json", "xml"])
 def test_synth_and_measure_run_without_blender(tmp_path, references, kind):
     out = tmp_path / f"woman.{kind}"
-    code, stdout, stderr = without_blender("synth", *REQUEST, "--cushions", "-o", str(out), "--references",
-                                           references)
+    code, stdout, stderr = without_blender("synth", *REQUEST, "--cushions", "-o", str(out), "--references", references)
     assert code == 0, stderr
     assert stdout.startswith(f"wrote {out}: 'ElliMann 165-41.5-101.25-82.75-117.5' (exact), m_T He 165.00, ")
     assert out.is_file()
@@ -69,7 +72,8 @@ def test_synth_and_measure_run_without_blender(tmp_path, references, kind):
         printed = json.loads(stdout)  # the five, then the extra measurements (docs/measurements.md)
         assert list(printed) == ["He", "Sh", "Br", "Wa", "Hi", *EXTRA_MEASUREMENTS]
         assert {key: printed[key] for key in ("He", "Sh", "Br", "Wa", "Hi")} == pytest.approx(
-            dict(zip(("He", "Sh", "Br", "Wa", "Hi"), (165, 41.5, 101.25, 82.75, 117.5))), rel=1e-4)
+            dict(zip(("He", "Sh", "Br", "Wa", "Hi"), (165, 41.5, 101.25, 82.75, 117.5))), rel=1e-4
+        )
         code, stdout, _ = without_blender("measure", str(out))
         assert code == 0 and "He Height" in stdout
 
@@ -77,11 +81,11 @@ def test_synth_and_measure_run_without_blender(tmp_path, references, kind):
 def test_batch_to_core_formats_runs_without_blender(tmp_path, references):
     source = tmp_path / "in.csv"
     source.write_text("He,Sh,Br,Wa,Hi,name\n160,40,95,80,105,a\n170,42,100,85,110,b\n", encoding="utf-8")
-    code, stdout, stderr = without_blender("batch", str(source), "-o", str(tmp_path / "out"), "--format",
-                                           "json,mjcf", "--references", references)
+    code, stdout, stderr = without_blender(
+        "batch", str(source), "-o", str(tmp_path / "out"), "--format", "json,mjcf", "--references", references
+    )
     assert code == 0, stderr
-    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["a.json", "a.xml", "b.json", "b.xml",
-                                                                    "report.csv"]
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["a.json", "a.xml", "b.json", "b.xml", "report.csv"]
 
 
 def test_posed_core_formats_run_without_blender(tmp_path):
@@ -89,17 +93,28 @@ def test_posed_core_formats_run_without_blender(tmp_path):
     code, _, stderr = without_blender("synth", *REQUEST, "-o", str(rest))
     assert code == 0, stderr
     for pose, out in (("sit", "sit.obj"), ("walk", "walk.xml"), ("t_pose", "t.json")):
-        code, stdout, stderr = without_blender("pose", str(rest), "--pose", pose, "--cushions", "-o",
-                                               str(tmp_path / out))
+        code, stdout, stderr = without_blender(
+            "pose", str(rest), "--pose", pose, "--cushions", "-o", str(tmp_path / out)
+        )
         assert code == 0, stderr
         assert stdout.startswith(f"wrote {tmp_path / out}: 'ElliMann 165-41.5-101.25-82.75-117.5' in pose {pose}")
     code, _, stderr = without_blender("synth", *REQUEST, "--pose", "attention", "-o", str(tmp_path / "a.obj"))
     assert code == 0, stderr
 
 
-@pytest.mark.parametrize("argv", [["--help"], ["synth", "--help"], ["batch", "--help"], ["measure", "--help"],
-                                  ["demo", "--help"], ["drape", "--help"], ["population", "--help"],
-                                  ["pose", "--help"]])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--help"],
+        ["synth", "--help"],
+        ["batch", "--help"],
+        ["measure", "--help"],
+        ["demo", "--help"],
+        ["drape", "--help"],
+        ["population", "--help"],
+        ["pose", "--help"],
+    ],
+)
 def test_help_runs_without_blender(argv):
     code, stdout, _ = without_blender(*argv)
     assert code == 0 and "usage: ellimann" in stdout
@@ -107,23 +122,27 @@ def test_help_runs_without_blender(argv):
         assert "(default 60, at 24 fps)" in " ".join(stdout.split())
 
 
-@pytest.mark.parametrize("argv, what", [
-    (["synth", *REQUEST, "-o", "{tmp}/w.blend"], "writing {tmp}/w.blend"),
-    (["synth", *REQUEST, "-o", "{tmp}/w.glb"], "writing {tmp}/w.glb"),
-    (["synth", *REQUEST, "-o", "{tmp}/w.obj"], "writing {tmp}/w.obj"),
-    (["batch", "{tmp}/in.csv", "-o", "{tmp}/out", "--format", "json,blend"], "--format blend"),
-    (["measure", "{tmp}/w.blend"], "reading {tmp}/w.blend"),
-    (["synth", *REQUEST, "--pose", "walk", "-o", "{tmp}/w.glb"], "writing {tmp}/w.glb"),
-    (["drape", "{tmp}/w.json", "-o", "{tmp}/d.blend"], "the cloth simulation"),
-    (["demo", "-o", "{tmp}/demo"], "the demo (.blend files and a line-up picture)"),
-])
+@pytest.mark.parametrize(
+    "argv, what",
+    [
+        (["synth", *REQUEST, "-o", "{tmp}/w.blend"], "writing {tmp}/w.blend"),
+        (["synth", *REQUEST, "-o", "{tmp}/w.glb"], "writing {tmp}/w.glb"),
+        (["synth", *REQUEST, "-o", "{tmp}/w.obj"], "writing {tmp}/w.obj"),
+        (["batch", "{tmp}/in.csv", "-o", "{tmp}/out", "--format", "json,blend"], "--format blend"),
+        (["measure", "{tmp}/w.blend"], "reading {tmp}/w.blend"),
+        (["synth", *REQUEST, "--pose", "walk", "-o", "{tmp}/w.glb"], "writing {tmp}/w.glb"),
+        (["drape", "{tmp}/w.json", "-o", "{tmp}/d.blend"], "the cloth simulation"),
+        (["demo", "-o", "{tmp}/demo"], "the demo (.blend files and a line-up picture)"),
+    ],
+)
 def test_what_needs_blender_is_refused_in_one_line(tmp_path, argv, what):
     code, stdout, stderr = without_blender(*(a.format(tmp=tmp_path) for a in argv))
     assert code == 1 and stdout == ""
     lines = stderr.splitlines()
     assert len(lines) == 1 and "Traceback" not in stderr, stderr
-    assert lines[0].startswith(f"ellimann {argv[0]}: error: {what.format(tmp=tmp_path)} needs Blender: the bpy "
-                               "module is not installed")
+    assert lines[0].startswith(
+        f"ellimann {argv[0]}: error: {what.format(tmp=tmp_path)} needs Blender: the bpy module is not installed"
+    )
     assert not list(tmp_path.iterdir())
 
 
@@ -138,15 +157,21 @@ def test_the_cli_imports_blender_only_inside_functions():
                 names = [("." * node.level) + (node.module or "")]
             else:
                 continue
-            offenders += [f"{path.name}: {n}" for n in names if n.split(".")[0] in ("bpy", "bmesh", "mathutils")
-                          or n.lstrip(".").startswith("blender") or n.startswith("ellimann_addon.blender")]
+            offenders += [
+                f"{path.name}: {n}"
+                for n in names
+                if n.split(".")[0] in ("bpy", "bmesh", "mathutils")
+                or n.lstrip(".").startswith("blender")
+                or n.startswith("ellimann_addon.blender")
+            ]
     assert offenders == []
 
 
 def test_one_table_for_the_options_of_the_cli_and_the_panels():
     from ellimann_addon.cli import build_parser
-    from ellimann_addon.core import garments
-    from ellimann_addon.core.options import DRAPE, SYNTHESIS, DrapeSettings, SynthesisOptions
+    from ellimann_addon.core.drape import garments
+    from ellimann_addon.core.drape.settings import DRAPE, DrapeSettings
+    from ellimann_addon.core.synthesis.options import SYNTHESIS, SynthesisOptions
 
     assert SynthesisOptions() == SynthesisOptions(**{k: o.default for k, o in SYNTHESIS.items()})
     assert SynthesisOptions().mode == "exact"

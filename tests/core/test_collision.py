@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from devkit.toy import make_toy_mannequin
-from ellimann_addon.core.collision import collision_pieces, triangle_count
-from ellimann_addon.core.cushion import cushion_mesh
+from ellimann_addon.core.drape.colliders import collision_pieces, triangle_count
 from ellimann_addon.core.errors import ElliMannError
+from ellimann_addon.core.geometry.cushion import cushion_mesh
 
 
 def test_ellipsoid_pieces_lie_on_their_ellipsoids():
@@ -35,8 +35,15 @@ def test_cushions_replace_their_pair():
         assert np.allclose(piece.matrix[:3, :3], toy.rotation[i])  # rigid: the first ellipsoid's frame
 
 
-@pytest.mark.parametrize("options", [{"sphere_subdivisions": 6}, {"cushion_subdivisions": -1},
-                                     {"sphere_subdivisions": 1.5}, {"cushion_subdivisions": True}])
+@pytest.mark.parametrize(
+    "options",
+    [
+        {"sphere_subdivisions": 6},
+        {"cushion_subdivisions": -1},
+        {"sphere_subdivisions": 1.5},
+        {"cushion_subdivisions": True},
+    ],
+)
 def test_bad_levels_are_refused(options):
     name = next(iter(options))
     with pytest.raises(ElliMannError, match=f"{name}: must be an integer from 0 to 5"):

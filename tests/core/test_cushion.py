@@ -4,13 +4,13 @@ from scipy.spatial import ConvexHull
 
 from devkit import synthetic
 from devkit.toy import rotation_from_vector
-from ellimann_addon.core import cushion, mesh
 from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS
-from ellimann_addon.core.ellipsoid import contains, support
 from ellimann_addon.core.errors import ElliMannError
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER
-from ellimann_addon.core.synthesis import synthesize
+from ellimann_addon.core.geometry import cushion, mesh
+from ellimann_addon.core.geometry.ellipsoid import contains, support
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
+from ellimann_addon.core.synthesis.synthesize import synthesize
 
 
 def check_convex_closed(v, f):
@@ -39,8 +39,9 @@ def test_resolution_converges():
 
 
 def random_pair(rng, lo=0.02):
-    make = lambda: (rotation_from_vector(rng.normal(size=3) * 2), rng.normal(size=3) * 0.1,  # noqa: E731
-                    rng.uniform(lo, 0.2, 3))
+    def make():
+        return rotation_from_vector(rng.normal(size=3) * 2), rng.normal(size=3) * 0.1, rng.uniform(lo, 0.2, 3)
+
     return make(), make()
 
 
@@ -88,8 +89,10 @@ def test_identical_and_nested_ellipsoids():
 def test_a_batch_builds_every_pair_as_if_alone(monkeypatch):
     """cushion_meshes runs all pairs through shared arrays; each mesh must be exactly the one built alone,
     also next to a flat pair whose folded triangulation is rebuilt by the exact hull."""
-    flat = ((rotation_from_vector((0.3, 0.5, 0.1)), (0, 0, 0), (0.2, 0.02, 0.15)),
-            (np.eye(3), (0.05, 0.02, 0.25), (0.08, 0.1, 0.12)))
+    flat = (
+        (rotation_from_vector((0.3, 0.5, 0.1)), (0, 0, 0), (0.2, 0.02, 0.15)),
+        (np.eye(3), (0.05, 0.02, 0.25), (0.08, 0.1, 0.12)),
+    )
     capsule = ((np.eye(3), (0, 0, 0), (0.1, 0.1, 0.1)), (np.eye(3), (0, 0, 0.3), (0.1, 0.1, 0.1)))
     rng = np.random.default_rng(3)
     pairs = [random_pair(rng), flat, capsule, (capsule[0], capsule[0]), random_pair(rng)]
@@ -109,8 +112,10 @@ def test_a_fold_left_by_the_flips_is_mended_into_the_exact_hull_from_a_small_pat
     """The shipped Average's right foot and toes: the flips end locally convex but folded (a few faces face the
     interior); the faces around the fold are rebuilt from the hull of a few of the points, not all of them."""
     average = Mannequin.load(REFERENCE_FOLDER / "average.json")
-    pair = [tuple(a[average.topology.index[name]] for a in (average.rotation, average.center, average.semi_axes))
-            for name in ("7.a Foot.R", "7.b Toes.R")]
+    pair = [
+        tuple(a[average.topology.index[name]] for a in (average.rotation, average.center, average.semi_axes))
+        for name in ("7.a Foot.R", "7.b Toes.R")
+    ]
     hulled = []
     real_hull = cushion.convex_hull_3d
     monkeypatch.setattr(cushion, "convex_hull_3d", lambda points: hulled.append(len(points)) or real_hull(points))
@@ -181,7 +186,7 @@ def test_cushion_vertices_are_the_hull_builders_support_points_for_every_pair_at
     mannequin, _, _ = synthesize(reference, REFERENCE_MEASUREMENTS["small_chubby"], mode="exact")
     pairs = mannequin.topology.cushion_pairs
     batch = cushion.cushion_vertices(mannequin.rotation, mannequin.center, mannequin.semi_axes, pairs, subdivisions)
-    assert batch.shape == (len(pairs), 10 * 4 ** subdivisions + 2, 3)
+    assert batch.shape == (len(pairs), 10 * 4**subdivisions + 2, 3)
     for vertices, (i, j) in zip(batch, pairs):
         first = (mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i])
         second = (mannequin.rotation[j], mannequin.center[j], mannequin.semi_axes[j])

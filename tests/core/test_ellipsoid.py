@@ -4,9 +4,9 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from devkit.toy import rotation_from_vector
-from ellimann_addon.core import ellipsoid as el
 from ellimann_addon.core.errors import FrameError
-from ellimann_addon.core.frames import is_rotation
+from ellimann_addon.core.geometry import ellipsoid as el
+from ellimann_addon.core.geometry.frames import is_rotation
 
 vectors = st.tuples(*[st.floats(-3, 3)] * 3)
 sizes = st.tuples(*[st.floats(0.02, 0.3)] * 3)
@@ -130,8 +130,12 @@ def test_decompose_refuses_negative_scale_shear_and_zero_scale():
 
 def test_decomposing_a_stack_is_one_decomposition_per_matrix_or_none_if_any_is_not_a_frame():
     rng = np.random.default_rng(7)
-    good = np.array([el.matrix_world(rotation_from_vector(rng.normal(size=3)), rng.normal(size=3),
-                                     rng.uniform(0.02, 0.3, 3)) for _ in range(12)])
+    good = np.array(
+        [
+            el.matrix_world(rotation_from_vector(rng.normal(size=3)), rng.normal(size=3), rng.uniform(0.02, 0.3, 3))
+            for _ in range(12)
+        ]
+    )
     stacked = el.decompose_matrices_world(good)
     for i, matrix in enumerate(good):
         for got, one in zip(stacked, el.decompose_matrix_world(matrix)):
@@ -168,7 +172,8 @@ def same_set(matrix, repaired):
     rotation, center, semi = repaired
     linear = np.asarray(matrix)[:3, :3]
     return np.allclose(center, np.asarray(matrix)[:3, 3]) and np.allclose(
-        el.shape_matrix(rotation, semi), linear @ linear.T, atol=1e-12)
+        el.shape_matrix(rotation, semi), linear @ linear.T, atol=1e-12
+    )
 
 
 @settings(max_examples=30, deadline=None)

@@ -7,15 +7,15 @@ import numpy as np
 import pytest
 
 from devkit.toy import make_toy_mannequin
-from ellimann_addon.core import mesh
 from ellimann_addon.core.constants import MEASUREMENTS, MJCF_CUSHION_LEVEL
-from ellimann_addon.core.cushion import cushion_mesh, cushion_name
-from ellimann_addon.core.ellipsoid import bounds, contains
+from ellimann_addon.core.drape.fit_metrics import BodyPieces
 from ellimann_addon.core.errors import ElliMannError, MannequinError
-from ellimann_addon.core.export_mjcf import mannequin_to_mjcf, write_mjcf
-from ellimann_addon.core.garment_fit import BodyPieces
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.reference_manifest import MANIFEST_FILE
+from ellimann_addon.core.formats.mjcf import mannequin_to_mjcf, write_mjcf
+from ellimann_addon.core.geometry import mesh
+from ellimann_addon.core.geometry.cushion import cushion_mesh, cushion_name
+from ellimann_addon.core.geometry.ellipsoid import bounds, contains
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.manifest import MANIFEST_FILE
 
 mujoco = pytest.importorskip("mujoco")  # a dev dependency (requirements-dev.txt); CI always has it
 
@@ -86,7 +86,7 @@ def test_cushions_become_convex_mesh_geoms_of_the_right_volume(make):
         assert model.body_mass[body.id] / DENSITY == pytest.approx(mesh.volume(vertices, faces), rel=1e-4)
         # MuJoCo keeps the mesh in its inertial frame; placed by the geom pose it is the cushion.
         start, count = model.mesh_vertadr[g.dataid[0]], model.mesh_vertnum[g.dataid[0]]
-        local = model.mesh_vert[start:start + count].astype(float)
+        local = model.mesh_vert[start : start + count].astype(float)
         world = local @ data.geom_xmat[g.id].reshape(3, 3).T + data.geom_xpos[g.id]
         assert np.allclose((world @ directions.T).max(axis=0), (vertices @ directions.T).max(axis=0), atol=2e-6)
     for i in set(range(len(mannequin))) - {i for pair in pairs for i in pair}:
@@ -120,7 +120,7 @@ def test_names_need_no_sanitising_and_comments_stay_valid(toy):
 def _text(model, name):
     i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, name)
     start = model.text_adr[i]
-    return bytes(model.text_data[start:start + model.text_size[i] - 1]).decode()
+    return bytes(model.text_data[start : start + model.text_size[i] - 1]).decode()
 
 
 def test_write_is_atomic_and_bad_input_writes_nothing(toy, tmp_path):
@@ -162,8 +162,16 @@ def drop_balls(mannequin, cushions):
             body = ET.SubElement(world, "body", name=name, pos=f"{x} {y} {z}")
             ET.SubElement(body, "freejoint")
             # Rolling friction lets balls settle on slopes instead of rolling forever.
-            ET.SubElement(body, "geom", name=name, type="sphere", size=str(BALL_RADIUS), mass="0.05",
-                          condim="6", friction="1.5 0.05 0.05")
+            ET.SubElement(
+                body,
+                "geom",
+                name=name,
+                type="sphere",
+                size=str(BALL_RADIUS),
+                mass="0.05",
+                condim="6",
+                friction="1.5 0.05 0.05",
+            )
             names.append(name)
     model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
     data = mujoco.MjData(model)
@@ -177,7 +185,7 @@ def drop_balls(mannequin, cushions):
     deepest_contact = 0.0
     for step in range(int(SETTLE_SECONDS / model.opt.timestep)):
         mujoco.mj_step(model, data)
-        for contact in data.contact[:data.ncon]:
+        for contact in data.contact[: data.ncon]:
             pair = {int(contact.geom1), int(contact.geom2)}
             if pair & body_geoms and pair & ball_geoms:
                 hit_body |= pair & ball_geoms
@@ -190,11 +198,20 @@ def drop_balls(mannequin, cushions):
     # Held by something: within a millimetre of the floor, the body or another ball. (A resting
     # ball can sit a hair above its support at the last step, with no contact listed.)
     apart = np.linalg.norm(final[:, None] - final[None], axis=-1) + np.eye(len(final))
-    supported = ((final[:, 2] - BALL_RADIUS <= 1e-3)
-                 | (pieces.signed_distance(final)[0] - BALL_RADIUS <= 1e-3)
-                 | (apart.min(axis=1) - 2 * BALL_RADIUS <= 1e-3))
-    return dict(final=final, speed=speed, closest=closest, hit_body=len(hit_body), count=len(names),
-                supported=supported, deepest_contact=deepest_contact)
+    supported = (
+        (final[:, 2] - BALL_RADIUS <= 1e-3)
+        | (pieces.signed_distance(final)[0] - BALL_RADIUS <= 1e-3)
+        | (apart.min(axis=1) - 2 * BALL_RADIUS <= 1e-3)
+    )
+    return dict(
+        final=final,
+        speed=speed,
+        closest=closest,
+        hit_body=len(hit_body),
+        count=len(names),
+        supported=supported,
+        deepest_contact=deepest_contact,
+    )
 
 
 # MuJoCo's contacts are soft: a 2 cm ball dropped onto a thin piece sinks in by up to ~3.5 mm.

@@ -5,14 +5,14 @@ gravity stays finite and within its joint limits."""
 import numpy as np
 import pytest
 
-from ellimann_addon.core import poses
 from ellimann_addon.core.errors import ElliMannError
-from ellimann_addon.core.export_mjcf_articulated import BODY_DENSITY, articulated_mjcf, overlap_share, pose_qpos
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.pose import pose_mannequin
-from ellimann_addon.core.posed import PosingRig, union_volume
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER
-from ellimann_addon.core.skeleton import HINGES, JOINT_COUNT, JOINT_NAMES, PARENTS, limits
+from ellimann_addon.core.formats.mjcf_articulated import BODY_DENSITY, articulated_mjcf, overlap_share, pose_qpos
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.skeleton import HINGES, JOINT_COUNT, JOINT_NAMES, PARENTS, limits
+from ellimann_addon.core.pose import standard as poses
+from ellimann_addon.core.pose.kinematics import pose_mannequin
+from ellimann_addon.core.pose.posed_pieces import PosingRig, union_volume
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
 mujoco = pytest.importorskip("mujoco")  # a dev dependency (requirements-dev.txt); CI always has it
 
@@ -81,8 +81,12 @@ def test_qpos_of_the_rest_pose_is_mujocos_rest(average, model):
 def test_mass_is_the_union_volume_at_body_density(average, model, rig):
     body = rig.pose(poses.a_pose(average.joints))
     single = average.topology.single_parts(True)
-    union, error = union_volume((average.rotation[single], average.center[single], average.semi_axes[single]),
-                                [(c.vertices, c.faces) for c in body.cushions], 100_000, seed=7)
+    union, error = union_volume(
+        (average.rotation[single], average.center[single], average.semi_axes[single]),
+        [(c.vertices, c.faces) for c in body.cushions],
+        100_000,
+        seed=7,
+    )
     mass = model.body_subtreemass[1]
     assert abs(mass - union * BODY_DENSITY) < 4.0 * error * BODY_DENSITY + 0.01 * mass
     assert 0.5 < overlap_share(rig) < 1.0  # the pieces overlap: their sum of volumes is more than the body

@@ -1,4 +1,4 @@
-"""The extra measurements' smooth band search (core.extra_measures.extremes_over_bands) against known extremes,
+"""The extra measurements' smooth band search (core.measure.extra.extremes_over_bands) against known extremes,
 and the mannequin's measurements against main's (devkit.extra_before: golden section per band) on the shipped
 sets and synthesized mannequins: the same values (1e-6 cm), the same local extremes."""
 
@@ -9,9 +9,8 @@ import pytest
 
 from devkit.extra_before import MannequinLandmarksBefore, _farthest_distance, mannequin_extra_measurements_before
 from devkit.toy import make_toy_mannequin
-from ellimann_addon.core import synthesis
 from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
-from ellimann_addon.core.extra_measures import (
+from ellimann_addon.core.measure.extra import (
     EXTRA_MEASUREMENTS,
     SIDES,
     MannequinLandmarks,
@@ -20,19 +19,22 @@ from ellimann_addon.core.extra_measures import (
     mannequin_extra_measurements,
     split_measurements,
 )
-from ellimann_addon.core.shipped_sets import FEMALE_SET, MALE_SET, named_reference_set
+from ellimann_addon.core.synthesis import synthesize as synthesis
+from ellimann_addon.core.synthesis.shipped import FEMALE_SET, MALE_SET, named_reference_set
 
 SAME_CM = 1e-6
 
 
 def search(functions, bands, points=()):
     """extremes_over_bands with one plain function of the height per family."""
+
     def evaluate(family, heights):
         out = np.empty(len(heights))
         for index, function in enumerate(functions):
             rows = family == index
             out[rows] = function(heights[rows])
         return out
+
     return extremes_over_bands(evaluate, bands, points)
 
 
@@ -43,8 +45,12 @@ def test_smooth_extremes_kinks_jumps_and_square_roots():
         lambda z: np.where(z > 0.6, 1.0 + np.sqrt(np.maximum(z - 0.6, 0.0)) - 2.0 * (z - 0.6), 1.0),  # sqrt at a break
         lambda z: np.where(z <= 0.5, 2.0, 1.0 + (z - 0.5)),  # a jump at a break: the limit 1 beside it
     ]
-    bands = [(0, 0.0, 1.0, True, ()), (1, 0.0, 1.0, False, ()), (2, 0.0, 1.0, True, (0.6,)),
-             (3, 0.0, 1.0, False, (0.5,))]
+    bands = [
+        (0, 0.0, 1.0, True, ()),
+        (1, 0.0, 1.0, False, ()),
+        (2, 0.0, 1.0, True, (0.6,)),
+        (3, 0.0, 1.0, False, (0.5,)),
+    ]
     extremes, at_points = search(functions, bands, [(0, 0.3137), (1, 0.0)])
     assert extremes[0] == pytest.approx(1.0, abs=1e-12)
     assert extremes[1] == pytest.approx(0.2, abs=1e-9)
@@ -104,8 +110,9 @@ def test_the_farthest_points_stop_with_the_bits_of_a_hundred_steps():
         for side, (start, axis, length) in zip(SIDES, marks.arm_axes()):
             arm = marks.arm_mask(side)
             rotation, center, semi = mannequin.rotation[arm], mannequin.center[arm], mannequin.semi_axes[arm]
-            assert np.array_equal(_farthest_points(rotation, center, semi, start)[0],
-                                  _farthest_distance(rotation, center, semi, start))
+            assert np.array_equal(
+                _farthest_points(rotation, center, semi, start)[0], _farthest_distance(rotation, center, semi, start)
+            )
             old_start, old_axis, old_length = before.arm_axis(side)
             assert np.array_equal(start, old_start) and length == old_length
             assert axis == pytest.approx(old_axis, abs=1e-12)

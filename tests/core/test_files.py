@@ -22,8 +22,9 @@ def blend_4x(pointer=8, order="<", blocks=((b"REND", 72), (b"GLOB", 1000), (b"DA
     """An uncompressed Blender 4.x file: ``BLENDER-v402`` (or ``_``/``V``) and BHead4/BHead8 block headers."""
     header = b"BLENDER" + (b"-" if pointer == 8 else b"_") + (b"v" if order == "<" else b"V") + b"402"
     head = struct.Struct(f"{order}4si{'Q' if pointer == 8 else 'I'}ii")
-    body = b"".join(head.pack(code, length, 0x1000 + i, 0, 1) + bytes([i % 251]) * length
-                    for i, (code, length) in enumerate(blocks))
+    body = b"".join(
+        head.pack(code, length, 0x1000 + i, 0, 1) + bytes([i % 251]) * length for i, (code, length) in enumerate(blocks)
+    )
     return header + body + head.pack(b"ENDB", 0, 0, 0, 0)
 
 
@@ -31,8 +32,9 @@ def blend_5x(order="<", blocks=((b"REND", 264), (b"GLOB", 1200), (b"DATA", 8), (
     """An uncompressed Blender 5.x file: ``BLENDER17-01v0500`` and 32-byte block headers with 64-bit lengths."""
     header = b"BLENDER17-01" + (b"v" if order == "<" else b"V") + b"0500"
     head = struct.Struct(f"{order}4siQqq")
-    body = b"".join(head.pack(code, 0, 0x1000 + i, length, 1) + bytes([i % 251]) * length
-                    for i, (code, length) in enumerate(blocks))
+    body = b"".join(
+        head.pack(code, 0, 0x1000 + i, length, 1) + bytes([i % 251]) * length for i, (code, length) in enumerate(blocks)
+    )
     return header + body + head.pack(b"ENDB", 0, 0, 0, 0)
 
 
@@ -56,8 +58,11 @@ def every_truncation_is_caught(tmp_path, data, name):
     assert accepted == []
 
 
-@pytest.mark.parametrize("data", [blend_4x(), blend_4x(pointer=4), blend_4x(order=">"), blend_5x(), blend_5x(">")],
-                         ids=["4x", "4x-32bit", "4x-big-endian", "5x", "5x-big-endian"])
+@pytest.mark.parametrize(
+    "data",
+    [blend_4x(), blend_4x(pointer=4), blend_4x(order=">"), blend_5x(), blend_5x(">")],
+    ids=["4x", "4x-32bit", "4x-big-endian", "5x", "5x-big-endian"],
+)
 def test_a_cut_short_blend_is_caught_in_4x_and_5x_layouts(tmp_path, data):
     every_truncation_is_caught(tmp_path, data, "m.blend")
 
@@ -194,8 +199,14 @@ def test_stale_temporaries_of_killed_runs_are_removed_and_running_ones_kept(tmp_
             if kind == "olddir":
                 os.utime(path / "m.blend", (old, old))
     removed = clean_stale_temporaries(tmp_path)
-    assert sorted(removed) == sorted([f".ellimann-{dead}@{host}-abcdefgh.tmp", f".ellimann-{dead}@{host}-ijklmnop",
-                                      f".ellimann-{dead}@old-host-abcdefgh.tmp", ".ellimann-k2j4h6g8.tmp"])
+    assert sorted(removed) == sorted(
+        [
+            f".ellimann-{dead}@{host}-abcdefgh.tmp",
+            f".ellimann-{dead}@{host}-ijklmnop",
+            f".ellimann-{dead}@old-host-abcdefgh.tmp",
+            ".ellimann-k2j4h6g8.tmp",
+        ]
+    )
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(set(made) - set(removed))
     assert clean_stale_temporaries(tmp_path / "missing") == []
 

@@ -2,8 +2,9 @@ import numpy as np
 import pytest
 
 from devkit.toy import rotation_from_vector
-from ellimann_addon.core import fit, mesh
-from ellimann_addon.core.frames import is_rotation
+from ellimann_addon.core.fitting import point_fit as fit
+from ellimann_addon.core.geometry import mesh
+from ellimann_addon.core.geometry.frames import is_rotation
 
 
 def surface(rotation, center, semi, subdivisions=3):
@@ -78,7 +79,8 @@ def test_inscribed_fit_keeps_the_unselected_rest_of_the_surface_outside():
     assert np.allclose(fitted[0], alone[0]) and np.allclose(fitted[1], alone[1])  # same axes, only smaller
     assert np.all(fitted[2] < alone[2])
     for mode in ("moments", "enclosing"):  # the surface only bounds the inscribed size
-        assert np.array_equal(fit.fit_ellipsoid(body[~groove], mode, surface=body[groove])[2],
-                              fit.fit_ellipsoid(body[~groove], mode)[2])
+        assert np.array_equal(
+            fit.fit_ellipsoid(body[~groove], mode, surface=body[groove])[2], fit.fit_ellipsoid(body[~groove], mode)[2]
+        )
     with pytest.raises(ValueError, match="surface"):
         fit.fit_ellipsoid(body[~groove], "inscribed", surface=np.full((2, 3), np.nan))

@@ -4,8 +4,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from devkit.toy import rotation_from_vector
-from ellimann_addon.core import frames
-from ellimann_addon.core.ellipsoid import shape_matrix
+from ellimann_addon.core.geometry import frames
+from ellimann_addon.core.geometry.ellipsoid import shape_matrix
 
 vectors = st.tuples(*[st.floats(-3.2, 3.2)] * 3)
 sizes = st.tuples(*[st.floats(0.01, 0.5)] * 3)
@@ -116,7 +116,8 @@ def test_a_matrix_whose_iteration_would_overflow_is_projected_by_the_svd():
 def test_means_of_nearby_rotations_need_no_svd(monkeypatch):
     rng = np.random.default_rng(5)
     means = np.stack([rotation_from_vector(v) for v in rng.normal(size=(100, 3))]) * 0.9 + 0.02 * rng.normal(
-        size=(100, 3, 3))
+        size=(100, 3, 3)
+    )
     expected = nearest_rotation_by_svd(means)
 
     def refused(*args, **kwargs):

@@ -5,11 +5,11 @@ from hypothesis import strategies as st
 from scipy.spatial import cKDTree
 
 from devkit.toy import rotation_from_vector
-from ellimann_addon.core import garment_fit as fm
-from ellimann_addon.core.cushion import cushion_mesh
-from ellimann_addon.core.ellipsoid import contains
+from ellimann_addon.core.drape import fit_metrics as fm
 from ellimann_addon.core.errors import ElliMannError
-from ellimann_addon.core.mesh import icosphere
+from ellimann_addon.core.geometry.cushion import cushion_mesh
+from ellimann_addon.core.geometry.ellipsoid import contains
+from ellimann_addon.core.geometry.mesh import icosphere
 
 vectors = st.tuples(*[st.floats(-3.2, 3.2)] * 3)
 sizes = st.tuples(*[st.floats(0.02, 0.4)] * 3)
@@ -87,8 +87,9 @@ def test_degenerate_inside_points_on_symmetry_planes():
     a = np.array([0.1, 0.2, 0.3])
     # The centre: nearest is the end of the shortest axis. Equal short axes: any of them.
     assert fm.ellipsoid_signed_distance(np.zeros((1, 3)), np.eye(3), np.zeros(3), a)[0] == pytest.approx(-0.1)
-    assert fm.ellipsoid_signed_distance(np.zeros((1, 3)), np.eye(3), np.zeros(3), (0.1, 0.1, 0.3))[0] == \
-        pytest.approx(-0.1)
+    assert fm.ellipsoid_signed_distance(np.zeros((1, 3)), np.eye(3), np.zeros(3), (0.1, 0.1, 0.3))[0] == pytest.approx(
+        -0.1
+    )
     p = np.array([[0.0, 0.05, 0.02], [0.0, -0.1, 0.0], [0.0, 0.0, 0.1]])
     d, q = fm.ellipsoid_signed_distance(p, np.eye(3), np.zeros(3), a, return_closest=True)
     assert np.all(d < 0)
@@ -124,13 +125,15 @@ def box_distance(p, h=0.5):
 
 def test_point_triangle_distance_in_every_region():
     a, b, c = np.array([0.0, 0, 0]), np.array([1.0, 0, 0]), np.array([0.0, 1, 0])
-    p = np.array([
-        [0.2, 0.2, 0.3],    # above the face: its height
-        [0.5, -0.4, 0.0],   # beyond edge ab: distance to the edge
-        [0.8, 0.8, 0.0],    # beyond edge bc: (0.8 + 0.8 - 1) / sqrt 2
-        [-0.3, -0.4, 0.0],  # beyond vertex a
-        [1.3, -0.4, 1.2],   # beyond vertex b, off the plane
-    ])
+    p = np.array(
+        [
+            [0.2, 0.2, 0.3],  # above the face: its height
+            [0.5, -0.4, 0.0],  # beyond edge ab: distance to the edge
+            [0.8, 0.8, 0.0],  # beyond edge bc: (0.8 + 0.8 - 1) / sqrt 2
+            [-0.3, -0.4, 0.0],  # beyond vertex a
+            [1.3, -0.4, 1.2],  # beyond vertex b, off the plane
+        ]
+    )
     q = fm.closest_points_on_triangles(p, a, b, c)
     d = np.linalg.norm(p - q, axis=1)
     assert np.allclose(d, [0.3, 0.4, 0.6 / np.sqrt(2), 0.5, 1.3], atol=1e-12)
@@ -144,8 +147,9 @@ def test_mesh_distance_on_a_cube_matches_the_box_sdf():
     assert np.allclose(d, box_distance(p), atol=1e-12)
     assert np.allclose(fm.convex_mesh_signed_distance(p, v, f), box_distance(p), atol=1e-12)
     # Points just off vertices and edges (where a face normal alone gives the wrong sign).
-    corners = np.array([[0.5001, 0.5001, 0.5001], [0.4999, 0.4999, 0.4999], [0.5001, 0.5001, 0.0],
-                        [0.4999, 0.4999, 0.2]])
+    corners = np.array(
+        [[0.5001, 0.5001, 0.5001], [0.4999, 0.4999, 0.4999], [0.5001, 0.5001, 0.0], [0.4999, 0.4999, 0.2]]
+    )
     assert np.allclose(fm.mesh_distance(corners, v, f)[0], box_distance(corners), atol=1e-12)
 
 

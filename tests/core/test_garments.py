@@ -5,13 +5,14 @@ import pytest
 
 from devkit.poses import make_apose_toy
 from devkit.toy import make_toy_mannequin
-from ellimann_addon.core import garments, mesh
 from ellimann_addon.core.constants import SECTION_FRACTIONS
-from ellimann_addon.core.ellipsoid import axis_extent
+from ellimann_addon.core.drape import garments
+from ellimann_addon.core.drape.fit_metrics import BodyPieces, mannequin_signed_distance
 from ellimann_addon.core.errors import ElliMannError, MeasurementError, ReferenceSetError
-from ellimann_addon.core.garment_fit import BodyPieces, mannequin_signed_distance
-from ellimann_addon.core.measure import section_heights
-from ellimann_addon.core.synthesis import load_reference_set
+from ellimann_addon.core.geometry import mesh
+from ellimann_addon.core.geometry.ellipsoid import axis_extent
+from ellimann_addon.core.measure.tailor import section_heights
+from ellimann_addon.core.synthesis.synthesize import load_reference_set
 
 
 @pytest.fixture(scope="module")
@@ -190,8 +191,9 @@ def test_bad_input_is_refused(body):
     with pytest.raises(MeasurementError, match="Hi"):
         garments.t_shirt(body, measurements={"He": 160, "Sh": 40, "Br": 90, "Wa": 70})
     target = body.copy(measurements={"He": 161.0, "Sh": 49.0, "Br": 90.0, "Wa": 70.0, "Hi": 95.0})
-    assert garments.tube_dress(target, measurements="target").pattern["requested_width_cm"] == \
-        pytest.approx(95.0 * 1.06)
+    assert garments.tube_dress(target, measurements="target").pattern["requested_width_cm"] == pytest.approx(
+        95.0 * 1.06
+    )
 
 
 def test_clear_of_moves_vertices_out_of_the_cushion_hulls(shirt, body):

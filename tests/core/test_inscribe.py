@@ -1,14 +1,14 @@
-"""The reference builder's ellipsoid fits (core/inscribe.py) and body helpers (core/body_mesh.py), on meshes
-whose answer is known."""
+"""The reference builder's ellipsoid fits (core/fitting/inscribed.py) and body helpers
+(core/fitting/body_mesh.py), on meshes whose answer is known."""
 
 import numpy as np
 import pytest
 
 from devkit.toy import rotation_from_vector
-from ellimann_addon.core.body_mesh import hidden_vertices, vertex_areas, vertex_normals
-from ellimann_addon.core.frames import is_rotation
-from ellimann_addon.core.inscribe import _grow, hull_surface, inscribed_ellipsoid, principal_frame
-from ellimann_addon.core.mesh import icosphere
+from ellimann_addon.core.fitting.body_mesh import hidden_vertices, vertex_areas, vertex_normals
+from ellimann_addon.core.fitting.inscribed import _grow, hull_surface, inscribed_ellipsoid, principal_frame
+from ellimann_addon.core.geometry.frames import is_rotation
+from ellimann_addon.core.geometry.mesh import icosphere
 
 ROTATION = rotation_from_vector([0.3, -0.2, 0.5])
 SEMI = np.array([0.05, 0.08, 0.12])
@@ -25,14 +25,15 @@ def test_the_inscribed_fit_of_an_ellipsoid_mesh_is_that_ellipsoid(frame):
     areas = vertex_areas(vertices, faces)
     # one axis comes from the points, the roll about it from the reference (here a relabelled true frame)
     reference = ROTATION[:, [1, 2, 0]]
-    rotation, center, semi, kept = inscribed_ellipsoid(vertices, areas, vertices, areas, reference,
-                                                       inside_fraction=0.0, frame=frame)
+    rotation, center, semi, kept = inscribed_ellipsoid(
+        vertices, areas, vertices, areas, reference, inside_fraction=0.0, frame=frame
+    )
     assert is_rotation(rotation)
     assert np.allclose(np.abs(rotation.T @ reference), np.eye(3), atol=2e-3)
     assert np.allclose(center, (0.1, -0.2, 0.9), atol=2e-3)
     assert np.all(semi <= SEMI[[1, 2, 0]] * 1.001) and np.all(semi >= SEMI[[1, 2, 0]] * 0.95)
     local = (vertices - center) @ rotation / semi
-    assert np.sqrt((local ** 2).sum(axis=1)).min() >= 1.0 - 1e-9  # no vertex inside
+    assert np.sqrt((local**2).sum(axis=1)).min() >= 1.0 - 1e-9  # no vertex inside
 
 
 def test_obstacles_moved_out_let_the_ellipsoid_reach_that_far():
@@ -62,8 +63,9 @@ def test_a_fixed_frame_is_the_reference_and_the_box_caps_the_size():
     vertices, faces = ellipsoid_mesh(np.eye(3), np.array([0.1, 0.1, 0.1]), (0.0, 0.0, 0.0))
     areas = vertex_areas(vertices, faces)
     top = vertices[:, 2] > 0.05  # a cap: its box is short in z, so the ellipsoid must be too
-    rotation, center, semi, kept = inscribed_ellipsoid(vertices[top], areas[top], vertices, areas, frame="fixed",
-                                                       margin=0.0, inside_fraction=0.0)
+    rotation, center, semi, kept = inscribed_ellipsoid(
+        vertices[top], areas[top], vertices, areas, frame="fixed", margin=0.0, inside_fraction=0.0
+    )
     assert np.array_equal(rotation, np.eye(3)) and kept is None
     assert semi[2] <= 0.5 * (0.1 - vertices[top, 2].min()) + 1e-12
     assert center[2] - semi[2] >= vertices[top, 2].min() - 1e-12
@@ -83,8 +85,12 @@ def test_limb_frame_follows_the_limb_and_keeps_the_reference_roll():
     assert is_rotation(rotation)
     assert abs(rotation[:, kept] @ axis) > 0.999
     # roll from the world axes: another axis lies in the plane of the limb and a world axis
-    in_world_plane = [abs(np.linalg.det(np.stack([rotation[:, i], rotation[:, kept], np.eye(3)[j]]))) < 1e-12
-                      for i in range(3) if i != kept for j in range(3)]
+    in_world_plane = [
+        abs(np.linalg.det(np.stack([rotation[:, i], rotation[:, kept], np.eye(3)[j]]))) < 1e-12
+        for i in range(3)
+        if i != kept
+        for j in range(3)
+    ]
     assert any(in_world_plane)
 
 
@@ -99,8 +105,9 @@ def test_match_picks_the_principal_axis_closest_to_the_other_body_s():
 def test_floor_and_ceiling_bound_the_ellipsoid_s_height_exactly():
     vertices, faces = ellipsoid_mesh()  # tilted: the bound is on the world-z extent, not a local axis
     areas = vertex_areas(vertices, faces)
-    rotation, center, semi, _ = inscribed_ellipsoid(vertices, areas, vertices, areas, inside_fraction=0.0,
-                                                    floor=0.86, ceiling=0.95)
+    rotation, center, semi, _ = inscribed_ellipsoid(
+        vertices, areas, vertices, areas, inside_fraction=0.0, floor=0.86, ceiling=0.95
+    )
     half_height = np.sqrt(np.sum((rotation[2] * semi) ** 2))
     assert center[2] - half_height >= 0.86 - 1e-9 and center[2] + half_height <= 0.95 + 1e-9
     assert 0.95 - 0.86 - 2.0 * half_height < 0.01  # and it uses the height it has
@@ -139,13 +146,18 @@ def test_span_reaches_from_one_end_of_the_limb_to_the_other():
 def test_fill_weights_draw_the_part_to_the_volume_that_counts():
     points = tube(lambda x: np.full_like(x, 0.05), half_length=0.3)
     weights = np.ones(len(points))
-    grid = np.stack(np.meshgrid(np.linspace(-0.3, 0.3, 61), np.linspace(-0.05, 0.05, 11),
-                                np.linspace(-0.05, 0.05, 11), indexing="ij"), axis=-1).reshape(-1, 3)
+    grid = np.stack(
+        np.meshgrid(
+            np.linspace(-0.3, 0.3, 61), np.linspace(-0.05, 0.05, 11), np.linspace(-0.05, 0.05, 11), indexing="ij"
+        ),
+        axis=-1,
+    ).reshape(-1, 3)
     inside = grid[np.hypot(grid[:, 1], grid[:, 2]) < 0.05]
     fit = dict(frame="fixed", inside_fraction=0.0, margin=0.0, fill=inside, fill_spacing=0.01)
     _, even, _, _ = inscribed_ellipsoid(points, weights, points, weights, **fit)
-    _, right, _, _ = inscribed_ellipsoid(points, weights, points, weights, **fit,
-                                         fill_weight=(inside[:, 0] > 0.1).astype(float))
+    _, right, _, _ = inscribed_ellipsoid(
+        points, weights, points, weights, **fit, fill_weight=(inside[:, 0] > 0.1).astype(float)
+    )
     assert abs(even[0]) < 0.02 and right[0] > 0.1
 
 
@@ -168,7 +180,7 @@ def test_hidden_vertices_are_those_that_cannot_see_out():
     faces = np.concatenate([outer_faces, inner_faces + len(outer)])
     normals = vertex_normals(vertices, faces)
     hidden = hidden_vertices(vertices, faces, normals, np.arange(len(vertices)), reach=0.6, cell=0.1)
-    assert not hidden[:len(outer)].any() and hidden[len(outer):].all()
+    assert not hidden[: len(outer)].any() and hidden[len(outer) :].all()
     # beyond reach nothing is met
     assert not hidden_vertices(vertices, faces, normals, np.arange(len(vertices)), reach=0.4, cell=0.1).any()
 

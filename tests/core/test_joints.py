@@ -7,14 +7,14 @@ import json
 import numpy as np
 import pytest
 
-from ellimann_addon.core import skeleton
-from ellimann_addon.core.clean import register_to_world, symmetrize
 from ellimann_addon.core.errors import MannequinError
-from ellimann_addon.core.idw import idw_weights, interpolate
-from ellimann_addon.core.joints import anchor_indices, follow_pieces, interpolate_joints, joints_from_dict
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER, REFERENCE_NAMES, load_reference_set
-from ellimann_addon.core.synthesis import synthesize, synthesize_batch
+from ellimann_addon.core.mannequin import skeleton
+from ellimann_addon.core.mannequin.clean import register_to_world, symmetrize
+from ellimann_addon.core.mannequin.joints import anchor_indices, follow_pieces, joints_from_dict
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.idw import idw_weights, interpolate, interpolate_joints
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, REFERENCE_NAMES, load_reference_set
+from ellimann_addon.core.synthesis.synthesize import synthesize, synthesize_batch
 
 STEMS = ("base_mannequin",) + REFERENCE_NAMES
 
@@ -31,8 +31,14 @@ def average():
 
 def test_every_shipped_mannequin_has_symmetric_joints_near_its_body_landmarks():
     # Landmarks of the average body (refmodels/README.md, "Skeleton"): joint height / He.
-    landmarks = {"L_Hip": 0.515, "L_Knee": 0.292, "L_Ankle": 0.050, "L_Shoulder": 0.792, "L_Elbow": 0.666,
-                 "L_Wrist": 0.564}
+    landmarks = {
+        "L_Hip": 0.515,
+        "L_Knee": 0.292,
+        "L_Ankle": 0.050,
+        "L_Shoulder": 0.792,
+        "L_Elbow": 0.666,
+        "L_Wrist": 0.564,
+    }
     for stem in STEMS:
         m = Mannequin.load(REFERENCE_FOLDER / f"{stem}.json")
         assert m.joints is not None and m.joints.shape == (24, 3) and m.problems() == []
@@ -56,13 +62,16 @@ def test_joints_json_round_trip_and_old_files_load(tmp_path, average):
     assert old.joints is None and "joints" not in old.to_dict()
 
 
-@pytest.mark.parametrize("change, words", [
-    (lambda j: dict(j, version=2), ["joints.version", "2"]),
-    (lambda j: dict(j, names=j["names"][::-1]), ["joints.names", "SMPL"]),
-    (lambda j: dict(j, positions=j["positions"][:5]), ["joints.positions", "24x3"]),
-    (lambda j: dict(j, positions=[[0, 0, "a"]] * 24), ["joints.positions"]),
-    (lambda j: "joints", ["joints", "object"]),
-])
+@pytest.mark.parametrize(
+    "change, words",
+    [
+        (lambda j: dict(j, version=2), ["joints.version", "2"]),
+        (lambda j: dict(j, names=j["names"][::-1]), ["joints.names", "SMPL"]),
+        (lambda j: dict(j, positions=j["positions"][:5]), ["joints.positions", "24x3"]),
+        (lambda j: dict(j, positions=[[0, 0, "a"]] * 24), ["joints.positions"]),
+        (lambda j: "joints", ["joints", "object"]),
+    ],
+)
 def test_a_bad_joints_section_is_refused_naming_the_field(average, change, words):
     data = average.to_dict()
     data["joints"] = change(data["joints"])
@@ -79,8 +88,9 @@ def test_joints_of_another_mannequin_do_not_match_its_topology(average):
     moved = average.copy(joints=average.joints + [0.0, 0.0, 0.2])
     assert any(p.field == "joints" for p in moved.problems())
     shuffled = average.joints.copy()
-    shuffled[[skeleton.JOINT_INDEX["L_Wrist"], skeleton.JOINT_INDEX["L_Ankle"]]] = \
-        shuffled[[skeleton.JOINT_INDEX["L_Ankle"], skeleton.JOINT_INDEX["L_Wrist"]]]
+    shuffled[[skeleton.JOINT_INDEX["L_Wrist"], skeleton.JOINT_INDEX["L_Ankle"]]] = shuffled[
+        [skeleton.JOINT_INDEX["L_Ankle"], skeleton.JOINT_INDEX["L_Wrist"]]
+    ]
     assert any("L_Wrist" in p.message for p in average.copy(joints=shuffled).problems())
 
 
@@ -97,11 +107,14 @@ def test_a_topology_whose_parts_have_no_bone_cannot_carry_joints(average):
 def test_every_part_has_a_bone_and_cushions_cross_exactly_four_kinds_of_joint(average):
     bones = skeleton.bone_names(average.topology)
     assert set(bones) == set(average.topology.names)
-    crossing = {(average.topology.names[i], skeleton.JOINT_NAMES[j])
-                for i, _, j in skeleton.cross_joint_pairs(average.topology)}
-    assert crossing == {(f"{p}.{s}", f"{s}_{j}") for s in "LR" for p, j in (
-        ("3.a Upper Arm", "Elbow"), ("4.a Hand", "Hand"), ("7.a Foot", "Foot"))} | {
-        (f"12.a Oblique.{s}", "Spine1") for s in "LR"}
+    crossing = {
+        (average.topology.names[i], skeleton.JOINT_NAMES[j]) for i, _, j in skeleton.cross_joint_pairs(average.topology)
+    }
+    assert crossing == {
+        (f"{p}.{s}", f"{s}_{j}")
+        for s in "LR"
+        for p, j in (("3.a Upper Arm", "Elbow"), ("4.a Hand", "Hand"), ("7.a Foot", "Foot"))
+    } | {(f"12.a Oblique.{s}", "Spine1") for s in "LR"}
 
 
 def test_rig_name_maps_reach_every_joint_once():
@@ -138,8 +151,10 @@ def test_a_request_alone_gets_the_joints_it_gets_in_a_batch(reference):
         assert np.array_equal(synthesize_batch(reference, [request]).joints[0], batch.joints[i])
 
 
-@pytest.mark.parametrize("metric, power, normalize", [("raw", 2.0, "proportional"), ("normalized", 1.0, "none"),
-                                                      ("normalized", 4.0, "height")])
+@pytest.mark.parametrize(
+    "metric, power, normalize",
+    [("raw", 2.0, "proportional"), ("normalized", 1.0, "none"), ("normalized", 4.0, "height")],
+)
 def test_a_batch_shares_its_idw_weights_with_the_same_results_as_each_part_alone(reference, metric, power, normalize):
     requests = np.array([[165, 41.5, 101.25, 82.75, 117.5], [150, 35, 90, 70, 95], [170, 50, 140, 130, 140]])
     batch = synthesize_batch(reference, requests, mode="idw", metric=metric, power=power, normalize=normalize)
@@ -162,8 +177,9 @@ def test_a_deformation_carries_each_joint_with_its_anchor_piece(average):
     turn = np.array([[np.cos(angle), -np.sin(angle), 0.0], [np.sin(angle), np.cos(angle), 0.0], [0.0, 0.0, 1.0]])
     shift = np.array([0.1, -0.2, 0.05])
     after = (turn @ average.rotation, average.center @ turn.T + shift, average.semi_axes)
-    assert np.allclose(follow_pieces(average.joints, anchors, before, after), average.joints @ turn.T + shift,
-                       atol=1e-12)
+    assert np.allclose(
+        follow_pieces(average.joints, anchors, before, after), average.joints @ turn.T + shift, atol=1e-12
+    )
     # Scaling every piece about the floor by s scales the joints the same way.
     after = (average.rotation, average.center * 1.1, average.semi_axes * 1.1)
     assert np.allclose(follow_pieces(average.joints, anchors, before, after), average.joints * 1.1, atol=1e-12)

@@ -22,29 +22,36 @@ def test_core_source_imports_no_blender_module():
     assert offenders == []
 
 
+def core_modules():
+    """Every module under core, dotted (packages too)."""
+    names = []
+    for path in sorted(CORE.rglob("*.py")):
+        parts = path.relative_to(CORE.parents[1]).with_suffix("").parts
+        names.append(".".join(parts[:-1] if parts[-1] == "__init__" else parts))
+    return names
+
+
 def test_importing_every_core_module_loads_no_blender_module():
-    modules = [p.stem for p in CORE.glob("*.py") if p.stem != "__init__"]
+    modules = core_modules()
     code = (
         "import sys, importlib\n"
-        f"for m in {modules!r}: importlib.import_module('ellimann_addon.core.' + m)\n"
+        f"for m in {modules!r}: importlib.import_module(m)\n"
         f"print(sorted(set(sys.modules) & set({sorted(BLENDER_MODULES)!r})))\n"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                         cwd=CORE.parents[1])
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=CORE.parents[1])
     assert out.stdout.strip() == "[]"
 
 
 def test_importing_every_core_module_loads_no_package_blender_lacks():
     """Blender bundles numpy, not scipy (nor the dev tools): the core, the reference builder included, needs none."""
-    modules = [p.stem for p in CORE.glob("*.py") if p.stem != "__init__"]
+    modules = core_modules()
     code = (
         "import sys, importlib\n"
-        f"for m in {modules!r}: importlib.import_module('ellimann_addon.core.' + m)\n"
+        f"for m in {modules!r}: importlib.import_module(m)\n"
         "loaded = {name.partition('.')[0] for name in sys.modules}\n"
         "print(sorted(loaded & {'scipy', 'pytest', 'hypothesis', 'mujoco'}))\n"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                         cwd=CORE.parents[1])
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=CORE.parents[1])
     assert out.stdout.strip() == "[]"
 
 
@@ -72,7 +79,7 @@ def resolved_imports(path, text=None):
             found += [alias.name for alias in node.names]
         elif isinstance(node, ast.ImportFrom):
             if node.level:
-                base = package[:len(package) - (node.level - 1)] if node.level > 1 else package
+                base = package[: len(package) - (node.level - 1)] if node.level > 1 else package
                 module = ".".join(base + ([node.module] if node.module else []))
             else:
                 module = node.module or ""
@@ -82,19 +89,31 @@ def resolved_imports(path, text=None):
 
 
 def test_core_imports_nothing_of_the_blender_layer_relatively_either():
-    offenders = [f"{p.relative_to(PACKAGE)}: {m}" for p in CORE.rglob("*.py") for m in resolved_imports(p)
-                 if m == "ellimann_addon.blender" or m.startswith("ellimann_addon.blender.")]
+    offenders = [
+        f"{p.relative_to(PACKAGE)}: {m}"
+        for p in CORE.rglob("*.py")
+        for m in resolved_imports(p)
+        if m == "ellimann_addon.blender" or m.startswith("ellimann_addon.blender.")
+    ]
     assert offenders == []
 
 
 def test_blender_bridge_and_services_import_no_feature():
     """bridge/ (objects <-> core) and services/ (building, writing) are below the features: they never import one."""
-    offenders = [f"{p.relative_to(PACKAGE)}: {m}" for folder in ("bridge", "services")
-                 for p in (BLENDER / folder).rglob("*.py") for m in resolved_imports(p)
-                 if m.startswith(("ellimann_addon.blender.features", "ellimann_addon.blender.registry"))]
+    offenders = [
+        f"{p.relative_to(PACKAGE)}: {m}"
+        for folder in ("bridge", "services")
+        for p in (BLENDER / folder).rglob("*.py")
+        for m in resolved_imports(p)
+        if m.startswith(("ellimann_addon.blender.features", "ellimann_addon.blender.registry"))
+    ]
     assert offenders == []
-    offenders = [f"{p.relative_to(PACKAGE)}: {m}" for p in (BLENDER / "bridge").rglob("*.py")
-                 for m in resolved_imports(p) if m.startswith("ellimann_addon.blender.services")]
+    offenders = [
+        f"{p.relative_to(PACKAGE)}: {m}"
+        for p in (BLENDER / "bridge").rglob("*.py")
+        for m in resolved_imports(p)
+        if m.startswith("ellimann_addon.blender.services")
+    ]
     assert offenders == []
 
 
@@ -103,4 +122,130 @@ def test_the_layering_check_sees_a_relative_import_into_blender():
     found = resolved_imports(probe, "from ..blender import registry\nfrom ..blender.features import base\n")
     assert "ellimann_addon.blender.registry" in found and "ellimann_addon.blender.features" in found
     assert resolved_imports(CORE / "sub" / "probe.py", "from ...blender import ids\n") == [
-        "ellimann_addon.blender", "ellimann_addon.blender.ids"]
+        "ellimann_addon.blender",
+        "ellimann_addon.blender.ids",
+    ]
+
+
+# The core's house plan: shared modules at its top, then one package per domain. A package imports the shared
+# modules and the packages on floors below its own, never one beside or above it (so the imports form one
+# direction and no cycle can arise).
+SHARED = {"constants", "errors", "files", "option_table"}
+FLOORS = {
+    "geometry": 1,
+    "measure": 2,
+    "mannequin": 3,
+    "synthesis": 4,
+    "pose": 4,
+    "drape": 4,
+    "fitting": 5,
+    "formats": 5,
+}
+
+
+def core_unit(dotted):
+    """The shared module or domain package a dotted name under ellimann_addon.core belongs to (None: outside)."""
+    parts = dotted.split(".")
+    if parts[:2] != ["ellimann_addon", "core"] or len(parts) < 3:
+        return None
+    return parts[2]
+
+
+def test_the_core_is_shared_modules_and_domain_packages_only():
+    units = {p.stem for p in CORE.glob("*.py")} | {p.name for p in CORE.iterdir() if (p / "__init__.py").is_file()}
+    assert units - {"__init__"} == SHARED | set(FLOORS)
+
+
+def test_each_core_package_imports_only_floors_below_it():
+    offenders = []
+    for path in CORE.rglob("*.py"):
+        here = core_unit(".".join(path.relative_to(PACKAGE.parent).with_suffix("").parts))
+        for module in resolved_imports(path):
+            there = core_unit(module)
+            if there is None or there == here or there in SHARED:
+                continue
+            if here in SHARED or FLOORS[there] >= FLOORS[here]:
+                offenders.append(f"{path.relative_to(CORE)} ({here}) imports {module} ({there})")
+    assert offenders == []
+
+
+def test_each_core_package_init_names_every_module_it_holds():
+    """An ``__init__`` is a table of contents, a line per module (``- name: what it holds``), and imports nothing
+    (importing a package loads none of its modules)."""
+    for package in FLOORS:
+        tree = ast.parse((CORE / package / "__init__.py").read_text())
+        doc = ast.get_docstring(tree) or ""
+        listed = {line[2:].partition(":")[0] for line in doc.splitlines() if line.startswith("- ")}
+        held = {p.stem for p in (CORE / package).glob("*.py")} - {"__init__"}
+        assert listed == held, package
+        assert not [n for n in tree.body if isinstance(n, (ast.Import, ast.ImportFrom))], package
+
+
+def test_no_module_in_the_package_is_over_500_lines():
+    long = [
+        f"{p.relative_to(PACKAGE)}: {n}" for p in PACKAGE.rglob("*.py") if (n := len(p.read_text().splitlines())) > 500
+    ]
+    assert long == []
+
+
+def test_no_private_name_is_imported_across_modules():
+    offenders = []
+    for path in PACKAGE.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.level:
+                offenders += [
+                    f"{path.relative_to(PACKAGE)}: {a.name}"
+                    for a in node.names
+                    if a.name.startswith("_") and not a.name.startswith("__")
+                ]
+    assert offenders == []
+
+
+def module_graph():
+    """Each module of the package -> the modules of the package it imports."""
+    graph = {}
+    for path in PACKAGE.rglob("*.py"):
+        parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+        graph[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = set(resolved_imports(path))
+    # a module's own packages are loaded before it, whatever it imports of them (``from . import x``): no edge
+    return {
+        name: {m for m in deps if m in graph and m != name and not name.startswith(m + ".")}
+        for name, deps in graph.items()
+    }
+
+
+def find_cycle(graph):
+    """One import cycle as a list of modules, or []."""
+    state = {}
+
+    def visit(node, trail):
+        state[node] = "open"
+        for nxt in sorted(graph[node]):
+            if state.get(nxt) == "open":
+                return trail[trail.index(nxt) :] + [nxt]
+            if nxt not in state and (found := visit(nxt, trail + [nxt])):
+                return found
+        state[node] = "done"
+        return []
+
+    for node in sorted(graph):
+        if node not in state and (found := visit(node, [node])):
+            return found
+    return []
+
+
+def test_no_import_cycle_in_the_package():
+    assert find_cycle(module_graph()) == []
+
+
+def test_the_cycle_check_finds_a_cycle():
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": set()}) == ["a", "b", "c", "a"]
+    assert find_cycle({"a": {"b"}, "b": set()}) == []
+
+
+def test_every_folder_of_the_package_has_a_one_line_readme():
+    folders = [PACKAGE] + [p for p in PACKAGE.rglob("*") if p.is_dir() and p.name != "__pycache__"]
+    missing = [str(f.relative_to(PACKAGE.parent)) for f in folders if not (f / "README.md").is_file()]
+    assert missing == []
+    long = [str(f.relative_to(PACKAGE.parent)) for f in folders if len((f / "README.md").read_text().splitlines()) != 1]
+    assert long == []

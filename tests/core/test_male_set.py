@@ -9,12 +9,12 @@ import pytest
 
 from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, SECTION_FRACTIONS, quartile_points
 from ellimann_addon.core.errors import MannequinError, MeasurementError, ReferenceSetError
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.measure import section_heights, tailor_measurements
-from ellimann_addon.core.reference_set import load_reference_set
-from ellimann_addon.core.request import validate_request
-from ellimann_addon.core.shipped_sets import SHIPPED_SETS, reference_folder
-from ellimann_addon.core.synthesis import EXACT_TOLERANCE, synthesize, synthesize_batch
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.measure.tailor import section_heights, tailor_measurements
+from ellimann_addon.core.synthesis.reference_set import load_reference_set
+from ellimann_addon.core.synthesis.request import validate_request
+from ellimann_addon.core.synthesis.shipped import SHIPPED_SETS, reference_folder
+from ellimann_addon.core.synthesis.synthesize import EXACT_TOLERANCE, synthesize, synthesize_batch
 
 TOLERANCE = 0.005  # the issue: the male RMs meet their targets within 0.5%
 MALE_FRACTIONS = {"Sh": 0.800, "Br": 0.720, "Wa": 0.625, "Hi": 0.515}  # ../shared/refmodels_male/README.md
@@ -52,10 +52,10 @@ def test_the_female_heights_cut_the_male_hip_elsewhere(male):
     """The same mannequin measured at the female heights differs where the sections move (Sh, Wa, Hi), and
     not at Br, whose height the two sets share."""
     average = male.mannequins[male.names.index("average")]
-    at_male = tailor_measurements(average.rotation, average.center, average.semi_axes, average.topology.girth_mask,
-                                  MALE_FRACTIONS)
-    at_female = tailor_measurements(average.rotation, average.center, average.semi_axes,
-                                    average.topology.girth_mask)
+    at_male = tailor_measurements(
+        average.rotation, average.center, average.semi_axes, average.topology.girth_mask, MALE_FRACTIONS
+    )
+    at_female = tailor_measurements(average.rotation, average.center, average.semi_axes, average.topology.girth_mask)
     index = {key: i for i, key in enumerate(MEASUREMENTS)}
     assert at_male[index["He"]] == at_female[index["He"]] and at_male[index["Br"]] == at_female[index["Br"]]
     for key in ("Sh", "Wa", "Hi"):
@@ -96,10 +96,12 @@ def test_old_files_load_as_female_and_bad_heights_are_named():
     data["version"] = 1
     old = Mannequin.from_dict(data)
     assert old.reference_set == "female" and old.section_fractions == SECTION_FRACTIONS
-    for fractions, words in (({"Sh": 0.8, "Br": 0.72, "Wa": 0.625}, "exactly Sh, Br, Wa, Hi"),
-                             ({"Sh": 0.8, "Br": 0.6, "Wa": 0.625, "Hi": 0.515}, "Hi < Wa < Br"),
-                             ({"Sh": 1.2, "Br": 0.72, "Wa": 0.625, "Hi": 0.515}, "Sh=1.2"),
-                             ("high", "must be an object")):
+    for fractions, words in (
+        ({"Sh": 0.8, "Br": 0.72, "Wa": 0.625}, "exactly Sh, Br, Wa, Hi"),
+        ({"Sh": 0.8, "Br": 0.6, "Wa": 0.625, "Hi": 0.515}, "Hi < Wa < Br"),
+        ({"Sh": 1.2, "Br": 0.72, "Wa": 0.625, "Hi": 0.515}, "Sh=1.2"),
+        ("high", "must be an object"),
+    ):
         data["measured_with"] = {"reference_set": "x", "section_fractions": fractions}
         with pytest.raises(MannequinError, match="section_fractions") as info:
             Mannequin.from_dict(data)
@@ -125,10 +127,10 @@ def test_exact_mode_converges_on_the_male_grid(male):
 def test_a_male_mannequin_has_its_bodys_joints_poses_rigidly_and_simulates(male):
     """The male RMs carry the male bodies' joints (../shared/refmodels_male/skeleton.json), so a male mannequin
     is synthesized with joints, poses like a female one, and loads and falls in MuJoCo as an articulated body."""
-    from ellimann_addon.core import poses
-    from ellimann_addon.core.export_mjcf_articulated import articulated_mjcf
-    from ellimann_addon.core.pose import pose_mannequin
-    from ellimann_addon.core.skeleton import JOINT_INDEX
+    from ellimann_addon.core.formats.mjcf_articulated import articulated_mjcf
+    from ellimann_addon.core.mannequin.skeleton import JOINT_INDEX
+    from ellimann_addon.core.pose import standard as poses
+    from ellimann_addon.core.pose.kinematics import pose_mannequin
 
     mujoco = pytest.importorskip("mujoco")  # requirements-dev.txt: CI has it
     for rm in male.mannequins:

@@ -6,7 +6,8 @@ import pytest
 from devkit.toy import TOY_PARTS, make_toy_mannequin
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.errors import MannequinError
-from ellimann_addon.core.mannequin import Mannequin, Part, Topology, stack, twin_name
+from ellimann_addon.core.mannequin.model import Mannequin, stack
+from ellimann_addon.core.mannequin.topology import Part, Topology, twin_name
 
 
 def problems_of(parts):
@@ -95,7 +96,8 @@ def test_infinity_in_a_file_and_in_the_measurements_is_refused(toy):
         Mannequin.from_dict(json.loads(json.dumps(data)))
     bad = toy.copy(measurements={"He": float("inf"), "Sh": 40.0})
     assert [str(p) for p in bad.problems()] == [
-        "measurements: He=inf is not a positive measurement (accepted range 50-250 cm)"]
+        "measurements: He=inf is not a positive measurement (accepted range 50-250 cm)"
+    ]
 
 
 @pytest.mark.parametrize("name", ["", None, 7])
@@ -109,14 +111,17 @@ def test_an_ellipsoid_without_a_name_is_refused(toy, name):
     with pytest.raises(MannequinError) as info:
         Mannequin.from_dict(data)
     # A nameless entry cannot be named, so the problem names the field; the others are still reported.
-    assert [str(p) for p in info.value.problems] == ["name: every ellipsoid needs a non-empty name",
-                                                     "'5.a Arm.R' side: missing or not a str"]
+    assert [str(p) for p in info.value.problems] == [
+        "name: every ellipsoid needs a non-empty name",
+        "'5.a Arm.R' side: missing or not a str",
+    ]
     assert info.value.problems[0].field == "name" and info.value.problems[0].ellipsoid == ""
 
 
 def test_an_empty_part_name_is_refused_by_the_topology():
     assert problems_of(replace(TOY_PARTS, "1.a Head", name="")) == [
-        "name: must look like '10.a Trapezius.L' (number.letter label[.L|.R])"]
+        "name: must look like '10.a Trapezius.L' (number.letter label[.L|.R])"
+    ]
 
 
 def test_json_round_trip_is_exact(toy, tmp_path):
@@ -173,6 +178,6 @@ def test_measure_returns_centimetres(toy):
 
 
 def test_fixture_is_symmetric():
-    from ellimann_addon.core.clean import asymmetry
+    from ellimann_addon.core.mannequin.clean import asymmetry
 
     assert asymmetry(make_toy_mannequin()) < 1e-12

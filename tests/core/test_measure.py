@@ -10,10 +10,10 @@ from scipy.special import ellipe
 from devkit.hull_before import hull_perimeter_before
 from devkit.reference import brute_force_measure, random_mannequin_arrays
 from devkit.toy import rotation_from_vector
-from ellimann_addon.core import measure
 from ellimann_addon.core.constants import SECTION_FRACTIONS
-from ellimann_addon.core.cushion import cushion_mesh
-from ellimann_addon.core.mesh import icosphere
+from ellimann_addon.core.geometry.cushion import cushion_mesh
+from ellimann_addon.core.geometry.mesh import icosphere
+from ellimann_addon.core.measure import tailor as measure
 
 
 def perimeter(centres, ks):
@@ -38,7 +38,8 @@ def test_ellipse_perimeter_is_the_complete_elliptic_integral(a, b, angle):
 @pytest.mark.parametrize("angle", [0.0, 0.3, 1.1])
 def test_ellipse_perimeter_to_rounding_with_the_nodes_the_error_bound_chooses(aspect, angle):
     """8 Gauss-Legendre nodes per cell up to aspect ~2 (every girth section of the shipped sets), more for flatter
-    ellipses (core.hull._gauss_orders): within a few ulps of the complete elliptic integral throughout."""
+    ellipses (core.geometry.section_hull._gauss_orders): within a few ulps of the complete elliptic integral
+    throughout."""
     rot = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
     k = rot @ np.diag([aspect**2 * 0.01, 0.01]) @ rot.T
     exact = 4 * 0.1 * aspect * ellipe(1 - aspect**-2)
@@ -104,8 +105,9 @@ def test_agrees_with_the_implementation_it_replaced():
         centre, k, hit = measure.section_at_height(r[:, None], c[:, None], d[:, None], heights[:, :, None])
         active = (hit & g[0]).reshape(-1, 24)
         centre, k = centre.reshape(-1, 24, 2), k.reshape(-1, 24, 2, 2)
-        np.testing.assert_allclose(measure.hull_perimeter(centre, k, active),
-                                   hull_perimeter_before(centre, k, active), rtol=1e-13, atol=0.0)
+        np.testing.assert_allclose(
+            measure.hull_perimeter(centre, k, active), hull_perimeter_before(centre, k, active), rtol=1e-13, atol=0.0
+        )
 
 
 def test_batch_equals_one_by_one():
@@ -149,8 +151,9 @@ def test_invariant_to_horizontal_moves_and_turns_about_z(dx, dy, dz, angle, seed
 
 def test_measurements_scale_linearly():
     r, c, d, g = random_mannequin_arrays(np.random.default_rng(11), 25)
-    assert np.allclose(measure.tailor_measurements(r, 1.7 * c, 1.7 * d, g),
-                       1.7 * measure.tailor_measurements(r, c, d, g), rtol=1e-9)
+    assert np.allclose(
+        measure.tailor_measurements(r, 1.7 * c, 1.7 * d, g), 1.7 * measure.tailor_measurements(r, c, d, g), rtol=1e-9
+    )
 
 
 def test_hull_boundary_points_lie_on_the_hull():
@@ -163,8 +166,10 @@ def test_hull_boundary_points_lie_on_the_hull():
 
 def ellipsoid_meshes(mannequin, subdivisions):
     unit, faces = icosphere(subdivisions)
-    return [(unit * mannequin.semi_axes[i] @ mannequin.rotation[i].T + mannequin.center[i], faces)
-            for i in range(len(mannequin))]
+    return [
+        (unit * mannequin.semi_axes[i] @ mannequin.rotation[i].T + mannequin.center[i], faces)
+        for i in range(len(mannequin))
+    ]
 
 
 def test_mesh_measure_converges_to_the_closed_form_from_inside(toy):
@@ -248,10 +253,12 @@ def _hull_of_points(centres, ks, count=20_000):
 
 @pytest.mark.parametrize("seed", range(12))
 def test_a_symmetric_section_measured_on_its_right_half_equals_the_whole_circle(seed):
-    """core.hull integrates a section that is its own mirror image over the right half only, without the left
+    """core.geometry.section_hull integrates a section that is its own mirror image over the right half only, without
+    the left
     ellipses that cannot reach into it: the same perimeter as the whole circle's (the section moved by 1e-12 m, no
     longer symmetric bit for bit) and as a brute-force hull. Some ellipses cross the mid-plane (kept both)."""
-    from ellimann_addon.core import hull
+    from ellimann_addon.core.geometry import section_hull as hull
+
     rng = np.random.default_rng(seed)
     centres, ks = _mirror_pairs(rng, pairs=int(rng.integers(1, 4)), central=int(rng.integers(0, 3)))
     active = np.ones((1, len(centres)), bool)
@@ -267,7 +274,8 @@ def test_a_symmetric_section_measured_on_its_right_half_equals_the_whole_circle(
 
 
 def test_the_right_half_drops_the_left_ellipses_their_mirror_images_cover():
-    from ellimann_addon.core import hull
+    from ellimann_addon.core.geometry import section_hull as hull
+
     centres, ks = _mirror_pairs(np.random.default_rng(5), pairs=3, central=1)
     centres[:6:2, 0] = np.abs(centres[:6:2, 0]) + 0.3  # every pair well apart
     centres[1:6:2, 0] = -centres[:6:2, 0]
@@ -278,7 +286,8 @@ def test_the_right_half_drops_the_left_ellipses_their_mirror_images_cover():
 def test_a_left_ellipse_reaching_across_the_mid_plane_is_kept():
     """A long ellipse tilted across x = 0 (|c_x| b < |k_xy|): its mirror image does not cover it on the right half,
     so both are integrated (dropping the left one would miss the hull's right tip)."""
-    from ellimann_addon.core import hull
+    from ellimann_addon.core.geometry import section_hull as hull
+
     angle = 0.6
     rot = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
     k = rot @ np.diag([0.3**2, 0.03**2]) @ rot.T
@@ -308,11 +317,13 @@ def _moved_grid_sections(scale_x=1.01, scale_y=0.995):
     centre, k, active = centre.reshape(-1, 20, 2), k.reshape(-1, 20, 2, 2), (hit & g[0]).reshape(-1, 20)
     flip = np.array([[1.0, -1.0], [-1.0, 1.0]])
     # the same sections padded to 40 ellipses, and each with its mirror image added (measured on the right half)
-    centre = np.concatenate([np.concatenate([centre, centre], axis=1),
-                             np.concatenate([centre, centre * (-1, 1)], axis=1)])
+    centre = np.concatenate(
+        [np.concatenate([centre, centre], axis=1), np.concatenate([centre, centre * (-1, 1)], axis=1)]
+    )
     k = np.concatenate([np.concatenate([k, k], axis=1), np.concatenate([k, k * flip], axis=1)])
-    active = np.concatenate([np.concatenate([active, np.zeros_like(active)], axis=1),
-                             np.concatenate([active, active], axis=1)])
+    active = np.concatenate(
+        [np.concatenate([active, np.zeros_like(active)], axis=1), np.concatenate([active, active], axis=1)]
+    )
     scale = np.array([scale_x, scale_y])
     return (centre, k, active), (centre * scale, k * scale[:, None] * scale[None, :], active)
 
@@ -321,7 +332,8 @@ def test_followed_sections_give_the_searched_perimeters():
     """hull_perimeter(warm=structure) solves the kinks again from where they were instead of searching: after a
     small move it gives the perimeters a search gives, and the same structure; one section alone gives the bits it
     gives in the batch."""
-    from ellimann_addon.core import hull
+    from ellimann_addon.core.geometry import section_hull as hull
+
     before, after = _moved_grid_sections()
     _, structure = measure.hull_perimeter(*before, structure=True)
     half = len(structure.mirrored) // 2
@@ -334,7 +346,7 @@ def test_followed_sections_give_the_searched_perimeters():
     np.testing.assert_array_equal(moved.kink_after, found.kink_after)
     np.testing.assert_allclose(moved.kink_theta, found.kink_theta, atol=1e-12)
     for i in (0, 5, len(followed) - 1):
-        one = measure.hull_perimeter(*(a[i:i + 1] for a in after), warm=structure.take([i]))
+        one = measure.hull_perimeter(*(a[i : i + 1] for a in after), warm=structure.take([i]))
         assert one[0] == followed[i]
     assert isinstance(structure.take([0]), hull.HullStructure)
 
@@ -350,19 +362,24 @@ def test_a_structure_that_no_longer_holds_is_searched_again():
     centre, k, active = after
     cut = active.copy()
     cut[np.arange(len(cut)), np.maximum(structure.first, 0)] = False  # the first outermost ellipse gone
-    np.testing.assert_allclose(measure.hull_perimeter(centre, k, cut, warm=structure),
-                               measure.hull_perimeter(centre, k, cut), rtol=1e-14)
+    np.testing.assert_allclose(
+        measure.hull_perimeter(centre, k, cut, warm=structure), measure.hull_perimeter(centre, k, cut), rtol=1e-14
+    )
 
 
 def test_the_elliptic_integral_of_the_pieces_matches_scipys_for_any_angle():
-    """core.hull._elliptic_e, E(u | m) for any real u (whole turns of pi add twice the complete integral), against
+    """core.geometry.elliptic.elliptic_e, E(u | m) for any real u (whole turns of pi add twice the complete
+    integral), against
     scipy.special.ellipeinc, up to aspect ratios of 100 (m = 1 - 1e-4)."""
     from scipy.special import ellipeinc
 
-    from ellimann_addon.core import hull
+    from ellimann_addon.core.geometry import elliptic
+
     rng = np.random.default_rng(4)
     m = np.concatenate([rng.uniform(0.0, 1.0, 4000), 1.0 - 10.0 ** rng.uniform(-4, -1, 1000), [0.0, 0.0]])
     u = np.concatenate([rng.uniform(-np.pi, 2.5 * np.pi, len(m) - 2), [np.pi / 2, -np.pi]])
-    np.testing.assert_allclose(hull._elliptic_e(u, m), ellipeinc(u, m), rtol=0, atol=3e-14)
+    np.testing.assert_allclose(elliptic.elliptic_e(u, m), ellipeinc(u, m), rtol=0, atol=3e-14)
     sharp = m < 1.0 - 1.0 / 150.0  # aspect below about 12
-    np.testing.assert_allclose(hull._elliptic_e(u[sharp], m[sharp]), ellipeinc(u[sharp], m[sharp]), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(
+        elliptic.elliptic_e(u[sharp], m[sharp]), ellipeinc(u[sharp], m[sharp]), rtol=0, atol=1e-14
+    )

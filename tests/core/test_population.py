@@ -11,7 +11,7 @@ import pytest
 
 from devkit import synthetic
 from devkit.cli_runs import assert_one_line_error, run
-from ellimann_addon.core.population import (
+from ellimann_addon.core.synthesis.population import (
     POPULATIONS_FOLDER,
     PopulationError,
     cholesky,
@@ -32,7 +32,7 @@ def test_sample_mean_and_covariance_are_the_surveys_within_sampling_error():
     assert mean_error.max() < 4.5  # 4.5 standard errors over 12 means
     sample = np.cov(rows, rowvar=False)
     # Standard error of a sample covariance of normal data: sqrt((s_ii s_jj + s_ij^2) / n).
-    error = np.sqrt((np.outer(variance, variance) + population.covariance ** 2) / count)
+    error = np.sqrt((np.outer(variance, variance) + population.covariance**2) / count)
     assert (np.abs(sample - population.covariance) / error).max() < 4.5
 
 
@@ -48,8 +48,9 @@ def test_sampling_is_the_mean_plus_the_factor_times_pcg64_normals():
     population = load_population("ansur2_female")
     rows, _ = population.sample(500, 9)
     deviates = np.random.Generator(np.random.PCG64(9)).standard_normal((500, len(population.keys)))
-    np.testing.assert_allclose(rows, population.mean + deviates @ np.linalg.cholesky(population.covariance).T,
-                               rtol=1e-13, atol=1e-10)
+    np.testing.assert_allclose(
+        rows, population.mean + deviates @ np.linalg.cholesky(population.covariance).T, rtol=1e-13, atol=1e-10
+    )
     again, _ = population.sample(500, 9)
     np.testing.assert_array_equal(rows, again)
     assert not np.array_equal(rows, population.sample(500, 10)[0])
@@ -61,18 +62,21 @@ def altered(change):
     return data
 
 
-@pytest.mark.parametrize("change, field", [
-    (lambda d: d["covariance"][1].__setitem__(1, 1.0) or d.pop("std"), "not positive definite (at Sh"),
-    (lambda d: d["covariance"][0].__setitem__(1, 99.0), "covariance is not symmetric"),
-    (lambda d: d["mean"].__setitem__("Wa", -80.0), "mean.Wa must be > 0"),
-    (lambda d: d.__setitem__("colour", "red"), "colour is not a field"),
-    (lambda d: d["mean"].__setitem__("elbow", 3.0), "mean.elbow is not one of keys"),
-    (lambda d: d["std"].__setitem__("He", 9.0), "std.He is 9"),
-    (lambda d: d.__setitem__("keys", ["Sh", "He", *d["keys"][2:]]), "keys must start with He, Sh"),
-    (lambda d: d["covariance"].pop(), "covariance must be a 12 x 12 matrix"),
-    (lambda d: d.pop("citation"), "citation is missing"),
-    (lambda d: d.__setitem__("units", "in"), "units must be 'cm'"),
-])
+@pytest.mark.parametrize(
+    "change, field",
+    [
+        (lambda d: d["covariance"][1].__setitem__(1, 1.0) or d.pop("std"), "not positive definite (at Sh"),
+        (lambda d: d["covariance"][0].__setitem__(1, 99.0), "covariance is not symmetric"),
+        (lambda d: d["mean"].__setitem__("Wa", -80.0), "mean.Wa must be > 0"),
+        (lambda d: d.__setitem__("colour", "red"), "colour is not a field"),
+        (lambda d: d["mean"].__setitem__("elbow", 3.0), "mean.elbow is not one of keys"),
+        (lambda d: d["std"].__setitem__("He", 9.0), "std.He is 9"),
+        (lambda d: d.__setitem__("keys", ["Sh", "He", *d["keys"][2:]]), "keys must start with He, Sh"),
+        (lambda d: d["covariance"].pop(), "covariance must be a 12 x 12 matrix"),
+        (lambda d: d.pop("citation"), "citation is missing"),
+        (lambda d: d.__setitem__("units", "in"), "units must be 'cm'"),
+    ],
+)
 def test_bad_statistics_are_refused_naming_the_field(change, field):
     with pytest.raises(PopulationError, match="x") as caught:
         population_from_dict(altered(change), "x")
@@ -85,12 +89,15 @@ def write_stats(tmp_path, data):
     return str(path)
 
 
-@pytest.mark.parametrize("argv, words", [
-    (["--n", "0"], ["from 1 to 1,000,000", "got 0"]),
-    (["--n", "5000000"], ["from 1 to 1,000,000"]),
-    (["--n", "5", "--seed", "-1"], ["seed must be a non-negative integer"]),
-    (["--n", "5", "--stats", "nowhere"], ["no shipped statistics named 'nowhere'"]),
-])
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        (["--n", "0"], ["from 1 to 1,000,000", "got 0"]),
+        (["--n", "5000000"], ["from 1 to 1,000,000"]),
+        (["--n", "5", "--seed", "-1"], ["seed must be a non-negative integer"]),
+        (["--n", "5", "--stats", "nowhere"], ["no shipped statistics named 'nowhere'"]),
+    ],
+)
 def test_bad_command_lines_write_nothing(tmp_path, capsys, argv, words):
     stats = [] if "--stats" in argv else ["--stats", "ansur2_female"]
     code, _, err = run(["population", *stats, *argv, "-o", str(tmp_path / "p.csv")], capsys)
@@ -108,6 +115,7 @@ def test_a_non_positive_definite_file_is_one_line_and_nothing_written(tmp_path, 
 def test_rows_outside_a_body_are_refused_and_counted(tmp_path, capsys):
     def short(data):  # a population around the He limit of 50 cm: about half its rows are below it
         data["mean"]["He"] = 50.0
+
     stats = write_stats(tmp_path, altered(short))
     out = tmp_path / "p.csv"
     code, stdout, err = run(["population", "--stats", stats, "--n", "400", "--seed", "3", "-o", str(out)], capsys)
@@ -122,9 +130,25 @@ def test_rows_outside_a_body_are_refused_and_counted(tmp_path, capsys):
 
 def test_synthesize_writes_the_batch(tmp_path, capsys):
     references = str(synthetic.write_reference_folder(tmp_path / "rm"))
-    code, stdout, err = run(["population", "--stats", "ansur2_female", "--n", "12", "--seed", "5", "-q",
-                             "-o", str(tmp_path / "p.csv"), "--synthesize", str(tmp_path / "out"),
-                             "--references", references], capsys)
+    code, stdout, err = run(
+        [
+            "population",
+            "--stats",
+            "ansur2_female",
+            "--n",
+            "12",
+            "--seed",
+            "5",
+            "-q",
+            "-o",
+            str(tmp_path / "p.csv"),
+            "--synthesize",
+            str(tmp_path / "out"),
+            "--references",
+            references,
+        ],
+        capsys,
+    )
     assert code in (0, 3), err
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["mannequins.npz", "report.csv"]
     report = list(csv.DictReader((tmp_path / "out" / "report.csv").open(encoding="utf-8")))
@@ -138,8 +162,9 @@ def test_the_csv_holds_the_five_unless_extras_are_asked(tmp_path, capsys):
     mannequin: they are written only with --extras, on the same sampled rows."""
     five, every = tmp_path / "five.csv", tmp_path / "every.csv"
     for path, more in ((five, []), (every, ["--extras"])):
-        code, _, err = run(["population", "--stats", "ansur2_female", "--n", "20", "--seed", "3", "-q",
-                            "-o", str(path), *more], capsys)
+        code, _, err = run(
+            ["population", "--stats", "ansur2_female", "--n", "20", "--seed", "3", "-q", "-o", str(path), *more], capsys
+        )
         assert code == 0, err
     short = list(csv.DictReader(five.open(encoding="utf-8")))
     full = list(csv.DictReader(every.open(encoding="utf-8")))

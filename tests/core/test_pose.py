@@ -4,14 +4,11 @@ rigidity of the pieces, limits and clamping, on the shipped Reference Mannequins
 import numpy as np
 import pytest
 
-from ellimann_addon.core import pose as kinematics
-from ellimann_addon.core import poses
-from ellimann_addon.core.ellipsoid import axis_extent, shape_matrix
 from ellimann_addon.core.errors import ElliMannError
-from ellimann_addon.core.frames import is_rotation
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER, REFERENCE_NAMES
-from ellimann_addon.core.skeleton import (
+from ellimann_addon.core.geometry.ellipsoid import axis_extent, shape_matrix
+from ellimann_addon.core.geometry.frames import is_rotation
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.skeleton import (
     BASE_LIMITS,
     JOINT_COUNT,
     JOINT_INDEX,
@@ -21,6 +18,9 @@ from ellimann_addon.core.skeleton import (
     limits,
     part_bones,
 )
+from ellimann_addon.core.pose import kinematics as kinematics
+from ellimann_addon.core.pose import standard as poses
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, REFERENCE_NAMES
 
 J = JOINT_INDEX
 STEMS = ("base_mannequin",) + REFERENCE_NAMES
@@ -174,8 +174,11 @@ def test_posing_is_rigid(mannequin, seed):
         rest = np.linalg.norm(mannequin.center[same] - mannequin.center[a], axis=1)
         assert np.allclose(np.linalg.norm(posed.center[same] - posed.center[a], axis=1), rest, atol=1e-12)
         joint = bones[a]
-        assert np.isclose(np.linalg.norm(posed.center[a] - posed.joints[joint]),
-                          np.linalg.norm(mannequin.center[a] - mannequin.joints[joint]), atol=1e-12)
+        assert np.isclose(
+            np.linalg.norm(posed.center[a] - posed.joints[joint]),
+            np.linalg.norm(mannequin.center[a] - mannequin.joints[joint]),
+            atol=1e-12,
+        )
 
 
 def test_euler_angles_round_trip():

@@ -5,14 +5,14 @@ that are exactly the cushion at rest."""
 import numpy as np
 import pytest
 
-from ellimann_addon.core import pose as kinematics
-from ellimann_addon.core import poses
-from ellimann_addon.core.cushion import cushion_meshes
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.mesh import convexity_defect, is_closed_manifold, volume
-from ellimann_addon.core.posed import PosingRig, clip_convex_mesh, split_cushion_names, union_volume
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER
-from ellimann_addon.core.skeleton import JOINT_INDEX, cross_joint_pairs, joint_frames
+from ellimann_addon.core.geometry.cushion import cushion_meshes
+from ellimann_addon.core.geometry.mesh import convexity_defect, is_closed_manifold, volume
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.skeleton import JOINT_INDEX, cross_joint_pairs, joint_frames
+from ellimann_addon.core.pose import kinematics as kinematics
+from ellimann_addon.core.pose import standard as poses
+from ellimann_addon.core.pose.posed_pieces import PosingRig, clip_convex_mesh, split_cushion_names, union_volume
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
 LEVEL = 3  # cushion resolution of these checks
 SAMPLES = 100_000  # Monte Carlo samples per volume (standard error about 0.4% of a cushion)
@@ -40,8 +40,15 @@ def elbows_bent(joints, degrees=90.0):
 
 
 def test_clipping_a_closed_convex_mesh_gives_two_closed_convex_halves_of_its_volume():
-    (vertices, faces), = cushion_meshes([((np.eye(3), np.zeros(3), np.array([0.1, 0.05, 0.2])),
-                                          (np.eye(3), np.array([0.0, 0.0, 0.3]), np.array([0.06, 0.05, 0.1])))], 3)
+    ((vertices, faces),) = cushion_meshes(
+        [
+            (
+                (np.eye(3), np.zeros(3), np.array([0.1, 0.05, 0.2])),
+                (np.eye(3), np.array([0.0, 0.0, 0.3]), np.array([0.06, 0.05, 0.1])),
+            )
+        ],
+        3,
+    )
     point, normal = np.array([0.01, 0.0, 0.2]), np.array([0.1, 0.2, 1.0])
     halves = [clip_convex_mesh(vertices, faces, point, n) for n in (normal, -normal)]
     for v, f in halves:
@@ -71,7 +78,7 @@ def _cushion_volumes(rig, pose, first):
     m = body.mannequin
     i = m.topology.index[first]
     j = m.topology.index[m.topology.parts[i].partner]
-    (v, f), = cushion_meshes([tuple((m.rotation[k], m.center[k], m.semi_axes[k]) for k in (i, j))], LEVEL)
+    ((v, f),) = cushion_meshes([tuple((m.rotation[k], m.center[k], m.semi_axes[k]) for k in (i, j))], LEVEL)
     return union, volume(v, f)
 
 
@@ -103,8 +110,7 @@ def test_posing_with_the_rig_is_posing_every_piece_rigidly(average, rig):
     pose = poses.sit(average.joints)
     body = rig.pose(pose)
     same = kinematics.pose_mannequin(average, pose)
-    assert np.array_equal(body.mannequin.center, same.center) and np.array_equal(body.mannequin.rotation,
-                                                                                  same.rotation)
+    assert np.array_equal(body.mannequin.center, same.center) and np.array_equal(body.mannequin.rotation, same.rotation)
     world, offset, _ = kinematics.forward_kinematics(average.joints, pose.rotations, pose.translation)
     for mesh, posed in zip(rig.meshes, body.cushions):
         assert np.allclose(posed.vertices, mesh.vertices @ world[mesh.bone].T + offset[mesh.bone], atol=1e-12)

@@ -4,8 +4,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from devkit.toy import rotation_from_vector
-from ellimann_addon.core.frames import is_rotation
-from ellimann_addon.core.quaternion import quaternion_to_rotation, rotation_to_quaternion
+from ellimann_addon.core.geometry.frames import is_rotation
+from ellimann_addon.core.geometry.quaternion import quaternion_to_rotation, rotation_to_quaternion
 
 vectors = st.tuples(*[st.floats(-3.2, 3.2)] * 3)
 

@@ -8,11 +8,11 @@ import pytest
 
 from devkit.cli_runs import assert_one_line_error, run
 from devkit.toy import make_toy_mannequin
-from ellimann_addon.core.body_mesh import BodyMesh, connectivity_fingerprint, from_polygons, read_obj
 from ellimann_addon.core.constants import MEASUREMENTS
-from ellimann_addon.core.mesh import icosphere
-from ellimann_addon.core.reference_build import ReferenceBuildError, central_body, validate_inputs
-from ellimann_addon.core.trace import FitSettings, PartTrace
+from ellimann_addon.core.fitting.body_mesh import BodyMesh, connectivity_fingerprint, from_polygons, read_obj
+from ellimann_addon.core.fitting.reference_build import ReferenceBuildError, central_body, validate_inputs
+from ellimann_addon.core.geometry.mesh import icosphere
+from ellimann_addon.core.mannequin.traces import FitSettings, PartTrace
 
 TARGETS = {"a": (150, 32, 86, 64, 84), "b": (170, 31, 85, 64, 85), "c": (160, 43, 117, 104, 117)}
 
@@ -24,8 +24,12 @@ def _sphere(name, scale=1.0):
 
 def _base(body):
     mannequin = make_toy_mannequin()
-    traces = {part.name: PartTrace("traced", len(body.vertices), body.edges_crc, np.arange(10 * i, 10 * i + 10),
-                                   FitSettings()) for i, part in enumerate(mannequin.topology)}
+    traces = {
+        part.name: PartTrace(
+            "traced", len(body.vertices), body.edges_crc, np.arange(10 * i, 10 * i + 10), FitSettings()
+        )
+        for i, part in enumerate(mannequin.topology)
+    }
     return mannequin.copy(role="base", name="Base", traces=traces)
 
 
@@ -104,8 +108,10 @@ def test_an_obj_with_quads_reads_as_triangles_with_the_quads_fingerprint(tmp_pat
     path = tmp_path / "cube.obj"
     corners = [(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)]
     quads = [(1, 2, 4, 3), (5, 7, 8, 6), (1, 5, 6, 2), (3, 4, 8, 7), (1, 3, 7, 5), (2, 6, 8, 4)]
-    path.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in corners) + "".join(
-        "f " + " ".join(f"{i}/1" for i in q) + "\n" for q in quads))
+    path.write_text(
+        "".join(f"v {x} {y} {z}\n" for x, y, z in corners)
+        + "".join("f " + " ".join(f"{i}/1" for i in q) + "\n" for q in quads)
+    )
     body = read_obj(path)
     assert body.name == "cube" and body.faces.shape == (12, 3)
     assert body.edges_crc == connectivity_fingerprint([[i - 1 for i in q] for q in quads])
@@ -120,21 +126,32 @@ def _files(inputs, tmp_path, targets_text=None):
     paths = []
     for body in bodies:
         path = tmp_path / f"{body.name}.obj"
-        path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in body.vertices)
-                        + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in body.faces))
+        path.write_text(
+            "".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in body.vertices)
+            + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in body.faces)
+        )
         paths.append(str(path))
     csv = tmp_path / "targets.csv"
-    csv.write_text(targets_text if targets_text is not None else "name," + ",".join(MEASUREMENTS) + "\n" + "".join(
-        f"{name}," + ",".join(f"{row[k]:g}" for k in MEASUREMENTS) + "\n" for name, row in targets.items()))
+    csv.write_text(
+        targets_text
+        if targets_text is not None
+        else "name,"
+        + ",".join(MEASUREMENTS)
+        + "\n"
+        + "".join(f"{name}," + ",".join(f"{row[k]:g}" for k in MEASUREMENTS) + "\n" for name, row in targets.items())
+    )
     return ["references", "build", "--base", str(tmp_path / "base.json"), "--targets", str(csv), "--bodies", *paths]
 
 
-@pytest.mark.parametrize("case, words", [
-    ("two bodies", ["at least 3 bodies"]),
-    ("missing row", ["no row for body 'c'"]),
-    ("not a number", ["Hi='wide' is not a number"]),
-    ("old base", ["no recorded selection"]),
-])
+@pytest.mark.parametrize(
+    "case, words",
+    [
+        ("two bodies", ["at least 3 bodies"]),
+        ("missing row", ["no row for body 'c'"]),
+        ("not a number", ["Hi='wide' is not a number"]),
+        ("old base", ["no recorded selection"]),
+    ],
+)
 def test_the_command_refuses_in_one_line_and_writes_nothing(inputs, tmp_path, capsys, case, words):
     base, bodies, targets = inputs
     text = None
@@ -155,27 +172,34 @@ def test_check_reports_each_rm_of_the_shipped_set(capsys):
     code, out, err = run(["references", "check", "reference_blends"], capsys)
     assert code == 0, err
     assert "6 RMs" not in out and "5 RMs, manifest reference_set.json" in out
-    assert sum(line.startswith(("small_slim:", "tall_slim:", "small_chubby:", "tall_chubby:", "average:"))
-               for line in out.splitlines()) == 5
+    assert (
+        sum(
+            line.startswith(("small_slim:", "tall_slim:", "small_chubby:", "tall_chubby:", "average:"))
+            for line in out.splitlines()
+        )
+        == 5
+    )
 
 
 def test_check_flags_an_rm_off_its_targets(tmp_path, capsys):
     from devkit.synthetic import make_reference_mannequins
-    from ellimann_addon.core.clean import register_to_world
-    from ellimann_addon.core.reference_manifest import Manifest, write_reference_set
+    from ellimann_addon.core.mannequin.clean import register_to_world
+    from ellimann_addon.core.synthesis.manifest import Manifest, write_reference_set
 
     mannequins = [register_to_world(m) for m in make_reference_mannequins()[:3]]
     targets = {m.name: dict(m.measurements) for m in mannequins}
     targets[mannequins[0].name]["Hi"] *= 1.05
-    write_reference_set(tmp_path, {m.name: m for m in mannequins},
-                        dataclasses.replace(Manifest("x", list(targets)), targets_cm=targets))
+    write_reference_set(
+        tmp_path, {m.name: m for m in mannequins}, dataclasses.replace(Manifest("x", list(targets)), targets_cm=targets)
+    )
     code, _, err = run(["references", "check", str(tmp_path)], capsys)
     assert_one_line_error(code, err, mannequins[0].name, "Hi is off its target")
 
 
 def test_voxel_iou_of_a_ball_in_a_ball_is_their_volume_ratio_and_of_a_ball_with_itself_one():
-    from ellimann_addon.core.mannequin import Mannequin, Part, Topology
-    from ellimann_addon.core.volume import BodyVolume, voxel_iou
+    from ellimann_addon.core.geometry.volume import BodyVolume, voxel_iou
+    from ellimann_addon.core.mannequin.model import Mannequin
+    from ellimann_addon.core.mannequin.topology import Part, Topology
 
     vertices, faces = icosphere(4)
     topology = Topology([Part("1.a Ball", "C", "body", True, ("He",))])

@@ -5,12 +5,13 @@ import pathlib
 import numpy as np
 import pytest
 
-from ellimann_addon.core.clean import asymmetry, landmark_indices
 from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS
-from ellimann_addon.core.ellipsoid import section_at_height
-from ellimann_addon.core.frames import axis_agreement, is_rotation
-from ellimann_addon.core.mannequin import NAME_PATTERN, Mannequin
-from ellimann_addon.core.measure import section_heights
+from ellimann_addon.core.geometry.ellipsoid import section_at_height
+from ellimann_addon.core.geometry.frames import axis_agreement, is_rotation
+from ellimann_addon.core.mannequin.clean import asymmetry, landmark_indices
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.topology import NAME_PATTERN
+from ellimann_addon.core.measure.tailor import section_heights
 
 FOLDER = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"
 DOCS = pathlib.Path(__file__).resolve().parents[2] / "docs"
@@ -52,8 +53,19 @@ def test_every_reference_mannequin_has_the_base_topology(base, rms):
 
 def test_topology_has_the_registration_landmarks_and_a_whole_body(base):
     labels = {NAME_PATTERN.match(n).group("label") for n in base.topology.names}
-    assert {"Trapezius", "Cranium", "Breast", "Thorax", "Rectus Abdominalis", "Pelvis", "Thigh", "Foot",
-            "Upper Arm", "Forearm", "Hand"} <= labels
+    assert {
+        "Trapezius",
+        "Cranium",
+        "Breast",
+        "Thorax",
+        "Rectus Abdominalis",
+        "Pelvis",
+        "Thigh",
+        "Foot",
+        "Upper Arm",
+        "Forearm",
+        "Hand",
+    } <= labels
     trapezius = [base.topology.names[i] for i in landmark_indices(base.topology)]
     assert sorted(trapezius) == ["10.a Trapezius.L", "10.a Trapezius.R"]
     for part in base.topology:

@@ -9,24 +9,31 @@ from devkit.synthetic import make_reference_mannequins, write_reference_folder
 from devkit.toy import make_toy_mannequin
 from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, SECTION_FRACTIONS
 from ellimann_addon.core.errors import MannequinError, ReferenceSetError
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.reference_manifest import (
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.traces import FitSettings, PartTrace, format_runs, parse_runs
+from ellimann_addon.core.synthesis.manifest import (
     MANIFEST_FILE,
     Manifest,
     read_manifest,
     targets_range,
     write_reference_set,
 )
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER, load_reference_set
-from ellimann_addon.core.synthesis import synthesize_batch
-from ellimann_addon.core.trace import FitSettings, PartTrace, format_runs, parse_runs
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, load_reference_set
+from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 
 
 def _trace(count=500, seed=0):
     rng = np.random.default_rng(seed)
     vertices = np.unique(rng.integers(0, count, 120))
-    return PartTrace("body", count, 12345, vertices, FitSettings(margin=0.2, frame="limb", level="Wa", kept=2),
-                     np.array([3, 4, 5, 9]), "enclosing")
+    return PartTrace(
+        "body",
+        count,
+        12345,
+        vertices,
+        FitSettings(margin=0.2, frame="limb", level="Wa", kept=2),
+        np.array([3, 4, 5, 9]),
+        "enclosing",
+    )
 
 
 def test_runs_round_trip_any_sorted_indices():
@@ -76,8 +83,9 @@ def test_a_trace_for_an_unknown_part_or_a_bad_setting_is_refused():
 
 def _write_set(folder, mannequins, **fields):
     targets = {m.name: dict(m.measurements) for m in mannequins}
-    manifest = Manifest(name="three", mannequins=list(targets), targets_cm=targets, ranges_cm=targets_range(targets),
-                        **fields)
+    manifest = Manifest(
+        name="three", mannequins=list(targets), targets_cm=targets, ranges_cm=targets_range(targets), **fields
+    )
     write_reference_set(folder, {m.name: m for m in mannequins}, manifest)
     return manifest
 
@@ -125,14 +133,17 @@ def test_the_shipped_set_has_a_manifest_with_todays_constants():
     assert reference.ranges == RANGES and reference.absurd_limits == ABSURD_LIMITS
 
 
-@pytest.mark.parametrize("change, field", [
-    (lambda d: d.update(mannequins=d["mannequins"][:2]), "mannequins"),
-    (lambda d: d.update(version=99), "version"),
-    (lambda d: d["section_fractions"].pop("Wa"), "section_fractions"),
-    (lambda d: d["ranges_cm"].update(He=[200.0, 100.0]), "ranges_cm"),
-    (lambda d: d.update(mannequins=["../escape", "b", "c"]), "mannequins"),
-    (lambda d: d.update(sex="other"), "sex"),
-])
+@pytest.mark.parametrize(
+    "change, field",
+    [
+        (lambda d: d.update(mannequins=d["mannequins"][:2]), "mannequins"),
+        (lambda d: d.update(version=99), "version"),
+        (lambda d: d["section_fractions"].pop("Wa"), "section_fractions"),
+        (lambda d: d["ranges_cm"].update(He=[200.0, 100.0]), "ranges_cm"),
+        (lambda d: d.update(mannequins=["../escape", "b", "c"]), "mannequins"),
+        (lambda d: d.update(sex="other"), "sex"),
+    ],
+)
 def test_a_broken_manifest_is_refused_naming_the_field(tmp_path, change, field):
     _write_set(tmp_path, make_reference_mannequins()[:3])
     data = json.loads((tmp_path / MANIFEST_FILE).read_text())

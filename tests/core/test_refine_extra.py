@@ -1,4 +1,4 @@
-"""Exact mode with the extra measurements (core.refine_extra): each degree of freedom meets its measurement
+"""Exact mode with the extra measurements (core.synthesis.extra_refine): each degree of freedom meets its measurement
 within 1 mm with the five kept exact, on slim and heavy requests (the heavy bodies' neck and thigh were missed
 before); the girth deformations widen a section without moving what they must keep; contradictions are refused
 with the amount."""
@@ -7,36 +7,54 @@ import numpy as np
 import pytest
 
 from ellimann_addon.core.constants import MEASUREMENTS
-from ellimann_addon.core.ellipsoid import axis_extent
-from ellimann_addon.core.extra_measures import (
+from ellimann_addon.core.geometry.ellipsoid import axis_extent
+from ellimann_addon.core.measure.extra import (
     EXTRA_MEASUREMENTS,
     THIGH_DROP,
     MannequinLandmarks,
     mannequin_extra_measurements,
 )
-from ellimann_addon.core.reference_set import ReferenceSet
-from ellimann_addon.core.refine_extra import (
+from ellimann_addon.core.synthesis.extra_refine import (
     EXTRA_FACTOR_LIMIT,
     MISS_CM,
     ExtraRequestError,
     _section_rows,
     _widen_at,
     extra_request_problems,
-    synthesize_extra,
 )
-from ellimann_addon.core.shipped_sets import named_reference_set
+from ellimann_addon.core.synthesis.reference_set import ReferenceSet
+from ellimann_addon.core.synthesis.shipped import named_reference_set
+from ellimann_addon.core.synthesis.synthesize import synthesize_extra
 
 FIVE_RELATIVE = 1e-5  # the five's exact-mode tolerance (0.001 %)
 # The five and the six of two of ../shared/refmodels' bodies as measured as meshes (docs/measurements.md).
 SLIM = dict(zip(MEASUREMENTS, (148.0, 31.11, 84.97, 63.0, 83.0)))
-SLIM_EXTRA = {"neck": 29.68, "upper_arm": 19.95, "thigh": 43.85, "calf": 32.30, "crotch_height": 67.17,
-              "arm_length": 57.02}
+SLIM_EXTRA = {
+    "neck": 29.68,
+    "upper_arm": 19.95,
+    "thigh": 43.85,
+    "calf": 32.30,
+    "crotch_height": 67.17,
+    "arm_length": 57.02,
+}
 TALL = dict(zip(MEASUREMENTS, (170.99, 30.22, 83.98, 62.99, 84.01)))
-TALL_EXTRA = {"neck": 31.17, "upper_arm": 19.50, "thigh": 43.55, "calf": 35.17, "crotch_height": 80.07,
-              "arm_length": 64.09}
+TALL_EXTRA = {
+    "neck": 31.17,
+    "upper_arm": 19.50,
+    "thigh": 43.55,
+    "calf": 35.17,
+    "crotch_height": 80.07,
+    "arm_length": 64.09,
+}
 HEAVY = dict(zip(MEASUREMENTS, (148.64, 47.69, 144.41, 138.79, 152.08)))
-HEAVY_EXTRA = {"neck": 42.64, "upper_arm": 26.12, "thigh": 86.13, "calf": 47.40, "crotch_height": 65.38,
-               "arm_length": 55.83}
+HEAVY_EXTRA = {
+    "neck": 42.64,
+    "upper_arm": 26.12,
+    "thigh": 86.13,
+    "calf": 47.40,
+    "crotch_height": 65.38,
+    "arm_length": 55.83,
+}
 
 
 @pytest.fixture(scope="module")
@@ -69,8 +87,9 @@ def test_each_extra_measurement_of_a_body_is_met_alone(reference, key, body):
     assert_met(reference, five, {key: extra[key]})
 
 
-@pytest.mark.parametrize("five, extra", [(SLIM, SLIM_EXTRA), (TALL, TALL_EXTRA), (HEAVY, HEAVY_EXTRA)],
-                         ids=["slim", "tall", "heavy"])
+@pytest.mark.parametrize(
+    "five, extra", [(SLIM, SLIM_EXTRA), (TALL, TALL_EXTRA), (HEAVY, HEAVY_EXTRA)], ids=["slim", "tall", "heavy"]
+)
 def test_all_six_of_a_body_are_met_at_once(reference, five, extra):
     assert_met(reference, five, extra)
 
@@ -99,8 +118,9 @@ def test_a_thigh_widened_keeps_its_mid_plane_edge_and_far_ends(reference):
     inner = np.abs(center[rows, 0] - marks.mid_x) - axis_extent(rotation[rows], semi[rows], 0)
     far = center[rows, 2] - np.sign(cut) * half
     before = marks.girths_at([z], marks.leg_mask("L"))[0]
-    _widen_at(rotation, center, semi, z, legs, 1.2, 2.0, np.zeros(len(center)), np.zeros(len(center)),
-              mid_x=marks.mid_x)
+    _widen_at(
+        rotation, center, semi, z, legs, 1.2, 2.0, np.zeros(len(center)), np.zeros(len(center)), mid_x=marks.mid_x
+    )
     widened = mannequin.copy(center=center, semi_axes=semi)
     after = MannequinLandmarks(widened)
     assert after.crotch() == pytest.approx(marks.crotch(), abs=1e-9)
@@ -144,8 +164,18 @@ def test_widening_lengthens_a_piece_at_most_by_the_factor_limit(reference):
     rows = _section_rows(rotation, center, semi, z, legs)[0]
     limit = np.log(EXTRA_FACTOR_LIMIT)
     free_center, free_semi = center.copy(), semi.copy()
-    _widen_at(rotation, free_center, free_semi, z, legs, 1.5, 2.0, np.zeros(len(center)), np.zeros(len(center)),
-              mid_x=marks.mid_x)
+    _widen_at(
+        rotation,
+        free_center,
+        free_semi,
+        z,
+        legs,
+        1.5,
+        2.0,
+        np.zeros(len(center)),
+        np.zeros(len(center)),
+        mid_x=marks.mid_x,
+    )
     stretch = np.zeros(len(center))
     stretch[rows] = limit - 0.01  # lengthened nearly to the limit already
     _widen_at(rotation, center, semi, z, legs, 1.5, 2.0, stretch, np.zeros(len(center)), mid_x=marks.mid_x)
@@ -208,18 +238,21 @@ def test_a_request_beyond_the_pieces_is_named_and_the_five_kept(reference):
     assert abs(measured["calf"] - 82.0) <= abs(start - 82.0)
 
 
-@pytest.mark.parametrize("extra, amount", [
-    ({"thigh": 90.0}, "thigh 90 cm >= Hi 83 cm by 7.00 cm"),
-    ({"neck": 86.0}, "neck (Neck girth) must be 15-80 cm, got 86"),
-    ({"thigh": 50.0, "calf": 51.0}, "calf 51 cm >= thigh 50 cm by 1.00 cm"),
-    ({"calf": 84.0}, "calf 84 cm >= Hi 83 cm by 1.00 cm"),
-    ({"upper_arm": 45.0}, "upper_arm 45 cm >= Br/2 42.485 cm by 2.52 cm"),
-    ({"crotch_height": 90.0}, "crotch_height 90 cm >= 0.6 He 88.8 cm by 1.20 cm"),
-    ({"crotch_height": 40.0}, "crotch_height 40 cm <= 0.3 He 44.4 cm by 4.40 cm"),
-    ({"arm_length": 75.0}, "arm_length 75 cm >= 0.5 He 74 cm by 1.00 cm"),
-    ({"neck": 10.0}, "neck (Neck girth) must be 15-80 cm, got 10"),
-    ({"waist": 10.0}, "waist: not a measurement"),
-])
+@pytest.mark.parametrize(
+    "extra, amount",
+    [
+        ({"thigh": 90.0}, "thigh 90 cm >= Hi 83 cm by 7.00 cm"),
+        ({"neck": 86.0}, "neck (Neck girth) must be 15-80 cm, got 86"),
+        ({"thigh": 50.0, "calf": 51.0}, "calf 51 cm >= thigh 50 cm by 1.00 cm"),
+        ({"calf": 84.0}, "calf 84 cm >= Hi 83 cm by 1.00 cm"),
+        ({"upper_arm": 45.0}, "upper_arm 45 cm >= Br/2 42.485 cm by 2.52 cm"),
+        ({"crotch_height": 90.0}, "crotch_height 90 cm >= 0.6 He 88.8 cm by 1.20 cm"),
+        ({"crotch_height": 40.0}, "crotch_height 40 cm <= 0.3 He 44.4 cm by 4.40 cm"),
+        ({"arm_length": 75.0}, "arm_length 75 cm >= 0.5 He 74 cm by 1.00 cm"),
+        ({"neck": 10.0}, "neck (Neck girth) must be 15-80 cm, got 10"),
+        ({"waist": 10.0}, "waist: not a measurement"),
+    ],
+)
 def test_contradictions_are_refused_with_the_amount(reference, extra, amount):
     problems = extra_request_problems(SLIM, extra)
     assert problems and problems[0].startswith(amount), problems
@@ -231,4 +264,5 @@ def test_contradictions_are_refused_with_the_amount(reference, extra, amount):
 def test_a_neck_above_the_breast_is_refused():
     flat = dict(SLIM, Br=70.0)
     assert extra_request_problems(flat, {"neck": 72.0})[0] == (
-        "neck 72 cm >= Br 70 cm by 2.00 cm: a neck cannot be larger than the breast")
+        "neck 72 cm >= Br 70 cm by 2.00 cm: a neck cannot be larger than the breast"
+    )

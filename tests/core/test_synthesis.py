@@ -11,8 +11,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from devkit import synthetic
-from ellimann_addon.core import idw, measure, refine, synthesis
-from ellimann_addon.core.clean import asymmetry
 from ellimann_addon.core.constants import (
     ABSURD_LIMITS,
     GIRTHS,
@@ -21,14 +19,19 @@ from ellimann_addon.core.constants import (
     SECTION_FRACTIONS,
     quartile_points,
 )
-from ellimann_addon.core.ellipsoid import shape_matrix
 from ellimann_addon.core.errors import ElliMannError, MeasurementError, ReferenceSetError
-from ellimann_addon.core.frames import is_rotation
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.measure import tailor_measurements
+from ellimann_addon.core.geometry.ellipsoid import shape_matrix
+from ellimann_addon.core.geometry.frames import is_rotation
+from ellimann_addon.core.mannequin.clean import asymmetry
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.measure import tailor as measure
+from ellimann_addon.core.measure.tailor import tailor_measurements
+from ellimann_addon.core.synthesis import idw, refine
+from ellimann_addon.core.synthesis import synthesize as synthesis
 
-SETS = ["synthetic"] + (["shipped"] if all((synthesis.REFERENCE_FOLDER / f"{n}.json").is_file()
-                                           for n in synthesis.REFERENCE_NAMES) else [])
+SETS = ["synthetic"] + (
+    ["shipped"] if all((synthesis.REFERENCE_FOLDER / f"{n}.json").is_file() for n in synthesis.REFERENCE_NAMES) else []
+)
 GRID = np.array(list(itertools.product(*[quartile_points(k) for k in MEASUREMENTS])))
 
 
@@ -54,10 +57,14 @@ def random_requests(seed, count, widen=0.0):
 @pytest.mark.parametrize("metric", synthesis.METRICS)
 @pytest.mark.parametrize("power", [1.0, 2.0, 4.0])
 def test_each_reference_mannequin_is_reproduced_exactly(reference, metric, power, normalize):
-    result = synthesis.synthesize_batch(reference, reference.measurements, mode="idw", metric=metric, power=power,
-                                        measure=False, normalize=normalize)
-    np.testing.assert_allclose(shape_matrix(result.rotation, result.semi_axes),
-                               shape_matrix(reference.rotation, reference.semi_axes), atol=1e-12)
+    result = synthesis.synthesize_batch(
+        reference, reference.measurements, mode="idw", metric=metric, power=power, measure=False, normalize=normalize
+    )
+    np.testing.assert_allclose(
+        shape_matrix(result.rotation, result.semi_axes),
+        shape_matrix(reference.rotation, reference.semi_axes),
+        atol=1e-12,
+    )
     np.testing.assert_allclose(result.center, reference.center, atol=1e-12)
     labelled = [i for i, name in enumerate(reference.topology.names) if name not in reference.mirror_label_mismatch]
     np.testing.assert_allclose(result.rotation[:, labelled], reference.rotation[:, labelled], atol=1e-12)
@@ -103,8 +110,11 @@ def test_parts_shared_by_coinciding_references_are_continuous(reference, normali
 
 
 @settings(max_examples=40, deadline=None)
-@given(seed=st.integers(0, 10_000), metric=st.sampled_from(synthesis.METRICS),
-       power=st.floats(synthesis.POWER_LIMITS[0], synthesis.POWER_LIMITS[1]))
+@given(
+    seed=st.integers(0, 10_000),
+    metric=st.sampled_from(synthesis.METRICS),
+    power=st.floats(synthesis.POWER_LIMITS[0], synthesis.POWER_LIMITS[1]),
+)
 def test_weights_are_non_negative_and_sum_to_one(seed, metric, power):
     reference = _SYNTHETIC
     requests = np.concatenate([random_requests(seed, 8, widen=0.5), reference.measurements[seed % 5][None]])
@@ -133,12 +143,13 @@ def test_proportions_stay_within_the_references(reference, metric, normalize):
     """Normalized IDW: a part's centre divided by the request's scales and its semi-axes divided by
     their axis scales lie within the RMs' same proportions (the geometry itself may leave them)."""
     requests = random_requests(4, 40, widen=0.3)
-    result = synthesis.synthesize_batch(reference, requests, mode="idw", metric=metric, measure=False,
-                                        normalize=normalize)
+    result = synthesis.synthesize_batch(
+        reference, requests, mode="idw", metric=metric, measure=False, normalize=normalize
+    )
     src = reference._source
     horizontal, vertical = reference.size_scales(requests, normalize)
-    center = result.center[:, src] / idw._center_scale(horizontal, vertical)
-    semi = result.semi_axes[:, src] / idw._axis_scale(result.rotation[:, src], horizontal, vertical)
+    center = result.center[:, src] / idw.center_scale(horizontal, vertical)
+    semi = result.semi_axes[:, src] / idw.axis_scale(result.rotation[:, src], horizontal, vertical)
     ref_center, ref_semi = reference.normalized_geometry(normalize)
     tol = 1e-12
     for array, stack in ((center, ref_center), (semi, ref_semi)):
@@ -173,15 +184,15 @@ def _scaled(reference, base, me):
     v = rotation[:, 2, :] ** 2
     center = reference.center[base] * np.stack([horizontal, horizontal, vertical], axis=-1)
     semi_axes = reference.semi_axes[base] * vertical[:, None] ** v * horizontal[:, None] ** (1 - v)
-    return Mannequin(reference.topology, rotation, center, semi_axes, role="reference",
-                     measurements=dict(zip(MEASUREMENTS, me)))
+    return Mannequin(
+        reference.topology, rotation, center, semi_axes, role="reference", measurements=dict(zip(MEASUREMENTS, me))
+    )
 
 
 def test_proportional_idw_reproduces_proportionally_scaled_bodies_exactly(reference):
     """If the RMs differ only by these scales, proportional IDW returns the body scaled to any request,
     outside L too; the paper's IDW does not."""
-    scaled = synthesis.ReferenceSet([_scaled(reference, 4, me) for me in reference.measurements],
-                                    names=reference.names)
+    scaled = synthesis.ReferenceSet([_scaled(reference, 4, me) for me in reference.measurements], names=reference.names)
     requests = random_requests(9, 12, widen=0.3)
     result = synthesis.synthesize_batch(scaled, requests, measure=False, normalize="proportional", mode="idw")
     paper = synthesis.synthesize_batch(scaled, requests, measure=False, normalize="none", mode="idw")
@@ -228,8 +239,12 @@ def test_exact_mode_meets_its_target_on_a_sample_of_the_grid(reference):
     assert error.max() <= 0.5
     assert exact.converged.all()
     # What it reports is m_T's of the result (the steps far from the target follow the sections' structure instead).
-    np.testing.assert_array_equal(exact.measured, measure.tailor_measurements(
-        exact.rotation, exact.center, exact.semi_axes, reference.topology.girth_mask, reference.section_fractions))
+    np.testing.assert_array_equal(
+        exact.measured,
+        measure.tailor_measurements(
+            exact.rotation, exact.center, exact.semi_axes, reference.topology.girth_mask, reference.section_fractions
+        ),
+    )
     # Refinement keeps the frames and the symmetry, and only scales (no part flips or collapses).
     np.testing.assert_array_equal(exact.rotation, idw.rotation)
     assert np.all(exact.semi_axes > 0)
@@ -248,15 +263,18 @@ def test_proportional_idw_starts_exact_mode_closer_than_the_papers(reference):
     paper = synthesis.synthesize_batch(reference, sample, mode="exact", normalize="none")
     proportional = synthesis.synthesize_batch(reference, sample, mode="exact")
     idw = synthesis.synthesize_batch(reference, sample, mode="idw")
-    assert np.all(idw.relative_error().mean(axis=0) < synthesis.synthesize_batch(
-        reference, sample, mode="idw", normalize="none").relative_error().mean(axis=0))
+    assert np.all(
+        idw.relative_error().mean(axis=0)
+        < synthesis.synthesize_batch(reference, sample, mode="idw", normalize="none").relative_error().mean(axis=0)
+    )
     assert np.all(np.abs(np.log(proportional.factors)).max(axis=0) < np.abs(np.log(paper.factors)).max(axis=0))
 
 
 def test_exact_mode_changes_nothing_when_m_T_already_matches(reference):
     """At an RM's own m_T the refinement has nothing to do: the result is that RM."""
-    measured = tailor_measurements(reference.rotation, reference.center, reference.semi_axes,
-                                             reference.topology.girth_mask)
+    measured = tailor_measurements(
+        reference.rotation, reference.center, reference.semi_axes, reference.topology.girth_mask
+    )
     # IDW at the RM's nominal point gives the RM; ask exact mode for what that RM measures.
     rotation, center, semi_axes = synthesis.interpolate(reference, reference.measurements)
     result = synthesis.refine(reference.topology, rotation, center, semi_axes, measured)
@@ -284,7 +302,7 @@ def test_refinement_responds_to_each_measurement_in_its_own_neighbourhood():
     rotation, center, semi_axes = synthesis.interpolate(reference, reference.measurements[4:5])
     girth = reference.topology.girth_mask
     measured = tailor_measurements(rotation, center, semi_axes, girth)
-    basis = refine._deform_basis(reference.topology, rotation, center, semi_axes, measured)
+    basis = refine.deform_basis(reference.topology, rotation, center, semi_axes, measured)
     for k, key in enumerate(MEASUREMENTS):
         factors = np.ones((1, 5))
         factors[0, k] = 1.02
@@ -322,23 +340,25 @@ def _deform_every_part(basis, center, semi, f):
     scaled = basis.shoulder_scaled[None, :]
     center[..., 0] = np.where(scaled, center[..., 0] * sh, center[..., 0])
     semi = np.where(scaled[..., None], semi * (1.0 + (sh[..., None] - 1.0) * basis.lateral), semi)
-    center[..., 0] += np.where(basis.shoulder_carried[None, :], np.sign(center[..., 0]) * (sh - 1.0)
-                               * basis.shoulder_half[:, None], 0.0)
+    center[..., 0] += np.where(
+        basis.shoulder_carried[None, :], np.sign(center[..., 0]) * (sh - 1.0) * basis.shoulder_half[:, None], 0.0
+    )
     return center, semi
 
 
 def test_deform_gives_the_bits_of_its_formula_applied_to_every_part(reference):
     requests = np.concatenate([GRID[::10], random_requests(12, 8, widen=0.2)])
     rotation, center, semi_axes = synthesis.interpolate(reference, requests)
-    measured = tailor_measurements(rotation, center, semi_axes, reference.topology.girth_mask,
-                                   reference.section_fractions)
-    basis = refine._deform_basis(reference.topology, rotation, center, semi_axes, measured,
-                                 reference.section_fractions)
+    measured = tailor_measurements(
+        rotation, center, semi_axes, reference.topology.girth_mask, reference.section_fractions
+    )
+    basis = refine.deform_basis(reference.topology, rotation, center, semi_axes, measured, reference.section_fractions)
     assert basis.taper.any() and not basis.taper.all() and basis.shoulder_carried.any()
     factors = np.exp(np.random.default_rng(4).normal(0.0, 0.05, size=(len(requests), 5)))
     for f in (factors, np.ones_like(factors)):
-        for got, expected in zip(synthesis.deform(basis, center, semi_axes, f),
-                                 _deform_every_part(basis, center, semi_axes, f)):
+        for got, expected in zip(
+            synthesis.deform(basis, center, semi_axes, f), _deform_every_part(basis, center, semi_axes, f)
+        ):
             assert got.tobytes() == expected.tobytes()
 
 
@@ -350,7 +370,7 @@ def test_the_fixed_order_solver_solves_and_gives_a_system_alone_its_bits_in_a_st
     x = refine._solve_positive(system, rhs)
     np.testing.assert_allclose(x, np.linalg.solve(system, rhs[..., None])[..., 0], rtol=1e-9, atol=1e-12)
     for i in range(len(system)):
-        assert refine._solve_positive(system[i:i + 1], rhs[i:i + 1])[0].tobytes() == x[i].tobytes()
+        assert refine._solve_positive(system[i : i + 1], rhs[i : i + 1])[0].tobytes() == x[i].tobytes()
 
 
 def test_the_girth_blend_hats_are_the_piecewise_linear_interpolation_of_their_knots():
@@ -361,7 +381,7 @@ def test_the_girth_blend_hats_are_the_piecewise_linear_interpolation_of_their_kn
     for g, key in enumerate(GIRTHS):
         expected = np.interp(x, knots, np.eye(len(knots))[refine._GIRTH_KNOT[key]])
         np.testing.assert_allclose(hats[:, g], expected, rtol=0, atol=1e-15)
-        assert hats[-len(knots):, g].tolist() == np.eye(len(knots))[refine._GIRTH_KNOT[key]].tolist()
+        assert hats[-len(knots) :, g].tolist() == np.eye(len(knots))[refine._GIRTH_KNOT[key]].tolist()
 
 
 # ---------------------------------------------------------------------------------------------- requests
@@ -370,17 +390,20 @@ def test_the_girth_blend_hats_are_the_piecewise_linear_interpolation_of_their_kn
 GOOD = {"He": 159.0, "Sh": 43.0, "Br": 117.0, "Wa": 104.0, "Hi": 117.0}
 
 
-@pytest.mark.parametrize("field, value, words", [
-    ("He", float("nan"), "finite"),
-    ("Sh", float("inf"), "finite"),
-    ("Br", 0.0, "> 0"),
-    ("Wa", -5.0, "> 0"),
-    ("Hi", "abc", "number"),
-    ("He", None, "number"),
-    ("Br", True, "number"),
-    ("He", 500.0, "plausible"),
-    ("Sh", 5.0, "plausible"),
-])
+@pytest.mark.parametrize(
+    "field, value, words",
+    [
+        ("He", float("nan"), "finite"),
+        ("Sh", float("inf"), "finite"),
+        ("Br", 0.0, "> 0"),
+        ("Wa", -5.0, "> 0"),
+        ("Hi", "abc", "number"),
+        ("He", None, "number"),
+        ("Br", True, "number"),
+        ("He", 500.0, "plausible"),
+        ("Sh", 5.0, "plausible"),
+    ],
+)
 def test_bad_requests_are_refused_naming_the_field_and_the_range(field, value, words):
     request = dict(GOOD, **{field: value})
     with pytest.raises(MeasurementError) as info:
@@ -415,8 +438,10 @@ def _row_by_row(requests, limits=None):
     return None
 
 
-@pytest.mark.parametrize("limits", [None, {**ABSURD_LIMITS, "He": (100.0, 200.0), "Hi": (60.0, 160.0)},
-                                    {**ABSURD_LIMITS, "Sh": (-10.0, 100.0)}])  # > 0 whatever the limits
+@pytest.mark.parametrize(
+    "limits",
+    [None, {**ABSURD_LIMITS, "He": (100.0, 200.0), "Hi": (60.0, 160.0)}, {**ABSURD_LIMITS, "Sh": (-10.0, 100.0)}],
+)  # > 0 whatever the limits
 def test_a_batch_is_refused_at_its_first_bad_row_and_field_as_row_by_row(limits):
     good = list(GOOD.values())
     bad_values = [float("nan"), float("inf"), -float("inf"), -1.0, 0.0, -0.0, 1e-300, 2.0, 5.0, 300.0, 1e308]
@@ -450,8 +475,13 @@ def test_values_outside_L_are_allowed_with_a_warning_saying_how_far():
 
 
 def test_bad_options_are_refused():
-    for options in ({"mode": "magic"}, {"metric": "manhattan"}, {"power": 0.0}, {"power": float("nan")},
-                    {"normalize": "width"}):
+    for options in (
+        {"mode": "magic"},
+        {"metric": "manhattan"},
+        {"power": 0.0},
+        {"power": float("nan")},
+        {"normalize": "width"},
+    ):
         with pytest.raises(ElliMannError):
             synthesis.synthesize_batch(_SYNTHETIC, [list(GOOD.values())], **options)
 
@@ -490,11 +520,14 @@ def test_a_topology_mismatch_is_named(folder):
         synthesis.load_reference_set(folder)
 
 
-@pytest.mark.parametrize("change, message", [
-    (lambda d: d["measurements_cm"].pop("Br"), r"small_chubby\.json: measurements_cm\.Br is missing"),
-    (lambda d: d.update(measurements_cm=None), r"small_chubby\.json: measurements_cm is missing"),
-    (lambda d: d["measurements_cm"].update(Hi=float("nan")), r"small_chubby\.json: file cannot be read.*Hi=nan"),
-])
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (lambda d: d["measurements_cm"].pop("Br"), r"small_chubby\.json: measurements_cm\.Br is missing"),
+        (lambda d: d.update(measurements_cm=None), r"small_chubby\.json: measurements_cm is missing"),
+        (lambda d: d["measurements_cm"].update(Hi=float("nan")), r"small_chubby\.json: file cannot be read.*Hi=nan"),
+    ],
+)
 def test_missing_or_invalid_measurements_are_named(folder, change, message):
     _edit(folder / "small_chubby.json", change)
     with pytest.raises(ReferenceSetError, match=message):
@@ -540,7 +573,7 @@ def test_mannequin_name_formats_the_request():
 
 
 def test_one_relative_error_formula_for_dicts_and_arrays():
-    """core.synthesis.relative_error is what the operator, the CLI reports and Synthesis use (in %)."""
+    """core.synthesis.synthesize.relative_error is what the operator, the CLI reports and Synthesis use (in %)."""
     request = dict(zip(MEASUREMENTS, (160.0, 40.0, 100.0, 80.0, 100.0)))
     measured = dict(zip(MEASUREMENTS, (160.0, 42.0, 99.0, 80.4, 100.0)))
     expected = [0.0, 5.0, 1.0, 0.5, 0.0]

@@ -11,7 +11,7 @@ print the same docs. It fails if the code moved the mannequins and if the build 
 import numpy as np
 import pytest
 
-from ellimann_addon.core.mannequin import Mannequin
+from ellimann_addon.core.mannequin.model import Mannequin
 from tools import build_reference
 
 JITTER = 1e-9  # m: a rounding-level change of the inputs
@@ -32,7 +32,7 @@ def test_the_build_from_rounding_level_perturbed_bodies_passes_check(perturbed, 
     monkeypatch.setattr(build_reference, "build", lambda *args, **kwargs: perturbed)
     status = build_reference.main(["--check", "--no-blend"])
     out = capsys.readouterr().out
-    assert status == 0, out[out.index("built in"):]
+    assert status == 0, out[out.index("built in") :]
     assert "identical to the files in" in out
 
 
@@ -40,15 +40,21 @@ def test_the_build_from_rounding_level_perturbed_bodies_passes_check(perturbed, 
 def test_every_shipped_number_is_within_tolerance_of_the_perturbed_build(perturbed):
     base, rms, _ = perturbed
     shipped = _shipped()
-    moved = {stem: max(float(np.abs(getattr(m, attr) - getattr(shipped[stem], attr)).max())
-                       for attr in ("rotation", "center", "semi_axes"))
-             for stem, m in {build_reference.BASE_FILE: base, **rms}.items()}
+    moved = {
+        stem: max(
+            float(np.abs(getattr(m, attr) - getattr(shipped[stem], attr)).max())
+            for attr in ("rotation", "center", "semi_axes")
+        )
+        for stem, m in {build_reference.BASE_FILE: base, **rms}.items()
+    }
     assert max(moved.values()) <= build_reference.CHECK_TOLERANCE, moved
 
 
 def _shipped():
-    return {stem: Mannequin.load(SHIPPED / f"{stem}.json")
-            for stem in (build_reference.BASE_FILE, *build_reference.RM_BODIES)}
+    return {
+        stem: Mannequin.load(SHIPPED / f"{stem}.json")
+        for stem in (build_reference.BASE_FILE, *build_reference.RM_BODIES)
+    }
 
 
 @pytest.mark.parametrize("shift, flagged", [(1e-8, False), (2 * build_reference.CHECK_TOLERANCE, True)])
@@ -74,5 +80,5 @@ def test_docs_are_compared_at_their_printed_precision():
     assert build_reference.docs_differ(row, "| Small Slim | 85.2% |")
     # a real change somewhere in the shipped docs is found
     first = next(m for m in build_reference._NUMBER.finditer(text) if "." in m.group())
-    changed = text[:first.start()] + f"{float(first.group()) + 0.5:.{len(first.group().partition('.')[2])}f}"
-    assert build_reference.docs_differ(text, changed + text[first.end():])
+    changed = text[: first.start()] + f"{float(first.group()) + 0.5:.{len(first.group().partition('.')[2])}f}"
+    assert build_reference.docs_differ(text, changed + text[first.end() :])

@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 
 from devkit.toy import rotation_from_vector
-from ellimann_addon.core.mannequin import Mannequin, Part, Topology
-from ellimann_addon.core.mesh import icosphere
-from ellimann_addon.core.mesh import volume as mesh_volume
+from ellimann_addon.core.geometry.mesh import icosphere
+from ellimann_addon.core.geometry.mesh import volume as mesh_volume
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.topology import Part, Topology
 from tools.coverage import BodyVolume, chain_gaps, fill_metrics, occupancy, report, separation
 
 RADIUS = 0.1
@@ -35,7 +36,7 @@ def ball():
 
 def test_the_grid_inside_a_closed_mesh_has_its_volume(ball):
     body, grid, volume = ball
-    assert np.count_nonzero(grid.inside) * grid.spacing ** 3 == pytest.approx(volume, rel=0.01)
+    assert np.count_nonzero(grid.inside) * grid.spacing**3 == pytest.approx(volume, rel=0.01)
 
 
 def test_inside_and_distance_of_points_near_a_sphere(ball):
@@ -77,15 +78,18 @@ def test_a_cushion_occupies_its_hull_a_capsule():
     grid = body.grid(0.004)
     r, half = 0.04, 0.1
     capsule = mannequin(("1.a End", (-half, 0, 0), (r,) * 3, "1.b End"), ("1.b End", (half, 0, 0), (r,) * 3, "1.a End"))
-    cell = grid.spacing ** 3
-    expected = np.pi * r ** 2 * 2 * half + 4.0 / 3.0 * np.pi * r ** 3
+    cell = grid.spacing**3
+    expected = np.pi * r**2 * 2 * half + 4.0 / 3.0 * np.pi * r**3
     assert np.count_nonzero(occupancy(grid, capsule, cushions=True)) * cell == pytest.approx(expected, rel=0.02)
-    assert np.count_nonzero(occupancy(grid, capsule)) * cell == pytest.approx(8.0 / 3.0 * np.pi * r ** 3, rel=0.02)
+    assert np.count_nonzero(occupancy(grid, capsule)) * cell == pytest.approx(8.0 / 3.0 * np.pi * r**3, rel=0.02)
 
 
 def test_separation_is_the_distance_between_hulls():
-    far = mannequin(("1.a A", (0, 0, 0), (0.05,) * 3, ""), ("2.a B", (0.2, 0, 0), (0.03,) * 3, ""),
-                    ("3.a C", (0.0, 0.3, 0), (0.05, 0.05, 0.05), ""))
+    far = mannequin(
+        ("1.a A", (0, 0, 0), (0.05,) * 3, ""),
+        ("2.a B", (0.2, 0, 0), (0.03,) * 3, ""),
+        ("3.a C", (0.0, 0.3, 0), (0.05, 0.05, 0.05), ""),
+    )
     assert separation(far, [0], [1]) == pytest.approx(0.2 - 0.08, abs=1e-6)
     # a capsule from A to C and B: the distance from B's centre to the segment, less both radii
     assert separation(far, [0, 2], [1]) == pytest.approx(0.2 - 0.08, abs=1e-6)
@@ -99,10 +103,12 @@ def test_separation_is_the_distance_between_hulls():
 
 def test_chain_gaps_follow_the_links_and_cushions_close_them():
     # thigh-knee and calf-ankle cushions of a leg; the knee and the calf leave a 2 cm gap
-    parts = [("5.a Thigh", (0, 0, 0.6), (0.06, 0.06, 0.12), "5.b Knee"),
-             ("5.b Knee", (0, 0, 0.3), (0.04,) * 3, "5.a Thigh"),
-             ("6.a Calf", (0, 0, 0.18), (0.05, 0.05, 0.06), "6.b Ankle"),
-             ("6.b Ankle", (0, 0, 0.1), (0.03,) * 3, "6.a Calf")]
+    parts = [
+        ("5.a Thigh", (0, 0, 0.6), (0.06, 0.06, 0.12), "5.b Knee"),
+        ("5.b Knee", (0, 0, 0.3), (0.04,) * 3, "5.a Thigh"),
+        ("6.a Calf", (0, 0, 0.18), (0.05, 0.05, 0.06), "6.b Ankle"),
+        ("6.b Ankle", (0, 0, 0.1), (0.03,) * 3, "6.a Calf"),
+    ]
     leg = mannequin(*parts)
     gaps = chain_gaps(leg)["leg"]
     assert gaps == pytest.approx([0.6 - 0.12 - 0.34, 0.26 - 0.24, 0.0], abs=1e-6)

@@ -1,13 +1,14 @@
-"""tools/overlap.py stands a mannequin where its body stands before core.volume.voxel_iou compares them: on a
+"""tools/overlap.py stands a mannequin where its body stands before core.geometry.volume.voxel_iou compares them: on a
 ball whose answer is known in closed form."""
 
 import numpy as np
 import pytest
 
-from ellimann_addon.core import volume
-from ellimann_addon.core.mannequin import Mannequin, Part, Topology
-from ellimann_addon.core.mesh import icosphere
-from ellimann_addon.core.mesh import volume as mesh_volume
+from ellimann_addon.core.geometry import volume
+from ellimann_addon.core.geometry.mesh import icosphere
+from ellimann_addon.core.geometry.mesh import volume as mesh_volume
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.topology import Part, Topology
 from tools.overlap import standing_in
 
 RADIUS = 0.1

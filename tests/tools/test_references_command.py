@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 
 from devkit.cli_runs import assert_one_line_error, run
-from ellimann_addon.core.body_mesh import read_obj
 from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS
-from ellimann_addon.core.mannequin import Mannequin
-from ellimann_addon.core.reference_set import REFERENCE_FOLDER, load_reference_set
-from ellimann_addon.core.synthesis import synthesize_batch
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, load_reference_set
+from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 from tools.build_reference import CHECK_TOLERANCE, DEFAULT_REFMODELS
 
 THREE = ("small_slim", "tall_chubby", "average")
@@ -18,18 +18,37 @@ THREE = ("small_slim", "tall_chubby", "average")
 
 def _targets_csv(folder):
     path = folder / "targets.csv"
-    path.write_text("name," + ",".join(MEASUREMENTS) + "\n" + "".join(
-        f"{name}," + ",".join(f"{REFERENCE_MEASUREMENTS[name][k]:g}" for k in MEASUREMENTS) + "\n"
-        for name in REFERENCE_MEASUREMENTS))
+    path.write_text(
+        "name,"
+        + ",".join(MEASUREMENTS)
+        + "\n"
+        + "".join(
+            f"{name}," + ",".join(f"{REFERENCE_MEASUREMENTS[name][k]:g}" for k in MEASUREMENTS) + "\n"
+            for name in REFERENCE_MEASUREMENTS
+        )
+    )
     return path
 
 
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
     folder = tmp_path_factory.mktemp("three")
-    args = ["references", "build", "--base", str(REFERENCE_FOLDER / "base_mannequin.json"), "--targets",
-            str(_targets_csv(folder)), "--bodies", *(str(DEFAULT_REFMODELS / f"{n}.obj") for n in THREE),
-            "-o", str(folder / "set"), "--workers", "2", "--name", "three"]
+    args = [
+        "references",
+        "build",
+        "--base",
+        str(REFERENCE_FOLDER / "base_mannequin.json"),
+        "--targets",
+        str(_targets_csv(folder)),
+        "--bodies",
+        *(str(DEFAULT_REFMODELS / f"{n}.obj") for n in THREE),
+        "-o",
+        str(folder / "set"),
+        "--workers",
+        "2",
+        "--name",
+        "three",
+    ]
     from ellimann_addon import cli
 
     assert cli.main(args) == 0
@@ -65,11 +84,26 @@ def test_a_body_with_shuffled_vertex_order_is_refused(tmp_path, capsys):
     order = np.random.default_rng(0).permutation(len(body.vertices))
     inverse = np.argsort(order)
     path = tmp_path / "average.obj"
-    path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in body.vertices[order])
-                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in inverse[body.faces]))
+    path.write_text(
+        "".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in body.vertices[order])
+        + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in inverse[body.faces])
+    )
     bodies = [str(DEFAULT_REFMODELS / "small_slim.obj"), str(DEFAULT_REFMODELS / "tall_chubby.obj"), str(path)]
     out = tmp_path / "set"
-    code, _, err = run(["references", "build", "--base", str(REFERENCE_FOLDER / "base_mannequin.json"), "--targets",
-                        str(_targets_csv(tmp_path)), "--bodies", *bodies, "-o", str(out)], capsys)
+    code, _, err = run(
+        [
+            "references",
+            "build",
+            "--base",
+            str(REFERENCE_FOLDER / "base_mannequin.json"),
+            "--targets",
+            str(_targets_csv(tmp_path)),
+            "--bodies",
+            *bodies,
+            "-o",
+            str(out),
+        ],
+        capsys,
+    )
     assert_one_line_error(code, err, "average", "vertex order")
     assert not out.exists()

@@ -1,15 +1,15 @@
-"""Mesh objects as the core's body meshes (core.body_mesh.BodyMesh) and the vertex selections Fit Ellipsoid
-records (core.trace.PartTrace)."""
+"""Mesh objects as the core's body meshes (core.fitting.body_mesh.BodyMesh) and the vertex selections Fit Ellipsoid
+records (core.mannequin.traces.PartTrace)."""
 
 import numpy as np
 
-from ...core.body_mesh import BodyMesh, loop_fingerprint
-from ...core.trace import FitSettings, PartTrace
+from ...core.fitting.body_mesh import BodyMesh, loop_fingerprint
+from ...core.mannequin.traces import FitSettings, PartTrace
 from .convert import mesh_vertices
 
 
 def mesh_fingerprint(mesh):
-    """core.body_mesh's connectivity fingerprint of a mesh's polygons (the same as of its OBJ file)."""
+    """core.fitting.body_mesh's connectivity fingerprint of a mesh's polygons (the same as of its OBJ file)."""
     corners = np.empty(len(mesh.loops), dtype=np.int64)
     mesh.loops.foreach_get("vertex_index", corners)
     starts = np.empty(len(mesh.polygons), dtype=np.int64)

@@ -8,11 +8,11 @@ reported by part name, and can be repaired exactly: the repaired ellipsoid is th
 import numpy as np
 
 from ...core.constants import UNIT_SPHERE_LEVEL
-from ...core.ellipsoid import repair_matrix_world
 from ...core.errors import FrameError, MannequinError, Problem
-from ...core.fit import fit_affine
-from ...core.mannequin import Topology
-from ...core.mesh import icosphere
+from ...core.fitting.point_fit import fit_affine
+from ...core.geometry.ellipsoid import repair_matrix_world
+from ...core.geometry.mesh import icosphere
+from ...core.mannequin.topology import Topology
 from .convert import (
     collection_to_mannequin,
     ellipsoid_frame,
@@ -27,11 +27,11 @@ AFFINE_TOLERANCE = 1e-4  # relative to the mesh size: a larger residual means th
 
 EXPLANATIONS = {
     "mesh": "Apply Scale/Rotation baked the transform into the mesh, so the object no longer reads as an "
-            "ellipsoid. Fix Frames moves it back into the object transform.",
+    "ellipsoid. Fix Frames moves it back into the object transform.",
     "negative": "A negative scale makes a left-handed frame. Fix Frames flips that axis back; the "
-                "ellipsoid stays the same shape in the same place.",
+    "ellipsoid stays the same shape in the same place.",
     "shear": "A non-uniformly scaled parent shears this rotated child. Fix Frames clears the parent "
-             "(keeping the shape) and gives it the ellipsoid's principal axes.",
+    "(keeping the shape) and gives it the ellipsoid's principal axes.",
     "zero": "A zero scale flattens the ellipsoid to nothing; give every axis a positive size.",
     "matrix": "The object matrix is not an affine transform.",
 }
@@ -59,12 +59,17 @@ def repaired_frame(obj):
         unit, _ = icosphere(UNIT_SPHERE_LEVEL)
         vertices = mesh_vertices(obj.data)
         if len(vertices) != len(unit):
-            raise FrameError("mesh", f"has {len(vertices)} vertices, not the unit sphere's {len(unit)}: it was "
-                             "edited, so fit a new ellipsoid to its vertices instead", "mesh")
+            raise FrameError(
+                "mesh",
+                f"has {len(vertices)} vertices, not the unit sphere's {len(unit)}: it was "
+                "edited, so fit a new ellipsoid to its vertices instead",
+                "mesh",
+            )
         applied, residual = fit_affine(unit, vertices)
         if residual > AFFINE_TOLERANCE * max(float(np.ptp(vertices, axis=0).max()), 1e-12):
-            raise FrameError("mesh", "was edited beyond a scale or rotation: fit a new ellipsoid to its "
-                             "vertices instead", "mesh")
+            raise FrameError(
+                "mesh", "was edited beyond a scale or rotation: fit a new ellipsoid to its vertices instead", "mesh"
+            )
         matrix = matrix @ applied
     negative = [i for i, s in enumerate(obj.scale) if s < 0.0]
     return repair_matrix_world(matrix, flip_axis=negative[0] if len(negative) == 1 else None)

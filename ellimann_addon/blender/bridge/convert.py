@@ -1,7 +1,7 @@
 """Mannequin <-> Blender collection. The only place where objects and core arrays meet.
 
 An ellipsoid is an object using one shared unit-sphere mesh with ``matrix_world = S @ diag(D, 1)``;
-its topology fields live in ``Object.ellimann`` (and what it was traced from, ``trace``: core.trace's JSON).
+its topology fields live in ``Object.ellimann`` (and what it was traced from, ``trace``: core.mannequin.traces's JSON).
 A mannequin is a collection holding those objects, with ``Collection.ellimann`` (role, target and measured
 values, rest joints when it has a skeleton).
 """
@@ -13,11 +13,12 @@ import numpy as np
 from mathutils import Matrix
 
 from ...core.constants import FEMALE_SET, MEASUREMENTS, UNIT_SPHERE_LEVEL
-from ...core.ellipsoid import decompose_matrices_world, decompose_matrix_world, matrix_world
 from ...core.errors import FrameError, MannequinError, Problem
-from ...core.mannequin import NAME_PATTERN, Mannequin, Part, Topology
-from ...core.mesh import icosphere
-from ...core.trace import PartTrace
+from ...core.geometry.ellipsoid import decompose_matrices_world, decompose_matrix_world, matrix_world
+from ...core.geometry.mesh import icosphere
+from ...core.mannequin.model import Mannequin
+from ...core.mannequin.topology import NAME_PATTERN, Part, Topology
+from ...core.mannequin.traces import PartTrace
 
 UNIT_SPHERE_NAME = "ElliMann Unit Sphere"
 UNIT_SPHERE_TOLERANCE = 1e-4  # single-precision vertices of the icosphere are within 1e-7
@@ -93,8 +94,9 @@ def ellipsoid_frame(obj, checked=None):
     if obj.type == "MESH" and obj.data.as_pointer() not in checked:
         checked[obj.data.as_pointer()] = is_unit_sphere(obj.data)
     if obj.type != "MESH" or not checked[obj.data.as_pointer()]:
-        raise FrameError("mesh", "is not a unit sphere: a scale or rotation was applied to the mesh "
-                         "(Fix Frames restores it)", "mesh")
+        raise FrameError(
+            "mesh", "is not a unit sphere: a scale or rotation was applied to the mesh (Fix Frames restores it)", "mesh"
+        )
     return decompose_matrix_world(np.array(obj.matrix_world))
 
 
@@ -206,12 +208,13 @@ def new_ellipsoid_object(part, rotation, center, semi_axes, collection, mesh=Non
 
 
 def write_trace(obj, trace):
-    """Record on the part what it was traced from (a core.trace.PartTrace, or None to clear it)."""
+    """Record on the part what it was traced from (a core.mannequin.traces.PartTrace, or None to clear it)."""
     obj.ellimann.trace = "" if trace is None else json.dumps(trace.to_dict())
 
 
 def read_trace(obj):
-    """The part's recorded trace (core.trace.PartTrace) or None; MannequinError naming the part if unreadable."""
+    """The part's recorded trace (core.mannequin.traces.PartTrace) or None; MannequinError naming the part if
+    unreadable."""
     text = obj.ellimann.trace
     if not text:
         return None
@@ -230,8 +233,9 @@ def mannequin_to_collection(mannequin, name=None, parent=None):
     mesh = unit_sphere_mesh()
     traces = mannequin.traces or {}
     for i, part in enumerate(mannequin.topology):
-        obj = new_ellipsoid_object(part, mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i],
-                                   collection, mesh)
+        obj = new_ellipsoid_object(
+            part, mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i], collection, mesh
+        )
         write_trace(obj, traces.get(part.name))
     return collection
 
@@ -246,9 +250,18 @@ def collection_to_mannequin(collection, check=True):
     props = collection.ellimann
     measurements = dict(zip(MEASUREMENTS, map(float, props.target))) if props.has_target else None
     traces = {obj.ellimann.part_name: trace for obj in objects if (trace := read_trace(obj)) is not None}
-    mannequin = Mannequin(topology, rotation, center, semi_axes, name=collection.name, role=props.role,
-                          measurements=measurements, traces=traces or None, joints=read_joints(collection),
-                          **read_landmarks(props))
+    mannequin = Mannequin(
+        topology,
+        rotation,
+        center,
+        semi_axes,
+        name=collection.name,
+        role=props.role,
+        measurements=measurements,
+        traces=traces or None,
+        joints=read_joints(collection),
+        **read_landmarks(props),
+    )
     return mannequin.check() if check else mannequin
 
 
@@ -271,8 +284,9 @@ def update_collection_geometry(collection, mannequin):
     missing = [name for name in mannequin.topology.names if name not in by_name]
     if missing:
         raise MannequinError([Problem(n, "collection", f"has no object in '{collection.name}'") for n in missing])
-    write_frames([by_name[name] for name in mannequin.topology.names], mannequin.rotation, mannequin.center,
-                 mannequin.semi_axes)
+    write_frames(
+        [by_name[name] for name in mannequin.topology.names], mannequin.rotation, mannequin.center, mannequin.semi_axes
+    )
     write_collection_props(collection, mannequin)
 
 

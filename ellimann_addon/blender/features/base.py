@@ -117,8 +117,12 @@ def cancel(operator, message, problems=()):
 
 
 def scope_property(default="SELECTED"):
-    return EnumProperty(name="Apply To", items=SCOPE_ITEMS, default=default,
-                        description="Work on the selected ellipsoids or on the whole active mannequin")
+    return EnumProperty(
+        name="Apply To",
+        items=SCOPE_ITEMS,
+        default=default,
+        description="Work on the selected ellipsoids or on the whole active mannequin",
+    )
 
 
 class ScopedOperator(ElliMannOperator):

@@ -1,4 +1,4 @@
-"""Reading a BVH clip with Blender's own importer (``import_anim.bvh``) into ``core.retarget.SourceMotion``.
+"""Reading a BVH clip with Blender's own importer (``import_anim.bvh``) into ``core.pose.retarget.SourceMotion``.
 
 The bone names are read from the file's HIERARCHY first (a few lines of text), so a clip with no bone
 the name map knows is refused before anything enters the scene. The importer then builds a temporary
@@ -14,8 +14,8 @@ import bpy
 import numpy as np
 
 from ...core.errors import ElliMannError
-from ...core.frames import project_to_rotation
-from ...core.retarget import SourceMotion
+from ...core.geometry.frames import project_to_rotation
+from ...core.pose.retarget import SourceMotion
 from .chatter import blender_output
 
 BONE_LINE = re.compile(r"^\s*(ROOT|JOINT)\s+(.+?)\s*$")
@@ -53,9 +53,16 @@ def sample_bvh(path):
     actions_before = {a.as_pointer() for a in bpy.data.actions}
     try:
         with blender_output():
-            result = bpy.ops.import_anim.bvh(filepath=path, global_scale=1.0, use_fps_scale=False,
-                                             update_scene_fps=False, update_scene_duration=False,
-                                             rotate_mode="NATIVE", axis_forward="-Z", axis_up="Y")
+            result = bpy.ops.import_anim.bvh(
+                filepath=path,
+                global_scale=1.0,
+                use_fps_scale=False,
+                update_scene_fps=False,
+                update_scene_duration=False,
+                rotate_mode="NATIVE",
+                axis_forward="-Z",
+                axis_up="Y",
+            )
     except RuntimeError as error:
         _remove_new(before, actions_before)
         raise ElliMannError(f"filepath: Blender's BVH importer refused {path}: {error}") from error

@@ -182,9 +182,13 @@ def _uses_fd(stream, fd):
 
 def _text(fd, like):
     """A text stream on ``fd``, encoded and buffered like the stream ``like``."""
-    return open(fd, "w", buffering=1 if getattr(like, "line_buffering", True) else -1,
-                encoding=getattr(like, "encoding", None) or "utf-8",
-                errors=getattr(like, "errors", None) or "backslashreplace")
+    return open(
+        fd,
+        "w",
+        buffering=1 if getattr(like, "line_buffering", True) else -1,
+        encoding=getattr(like, "encoding", None) or "utf-8",
+        errors=getattr(like, "errors", None) or "backslashreplace",
+    )
 
 
 def _flush():

@@ -6,9 +6,9 @@ Shared by the Build Cushions operator, the Synthesize feature (live updates) and
 from mathutils import Matrix
 
 from ...core.constants import CUSHION_LEVEL
-from ...core.cushion import mannequin_cushions
 from ...core.errors import MannequinError, Problem
-from ...core.frames import rigid_matrix
+from ...core.geometry.cushion import mannequin_cushions
+from ...core.geometry.frames import rigid_matrix
 from ..bridge.built import built_collection, new_cushion_object, remove_built
 from ..bridge.convert import collection_to_mannequin, rig_object
 from ..bridge.selection import part_lookup
@@ -16,7 +16,7 @@ from .rig import bind_cushions
 
 
 def rigid_frame(rotation, center):
-    """:func:`core.frames.rigid_matrix` as a mathutils Matrix (a cushion object's matrix_world)."""
+    """:func:`core.geometry.frames.rigid_matrix` as a mathutils Matrix (a cushion object's matrix_world)."""
     return Matrix(rigid_matrix(rotation, center).tolist())
 
 
@@ -34,8 +34,13 @@ def build_cushions(collection, subdivisions=CUSHION_LEVEL, mannequin=None):
     topology = mannequin.topology
     pairs = topology.cushion_pairs
     if not pairs:
-        raise MannequinError([Problem("", "cushions", f"'{collection.name}' has no cushion pairs: "
-                                                      "set Cushion Partner on two ellipsoids")])
+        raise MannequinError(
+            [
+                Problem(
+                    "", "cushions", f"'{collection.name}' has no cushion pairs: set Cushion Partner on two ellipsoids"
+                )
+            ]
+        )
     hulls = mannequin_cushions(mannequin, subdivisions, local=True)
     removed = remove_built(collection, "CUSHION")
     target = built_collection(collection, "CUSHION")
@@ -43,9 +48,17 @@ def build_cushions(collection, subdivisions=CUSHION_LEVEL, mannequin=None):
     objects = []
     for hull in hulls:
         first, second = topology.names[hull.first], topology.names[hull.second]
-        objects.append(new_cushion_object(hull.name, parts[first], parts[second], hull.vertices, hull.faces,
-                                          rigid_frame(mannequin.rotation[hull.first], mannequin.center[hull.first]),
-                                          target))
+        objects.append(
+            new_cushion_object(
+                hull.name,
+                parts[first],
+                parts[second],
+                hull.vertices,
+                hull.faces,
+                rigid_frame(mannequin.rotation[hull.first], mannequin.center[hull.first]),
+                target,
+            )
+        )
     if rig_object(collection) is not None and mannequin.joints is not None:  # a rigged mannequin: bind them too
         bind_cushions(collection, mannequin)
     return objects, removed

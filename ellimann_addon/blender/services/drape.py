@@ -1,10 +1,10 @@
 """Drape a procedural garment on a mannequin with Blender's cloth simulation, headless or in the GUI.
 
 :func:`drape` builds, in a new collection ``"Drape <garment> on <mannequin>"`` under the scene:
-- the garment (:mod:`core.garments`, sized from the mannequin's m_T) as a mesh object with a Cloth
+- the garment (:mod:`core.drape.garments`, sized from the mannequin's m_T) as a mesh object with a Cloth
   modifier; the garment's ``pins`` form the vertex group "Pin" (the cloth's pin group) and its
   ``seams`` become loose edges pulled together by sewing springs;
-- a child collection "Colliders": one object per convex piece (:mod:`core.collision`: cushions
+- a child collection "Colliders": one object per convex piece (:mod:`core.drape.colliders`: cushions
   and the ellipsoids not in a cushion, or every ellipsoid) with a Collision modifier, hidden in
   the viewport and in renders. The cloth collides with that collection only.
 It then steps the frames one by one (``scene.frame_set``, timing each step) and turns the memory
@@ -25,13 +25,13 @@ import bpy
 import numpy as np
 from mathutils import Matrix
 
-from ...core import garments
-from ...core.collision import CollisionPiece, collision_pieces, triangle_count
 from ...core.constants import CLEARING_CUSHION_LEVEL, FIT_CUSHION_LEVEL
+from ...core.drape import garments
+from ...core.drape.colliders import CollisionPiece, collision_pieces, triangle_count
+from ...core.drape.fit_metrics import BodyPieces, fit_statistics
+from ...core.drape.settings import FRAME_RANGE, MAX_CLOTH_VERTICES, DrapeSettings  # noqa: F401  (DrapeSettings: public here)
 from ...core.errors import ElliMannError
-from ...core.garment_fit import BodyPieces, fit_statistics
-from ...core.options import FRAME_RANGE, MAX_CLOTH_VERTICES, DrapeSettings  # noqa: F401  (DrapeSettings: public here)
-from ...core.pose import pose_mannequin
+from ...core.pose.kinematics import pose_mannequin
 from ..bridge.convert import mesh_from_arrays, new_collection
 from .drape_motion import PIECE_KEY, animate_drape
 from .rig import check_rig
@@ -48,7 +48,7 @@ CLEARING_CUTOFF = 0.05
 # shipped Average RM at 2, 1 and 0.5 cm edges: building, clearing, Blender's cloth and the fit
 # together, on top of some 0.3 GB for Blender itself), and time at least as fast: 27,000 vertices (a
 # tube dress at 0.5 cm) took 2.6 GB and 2.5 minutes for 3 frames. A drape is refused above
-# MAX_CLOTH_VERTICES (about 4 GB, core.options) before anything is built; the command line warns above
+# MAX_CLOTH_VERTICES (about 4 GB, core.synthesis.options) before anything is built; the command line warns above
 # WARN_CLOTH_VERTICES.
 BYTES_PER_VERTEX = 85_000
 WARN_CLOTH_VERTICES = 20_000
@@ -86,10 +86,12 @@ class DrapeResult:
 
     def summary(self):
         fit = self.fit
-        text = (f"{self.frames} frames, {self.seconds_per_frame:.3f} s/frame, "
-                f"{self.collider_triangles} collider triangles; {fit['penetrating']} of {fit['count']} "
-                f"vertices inside the body (deepest {fit['max_depth'] * 1e3:.1f} mm), median gap "
-                f"{fit['median'] * 1e3:.1f} mm")
+        text = (
+            f"{self.frames} frames, {self.seconds_per_frame:.3f} s/frame, "
+            f"{self.collider_triangles} collider triangles; {fit['penetrating']} of {fit['count']} "
+            f"vertices inside the body (deepest {fit['max_depth'] * 1e3:.1f} mm), median gap "
+            f"{fit['median'] * 1e3:.1f} mm"
+        )
         if len(self.garment.seams):
             gaps = self.seam_gaps()
             text += f"; seams closed to {np.median(gaps) * 1e3:.1f} mm (median), {gaps.max() * 1e3:.1f} mm (max)"
@@ -138,8 +140,11 @@ def collider_objects(pieces, collection):
         key = (piece.kind, len(piece.vertices)) if piece.kind == "ELLIPSOID" else None
         mesh = shared.get(key) if key else None
         if mesh is None:
-            mesh = mesh_from_arrays(f"Collider {piece.name}" if key is None else f"Collider sphere {len(piece.faces)}",
-                                    piece.vertices, piece.faces)
+            mesh = mesh_from_arrays(
+                f"Collider {piece.name}" if key is None else f"Collider sphere {len(piece.faces)}",
+                piece.vertices,
+                piece.faces,
+            )
             if key:
                 shared[key] = mesh
         obj = bpy.data.objects.new(f"Collider {piece.name}", mesh)
@@ -248,12 +253,17 @@ def check_cloth_size(mannequin, garment, settings):
     if vertices <= limit:
         return vertices, size
     what = garment if isinstance(garment, str) else garment.name
-    text = (f"cloth: a {what} with {settings.edge * 100:g} cm edges would have about {vertices:,} vertices and need "
-            f"about {_gigabytes(size)} (limit {limit:,} vertices, about {_gigabytes(limit * BYTES_PER_VERTEX)})")
+    text = (
+        f"cloth: a {what} with {settings.edge * 100:g} cm edges would have about {vertices:,} vertices and need "
+        f"about {_gigabytes(size)} (limit {limit:,} vertices, about {_gigabytes(limit * BYTES_PER_VERTEX)})"
+    )
     if isinstance(garment, str):
         fits = _fitting_edge(mannequin, garment, settings.edge, vertices, limit)
-        text += (f"; an edge of {fits * 100:g} cm or more fits" if fits is not None
-                 else "; no edge up to the largest allowed fits")
+        text += (
+            f"; an edge of {fits * 100:g} cm or more fits"
+            if fits is not None
+            else "; no edge up to the largest allowed fits"
+        )
     raise ElliMannError(text)
 
 
@@ -275,9 +285,10 @@ def _gigabytes(size):
 # ------------------------------------------------------------------------------------------------ drape
 
 
-def drape(mannequin, garment="tube_dress", settings=None, name=None, scene=None, progress=None, motion=None,
-          loop=False):
-    """Drape ``garment`` (a ``core.garments.BUILDERS`` key or a core Garment) on ``mannequin`` (a core Mannequin).
+def drape(
+    mannequin, garment="tube_dress", settings=None, name=None, scene=None, progress=None, motion=None, loop=False
+):
+    """Drape ``garment`` (a ``core.drape.garments.BUILDERS`` key or a core Garment) on ``mannequin`` (a core Mannequin).
 
     ``motion``: core poses (one, or a motion's frames; ``loop`` for a cycle such as the walk): the body goes
     from rest into them and the cloth follows (``services.drape_motion``); the mannequin needs joints. The

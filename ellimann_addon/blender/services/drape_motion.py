@@ -1,5 +1,5 @@
 """A drape on a moving body: the colliders of a drape (``services.drape``) bound to an armature of their own
-that moves from the rest pose into a pose or a motion (``core.motion.drape_motion``), and the garment's pins
+that moves from the rest pose into a pose or a motion (``core.pose.motion.drape_motion``), and the garment's pins
 carried by the torso, so the cloth follows a walking body.
 
 The armature lives in the drape's collection (hidden), so the mannequin and its own armature are left as
@@ -13,9 +13,9 @@ torso goes; the other vertices are the simulation's.
 
 import numpy as np
 
-from ...core.cushion import cushion_name
-from ...core.motion import arms_out, drape_motion, loop_drift
-from ...core.skeleton import JOINT_INDEX, JOINT_NAMES, cross_joint_pairs
+from ...core.geometry.cushion import cushion_name
+from ...core.mannequin.skeleton import JOINT_INDEX, JOINT_NAMES, cross_joint_pairs
+from ...core.pose.motion import arms_out, drape_motion, loop_drift
 from .rig import bake_action, bare_armature, bind_across, bind_piece, bind_weights, check_rig
 
 PIECE_KEY = "ellimann_piece"  # on a collider: the name of the piece it stands for (a part or a cushion)
@@ -47,20 +47,31 @@ def animate_drape(collection, colliders, garment_object, mannequin, poses, loop,
         piece = obj.get(PIECE_KEY, "")
         if piece in crossing:
             i, j, joint = crossing[piece]
-            bind_across(obj, rig, joints[joint], mannequin.center[j] - mannequin.center[i], JOINT_NAMES[bones[i]],
-                        JOINT_NAMES[bones[j]])
+            bind_across(
+                obj,
+                rig,
+                joints[joint],
+                mannequin.center[j] - mannequin.center[i],
+                JOINT_NAMES[bones[i]],
+                JOINT_NAMES[bones[j]],
+            )
         else:
             bind_piece(obj, rig, JOINT_NAMES[bones[topology.index[piece] if piece in topology.index else pairs[piece]]])
     bind_weights(garment_object, rig, nearest_joint_weights(garment_object, joints))
     motion = body_motion(poses, frames, loop)
-    bake_action(rig, JOINT_NAMES, np.stack([p.rotations for p in motion]), np.stack([p.translation for p in motion]),
-                f"{collection.name} motion")
+    bake_action(
+        rig,
+        JOINT_NAMES,
+        np.stack([p.rotations for p in motion]),
+        np.stack([p.translation for p in motion]),
+        f"{collection.name} motion",
+    )
     return motion[-1]
 
 
 def body_motion(poses, frames, loop):
     """The drape's body, frame by frame: ``poses`` with the arms ARMS_OUT_DEGREES further out, reached from
-    rest over ``settle_frames(frames)`` frames, then held or looped (``core.motion.drape_motion``)."""
+    rest over ``settle_frames(frames)`` frames, then held or looped (``core.pose.motion.drape_motion``)."""
     poses = arms_out(poses, ARMS_OUT_DEGREES)
     return drape_motion(poses, frames, settle_frames(frames), loop, loop_drift(poses) if loop else None)
 

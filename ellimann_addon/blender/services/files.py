@@ -46,7 +46,7 @@ import numpy as np
 from ...core.constants import MEASUREMENTS
 from ...core.errors import ElliMannError
 from ...core.files import atomic_output
-from ...core.formats import BLENDER_FORMATS, extension_of
+from ...core.formats.table import BLENDER_FORMATS, extension_of
 from ..bridge.built import built_objects, is_stale
 from ..bridge.convert import collection_to_mannequin, objects_recursive
 from ..bridge.selection import part_lookup
@@ -64,22 +64,34 @@ EXTRAS_VERSION = 1
 def part_extras(obj):
     """The node extras of one ElliMann object (ellipsoid or cushion)."""
     props = obj.ellimann
-    extras = {"part": props.part_name, "kind": props.kind, "side": props.side, "region": props.region,
-              "girth": bool(props.girth), "depends": [m for m in MEASUREMENTS if m in props.depends],
-              "partner": props.partner}
+    extras = {
+        "part": props.part_name,
+        "kind": props.kind,
+        "side": props.side,
+        "region": props.region,
+        "girth": bool(props.girth),
+        "depends": [m for m in MEASUREMENTS if m in props.depends],
+        "partner": props.partner,
+    }
     if props.kind == "ELLIPSOID":
         matrix = np.array(obj.matrix_world)
         semi = np.linalg.norm(matrix[:3, :3], axis=0)
-        extras.update(center_m=matrix[:3, 3].tolist(), axes=(matrix[:3, :3] / semi).T.tolist(),
-                      semi_axes_m=semi.tolist())
+        extras.update(
+            center_m=matrix[:3, 3].tolist(), axes=(matrix[:3, :3] / semi).T.tolist(), semi_axes_m=semi.tolist()
+        )
     return extras
 
 
 def scene_extras(mannequin):
-    out = {"format": EXTRAS_FORMAT, "version": EXTRAS_VERSION, "name": mannequin.name, "role": mannequin.role,
-           "units": "m (geometry), cm (measurements)",
-           "up": "ElliMann data is Z-up, facing -Y; glTF nodes are Y-up as glTF requires",
-           "measured_cm": mannequin.measure()}
+    out = {
+        "format": EXTRAS_FORMAT,
+        "version": EXTRAS_VERSION,
+        "name": mannequin.name,
+        "role": mannequin.role,
+        "units": "m (geometry), cm (measurements)",
+        "up": "ElliMann data is Z-up, facing -Y; glTF nodes are Y-up as glTF requires",
+        "measured_cm": mannequin.measure(),
+    }
     if mannequin.measurements:
         out["target_cm"] = {k: float(v) for k, v in mannequin.measurements.items()}
     return out
@@ -106,16 +118,24 @@ def export_gltf(collection, path):
     stale = [c.name for c in built_objects(collection, "CUSHION") if is_stale(c, parts)]
     if stale:
         more = f" and {len(stale) - 1} more" if len(stale) > 1 else ""
-        raise ElliMannError(f"the cushions of '{collection.name}' are out of date ('{stale[0]}'{more}: their "
-                            "ellipsoids moved since they were built): Build Cushions first")
+        raise ElliMannError(
+            f"the cushions of '{collection.name}' are out of date ('{stale[0]}'{more}: their "
+            "ellipsoids moved since they were built): Build Cushions first"
+        )
     objects = [o for o in objects_recursive(collection) if o.ellimann.is_part]
     node_extras = {o.name: part_extras(o) for o in objects}
     with atomic_output(path) as temp:
         # Skins and animations are the exporter's defaults; the armature's node transforms are its current
         # pose rather than its rest (a posed mannequin shows posed; an action plays the same either way).
-        result = bpy.ops.export_scene.gltf(filepath=temp, export_format="GLB", export_extras=True,
-                                           collection=collection.name, export_yup=True, use_renderable=True,
-                                           export_rest_position_armature=False)
+        result = bpy.ops.export_scene.gltf(
+            filepath=temp,
+            export_format="GLB",
+            export_extras=True,
+            collection=collection.name,
+            export_yup=True,
+            use_renderable=True,
+            export_rest_position_armature=False,
+        )
         if result != {"FINISHED"}:
             raise ElliMannError(f"path: Blender's glTF exporter did not finish ({result})")
         _set_extras(temp, node_extras, scene_extras(mannequin))
@@ -148,7 +168,7 @@ def _split_glb(data, path):
     length, kind = struct.unpack_from("<I4s", data, 12)
     if magic != b"glTF" or kind != b"JSON" or total != len(data) or 20 + length > len(data):
         raise ElliMannError(f"path: {path} is not a whole binary glTF file")
-    return json.loads(data[20:20 + length]), data[20 + length:]
+    return json.loads(data[20 : 20 + length]), data[20 + length :]
 
 
 def read_glb_json(path):
@@ -162,7 +182,7 @@ def read_glb_json(path):
 
 def write_mannequin(mannequin, paths, measured=None, cushions=False):
     """Write one mannequin to every .blend, .glb and .obj in ``paths`` (format from the extension), all
-    from one empty scene. Returns the paths. (.json and MJCF need no Blender: ``core.writers``; a posed
+    from one empty scene. Returns the paths. (.json and MJCF need no Blender: ``core.formats.core_writers``; a posed
     mannequin: ``services.posing``.)
 
     ``cushions``: the files show the cushions instead of the ellipsoids they replace. A path of another
@@ -199,8 +219,9 @@ def write_blender_file(path, collection):
             bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)
         else:
             _select_only(shown_objects(collection))
-            bpy.ops.wm.obj_export(filepath=temp, export_selected_objects=True, export_materials=False,
-                                  check_existing=False)
+            bpy.ops.wm.obj_export(
+                filepath=temp, export_selected_objects=True, export_materials=False, check_existing=False
+            )
 
 
 def _select_only(objects):

@@ -6,7 +6,7 @@ import os
 import bpy
 import numpy as np
 
-from ...core.ellipsoid import bounds
+from ...core.geometry.ellipsoid import bounds
 from .chatter import blender_output
 from .files import atomic_output
 from .scene import add_mannequin, empty_scene

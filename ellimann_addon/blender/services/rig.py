@@ -1,14 +1,14 @@
 """A mannequin's armature: bones at its joints, its pieces bound to them, poses and actions on it.
 
 The armature object (tagged ``ellimann_rig``) lives in the mannequin's collection, one bone per joint
-with the SMPL names; its layout (heads, tails, frames, limits) comes from ``core.bones``. Each piece is
+with the SMPL names; its layout (heads, tails, frames, limits) comes from ``core.pose.bones``. Each piece is
 bound rigidly by an Armature modifier and one vertex group weighted 1.0 to its bone (ellipsoids share
 one unit-sphere mesh per bone, since vertex group names live on the mesh), not parented to a bone:
 the glTF exporter writes that as a skin, a cloth collider built the same way follows the deformed
 mesh, and the objects' own matrices stay the rest pose, so m_T read from the scene is always the rest
 pose's. A cushion joining pieces on two bones gets both bones' groups with per-vertex weights.
 Rotation limits are Limit Rotation constraints in each bone's local space (exactly the core's ranges:
-``core.bones.bone_limit``).
+``core.pose.bones.bone_limit``).
 
 Everything is computed before the scene changes; building raises ElliMannError without touching it.
 """
@@ -17,13 +17,21 @@ import bpy
 import numpy as np
 from mathutils import Matrix, Vector
 
-from ...core import bones as core_bones
 from ...core.errors import ElliMannError
-from ...core.motion import clamped_motion, loop_drift
-from ...core.pose import require_joints
-from ...core.posed import clip_convex_mesh
-from ...core.poses import WALK_FPS
-from ...core.skeleton import JOINT_INDEX, JOINT_NAMES, PARENTS, cross_joint_pairs, joint_frames, limits, part_bones
+from ...core.mannequin.skeleton import (
+    JOINT_INDEX,
+    JOINT_NAMES,
+    PARENTS,
+    cross_joint_pairs,
+    joint_frames,
+    limits,
+    part_bones,
+)
+from ...core.pose import bones as core_bones
+from ...core.pose.kinematics import require_joints
+from ...core.pose.motion import clamped_motion, loop_drift
+from ...core.pose.posed_pieces import clip_convex_mesh
+from ...core.pose.standard import WALK_FPS
 from ..bridge.built import built_objects
 from ..bridge.convert import RIG_KEY, ellipsoid_objects, mesh_from_arrays, rig_object, unit_sphere_mesh, world_triangles
 
@@ -74,8 +82,9 @@ def build_rig(collection, mannequin):
     view_layer = bpy.context.view_layer
     view_layer.update()  # objects just linked get their view-layer bases
     if any(view_layer.objects.get(o.name) != o for o in objects[:1]):  # Edit Mode needs the armature there
-        raise ElliMannError(f"collection: '{collection.name}' is not in view layer '{view_layer.name}' (include it "
-                            "there to rig it)")
+        raise ElliMannError(
+            f"collection: '{collection.name}' is not in view layer '{view_layer.name}' (include it there to rig it)"
+        )
     remove_rig(collection)
     rig = _armature_object(f"{collection.name} Rig", layout, collection)
     rig[RIG_KEY] = collection.name
@@ -88,7 +97,7 @@ def build_rig(collection, mannequin):
 
 
 def skeleton_layout(joints):
-    """The bones (``core.bones.Bone``) of SMPL joints at ``joints`` (24, 3)."""
+    """The bones (``core.pose.bones.Bone``) of SMPL joints at ``joints`` (24, 3)."""
     return core_bones.layout_bones(JOINT_NAMES, joints, PARENTS, joint_frames(joints), PREFERRED_CHILD)
 
 
@@ -210,7 +219,7 @@ def _armature_modifier(obj, rig):
 
 def bind_cushions(collection, mannequin, rig=None):
     """Bind the built cushions of ``collection`` to its rig (if it has one). A cushion on one bone follows it
-    rigidly; one across a joint is cut there into two convex halves, as ``core.posed.PosingRig`` does (the
+    rigidly; one across a joint is cut there into two convex halves, as ``core.pose.posed_pieces.PosingRig`` does (the
     plane through the joint across the line between its two parts' centres), each half riding on its own
     part's bone: bent, the halves open on the outside and overlap on the inside instead of webbing across."""
     rig = rig or rig_object(collection)
@@ -230,8 +239,13 @@ def bind_cushions(collection, mannequin, rig=None):
         if joint is None:
             _set_weights(cushion, {first_bone: np.ones(len(cushion.data.vertices))})
         else:
-            _split_at_joint(cushion, joints[joint], mannequin.center[topology.index[second]]
-                            - mannequin.center[topology.index[first]], first_bone, second_bone)
+            _split_at_joint(
+                cushion,
+                joints[joint],
+                mannequin.center[topology.index[second]] - mannequin.center[topology.index[first]],
+                first_bone,
+                second_bone,
+            )
         _armature_modifier(cushion, rig)
 
 
@@ -369,7 +383,7 @@ def apply_pose(rig, pose):
 
 def apply_motion(rig, poses, name, start=1, loop=False):
     """Bake core poses (one per frame) as an action; ``loop``: a cycle whose next start is the first pose
-    moved on by the clip's drift (``core.motion.loop_drift``: along the walking direction, -Y)."""
+    moved on by the clip's drift (``core.pose.motion.loop_drift``: along the walking direction, -Y)."""
     rotations = np.stack([p.rotations for p in poses])
     translations = np.stack([p.translation for p in poses])
     closing = translations[0] + loop_drift(poses) if loop else None

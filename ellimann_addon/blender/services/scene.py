@@ -25,8 +25,15 @@ def shown_objects(collection):
     """What a file shows: cushions where there are any, ellipsoids for every part without a cushion."""
     objects = objects_recursive(collection)
     has_cushions = any(o.ellimann.kind == "CUSHION" for o in objects)
-    return [o for o in objects if o.ellimann.is_part and (
-        o.ellimann.kind == "CUSHION" or (o.ellimann.kind == "ELLIPSOID" and not (has_cushions and o.ellimann.partner)))]
+    return [
+        o
+        for o in objects
+        if o.ellimann.is_part
+        and (
+            o.ellimann.kind == "CUSHION"
+            or (o.ellimann.kind == "ELLIPSOID" and not (has_cushions and o.ellimann.partner))
+        )
+    ]
 
 
 def add_mannequin(mannequin, measured=None, cushions=False):
@@ -50,12 +57,17 @@ def _add_cushions(collection, subdivisions=CUSHION_LEVEL, view_layer=None, manne
     # Hidden in the view layer, not disabled (hide_viewport): Blender does not evaluate disabled
     # objects, so after reopening the file their matrix_world would be the identity.
     view_layer.update()  # new objects get their view-layer bases (hide_set needs them)
-    replaced = [o for o in objects_recursive(collection)
-                if o.ellimann.is_part and o.ellimann.kind == "ELLIPSOID" and o.ellimann.partner]
+    replaced = [
+        o
+        for o in objects_recursive(collection)
+        if o.ellimann.is_part and o.ellimann.kind == "ELLIPSOID" and o.ellimann.partner
+    ]
     missing = [o.name for o in replaced if view_layer.objects.get(o.name) != o]
     if missing:
-        raise ElliMannError(f"cannot hide '{missing[0]}' of '{collection.name}': it is not in view layer "
-                            f"'{view_layer.name}' (include the mannequin there to build its cushions)")
+        raise ElliMannError(
+            f"cannot hide '{missing[0]}' of '{collection.name}': it is not in view layer "
+            f"'{view_layer.name}' (include the mannequin there to build its cushions)"
+        )
     build_cushions(collection, subdivisions, mannequin=mannequin)
     for obj in replaced:
         obj.hide_set(True, view_layer=view_layer)

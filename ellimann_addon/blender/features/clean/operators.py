@@ -6,10 +6,10 @@ import numpy as np
 from bpy.props import StringProperty
 from mathutils import Vector
 
-from ....core.clean import register_to_world
 from ....core.errors import MannequinError
-from ....core.frames import relabel_to_reference, symmetrize_central
-from ....core.mannequin import side_of_name
+from ....core.geometry.frames import relabel_to_reference, symmetrize_central
+from ....core.mannequin.clean import register_to_world
+from ....core.mannequin.topology import side_of_name
 from ... import ids
 from ...bridge.built import built_objects
 from ...bridge.convert import (
@@ -47,8 +47,10 @@ class ELLIMANN_OT_relabel_axes(ScopedOperator, bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     scope: scope_property("MANNEQUIN")
-    reference: StringProperty(name="Reference", description="Mannequin collection whose ellipsoids' axes are "
-                                                            "the reference (matched by part name)")
+    reference: StringProperty(
+        name="Reference",
+        description="Mannequin collection whose ellipsoids' axes are the reference (matched by part name)",
+    )
 
     def invoke(self, context, event):
         if not self.reference:
@@ -65,24 +67,28 @@ class ELLIMANN_OT_relabel_axes(ScopedOperator, bpy.types.Operator):
             raise OperatorError(f"Choose a reference mannequin collection ('{self.reference}' is not one)")
         objects = [o for o in self.targets(context) if reference.objects.get(o.name) != o]
         if not objects:
-            raise OperatorError("No ellipsoids to relabel outside the reference: select some, or make another "
-                                "mannequin active")
+            raise OperatorError(
+                "No ellipsoids to relabel outside the reference: select some, or make another mannequin active"
+            )
         lookup = part_lookup(reference)
         matched = [o for o in objects if o.ellimann.part_name in lookup]
         missing = [o.ellimann.part_name for o in objects if o.ellimann.part_name not in lookup]
         if not matched:
-            raise OperatorError(f"None of the {plural(len(objects), 'ellipsoid')} has a part of the same name in "
-                                f"'{reference.name}'")
+            raise OperatorError(
+                f"None of the {plural(len(objects), 'ellipsoid')} has a part of the same name in '{reference.name}'"
+            )
         rotation, center, semi_axes = frames_or_cancel(matched)
         reference_rotation, _, _ = frames_or_cancel([lookup[o.ellimann.part_name] for o in matched])
         rotation, semi_axes, q = relabel_to_reference(rotation, semi_axes, reference_rotation)
         changed = ~np.all(np.isclose(q, np.eye(3)), axis=(1, 2))
-        write_frames([o for o, c in zip(matched, changed) if c], rotation[changed], center[changed],
-                     semi_axes[changed])
+        write_frames([o for o, c in zip(matched, changed) if c], rotation[changed], center[changed], semi_axes[changed])
         if missing:
             self.report({"WARNING"}, f"Not in '{reference.name}', left alone: {', '.join(missing)}")
-        self.report({"INFO"}, f"Relabelled {plural(int(changed.sum()), 'ellipsoid')} to agree with "
-                              f"'{reference.name}'; {int((~changed).sum())} already agreed")
+        self.report(
+            {"INFO"},
+            f"Relabelled {plural(int(changed.sum()), 'ellipsoid')} to agree with "
+            f"'{reference.name}'; {int((~changed).sum())} already agreed",
+        )
         return {"FINISHED"}
 
 
@@ -128,8 +134,10 @@ class ELLIMANN_OT_register_mannequin(MannequinOperator, bpy.types.Operator):
             matrix = obj.matrix_world.copy()
             matrix.translation += Vector(offset.tolist())
             obj.matrix_world = matrix
-        self.report({"INFO"}, f"Registered '{collection.name}': moved by ({offset[0]:+.4f}, {offset[1]:+.4f}, "
-                              f"{offset[2]:+.4f}) m")
+        self.report(
+            {"INFO"},
+            f"Registered '{collection.name}': moved by ({offset[0]:+.4f}, {offset[1]:+.4f}, {offset[2]:+.4f}) m",
+        )
         return {"FINISHED"}
 
 

@@ -67,8 +67,11 @@ class ELLIMANN_OT_fix_frames(ScopedOperator, bpy.types.Operator):
             self.report({"WARNING"}, problem)
         if unparented:
             self.report({"WARNING"}, f"Cleared the parent of {', '.join(unparented)} (its scale sheared them)")
-        self.report({"INFO"}, f"Repaired {plural(len(repairs), 'ellipsoid')}: "
-                              + ", ".join(f"{o.ellimann.part_name or o.name} ({kind})" for o, kind, _ in repairs))
+        self.report(
+            {"INFO"},
+            f"Repaired {plural(len(repairs), 'ellipsoid')}: "
+            + ", ".join(f"{o.ellimann.part_name or o.name} ({kind})" for o, kind, _ in repairs),
+        )
         return {"FINISHED"}
 
 

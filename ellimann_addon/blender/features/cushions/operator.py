@@ -17,10 +17,13 @@ class ELLIMANN_OT_build_cushions(MannequinOperator, bpy.types.Operator):
     bl_label = "Build Cushions"
     bl_options = {"REGISTER", "UNDO"}
 
-    subdivisions: IntProperty(name="Resolution", default=CUSHION_LEVEL, min=CUSHION_LEVELS[0],
-                              max=CUSHION_LEVELS[1],
-                              description="Icosphere subdivisions of the hull's directions "
-                                          "(vertices = 10 * 4^n + 2)")
+    subdivisions: IntProperty(
+        name="Resolution",
+        default=CUSHION_LEVEL,
+        min=CUSHION_LEVELS[0],
+        max=CUSHION_LEVELS[1],
+        description="Icosphere subdivisions of the hull's directions (vertices = 10 * 4^n + 2)",
+    )
 
     def run(self, context, collection):
         mannequin = mannequin_or_cancel(collection)

@@ -5,8 +5,8 @@ import contextlib
 import bpy
 
 from ....core.errors import ElliMannError, MannequinError
-from ....core.motion import clamped_motion
-from ....core.pose import require_joints
+from ....core.pose.kinematics import require_joints
+from ....core.pose.motion import clamped_motion
 from ... import ids
 from ...services.drape import drape
 from ..base import MannequinOperator, OperatorError, has_mannequin, mannequin_or_cancel
@@ -52,18 +52,25 @@ class ELLIMANN_OT_drape_garment(MannequinOperator, bpy.types.Operator):
         try:
             motion, loop = body_motion(mannequin, props.pose)
             with progress_bar(context.window_manager, settings.frames) as update:
-                result = drape(mannequin, props.garment, settings, scene=context.scene, progress=update,
-                               motion=motion, loop=loop)
+                result = drape(
+                    mannequin, props.garment, settings, scene=context.scene, progress=update, motion=motion, loop=loop
+                )
         except MannequinError as error:
             raise OperatorError(f"Cannot drape '{collection.name}'", error.problems) from error
         except ElliMannError as error:
             raise OperatorError(f"Cannot drape '{collection.name}': {error}") from error
         props.status = result.summary()
         if result.fit["penetrating_fraction"] > PENETRATION_WARNING:
-            self.report({"WARNING"}, f"{result.fit['penetrating']} garment vertices ended inside the body: try more "
-                                     "frames, a finer collider or a finer cloth")
-        self.report({"INFO"}, f"Baked {result.frames} frames ({result.seconds.sum():.1f} s): a {result.garment.name} "
-                              f"on '{collection.name}' in '{result.collection.name}': {props.status}")
+            self.report(
+                {"WARNING"},
+                f"{result.fit['penetrating']} garment vertices ended inside the body: try more "
+                "frames, a finer collider or a finer cloth",
+            )
+        self.report(
+            {"INFO"},
+            f"Baked {result.frames} frames ({result.seconds.sum():.1f} s): a {result.garment.name} "
+            f"on '{collection.name}' in '{result.collection.name}': {props.status}",
+        )
         return {"FINISHED"}
 
 

@@ -3,48 +3,82 @@
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
-from ....core.options import DRAPE, DrapeSettings
+from ....core.drape.settings import DRAPE, DrapeSettings
 from ..pose.operators import POSE_ITEMS
 
 REST = "REST"
 # The body under the cloth: as traced, or moving from rest into a standard pose or the walk.
-BODY_POSE_ITEMS = ((REST, "Rest", "The mannequin at rest (the traced A-pose), standing still"),
-                   *(item for item in POSE_ITEMS if item[0] != "a_pose"))
+BODY_POSE_ITEMS = (
+    (REST, "Rest", "The mannequin at rest (the traced A-pose), standing still"),
+    *(item for item in POSE_ITEMS if item[0] != "a_pose"),
+)
 
-# Items, defaults and descriptions: core.options.DRAPE (the command line's too).
+# Items, defaults and descriptions: core.drape.settings.DRAPE (the command line's too).
 GARMENT_ITEMS = tuple((c.value, c.label, c.description) for c in DRAPE["garment"].choices)  # keys as they are
 DEFAULTS = DrapeSettings()
 
 
 def _subdivisions(name):
     option = DRAPE[name]
-    return IntProperty(name=option.label, default=getattr(DEFAULTS, name), min=option.limits[0],
-                       max=option.limits[1], description=option.description)
+    return IntProperty(
+        name=option.label,
+        default=getattr(DEFAULTS, name),
+        min=option.limits[0],
+        max=option.limits[1],
+        description=option.description,
+    )
 
 
 class ELLIMANN_PG_drape(bpy.types.PropertyGroup):
     """Drape settings of a scene."""
 
-    garment: EnumProperty(name=DRAPE["garment"].label, items=GARMENT_ITEMS, default=DRAPE["garment"].default,
-                          description=DRAPE["garment"].description)
-    frames: IntProperty(name=DRAPE["frames"].label, default=DEFAULTS.frames, min=DRAPE["frames"].limits[0],
-                        max=DRAPE["frames"].limits[1], soft_max=250, description=DRAPE["frames"].description)
-    edge: FloatProperty(name=DRAPE["edge"].label, default=DEFAULTS.edge, min=DRAPE["edge"].limits[0],
-                        max=DRAPE["edge"].limits[1], soft_min=0.01, soft_max=0.05, subtype="DISTANCE", unit="LENGTH",
-                        description=DRAPE["edge"].description)
-    cushions: BoolProperty(name=DRAPE["cushions"].label, default=DEFAULTS.cushions,
-                           description=DRAPE["cushions"].description)
+    garment: EnumProperty(
+        name=DRAPE["garment"].label,
+        items=GARMENT_ITEMS,
+        default=DRAPE["garment"].default,
+        description=DRAPE["garment"].description,
+    )
+    frames: IntProperty(
+        name=DRAPE["frames"].label,
+        default=DEFAULTS.frames,
+        min=DRAPE["frames"].limits[0],
+        max=DRAPE["frames"].limits[1],
+        soft_max=250,
+        description=DRAPE["frames"].description,
+    )
+    edge: FloatProperty(
+        name=DRAPE["edge"].label,
+        default=DEFAULTS.edge,
+        min=DRAPE["edge"].limits[0],
+        max=DRAPE["edge"].limits[1],
+        soft_min=0.01,
+        soft_max=0.05,
+        subtype="DISTANCE",
+        unit="LENGTH",
+        description=DRAPE["edge"].description,
+    )
+    cushions: BoolProperty(
+        name=DRAPE["cushions"].label, default=DEFAULTS.cushions, description=DRAPE["cushions"].description
+    )
     sphere_subdivisions: _subdivisions("sphere_subdivisions")
     cushion_subdivisions: _subdivisions("cushion_subdivisions")
-    pose: EnumProperty(name="Body", items=BODY_POSE_ITEMS, default=REST,
-                       description="The body under the cloth: at rest, or turning from rest into a standard pose "
-                                   "(then holding it) or walking, the cloth following (needs joints)")
+    pose: EnumProperty(
+        name="Body",
+        items=BODY_POSE_ITEMS,
+        default=REST,
+        description="The body under the cloth: at rest, or turning from rest into a standard pose "
+        "(then holding it) or walking, the cloth following (needs joints)",
+    )
     status: StringProperty(name="Last Drape", description="Outcome of the last drape")
 
     def settings(self):
-        return DrapeSettings(frames=self.frames, edge=self.edge, cushions=self.cushions,
-                             sphere_subdivisions=self.sphere_subdivisions,
-                             cushion_subdivisions=self.cushion_subdivisions)
+        return DrapeSettings(
+            frames=self.frames,
+            edge=self.edge,
+            cushions=self.cushions,
+            sphere_subdivisions=self.sphere_subdivisions,
+            cushion_subdivisions=self.cushion_subdivisions,
+        )
 
 
 classes = (ELLIMANN_PG_drape,)

@@ -1,7 +1,7 @@
 """Export the active mannequin from the GUI: binary glTF with ElliMann's extras (.glb) or MuJoCo MJCF (.xml).
 
 File > Export > ElliMann Mannequin, or the button in the sidebar's ElliMann tab. The writers are the
-ones the CLI uses (:func:`...services.files.export_gltf`, :func:`...core.export_mjcf.write_mjcf`), so a file
+ones the CLI uses (:func:`...services.files.export_gltf`, :func:`...core.formats.mjcf.write_mjcf`), so a file
 written here is the same as ``ellimann synth -o``'s.
 """
 
@@ -12,8 +12,8 @@ from bpy.props import BoolProperty, EnumProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper
 
 from ....core.errors import ElliMannError
-from ....core.export_mjcf import write_mjcf
-from ....core.formats import FORMATS
+from ....core.formats.mjcf import write_mjcf
+from ....core.formats.table import FORMATS
 from ... import ids
 from ...bridge.built import built_objects
 from ...bridge.convert import collection_to_mannequin
@@ -22,12 +22,20 @@ from ...services.files import export_gltf
 from ..base import MannequinOperator, OperatorError, fix_first
 
 FORMAT_ITEMS = (
-    ("GLB", "glTF Binary (.glb)", "Binary glTF: one node per piece named after its part, with the part fields, "
-                                  "frames and measurements as extras (three.js, game engines)"),
-    ("MJCF", "MJCF (.xml)", "MuJoCo model: a native ellipsoid geom per part (or a convex mesh per cushion pair), "
-                            "welded to the world, measurements in <custom>"),
+    (
+        "GLB",
+        "glTF Binary (.glb)",
+        "Binary glTF: one node per piece named after its part, with the part fields, "
+        "frames and measurements as extras (three.js, game engines)",
+    ),
+    (
+        "MJCF",
+        "MJCF (.xml)",
+        "MuJoCo model: a native ellipsoid geom per part (or a convex mesh per cushion pair), "
+        "welded to the world, measurements in <custom>",
+    ),
 )
-EXTENSIONS = {kind: "." + FORMATS[kind.lower()].extension for kind in ("GLB", "MJCF")}  # core.formats
+EXTENSIONS = {kind: "." + FORMATS[kind.lower()].extension for kind in ("GLB", "MJCF")}  # core.formats.table
 NAMES = {"GLB": "glTF", "MJCF": "MJCF"}
 
 
@@ -70,14 +78,22 @@ class ELLIMANN_OT_export_mannequin(MannequinOperator, bpy.types.Operator, Export
     filename_ext = EXTENSIONS["GLB"]  # ExportHelper's default; check() follows the format
     # ExportHelper's filepath, but not remembered: Blender restores an operator's last-used properties, so
     # the next export (of another mannequin, perhaps) would suggest this one's file.
-    filepath: StringProperty(name="File Path", description="File to export to", maxlen=1024, subtype="FILE_PATH",
-                             options={"SKIP_SAVE"})
+    filepath: StringProperty(
+        name="File Path", description="File to export to", maxlen=1024, subtype="FILE_PATH", options={"SKIP_SAVE"}
+    )
     filter_glob: StringProperty(default="*.glb;*.xml", options={"HIDDEN"})
-    format: EnumProperty(name="Format", items=FORMAT_ITEMS, default="GLB",
-                         description="File format (a file name ending in .glb or .xml chooses it)")
-    cushions: BoolProperty(name="Cushions as Convex Meshes", default=False,
-                           description="MJCF: one convex mesh geom per cushion pair instead of its two ellipsoids "
-                                       "(a .glb holds what the mannequin shows: its built cushions, if any)")
+    format: EnumProperty(
+        name="Format",
+        items=FORMAT_ITEMS,
+        default="GLB",
+        description="File format (a file name ending in .glb or .xml chooses it)",
+    )
+    cushions: BoolProperty(
+        name="Cushions as Convex Meshes",
+        default=False,
+        description="MJCF: one convex mesh geom per cushion pair instead of its two ellipsoids "
+        "(a .glb holds what the mannequin shows: its built cushions, if any)",
+    )
     last_format: StringProperty(options={"HIDDEN", "SKIP_SAVE"})  # the format check() saw last
 
     OBJECT_MODE_ONLY = False
@@ -131,5 +147,6 @@ class ELLIMANN_OT_export_mannequin(MannequinOperator, bpy.types.Operator, Export
         what = "MJCF with cushion meshes" if kind == "MJCF" and self.cushions else NAMES[kind]
         self.report({"INFO"}, f"Exported '{collection.name}' ({what}) to {path}")
         return {"FINISHED"}
+
 
 classes = (ELLIMANN_OT_export_mannequin,)

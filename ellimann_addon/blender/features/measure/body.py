@@ -1,11 +1,11 @@
 """Measure Body Mesh: the five measurements and the extra ones of a selected mesh (a scan, a body from another
-tool) standing upright in an A-pose, its arms found by geometry alone (``core.body_measure``)."""
+tool) standing upright in an A-pose, its arms found by geometry alone (``core.measure.body``)."""
 
 import json
 
 import bpy
 
-from ....core.body_measure import ALL_MEASUREMENTS, measure_body_mesh
+from ....core.measure.body import ALL_MEASUREMENTS, measure_body_mesh
 from ... import ids
 from ...bridge.convert import world_triangles
 from ...bridge.selection import owning_mannequin

@@ -3,9 +3,9 @@
 import bpy
 from bpy.props import BoolProperty, EnumProperty
 
-from ....core.cushion import cushion_name
-from ....core.extra_measures import mannequin_extra_measurements
-from ....core.measure import as_dict, measure_meshes, measurement_line, section_hulls, tailor_measurements
+from ....core.geometry.cushion import cushion_name
+from ....core.measure.extra import mannequin_extra_measurements
+from ....core.measure.tailor import as_dict, measure_meshes, measurement_line, section_hulls, tailor_measurements
 from ... import ids
 from ...bridge.built import built_collection, built_objects, is_stale, new_section_object, remove_built
 from ...bridge.convert import ellipsoid_objects, world_triangles, write_measured
@@ -51,12 +51,18 @@ class ELLIMANN_OT_measure_mannequin(MannequinOperator, bpy.types.Operator):
     bl_label = "Measure"
     bl_options = {"REGISTER", "UNDO"}
 
-    source: EnumProperty(name="Measure On", items=SOURCE_ITEMS, default="AUTO",
-                         description="Measure the ellipsoids (exact, closed form) or the cushion mannequin (its "
-                                     "hull meshes)")
-    draw_sections: BoolProperty(name="Draw Sections", default=False,
-                                description="Draw the Sh, Br, Wa and Hi section hulls as curves at their heights "
-                                            "(replacing those drawn before)")
+    source: EnumProperty(
+        name="Measure On",
+        items=SOURCE_ITEMS,
+        default="AUTO",
+        description="Measure the ellipsoids (exact, closed form) or the cushion mannequin (its hull meshes)",
+    )
+    draw_sections: BoolProperty(
+        name="Draw Sections",
+        default=False,
+        description="Draw the Sh, Br, Wa and Hi section hulls as curves at their heights "
+        "(replacing those drawn before)",
+    )
 
     def run(self, context, collection):
         mannequin = mannequin_or_cancel(collection)
@@ -65,8 +71,10 @@ class ELLIMANN_OT_measure_mannequin(MannequinOperator, bpy.types.Operator):
         if on_hulls:
             meshes, girth, missing = cushion_mannequin_meshes(collection, mannequin, cushions)
             if missing:
-                raise OperatorError(f"Cushions missing or out of date for {', '.join(missing)}: build cushions "
-                                    "again, or measure on the ellipsoids")
+                raise OperatorError(
+                    f"Cushions missing or out of date for {', '.join(missing)}: build cushions "
+                    "again, or measure on the ellipsoids"
+                )
             values, sections = measure_meshes(meshes, girth, mannequin.section_fractions)
         else:
             r, c, d, g = mannequin.rotation, mannequin.center, mannequin.semi_axes, mannequin.topology.girth_mask
@@ -83,9 +91,13 @@ class ELLIMANN_OT_measure_mannequin(MannequinOperator, bpy.types.Operator):
                     new_section_object(f"{collection.name} {key}", key, z, points, target)
         where = "cushion hulls" if on_hulls else "ellipsoids"
         more = mannequin_extra_measurements(mannequin)  # closed forms on the ellipsoids, rest pose
-        self.report({"INFO"}, f"'{collection.name}' ({where}): {measurement_line(measured)}, "
-                              + ", ".join(f"{key} {value:.2f}" for key, value in more.items()) + " cm (the extra ones "
-                              "on the ellipsoids)")
+        self.report(
+            {"INFO"},
+            f"'{collection.name}' ({where}): {measurement_line(measured)}, "
+            + ", ".join(f"{key} {value:.2f}" for key, value in more.items())
+            + " cm (the extra ones "
+            "on the ellipsoids)",
+        )
         return {"FINISHED"}
 
 

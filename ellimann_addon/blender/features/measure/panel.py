@@ -5,7 +5,7 @@ import json
 import bpy
 
 from ....core.constants import MEASUREMENT_LABELS, MEASUREMENTS
-from ....core.extra_measures import EXTRA_LABELS
+from ....core.measure.extra import EXTRA_LABELS
 from ... import ids
 from ...bridge.selection import active_mannequin
 from ..base import SubPanel

@@ -8,9 +8,9 @@ from bpy.props import StringProperty
 from bpy_extras.io_utils import ImportHelper
 
 from ....core.errors import ElliMannError
-from ....core.pose import Pose, clamp_pose
-from ....core.retarget import retarget
-from ....core.skeleton import JOINT_NAMES, PARENTS, RIG_NAME_MAPS, joint_of_bone
+from ....core.mannequin.skeleton import JOINT_NAMES, PARENTS, RIG_NAME_MAPS, joint_of_bone
+from ....core.pose.kinematics import Pose, clamp_pose
+from ....core.pose.retarget import retarget
 from ... import ids
 from ...bridge.convert import read_joints, rig_object
 from ...services.bvh import bvh_header, sample_bvh
@@ -42,8 +42,9 @@ def motion_onto(collection, path, rig="AUTO"):
     if not mapping:
         shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
         which = "any of the maps (MakeHuman/CMU, Mixamo)" if rig == "AUTO" else f"the {RIG_LABELS.get(rig, rig)} map"
-        raise ElliMannError(f"bones: none of the {len(names)} bones of {os.path.basename(path)} ({shown}) is in "
-                            f"{which}")
+        raise ElliMannError(
+            f"bones: none of the {len(names)} bones of {os.path.basename(path)} ({shown}) is in {which}"
+        )
     clip = sample_bvh(path)
     rotations, translations = retarget(clip, JOINT_NAMES, joints, PARENTS, mapping, PREFERRED_CHILD)
     poses, reports = [], []
@@ -87,8 +88,11 @@ class ELLIMANN_OT_import_bvh(MannequinOperator, ImportHelper, bpy.types.Operator
         if reports:
             clamped += f" (first: {reports[0]})"
         props.status = f"{name}: {len(poses)} frames ({RIG_LABELS.get(key, key)} names){clamped}"
-        self.report({"INFO"}, f"Imported '{name}' onto '{collection.name}' as action '{action.name}': "
-                              f"{len(poses)} frames, {RIG_LABELS.get(key, key)} bone names{clamped}")
+        self.report(
+            {"INFO"},
+            f"Imported '{name}' onto '{collection.name}' as action '{action.name}': "
+            f"{len(poses)} frames, {RIG_LABELS.get(key, key)} bone names{clamped}",
+        )
         return {"FINISHED"}
 
 

@@ -4,7 +4,7 @@ import bpy
 from bpy.props import EnumProperty
 
 from ....core.errors import ElliMannError, MannequinError
-from ....core.poses import POSE_NAMES, WALK_FPS
+from ....core.pose.standard import POSE_NAMES, WALK_FPS
 from ... import ids
 from ...bridge.convert import read_joints, rig_object
 from ...bridge.selection import active_mannequin
@@ -53,8 +53,11 @@ class ELLIMANN_OT_add_armature(MannequinOperator, bpy.types.Operator):
         except ElliMannError as error:
             raise OperatorError(f"Cannot rig '{collection.name}': {error}") from error
         context.scene.ellimann_pose.status = ""
-        self.report({"INFO"}, f"Added '{rig.name}' to '{collection.name}': {plural(len(rig.data.bones), 'bone')}, "
-                              "every piece bound to its bone")
+        self.report(
+            {"INFO"},
+            f"Added '{rig.name}' to '{collection.name}': {plural(len(rig.data.bones), 'bone')}, "
+            "every piece bound to its bone",
+        )
         return {"FINISHED"}
 
 
@@ -79,21 +82,25 @@ class ELLIMANN_OT_apply_pose(MannequinOperator, bpy.types.Operator):
             raise OperatorError(f"Cannot pose '{collection.name}': it has no joints (rig it again: Add Armature)")
         label = POSE_LABELS.get(self.pose, self.pose)
         try:
-            poses, reports, action = pose_standard(rig, joints, self.pose, context.scene,
-                                                   f"{collection.name} {label}")
+            poses, reports, action = pose_standard(rig, joints, self.pose, context.scene, f"{collection.name} {label}")
         except ElliMannError as error:
             raise OperatorError(f"Cannot pose '{collection.name}': {error}") from error
         if action is not None:
-            text = (f"'{collection.name}' walks: action '{action.name}', frames 1-{len(poses)} at {WALK_FPS} fps, "
-                    "looping (play the timeline)")
+            text = (
+                f"'{collection.name}' walks: action '{action.name}', frames 1-{len(poses)} at {WALK_FPS} fps, "
+                "looping (play the timeline)"
+            )
         else:
             text = f"'{collection.name}' in {label}"
         for report in reports:
             self.report({"WARNING"}, f"clamped: {report}")
         status = f"{label}" + (f"; {plural(len(reports), 'joint angle')} clamped to the limits" if reports else "")
         context.scene.ellimann_pose.status = status
-        self.report({"INFO"}, f"{text}; measurements stay the rest pose's"
-                              + (f" ({plural(len(reports), 'joint angle')} clamped)" if reports else ""))
+        self.report(
+            {"INFO"},
+            f"{text}; measurements stay the rest pose's"
+            + (f" ({plural(len(reports), 'joint angle')} clamped)" if reports else ""),
+        )
         return {"FINISHED"}
 
 

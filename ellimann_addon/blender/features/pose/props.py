@@ -4,18 +4,24 @@ the outcome of the last pose or import."""
 import bpy
 from bpy.props import EnumProperty, PointerProperty, StringProperty
 
-from ....core.skeleton import RIG_NAME_MAPS
+from ....core.mannequin.skeleton import RIG_NAME_MAPS
 
 RIG_LABELS = {"makehuman": "MakeHuman", "cmu": "CMU", "mixamo": "Mixamo"}
-RIG_ITEMS = (("AUTO", "Automatic", "The bone-name map that knows most of the clip's bones"),
-             *((key, RIG_LABELS.get(key, key), f"{RIG_LABELS.get(key, key)} bone names") for key in RIG_NAME_MAPS))
+RIG_ITEMS = (
+    ("AUTO", "Automatic", "The bone-name map that knows most of the clip's bones"),
+    *((key, RIG_LABELS.get(key, key), f"{RIG_LABELS.get(key, key)} bone names") for key in RIG_NAME_MAPS),
+)
 
 
 class ELLIMANN_PG_pose(bpy.types.PropertyGroup):
     """Pose settings of a scene."""
 
-    rig: EnumProperty(name="Bone Names", items=RIG_ITEMS, default="AUTO",
-                      description="Whose bone names a BVH clip uses (mapped onto the mannequin's SMPL joints)")
+    rig: EnumProperty(
+        name="Bone Names",
+        items=RIG_ITEMS,
+        default="AUTO",
+        description="Whose bone names a BVH clip uses (mapped onto the mannequin's SMPL joints)",
+    )
     status: StringProperty(name="Last Pose", description="Outcome of the last pose or motion import")
 
 

@@ -1,5 +1,5 @@
 """Build Reference Set: Reference Mannequins from a traced Base Mannequin and N >= 3 bodies, saved as a
-reference-set folder (core/reference_build.py, core/reference_manifest.py)."""
+reference-set folder (core/fitting/reference_build.py, core/synthesis/manifest.py)."""
 
 from . import operators, panel, props
 

@@ -1,4 +1,4 @@
-"""Build Reference Set: the core builder (core/reference_build.py) on the chosen Base Mannequin and bodies.
+"""Build Reference Set: the core builder (core/fitting/reference_build.py) on the chosen Base Mannequin and bodies.
 
 Clicked (invoke), the build runs on a worker thread (pure numpy, no Blender data touched) while a modal
 timer shows its progress and Esc cancels it; run from a script (execute), it runs in place with Blender's
@@ -15,8 +15,8 @@ from bpy.props import IntProperty
 
 from ....core.constants import ABSURD_LIMITS, MEASUREMENTS
 from ....core.errors import ElliMannError, MannequinError
-from ....core.reference_build import BuildCancelledError, build_reference_set, validate_inputs
-from ....core.reference_manifest import MANIFEST_FILE, Manifest, targets_range, write_reference_set
+from ....core.fitting.reference_build import BuildCancelledError, build_reference_set, validate_inputs
+from ....core.synthesis.manifest import MANIFEST_FILE, Manifest, targets_range, write_reference_set
 from ... import ids
 from ...bridge.bodies import body_mesh
 from ...bridge.convert import collection_to_mannequin, mannequin_to_collection, new_collection
@@ -44,15 +44,19 @@ class Request:
             raise OperatorError(f"Fix '{props.base.name}' first", error.problems) from error
         rows = [row for row in props.bodies if row.body is not None]
         self.bodies = [body_mesh(row.body, stem_of(row.body.name)) for row in rows]
-        self.targets = {body.name: dict(zip(MEASUREMENTS, map(float, row.target)))
-                        for body, row in zip(self.bodies, rows)}
+        self.targets = {
+            body.name: dict(zip(MEASUREMENTS, map(float, row.target))) for body, row in zip(self.bodies, rows)
+        }
         if not props.folder.strip():
             raise OperatorError("Choose the folder the reference set is written to")
         self.folder = pathlib.Path(bpy.path.abspath(props.folder))
-        if self.folder.exists() and (not self.folder.is_dir() or (any(self.folder.iterdir()) and not (
-                self.folder / MANIFEST_FILE).is_file())):
-            raise OperatorError(f"{self.folder} is a file or a folder of other files: choose a new or empty folder "
-                                "(or one holding a reference set to replace)")
+        if self.folder.exists() and (
+            not self.folder.is_dir() or (any(self.folder.iterdir()) and not (self.folder / MANIFEST_FILE).is_file())
+        ):
+            raise OperatorError(
+                f"{self.folder} is a file or a folder of other files: choose a new or empty folder "
+                "(or one holding a reference set to replace)"
+            )
         if BASE_STEM in self.targets:
             raise OperatorError(f"A body may not be named '{BASE_STEM}' (the base's file in the set)")
         try:
@@ -65,14 +69,22 @@ class Request:
     def manifest(self, report):
         stems = [body.name for body in self.bodies]
         first = next(iter(self.base.traces.values()))
-        return Manifest(name=self.name, mannequins=stems, sex=self.sex, base=BASE_STEM,
-                        section_fractions=dict(self.base.section_fractions), ranges_cm=targets_range(self.targets),
-                        absurd_limits_cm={k: list(v) for k, v in ABSURD_LIMITS.items()}, targets_cm=self.targets,
-                        provenance={"built_by": "Blender: ElliMann > Build Reference Set",
-                                    "base": {"collection": self.base.name, "traced_mesh": first.mesh,
-                                             "vertex_count": first.vertex_count},
-                                    "bodies": {s: {"object": s} for s in stems},
-                                    "labelled_against": report.reference})
+        return Manifest(
+            name=self.name,
+            mannequins=stems,
+            sex=self.sex,
+            base=BASE_STEM,
+            section_fractions=dict(self.base.section_fractions),
+            ranges_cm=targets_range(self.targets),
+            absurd_limits_cm={k: list(v) for k, v in ABSURD_LIMITS.items()},
+            targets_cm=self.targets,
+            provenance={
+                "built_by": "Blender: ElliMann > Build Reference Set",
+                "base": {"collection": self.base.name, "traced_mesh": first.mesh, "vertex_count": first.vertex_count},
+                "bodies": {s: {"object": s} for s in stems},
+                "labelled_against": report.reference,
+            },
+        )
 
     def build(self, progress=None, cancel_flag=None):
         return build_reference_set(self.base, self.bodies, self.targets, progress=progress, cancel=cancel_flag)
@@ -92,11 +104,11 @@ def finish(operator, context, request, rms, report):
     worst = max((abs(report.worst(stem)[1]), stem) for stem in rms)
     filled = min(report.fill[stem]["ellipsoids"]["coverage"] for stem in rms) if report.fill else None
     props = context.scene.ellimann_references
-    props.status = (f"{len(rms)} RMs in {request.folder}; worst m_T error {worst[0]:.3%} ({worst[1]})"
-                    + (f"; each fills at least {filled:.0%} of its body" if filled is not None else ""))
+    props.status = f"{len(rms)} RMs in {request.folder}; worst m_T error {worst[0]:.3%} ({worst[1]})" + (
+        f"; each fills at least {filled:.0%} of its body" if filled is not None else ""
+    )
     props.progress = 1.0
-    operator.report({"INFO"}, f"Built '{manifest.name}': {props.status}; use it in Synthesize > Reference Set > "
-                              "Folder")
+    operator.report({"INFO"}, f"Built '{manifest.name}': {props.status}; use it in Synthesize > Reference Set > Folder")
     return {"FINISHED"}
 
 
@@ -117,8 +129,9 @@ class ELLIMANN_OT_build_reference_set(ElliMannOperator, bpy.types.Operator):
         window_manager = context.window_manager
         window_manager.progress_begin(0, 100)
         try:
-            rms, report = request.build(progress=lambda fraction, _text: window_manager.progress_update(
-                int(100 * fraction)))
+            rms, report = request.build(
+                progress=lambda fraction, _text: window_manager.progress_update(int(100 * fraction))
+            )
         except ElliMannError as error:
             raise OperatorError(f"Cannot build: {error}") from error
         finally:
@@ -181,7 +194,8 @@ class ELLIMANN_OT_add_reference_bodies(ElliMannOperator, bpy.types.Operator):
     @classmethod
     def poll(cls, context):
         return hasattr(context.scene, "ellimann_references") and any(
-            o.type == "MESH" and not o.ellimann.is_part for o in context.selected_objects)
+            o.type == "MESH" and not o.ellimann.is_part for o in context.selected_objects
+        )
 
     def run(self, context):
         props = context.scene.ellimann_references

@@ -7,8 +7,8 @@ from mathutils import Vector
 
 from ....core.constants import MEASUREMENTS
 from ....core.errors import ElliMannError
-from ....core.extra_measures import split_measurements
-from ....core.measure import measurement_line
+from ....core.measure.extra import split_measurements
+from ....core.measure.tailor import measurement_line
 from ... import ids
 from ...services.rig import build_rig, check_rig
 from ...services.scene import add_mannequin
@@ -26,11 +26,14 @@ class ELLIMANN_OT_synthesize_from_mesh(ElliMannOperator, bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return (context.mode == "OBJECT" and hasattr(context.scene, "ellimann_synthesis")
-                and is_body_mesh(context.active_object))
+        return (
+            context.mode == "OBJECT"
+            and hasattr(context.scene, "ellimann_synthesis")
+            and is_body_mesh(context.active_object)
+        )
 
     def run(self, context):
-        from ....core.refine_extra import synthesize_extra
+        from ....core.synthesis.synthesize import synthesize_extra
 
         obj = context.active_object
         props = context.scene.ellimann_synthesis
@@ -45,8 +48,10 @@ class ELLIMANN_OT_synthesize_from_mesh(ElliMannOperator, bpy.types.Operator):
             wm.progress_update(1)
             missing = [key for key in MEASUREMENTS if key not in values]
             if missing:
-                raise OperatorError(f"'{obj.name}': {problems[0] if problems else 'not measured'}; "
-                                    f"{', '.join(missing)} missing: cannot synthesize")
+                raise OperatorError(
+                    f"'{obj.name}': {problems[0] if problems else 'not measured'}; "
+                    f"{', '.join(missing)} missing: cannot synthesize"
+                )
             five, extra = split_measurements(values)
             try:
                 mannequin, measured, warnings = synthesize_extra(reference, five, extra, options_of(props))
@@ -66,9 +71,11 @@ class ELLIMANN_OT_synthesize_from_mesh(ElliMannOperator, bpy.types.Operator):
         props.target = collection
         for line in problems + warnings:
             self.report({"WARNING"}, line)
-        self.report({"INFO"}, f"'{obj.name}': {values_line(values)}; twin '{collection.name}': "
-                              f"{measurement_line(measured)}"
-                              + "".join(f", {key} {measured[key]:.2f}" for key in extra) + " cm")
+        self.report(
+            {"INFO"},
+            f"'{obj.name}': {values_line(values)}; twin '{collection.name}': "
+            f"{measurement_line(measured)}" + "".join(f", {key} {measured[key]:.2f}" for key in extra) + " cm",
+        )
         return {"FINISHED"}
 
 

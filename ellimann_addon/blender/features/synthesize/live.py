@@ -1,7 +1,7 @@
 """Live updates of the Synthesize feature: the last synthesized mannequin follows the request in place.
 
 Live updates with cushions keep up with a dragged slider by moving the existing cushion meshes:
-their vertices are rewritten in place (``core.cushion.cushion_vertices``, every pair in one
+their vertices are rewritten in place (``core.geometry.cushion.cushion_vertices``, every pair in one
 vectorised call; same vertex order at the same resolution) and their faces kept. Those faces were
 made convex for the previous ellipsoids, so the cushions count as out of date until the fields
 have been still for ``LIVE_SETTLE_SECONDS``; a timer then rebuilds them exactly (``settle_live``).
@@ -21,9 +21,9 @@ import bpy
 import numpy as np
 
 from ....core.constants import CUSHION_LEVEL, LIVE_CUSHION_LEVEL
-from ....core.cushion import cushion_vertices
 from ....core.errors import ElliMannError
-from ....core.mesh import icosphere_level
+from ....core.geometry.cushion import cushion_vertices
+from ....core.geometry.mesh import icosphere_level
 from ...bridge.built import built_objects, is_stale
 from ...bridge.convert import update_collection_geometry, write_measured
 from ...bridge.selection import part_lookup
@@ -150,8 +150,7 @@ def settle_restored(*_args):
     for scene in bpy.data.scenes:
         props = getattr(scene, "ellimann_synthesis", None)
         target = props.target if props is not None and props.live else None
-        if target is not None and target.ellimann.is_mannequin and _has_stale(
-                target, built_objects(target, "CUSHION")):
+        if target is not None and target.ellimann.is_mannequin and _has_stale(target, built_objects(target, "CUSHION")):
             _settle_later(scene)
 
 

@@ -5,8 +5,8 @@ import bpy
 
 from ....core.constants import MEASUREMENTS
 from ....core.errors import ElliMannError
-from ....core.measure import measurement_line
-from ....core.synthesis import relative_error
+from ....core.measure.tailor import measurement_line
+from ....core.synthesis.synthesize import relative_error
 from ... import ids
 from ...bridge.convert import ellipsoid_objects
 from ...services.rig import build_rig, check_rig
@@ -43,9 +43,12 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
             self.report({"WARNING"}, warning)
         worst = relative_error(five, request_of(props)).max()
         values = measurement_line(five) + "".join(f", {key} {measured[key]:.2f}" for key in extra_of(props))
-        self.report({"INFO"}, f"Synthesized '{collection.name}' ({len(ellipsoid_objects(collection))} ellipsoids, "
-                              f"{props.mode.lower()}{', with an armature' if rig else ''}): m_T {values} cm, "
-                              f"max error {worst:.2f}%")
+        self.report(
+            {"INFO"},
+            f"Synthesized '{collection.name}' ({len(ellipsoid_objects(collection))} ellipsoids, "
+            f"{props.mode.lower()}{', with an armature' if rig else ''}): m_T {values} cm, "
+            f"max error {worst:.2f}%",
+        )
         return {"FINISHED"}
 
 

@@ -3,7 +3,7 @@
 import bpy
 
 from ....core.constants import MEASUREMENT_LABELS, MEASUREMENTS
-from ....core.extra_measures import EXTRA_MEASUREMENTS
+from ....core.measure.extra import EXTRA_MEASUREMENTS
 from ... import ids
 from ..base import SubPanel
 from .presets import ELLIMANN_MT_measurement_presets

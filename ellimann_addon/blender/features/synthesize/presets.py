@@ -43,8 +43,12 @@ class ELLIMANN_MT_measurement_presets(bpy.types.Menu):
 
     def draw(self, _context):
         folders = [str(SHIPPED_PRESETS)] + bpy.utils.preset_paths(PRESET_SUBDIR)
-        self.path_menu(folders, self.preset_operator, filter_ext=lambda ext: ext.lower() == ".py",
-                       display_name=lambda path: bpy.path.display_name(os.path.basename(path), title_case=False))
+        self.path_menu(
+            folders,
+            self.preset_operator,
+            filter_ext=lambda ext: ext.lower() == ".py",
+            display_name=lambda path: bpy.path.display_name(os.path.basename(path), title_case=False),
+        )
 
 
 class ELLIMANN_OT_apply_measurement_preset(bpy.types.Operator):
@@ -54,8 +58,9 @@ class ELLIMANN_OT_apply_measurement_preset(bpy.types.Operator):
     bl_label = "Apply Measurement Preset"
     bl_options = {"REGISTER", "UNDO", "INTERNAL"}  # script.execute_preset has no undo step of its own
 
-    filepath: StringProperty(name="Preset", subtype="FILE_PATH", options={"HIDDEN", "SKIP_SAVE"},
-                             description="The preset file (.py) to run")
+    filepath: StringProperty(
+        name="Preset", subtype="FILE_PATH", options={"HIDDEN", "SKIP_SAVE"}, description="The preset file (.py) to run"
+    )
 
     @classmethod
     def poll(cls, context):

@@ -5,8 +5,8 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, PointerProperty, StringProperty
 
 from ....core.constants import ABSURD_LIMITS, MEASUREMENT_LABELS, RANGES, REFERENCE_MEASUREMENTS
-from ....core.extra_measures import EXTRA_ABSURD_LIMITS, EXTRA_DEFAULTS, EXTRA_LABELS, EXTRA_MEASUREMENTS
-from ....core.options import SYNTHESIS
+from ....core.measure.extra import EXTRA_ABSURD_LIMITS, EXTRA_DEFAULTS, EXTRA_LABELS, EXTRA_MEASUREMENTS
+from ....core.synthesis.options import SYNTHESIS
 from .live import on_request_change
 from .request import REFERENCE_SET_ITEMS
 
@@ -15,20 +15,39 @@ def _measurement(key):
     low, high = ABSURD_LIMITS[key]
     soft_low, soft_high = RANGES[key]
     return FloatProperty(
-        name=key, default=REFERENCE_MEASUREMENTS["average"][key], min=low, max=high, soft_min=soft_low,
-        soft_max=soft_high, step=25, precision=2, update=on_request_change,
+        name=key,
+        default=REFERENCE_MEASUREMENTS["average"][key],
+        min=low,
+        max=high,
+        soft_min=soft_low,
+        soft_max=soft_high,
+        step=25,
+        precision=2,
+        update=on_request_change,
         description=f"{MEASUREMENT_LABELS[key]} in cm. The female set's reference range {soft_low:g}-{soft_high:g} "
-                    f"cm (outside its set's range the result is extrapolated); accepted {low:g}-{high:g} cm")
+        f"cm (outside its set's range the result is extrapolated); accepted {low:g}-{high:g} cm",
+    )
 
 
 def _option(name):
-    """A synthesis option's property from ``core.options.SYNTHESIS`` (the command line's table too)."""
+    """A synthesis option's property from ``core.synthesis.options.SYNTHESIS`` (the command line's table too)."""
     option = SYNTHESIS[name]
     if option.choices:
-        return EnumProperty(name=option.label, default=option.enum_default, update=on_request_change,
-                            description=option.description, items=option.enum_items())
-    return FloatProperty(name=option.label, default=option.default, min=option.limits[0], max=option.limits[1],
-                         update=on_request_change, description=option.description)
+        return EnumProperty(
+            name=option.label,
+            default=option.enum_default,
+            update=on_request_change,
+            description=option.description,
+            items=option.enum_items(),
+        )
+    return FloatProperty(
+        name=option.label,
+        default=option.default,
+        min=option.limits[0],
+        max=option.limits[1],
+        update=on_request_change,
+        description=option.description,
+    )
 
 
 class ELLIMANN_PG_synthesis(bpy.types.PropertyGroup):
@@ -41,28 +60,51 @@ class ELLIMANN_PG_synthesis(bpy.types.PropertyGroup):
     hi: _measurement("Hi")
     mode: _option("mode")
     output: EnumProperty(
-        name="Pieces", default="ELLIPSOIDS",
+        name="Pieces",
+        default="ELLIPSOIDS",
         description="What Synthesize builds: ellipsoids only, or cushions (convex hulls of each cushion pair) in "
-                    "place of their two ellipsoids, which are kept but hidden",
-        items=(("ELLIPSOIDS", "Ellipsoids", "One ellipsoid object per part"),
-               ("CUSHIONS", "Cushions", "Cushions (convex hulls) for the cushion pairs, ellipsoids for the rest; "
-                                        "slower to build")))
+        "place of their two ellipsoids, which are kept but hidden",
+        items=(
+            ("ELLIPSOIDS", "Ellipsoids", "One ellipsoid object per part"),
+            (
+                "CUSHIONS",
+                "Cushions",
+                "Cushions (convex hulls) for the cushion pairs, ellipsoids for the rest; slower to build",
+            ),
+        ),
+    )
     normalize: _option("normalize")
     metric: _option("metric")
     power: _option("power")
-    live: BoolProperty(name="Live", default=False, update=on_request_change,
-                       description="Update the last synthesized mannequin in place while the fields change")
-    target: PointerProperty(name="Last Synthesized", type=bpy.types.Collection,
-                            poll=lambda _self, collection: collection.ellimann.is_mannequin,
-                            description="The mannequin that Live updates")
-    reference_set: EnumProperty(name="Reference Set", items=REFERENCE_SET_ITEMS, default="FEMALE",
-                                update=on_request_change,
-                                description="The Reference Mannequins to synthesize from: the shipped female or "
-                                            "male set, or a folder of your own")
-    references: StringProperty(name="References", subtype="DIR_PATH", default="", update=on_request_change,
-                               description="With Reference Set Folder: a reference-set folder, reference_set.json "
-                                           "and the Reference Mannequins' .json files it lists (Build Reference Set "
-                                           "writes one), or the five files of Table 2.3")
+    live: BoolProperty(
+        name="Live",
+        default=False,
+        update=on_request_change,
+        description="Update the last synthesized mannequin in place while the fields change",
+    )
+    target: PointerProperty(
+        name="Last Synthesized",
+        type=bpy.types.Collection,
+        poll=lambda _self, collection: collection.ellimann.is_mannequin,
+        description="The mannequin that Live updates",
+    )
+    reference_set: EnumProperty(
+        name="Reference Set",
+        items=REFERENCE_SET_ITEMS,
+        default="FEMALE",
+        update=on_request_change,
+        description="The Reference Mannequins to synthesize from: the shipped female or "
+        "male set, or a folder of your own",
+    )
+    references: StringProperty(
+        name="References",
+        subtype="DIR_PATH",
+        default="",
+        update=on_request_change,
+        description="With Reference Set Folder: a reference-set folder, reference_set.json "
+        "and the Reference Mannequins' .json files it lists (Build Reference Set "
+        "writes one), or the five files of Table 2.3",
+    )
     status: StringProperty(name="Status", description="Outcome of the last live update")
     live_ms: FloatProperty(name="Live Update Time", description="Duration of the last live update (ms)")
 
@@ -74,12 +116,22 @@ def _extra_fields():
         low, high = EXTRA_ABSURD_LIMITS[key]
         label = EXTRA_LABELS[key]
         fields[f"use_{key}"] = BoolProperty(
-            name=label, default=False, update=on_request_change,
+            name=label,
+            default=False,
+            update=on_request_change,
             description=f"Give the {label.lower()} too (exact mode meets it with pieces of its own; unticked, the "
-                        "reference set gives it)")
+            "reference set gives it)",
+        )
         fields[key] = FloatProperty(
-            name=label, default=EXTRA_DEFAULTS[key], min=low, max=high, step=25, precision=2,
-            update=on_request_change, description=f"{label} in cm (docs/measurements.md); accepted {low:g}-{high:g} cm")
+            name=label,
+            default=EXTRA_DEFAULTS[key],
+            min=low,
+            max=high,
+            step=25,
+            precision=2,
+            update=on_request_change,
+            description=f"{label} in cm (docs/measurements.md); accepted {low:g}-{high:g} cm",
+        )
     return fields
 
 

@@ -5,11 +5,11 @@ import bpy
 
 from ....core.constants import FEMALE_SET, MEASUREMENTS
 from ....core.errors import ReferenceSetError
-from ....core.extra_measures import EXTRA_MEASUREMENTS
-from ....core.options import SynthesisOptions
-from ....core.reference_set import cached_reference_set
-from ....core.refine_extra import synthesize_extra
-from ....core.shipped_sets import MALE_SET, SHIPPED_SETS
+from ....core.measure.extra import EXTRA_MEASUREMENTS
+from ....core.synthesis.options import SynthesisOptions
+from ....core.synthesis.reference_set import cached_reference_set
+from ....core.synthesis.shipped import MALE_SET, SHIPPED_SETS
+from ....core.synthesis.synthesize import synthesize_extra
 
 FIELDS = {key: key.lower() for key in MEASUREMENTS}  # He -> props.he
 REFERENCE_SET_ITEMS = (
@@ -41,11 +41,13 @@ def extra_of(props):
 def synthesize_request(props, extra=None):
     """(Mannequin, measured {the five and the extra ones: cm}, warnings) of the panel's request; ``extra``
     overrides the panel's extra measurements (a body's, for Synthesize from Mesh)."""
-    return synthesize_extra(reference_of(props), request_of(props), extra_of(props) if extra is None else extra,
-                            options_of(props))
+    return synthesize_extra(
+        reference_of(props), request_of(props), extra_of(props) if extra is None else extra, options_of(props)
+    )
 
 
 def options_of(props):
     """The SynthesisOptions of the panel's fields."""
-    return SynthesisOptions(mode=props.mode.lower(), metric=props.metric.lower(), power=props.power,
-                            normalize=props.normalize.lower())
+    return SynthesisOptions(
+        mode=props.mode.lower(), metric=props.metric.lower(), power=props.power, normalize=props.normalize.lower()
+    )

@@ -1,14 +1,14 @@
 """Mirroring across the sagittal plane x = 0: selected ellipsoids, or a whole side of a mannequin.
 
-The mirrored frame gets one axis flipped so it stays right-handed (core.frames.mirror_frame); the
+The mirrored frame gets one axis flipped so it stays right-handed (core.geometry.frames.mirror_frame); the
 twin is named with the other suffix (.L <-> .R) and its cushion partner mirrored likewise.
 """
 
 import bpy
 from bpy.props import BoolProperty, EnumProperty
 
-from ....core.frames import mirror_frame
-from ....core.mannequin import Part, side_of_name, twin_name
+from ....core.geometry.frames import mirror_frame
+from ....core.mannequin.topology import Part, side_of_name, twin_name
 from ... import ids
 from ...bridge.convert import (
     SIDE_COLORS,
@@ -21,14 +21,18 @@ from ...bridge.convert import (
 from ...bridge.selection import owning_mannequin, part_lookup, selected_ellipsoids
 from ..base import ElliMannOperator, MannequinOperator, OperatorError, frames_or_cancel, plural
 
-REPLACE = BoolProperty(name="Replace Existing", default=False,
-                       description="Move an existing twin onto the mirror image; otherwise it is left alone")
+REPLACE = BoolProperty(
+    name="Replace Existing",
+    default=False,
+    description="Move an existing twin onto the mirror image; otherwise it is left alone",
+)
 
 
 def mirrored_part(part):
     name = twin_name(part.name)
-    return Part(name, side_of_name(name), part.region, part.girth, part.depends,
-                twin_name(part.partner) if part.partner else "")
+    return Part(
+        name, side_of_name(name), part.region, part.girth, part.depends, twin_name(part.partner) if part.partner else ""
+    )
 
 
 def mirror_objects(operator, sources, replace, notes):
@@ -48,7 +52,7 @@ def mirror_objects(operator, sources, replace, notes):
         elif replace:
             write_part(twin, part)
             twin.color = SIDE_COLORS[part.side]
-            write_frames([twin], rotation[i:i + 1], center[i:i + 1], semi_axes[i:i + 1])
+            write_frames([twin], rotation[i : i + 1], center[i : i + 1], semi_axes[i : i + 1])
             replaced.append(part.name)
         else:
             notes.append(f"'{part.name}' exists in '{collection.name}': left alone (turn on Replace Existing)")
@@ -56,8 +60,11 @@ def mirror_objects(operator, sources, replace, notes):
         operator.report({"WARNING"}, note)
     if not created and not replaced:
         raise OperatorError("Nothing mirrored: " + (notes[0] if notes else "no left or right ellipsoids"))
-    operator.report({"INFO"}, f"Mirrored {plural(len(created) + len(replaced), 'ellipsoid')}: "
-                              f"{len(created)} created, {len(replaced)} replaced")
+    operator.report(
+        {"INFO"},
+        f"Mirrored {plural(len(created) + len(replaced), 'ellipsoid')}: "
+        f"{len(created)} created, {len(replaced)} replaced",
+    )
     return {"FINISHED"}
 
 
@@ -89,8 +96,7 @@ class ELLIMANN_OT_mirror_ellipsoids(ElliMannOperator, bpy.types.Operator):
             else:
                 sources.append(obj)
         if not sources:
-            raise OperatorError("Select left (.L) or right (.R) ellipsoids of a mannequin, one side only",
-                          notes)
+            raise OperatorError("Select left (.L) or right (.R) ellipsoids of a mannequin, one side only", notes)
         return mirror_objects(self, sources, self.replace, notes)
 
 
@@ -101,9 +107,15 @@ class ELLIMANN_OT_mirror_side(MannequinOperator, bpy.types.Operator):
     bl_label = "Mirror Side"
     bl_options = {"REGISTER", "UNDO"}
 
-    source: EnumProperty(name="From", default="L", description="The side that is copied to the other",
-                         items=(("L", "Left to Right", "Mirror the .L ellipsoids (+X) onto .R"),
-                                ("R", "Right to Left", "Mirror the .R ellipsoids (-X) onto .L")))
+    source: EnumProperty(
+        name="From",
+        default="L",
+        description="The side that is copied to the other",
+        items=(
+            ("L", "Left to Right", "Mirror the .L ellipsoids (+X) onto .R"),
+            ("R", "Right to Left", "Mirror the .R ellipsoids (-X) onto .L"),
+        ),
+    )
     replace: REPLACE
 
     def run(self, context, collection):

@@ -4,9 +4,9 @@ import bpy
 import numpy as np
 from bpy.props import EnumProperty, FloatVectorProperty, StringProperty
 
-from ....core.ellipsoid import axis_extent
-from ....core.fit import fit_ellipsoid
-from ....core.mannequin import NAME_PATTERN, Part, side_of_name
+from ....core.fitting.point_fit import fit_ellipsoid
+from ....core.geometry.ellipsoid import axis_extent
+from ....core.mannequin.topology import NAME_PATTERN, Part, side_of_name
 from ... import ids
 from ...bridge.bodies import selection_trace
 from ...bridge.convert import mesh_vertices, new_ellipsoid_object, write_trace
@@ -16,8 +16,12 @@ from ..base import ElliMannOperator, OperatorError
 
 DEFAULT_LABEL = "Ellipsoid"
 FIT_MODE_ITEMS = (
-    ("inscribed", "Inscribed", "Principal axes of the selection, sized so that no vertex of the mesh, selected or "
-                               "not, lies inside it: it stays inside the traced surface"),
+    (
+        "inscribed",
+        "Inscribed",
+        "Principal axes of the selection, sized so that no vertex of the mesh, selected or "
+        "not, lies inside it: it stays inside the traced surface",
+    ),
     ("moments", "Moments", "Principal axes and sizes from the second moments of the selected vertices"),
     ("enclosing", "Enclosing", "Principal axes of the selection, sized to enclose every selected vertex"),
 )
@@ -25,7 +29,8 @@ FIT_MODE_ITEMS = (
 PART_NAME = StringProperty(
     name="Part Name",
     description="Topology name such as '7.a Thigh.L' (the suffix .L/.R sets the side); empty: the next free "
-                "number, with a side from where the ellipsoid lies")
+    "number, with a side from where the ellipsoid lies",
+)
 
 
 def next_part_name(existing, center_x, half_width_x, label=DEFAULT_LABEL):
@@ -60,10 +65,17 @@ class ELLIMANN_OT_new_mannequin(ElliMannOperator, bpy.types.Operator):
     bl_label = "New Mannequin"
     bl_options = {"REGISTER", "UNDO"}
 
-    name: StringProperty(name="Name", default="Mannequin",
-                         description="Name of the new mannequin collection (Blender adds a number if it is taken)")
-    role: EnumProperty(name="Role", items=ROLE_ITEMS, default="base",
-                       description="Role of the new mannequin: one traced over a reference body is the Base")
+    name: StringProperty(
+        name="Name",
+        default="Mannequin",
+        description="Name of the new mannequin collection (Blender adds a number if it is taken)",
+    )
+    role: EnumProperty(
+        name="Role",
+        items=ROLE_ITEMS,
+        default="base",
+        description="Role of the new mannequin: one traced over a reference body is the Base",
+    )
 
     @classmethod
     def poll(cls, context):
@@ -83,9 +95,16 @@ class ELLIMANN_OT_add_ellipsoid(ElliMannOperator, bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     part_name: PART_NAME
-    semi_axes: FloatVectorProperty(name="Semi-Axes", size=3, default=(0.05, 0.05, 0.05), min=1e-4, soft_max=1.0,
-                                   subtype="XYZ_LENGTH", unit="LENGTH",
-                                   description="Half-lengths of the ellipsoid along its local x, y, z (m)")
+    semi_axes: FloatVectorProperty(
+        name="Semi-Axes",
+        size=3,
+        default=(0.05, 0.05, 0.05),
+        min=1e-4,
+        soft_max=1.0,
+        subtype="XYZ_LENGTH",
+        unit="LENGTH",
+        description="Half-lengths of the ellipsoid along its local x, y, z (m)",
+    )
 
     @classmethod
     def poll(cls, context):
@@ -122,9 +141,12 @@ def edit_mesh_world_vertices(context):
 
 
 def selected_traces(context, method):
-    """The recorded selection (core.trace.PartTrace) of every mesh in Edit Mode with selected vertices."""
-    return [trace for obj in context.objects_in_mode if obj.type == "MESH"
-            and (trace := selection_trace(obj, method)) is not None]
+    """The recorded selection (core.mannequin.traces.PartTrace) of every mesh in Edit Mode with selected vertices."""
+    return [
+        trace
+        for obj in context.objects_in_mode
+        if obj.type == "MESH" and (trace := selection_trace(obj, method)) is not None
+    ]
 
 
 class ELLIMANN_OT_fit_ellipsoid(ElliMannOperator, bpy.types.Operator):
@@ -134,8 +156,9 @@ class ELLIMANN_OT_fit_ellipsoid(ElliMannOperator, bpy.types.Operator):
     bl_label = "Fit Ellipsoid to Selection"
     bl_options = {"REGISTER", "UNDO"}
 
-    mode: EnumProperty(name="Size", items=FIT_MODE_ITEMS, default="inscribed",
-                       description="How big the fitted ellipsoid is")
+    mode: EnumProperty(
+        name="Size", items=FIT_MODE_ITEMS, default="inscribed", description="How big the fitted ellipsoid is"
+    )
     part_name: PART_NAME
 
     @classmethod
@@ -159,8 +182,11 @@ class ELLIMANN_OT_fit_ellipsoid(ElliMannOperator, bpy.types.Operator):
             write_trace(obj, traces[0])
         else:  # a part traced across meshes cannot be fitted again on other bodies of one mesh
             recorded = f"not recorded: the selection spans {len(traces)} meshes"
-        self.report({"INFO"}, f"Fitted '{obj.ellimann.part_name}' ({self.mode}) to {len(points)} vertices in "
-                              f"'{collection.name}' (selection {recorded})")
+        self.report(
+            {"INFO"},
+            f"Fitted '{obj.ellimann.part_name}' ({self.mode}) to {len(points)} vertices in "
+            f"'{collection.name}' (selection {recorded})",
+        )
         return {"FINISHED"}
 
 

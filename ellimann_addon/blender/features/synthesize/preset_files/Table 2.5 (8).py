@@ -7,5 +7,5 @@ props.sh = 41.5
 props.br = 101.25
 props.wa = 122.25
 props.hi = 117.5
-if props.reference_set == 'MALE':  # a female body: from the male set back to the female one
-    props.reference_set = 'FEMALE'
+if props.reference_set == "MALE":  # a female body: from the male set back to the female one
+    props.reference_set = "FEMALE"

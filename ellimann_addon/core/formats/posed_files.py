@@ -1,0 +1,110 @@
+"""Posed mannequin files the core writes without Blender (``--pose``): .json, MJCF .xml and .obj.
+
+- ``.json``: the rest mannequin with its joints (what ``Mannequin.load`` reads, measurements the rest pose's)
+  plus a ``pose`` section: ``{"version": 1, "name", "fps" (motions), "frames": [Pose.to_dict(), ...]}``; a still
+  pose is one frame, the walk cycle its frames.
+- ``.xml``: the articulated MJCF (``core.formats.mjcf_articulated``), the pose's frames as keyframes.
+- ``.obj``: the posed pieces, one object each (ellipsoids as icospheres, cushions as their hull meshes, those
+  across a joint in two halves, ``core.pose.posed_pieces``); a still pose only (OBJ holds no animation).
+
+:func:`read_pose` reads a pose file: such a ``.json`` (its ``pose`` section) or a bare ``Pose.to_dict``.
+"""
+
+import json
+
+import numpy as np
+
+from ..constants import CUSHION_LEVEL, UNIT_SPHERE_LEVEL
+from ..errors import ElliMannError
+from ..files import atomic_write_text
+from ..geometry.mesh import icosphere
+from ..pose.kinematics import Pose
+from ..pose.posed_pieces import PosingRig
+from .mjcf_articulated import write_articulated_mjcf
+from .table import FORMATS, format_of
+
+POSE_SECTION_VERSION = 1
+
+
+def pose_section(frames, fps=None):
+    """The JSON ``pose`` section of a list of poses (one for a still pose)."""
+    section = {
+        "version": POSE_SECTION_VERSION,
+        "name": frames[0].name.split(" ")[0] if frames else "",
+        "frames": [p.to_dict() for p in frames],
+    }
+    if fps is not None and len(frames) > 1:
+        section["fps"] = fps
+    return section
+
+
+def read_pose(path):
+    """The frames of a pose file (a posed mannequin .json, or one pose's own JSON): [Pose, ...]."""
+    try:
+        with open(path, encoding="utf-8") as stream:
+            data = json.load(stream)
+    except (UnicodeDecodeError, ValueError, RecursionError) as error:
+        raise ElliMannError(f"pose: {path} is not a JSON pose file ({' '.join(str(error).split())})") from None
+    section = data.get("pose") if isinstance(data, dict) and "pose" in data else None
+    if section is None:
+        return [Pose.from_dict(data)]
+    if (
+        not isinstance(section, dict)
+        or section.get("version") != POSE_SECTION_VERSION
+        or not isinstance(section.get("frames"), list)
+        or not section["frames"]
+    ):
+        raise ElliMannError(
+            f"pose: the pose section of {path} must have version {POSE_SECTION_VERSION} and a non-empty list of frames"
+        )
+    return [Pose.from_dict(frame) for frame in section["frames"]]
+
+
+def obj_text(mannequin, pose, cushions=False):
+    """Wavefront OBJ of the pieces of ``mannequin`` in ``pose``, one object (``o``) per piece."""
+    body = PosingRig(mannequin, cushions=cushions, subdivisions=CUSHION_LEVEL).pose(pose)
+    posed = body.mannequin
+    sphere, sphere_faces = icosphere(UNIT_SPHERE_LEVEL)
+    pieces = [
+        (
+            posed.topology.names[i],
+            np.einsum("ij,vj->vi", posed.rotation[i] * posed.semi_axes[i], sphere) + posed.center[i],
+            sphere_faces,
+        )
+        for i in posed.topology.single_parts(cushions)
+    ]
+    pieces += [(mesh.name, mesh.vertices, mesh.faces) for mesh in body.cushions]
+    lines = [
+        f"# ElliMann mannequin '{mannequin.name}' in pose '{pose.name}' (metres, Z up, facing -Y); measurements "
+        "are the rest pose's"
+    ]
+    start = 1
+    for name, vertices, faces in pieces:
+        lines.append(f"o {name}")
+        lines += [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in vertices]
+        lines += [f"f {a + start} {b + start} {c + start}" for a, b, c in faces]
+        start += len(vertices)
+    return "\n".join(lines) + "\n"
+
+
+def write_posed(mannequin, frames, path, cushions=False, fps=None):
+    """Write ``mannequin`` in ``frames`` (a list of Pose; the walk cycle's frames, or one pose) to a .json, .xml
+    or .obj, atomically. ElliMannError (nothing written) for another format or an animation in a .obj."""
+    kind = format_of(path)
+    if kind is None or kind.posed_writer != "core":
+        names = ", ".join(f".{f.extension}" for f in FORMATS.values() if f.posed_writer == "core")
+        raise ElliMannError(f"path: {path!r}: the core writes posed {names} files")
+    if len(frames) > 1 and not kind.animated:
+        raise ElliMannError(
+            f"pose: a .{kind.extension} file holds no animation; write the {len(frames)} frames "
+            f"of '{frames[0].name.split(' ')[0]}' to .json or .xml (keyframes), or pose a still pose"
+        )
+    if kind.name == "json":
+        data = mannequin.to_dict()
+        data["pose"] = pose_section(frames, fps)
+        atomic_write_text(path, json.dumps(data, indent=1) + "\n")
+    elif kind.name == "mjcf":
+        write_articulated_mjcf(mannequin, path, frames, cushions)
+    else:
+        atomic_write_text(path, obj_text(mannequin, frames[0], cushions))
+    return path
