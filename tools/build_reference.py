@@ -127,7 +127,7 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
     labels = load_labels(refmodels)
 
     def load_body(name):
-        body = read_obj(pathlib.Path(refmodels) / f"{name}.obj")
+        body = read_obj(pathlib.Path(refmodels) / f"{name}.obj", up="z")
         if not jitter:
             return body
         rng = np.random.default_rng(zlib.crc32(name.encode()))
@@ -139,7 +139,7 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
     base, base_shift = trace_base(reference_body, traces, joints=skeletons[REFERENCE_BODY])
     log(f"base mannequin fitted ({len(base)} parts)")
     bodies = [dataclasses.replace(load_body(name), joints=skeletons[name]) for name in RM_BODIES]
-    rms, built = build_reference_set(
+    built_set = build_reference_set(
         base,
         bodies,
         REFERENCE_MEASUREMENTS,
@@ -147,7 +147,7 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
         reference=REFERENCE_RM,
         progress=lambda fraction, text: log(f"{fraction:4.0%} {text}"),
     )
-    base = built.base
+    built, base, rms = built_set.report, built_set.base, built_set.mannequins
     shifts = {BASE_FILE: base_shift, **built.shifts}
     fill = {}
     for name, m in [(BASE_FILE, base), *rms.items()]:

@@ -43,7 +43,7 @@ def main(argv=None):
 
     ellimann_addon.register()
     mannequin = Mannequin.load(REFERENCE_FOLDER / f"{BODY}.json")
-    body = read_obj(REFMODELS / f"{BODY}.obj")
+    body = read_obj(REFMODELS / f"{BODY}.obj", up="z")
     body_vertices, body_faces = body.vertices, body.faces
     empty_scene()
     scene = bpy.context.scene

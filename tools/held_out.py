@@ -41,13 +41,14 @@ def six_rms(refmodels, workers):
     from ellimann_addon.core.fitting.reference_build import build_reference_set
 
     bodies = {
-        name: read_obj(pathlib.Path(refmodels) / f"{name}.obj") for name in (REFERENCE_BODY, *REFERENCE_MEASUREMENTS)
+        name: read_obj(pathlib.Path(refmodels) / f"{name}.obj", up="z")
+        for name in (REFERENCE_BODY, *REFERENCE_MEASUREMENTS)
     }
     targets = {name: dict(row) for name, row in REFERENCE_MEASUREMENTS.items()}
     # the reference body's targets: its own measurements (measured as refmodels/README.md says)
     targets[REFERENCE_BODY] = body_measurements(bodies[REFERENCE_BODY], load_labels(refmodels))
     base = Mannequin.load(REFERENCE_FOLDER / "base_mannequin.json")
-    rms, report = build_reference_set(
+    built = build_reference_set(
         base,
         list(bodies.values()),
         targets,
@@ -55,7 +56,7 @@ def six_rms(refmodels, workers):
         workers=workers,
         progress=lambda f, text: print(f"  {f:4.0%} {text}", file=sys.stderr),
     )
-    return rms, targets, report.shifts, bodies
+    return built.mannequins, targets, built.report.shifts, bodies
 
 
 def subset_set(rms, targets, names):

@@ -71,7 +71,7 @@ def set_landmarks(build_set):
         skeleton = json.load(stream)["bodies"]
     out = {}
     for name in (build_set.reference_body, *RM_BODIES):
-        body = read_obj(build_set.refmodels / f"{name}.obj")
+        body = read_obj(build_set.refmodels / f"{name}.obj", up="z")
         out[name] = (landmarks(body, labels, skeleton[name]), girth_profile(body, labels))
     return out
 

@@ -44,7 +44,7 @@ def set_overlaps(build_set, spacing=volume.IOU_SPACING):
     reference = load_reference_set(build_set.out)
     out = {}
     for name in (build_set.reference_body, *RM_BODIES):
-        body = read_obj(build_set.refmodels / f"{name}.obj")
+        body = read_obj(build_set.refmodels / f"{name}.obj", up="z")
         measured = body_measurements(body, labels, build_set.fractions)
         mannequin = synthesize_batch(reference, [[measured[key] for key in MEASUREMENTS]]).mannequin(0)
         grid = volume.BodyVolume(body.vertices, body.faces).grid(spacing, margin=volume.IOU_MARGIN)

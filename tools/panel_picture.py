@@ -163,7 +163,7 @@ def references_scene(refmodels):
         Mannequin.load(REFERENCE_FOLDER / "base_mannequin.json"), name="Base Mannequin"
     )
     for name, targets in REFERENCE_MEASUREMENTS.items():
-        body = read_obj(pathlib.Path(refmodels) / f"{name}.obj")
+        body = read_obj(pathlib.Path(refmodels) / f"{name}.obj", up="z")
         obj = bpy.data.objects.new(name, mesh_from_arrays(name, body.vertices, body.faces))
         bpy.context.scene.collection.objects.link(obj)
         row = props.bodies.add()

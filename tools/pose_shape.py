@@ -104,7 +104,7 @@ def main(argv=None):
     print(f"voxel IoU, body vs synthesized mannequin with cushions ({args.spacing * 1e3:g} mm voxels)")
     print(f"{'body':14s} {'rest (A-pose)':>14s} {'T-pose':>8s} {'change':>8s}")
     for name in RM_BODIES:
-        body = read_obj(args.refmodels / f"{name}.obj")
+        body = read_obj(args.refmodels / f"{name}.obj", up="z")
         heads = skeleton["bodies"][name]
         request = [REFERENCE_MEASUREMENTS[name][k] for k in ("He", "Sh", "Br", "Wa", "Hi")]
         mannequin = synthesize_batch(reference, [request]).mannequin(0)

@@ -10,8 +10,8 @@ male body as on a female one.
 import pathlib
 from dataclasses import dataclass
 
-from ellimann_addon.cli.references import read_targets
 from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
+from ellimann_addon.core.fitting.reference_build import read_targets
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 SHARED = REPO.parent / "shared"

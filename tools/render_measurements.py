@@ -84,7 +84,7 @@ def main(argv=None):
     mannequin_marks = marks(
         measure_body_mesh(*pieces_mesh(mannequin), mannequin.section_fractions).sections, "mannequin"
     )
-    body = read_obj(TRACING_FOLDER / f"{args.body}.obj")
+    body = read_obj(TRACING_FOLDER / f"{args.body}.obj", up="z")
     mesh = bpy.data.meshes.new(args.body)
     mesh.from_pydata(body.vertices.tolist(), [], body.faces.tolist())
     body_object = bpy.data.objects.new(args.body, mesh)

@@ -23,7 +23,7 @@ SPACING = 0.005  # m, bench_scan's grid
 
 def twins(name, reference):
     """(five-measurement twin, all-measurement twin) of body ``name``, each stood in the body."""
-    body = read_obj(DEFAULT_REFMODELS / f"{name}.obj")
+    body = read_obj(DEFAULT_REFMODELS / f"{name}.obj", up="z")
     found = measure_body_mesh(body.vertices, body.faces).values
     five, extra = split_measurements(found)
     grid = BodyVolume(body.vertices, body.faces).grid(SPACING, margin=IOU_MARGIN)

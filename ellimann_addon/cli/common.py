@@ -102,6 +102,18 @@ def add_synthesis_options(parser):
     add_references(parser, "the reference set to synthesize from")
 
 
+def add_mesh_axes(parser, what, default_up=None):
+    """--up and --unit of a command that reads body meshes (``what``: which), as ``core.fitting.body_mesh`` reads
+    them; ``default_up`` None: Y for .obj (Blender's OBJ axes), Z for .ply and .stl."""
+    from ..core.fitting.body_mesh import UNITS, UP_AXES
+
+    default = f"{default_up}" if default_up else "y for .obj, as Blender writes it; z for .ply and .stl"
+    parser.add_argument(
+        "--up", choices=UP_AXES, default=default_up, help=f"{what}: the file's up axis (default: {default})"
+    )
+    parser.add_argument("--unit", choices=tuple(UNITS), default="m", help=f"{what}: the file's length unit (default m)")
+
+
 def add_references(parser, what, shipped="female (the default) or male"):
     parser.add_argument(
         "--references",
@@ -236,13 +248,13 @@ def extension(kind):
 
 
 def write(mannequin, paths, measured, cushions, frames=None, fps=None):
-    """Write every path (format from the extension); Blender is loaded only for .blend/.glb/.obj (posed: .blend
-    and .glb). ``frames``: the pose (a list of core.pose.kinematics.Pose) to write the mannequin in, if any.
+    """Write every path (format from the extension); Blender is loaded only for .blend and .glb. ``frames``: the
+    pose (a list of core.pose.kinematics.Pose) to write the mannequin in, if any.
 
     A path that cannot be written raises UsageError naming it (not the temporary file behind it).
     """
     if frames is not None:
-        return write_posed(mannequin, paths, cushions, frames, fps)
+        return write_posed(mannequin, paths, cushions, frames, fps, measured)
     for path in paths:
         if core_format(path):
             with writing(path):
@@ -261,10 +273,9 @@ def write(mannequin, paths, measured, cushions, frames=None, fps=None):
     return paths
 
 
-def write_posed(mannequin, paths, cushions, frames, fps):
+def write_posed(mannequin, paths, cushions, frames, fps, measured=None):
     """:func:`write` of a posed mannequin: .json, .xml and .obj by the core (core.formats.posed_files), .blend and
-    .glb by
-    the Blender rig (``blender.services.posing.write_posed``)."""
+    .glb by the Blender rig (``blender.services.posing.write_posed``)."""
     from ..core.formats.posed_files import write_posed as write_core_posed
 
     blender = [p for p in paths if format_of(p).needs_blender_for(True)]
@@ -280,7 +291,7 @@ def write_posed(mannequin, paths, cushions, frames, fps):
                 f"writing a posed {blender[0]} needs ElliMann's Blender rig, which this build lacks; "
                 "write .json, .xml or .obj"
             ) from None
-        write_blender_posed(mannequin, frames, blender, cushions)
+        write_blender_posed(mannequin, frames, blender, cushions, fps, measured)
     return paths
 
 

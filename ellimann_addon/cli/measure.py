@@ -8,7 +8,7 @@ import sys
 
 from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS
 from ..core.errors import MannequinError
-from ..core.fitting.body_mesh import MESH_EXTENSIONS, UNITS, UP_AXES, BodyMeshError, read_body_mesh
+from ..core.fitting.body_mesh import MESH_EXTENSIONS, BodyMeshError, read_body_mesh
 from ..core.mannequin.model import Mannequin
 from ..core.measure.body import ALL_MEASUREMENTS, measure_body_mesh
 from ..core.measure.extra import EXTRA_LABELS, mannequin_extra_measurements
@@ -33,12 +33,7 @@ def add_parser(commands):
         help='print {"He": …, "Sh": …, "Br": …, "Wa": …, "Hi": …, "neck": …, …} (a body mesh: '
         "only the measurements that could be taken)",
     )
-    measure.add_argument(
-        "--up",
-        choices=UP_AXES,
-        help="a body mesh's up axis (default: y for .obj, as Blender imports it; z for .ply and .stl)",
-    )
-    measure.add_argument("--unit", choices=tuple(UNITS), default="m", help="a body mesh's length unit (default m)")
+    common.add_mesh_axes(measure, "a body mesh")
     measure.add_argument("--collection", help="the mannequin collection to measure in a .blend holding several")
     common.add_references(
         measure,

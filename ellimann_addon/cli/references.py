@@ -1,18 +1,24 @@
 """``ellimann references``: build a reference set from a traced Base Mannequin and N >= 3 body meshes
 (``build``), or check a reference-set folder (``check``). numpy only."""
 
-import csv
 import hashlib
-import math
 import os
 import pathlib
 import sys
 
-from ..core.constants import ABSURD_LIMITS, MEASUREMENTS
+from ..core.constants import MEASUREMENTS
 from ..core.fitting.body_mesh import BodyMeshError, read_obj
-from ..core.fitting.reference_build import build_reference_set, cleanliness_problems, relative_errors, validate_inputs
+from ..core.fitting.reference_build import (
+    MIN_BODIES,
+    build_reference_set,
+    cleanliness_problems,
+    read_targets,
+    relative_errors,
+    traced_mesh,
+    validate_inputs,
+)
 from ..core.mannequin.clean import asymmetry
-from ..core.synthesis.manifest import STEM, Manifest, read_manifest, targets_range, write_reference_set
+from ..core.synthesis.manifest import STEM, read_manifest
 from ..core.synthesis.reference_set import load_reference_set
 from . import common
 from .common import PROG, UsageError
@@ -32,8 +38,8 @@ def add_parser(commands):
         "build",
         help="Reference Mannequins from a traced Base Mannequin and N >= 3 bodies",
         description="Fit the Base Mannequin's traced parts in every body (OBJ meshes of the traced mesh's "
-        "topology), refine each until m_T meets its targets, clean them together and write a "
-        "reference-set folder (the RMs' JSON, the base and reference_set.json).",
+        "topology, Y up as Blender exports them unless --up z), refine each until m_T meets its targets, clean "
+        "them together and write a reference-set folder (the RMs' JSON, the base and reference_set.json).",
     )
     build.add_argument(
         "--base",
@@ -50,6 +56,7 @@ def add_parser(commands):
         metavar="BODY.obj",
         help="N >= 3 body meshes; each file's stem names its Reference Mannequin",
     )
+    common.add_mesh_axes(build, "--bodies", default_up="y")
     build.add_argument(
         "--targets",
         required=True,
@@ -84,44 +91,6 @@ def add_parser(commands):
     check.set_defaults(run=run_check, blender=lambda args: None)
 
 
-def read_targets(path):
-    """{name: {He, Sh, Br, Wa, Hi: cm}} from a CSV with a 'name' column and a column per measurement."""
-    try:
-        with open(path, encoding="utf-8-sig", newline="") as stream:
-            rows = list(csv.DictReader(stream))
-    except (OSError, UnicodeDecodeError, csv.Error) as error:
-        raise UsageError(f"{path}: cannot be read ({common.one_line(error)})") from None
-    if not rows or "name" not in rows[0]:
-        raise UsageError(f"{path}: needs a header with a 'name' column and {', '.join(MEASUREMENTS)}")
-    columns = {}
-    for key in MEASUREMENTS:
-        column = next((c for c in (key, f"target_{key}") if c in rows[0]), None)
-        if column is None:
-            raise UsageError(f"{path}: has no {key} column (cm)")
-        columns[key] = column
-    targets = {}
-    for line, row in enumerate(rows, 2):
-        name = (row.get("name") or "").strip()
-        values = {key: (row.get(column) or "").strip() for key, column in columns.items()}
-        if not name or not any(values.values()):
-            continue  # a body without targets (e.g. the traced one) is no RM
-        if name in targets:
-            raise UsageError(f"{path}: line {line}: '{name}' has a second row")
-        try:
-            targets[name] = {key: float(value) for key, value in values.items()}
-        except ValueError:
-            bad = next(key for key, value in values.items() if not _is_number(value))
-            raise UsageError(f"{path}: line {line}: {bad}={values[bad]!r} is not a number (cm)") from None
-    return targets
-
-
-def _is_number(text):
-    try:
-        return math.isfinite(float(text))
-    except ValueError:
-        return False
-
-
 def run_build(args):
     out = pathlib.Path(args.out)
     base = load_base(args.base)
@@ -135,49 +104,40 @@ def run_build(args):
     targets = read_targets(args.targets)
     if args.workers < 1:
         raise UsageError(f"--workers must be 1 or more, got {args.workers}")
-    if len(args.bodies) < 3:  # before reading any mesh
-        raise UsageError(f"--bodies: a reference set needs at least 3 bodies, got {len(args.bodies)}")
+    if len(args.bodies) < MIN_BODIES:  # before reading any mesh
+        raise UsageError(f"--bodies: a reference set needs at least {MIN_BODIES} bodies, got {len(args.bodies)}")
     try:
-        bodies = [read_obj(path) for path in args.bodies]
+        bodies = [read_obj(path, args.up, args.unit) for path in args.bodies]
     except BodyMeshError as error:
-        raise UsageError(str(error)) from None
+        raise UsageError(common.one_line(error)) from None
     validate_inputs(base, bodies, targets)  # before the folder is made: bad input writes nothing
     common.output_folder(str(out), "references build")
 
     def progress(fraction, text):
         common.say(f"{PROG} references build: {fraction:4.0%} {text}", file=sys.stderr)
 
-    rms, report = build_reference_set(
-        base, bodies, targets, progress=progress, reference=args.reference, workers=args.workers
-    )
-    fractions = dict(base.section_fractions)  # what the build measured at: the base's own set's
-    name = args.name or out.resolve().name
-    rms = {stem: rm.copy(reference_set=name) for stem, rm in rms.items()}
-    first = next(iter(base.traces.values()))
-    manifest = Manifest(
-        name=name,
-        mannequins=stems,
+    built = build_reference_set(
+        base,
+        bodies,
+        targets,
+        progress=progress,
+        reference=args.reference,
+        workers=args.workers,
+        name=args.name or out.resolve().name,
         sex=args.sex,
-        base=base_stem,
-        section_fractions=fractions,
-        ranges_cm=targets_range({s: targets[s] for s in stems}),
-        absurd_limits_cm={k: list(v) for k, v in ABSURD_LIMITS.items()},
-        targets_cm={s: dict(targets[s]) for s in stems},
+        base_stem=base_stem,
         provenance={
             "built_by": f"{PROG} references build",
-            "base": {
-                "file": pathlib.Path(args.base).name,
-                "traced_mesh": first.mesh,
-                "vertex_count": first.vertex_count,
-            },
+            "base": {"file": pathlib.Path(args.base).name, **traced_mesh(base)},
             "bodies": {
                 b.name: {"file": pathlib.Path(p).name, "sha256": _sha256(p)} for b, p in zip(bodies, args.bodies)
             },
-            "labelled_against": report.reference,
+            "bodies_read_as": {"up": args.up, "unit": args.unit},
         },
     )
     with common.writing(str(out), folder=True):
-        write_reference_set(out, rms, manifest, base=report.base.copy(reference_set=name))
+        built.write(out)
+    report = built.report
     for stem in stems:
         key, error = report.worst(stem)
         fill = report.fill.get(stem, {}).get("ellipsoids")

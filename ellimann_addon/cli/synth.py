@@ -5,7 +5,6 @@ import sys
 
 from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS, RANGES
 from ..core.errors import ElliMannError
-from ..core.fitting.body_mesh import UNITS, UP_AXES
 from ..core.formats.table import FORMATS
 from ..core.measure.extra import EXTRA_ABSURD_LIMITS, EXTRA_LABELS, EXTRA_MEASUREMENTS
 from ..core.synthesis.request import relative_error, validate_request
@@ -46,8 +45,7 @@ def add_parser(commands):
         help="a body mesh (.obj, .ply, .stl; upright A-pose): measure it and synthesize with every "
         "measurement found (a measurement given as an option wins)",
     )
-    synth.add_argument("--up", choices=UP_AXES, help="--from's up axis (default: y for .obj, z for .ply/.stl)")
-    synth.add_argument("--unit", choices=tuple(UNITS), default="m", help="--from's length unit (default m)")
+    common.add_mesh_axes(synth, "--from")
     synth.add_argument(
         "-o",
         "--output",

@@ -13,7 +13,7 @@ BODY = bench_drape.REFMODELS / f"{bench_drape.BODY}.obj"  # ../shared/refmodels,
 @pytest.mark.slow
 def test_drape_bench_prints_its_table_and_the_resolution_verdict(capsys):
     sweep = tuple(s for s in bench_drape.SWEEP if s[0] in ("cushions L1/L1", "cushions L2/L2", "ellipsoids L1"))
-    body = read_obj(BODY)
+    body = read_obj(BODY, up="z")
     bench_drape.compare(
         Mannequin.load(REFERENCE_FOLDER / "average.json"),
         body.vertices,

@@ -48,7 +48,7 @@ def test_measure_body_mesh_refuses_a_lying_body_and_changes_nothing():
     vertices, faces = toy_mesh()
     body_object(vertices[:, [2, 1, 0]], faces)
     before = state()
-    with pytest.raises(RuntimeError, match="not upright"):
+    with pytest.raises(RuntimeError, match="the body lies down .*: turn it to stand along Z; nothing measured"):
         bpy.ops.ellimann.measure_body()
     assert state() == before and RESULT_PROPERTY not in bpy.context.active_object
 
@@ -60,7 +60,7 @@ def test_poll_wants_a_mesh_outside_any_mannequin(toy_collection):
 
 def test_synthesize_from_mesh_makes_a_twin_in_a_new_collection():
     """The panel's default set (female) and the average reference body: the twin meets its five."""
-    average = read_obj(TRACING_FOLDER / "average.obj")
+    average = read_obj(TRACING_FOLDER / "average.obj", up="z")
     body_object(average.vertices, average.faces, "average")
     collections = set(bpy.data.collections)
     assert bpy.ops.ellimann.synthesize_from_mesh() == {"FINISHED"}
@@ -78,7 +78,7 @@ def test_panel_offers_every_extra_measurement():
 
 @pytest.mark.slow
 def test_a_mannequins_exported_obj_measures_as_the_mannequin(tmp_path, capsys):
-    """Blender's OBJ export (Y up) of a synthesized mannequin, measured as a body mesh: its m_T and the extra
+    """The OBJ (Y up) of a synthesized mannequin, measured as a body mesh: its m_T and the extra
     measurements within ISO 20685's allowances (the pieces are level-3 icospheres, inscribed: girths read a
     little short)."""
     from devkit.cli_runs import run
@@ -101,7 +101,7 @@ def test_the_twin_stands_beside_the_body_in_one_piece():
     """Every piece and the armature move together (children with their parents): the twin keeps its width."""
     from ellimann_addon.blender.bridge.convert import collection_to_mannequin
 
-    average = read_obj(TRACING_FOLDER / "average.obj")
+    average = read_obj(TRACING_FOLDER / "average.obj", up="z")
     body_object(average.vertices, average.faces, "average")
     collections = set(bpy.data.collections)
     bpy.ops.ellimann.synthesize_from_mesh()

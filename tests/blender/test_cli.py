@@ -508,8 +508,7 @@ def test_batch_in_every_blender_format_prints_only_ellimann_lines(tmp_path, refe
     assert verbose.returncode == 0 and verbose.stdout == done.stdout
     # Blender 4.x says 'Info: Saved "average.blend"', 5.x 'Info: Saved copy as "average.blend"'.
     assert re.search(r'^Info: Saved (copy as )?"average\.blend"$', verbose.stderr, re.MULTILINE), verbose.stderr
-    for line in ("| INFO: Finished glTF 2.0 export", "OBJ export of"):
-        assert line in verbose.stderr
+    assert "| INFO: Finished glTF 2.0 export" in verbose.stderr  # (the core writes the .obj: Blender says nothing)
 
 
 def test_demo_shows_no_blender_output_at_the_file_descriptors(tmp_path, capfd, references):
@@ -550,8 +549,8 @@ teardown.exit_with(main({argv!r}))
 @pytest.mark.skipif(not hasattr(os, "setrlimit") and sys.platform == "win32", reason="needs RLIMIT_FSIZE")
 @pytest.mark.parametrize("kind", ["blend", "glb", "obj", "json"])
 def test_a_write_cut_short_is_one_line_exit_1_and_the_old_file_stays(tmp_path, references, kind):
-    """RLIMIT_FSIZE stops every write at 4 KiB, as a full disk does: Blender's .blend and .obj writers
-    return normally from a cut-short file, the glTF exporter and the core raise; each ends in one line."""
+    """RLIMIT_FSIZE stops every write at 4 KiB, as a full disk does: Blender's .blend writer returns normally
+    from a cut-short file, the glTF exporter and the core (.obj, .json) raise; each ends in one line."""
     pytest.importorskip("resource")
     out = tmp_path / f"m.{kind}"
     out.write_bytes(b"the user's")
@@ -621,14 +620,14 @@ def test_a_batch_row_blender_fails_to_write_is_reported_and_the_batch_goes_on(
 
     real = files.export_gltf
 
-    def full_disk_for_t1(collection, path):
+    def full_disk_for_t1(collection, path, *given):
         if os.path.basename(path) == "t1.glb":
             with files.atomic_output(path) as temp:  # what a bpy.ops call raises when the disk is full
                 raise RuntimeError(
                     f"Error: Python: Traceback (most recent call last):\nOSError: [Errno 28] No "
                     f"space left on device: '{temp}'\nLocation: ops.py:109\n"
                 )
-        return real(collection, path)
+        return real(collection, path, *given)
 
     monkeypatch.setattr(files, "export_gltf", full_disk_for_t1)
     source = write_csv(tmp_path / "in.csv", GOOD_ROWS)

@@ -101,22 +101,25 @@ def test_a_build_is_written_as_a_set_and_loaded_into_a_new_collection(tmp_path, 
     names = [row.body.name for row in props.bodies]
     base = Mannequin.load(REFERENCE_FOLDER / "base_mannequin.json")
 
-    def build(self, progress=None, cancel_flag=None):
-        from ellimann_addon.core.fitting.reference_build import BuildReport
+    def build(base_, bodies, targets, progress=None, cancel=None, **manifest):
+        """The core's build without the fitting: the shipped RMs, assembled into a set as the core does."""
+        from ellimann_addon.core.fitting.reference_build import BuildReport, BuiltReferenceSet
 
         rms = {name: rm.copy(name=name) for name, rm in zip(names, shipped.mannequins)}
         report = BuildReport(base=base, reference=names[0])
         report.errors = {name: {"He": 0.0} for name in names}
-        return rms, report
+        return BuiltReferenceSet.assemble(rms, report, targets, **manifest)
 
-    monkeypatch.setattr(operators.Request, "build", build)
+    monkeypatch.setattr(operators, "build_reference_set", build)
     monkeypatch.setattr(operators, "validate_inputs", lambda *args: None)
     collections = set(bpy.data.collections)
     assert bpy.ops.ellimann.build_reference_set() == {"FINISHED"}
     new = set(bpy.data.collections) - collections
     assert len(new) == 4  # the set's collection and one per RM
     manifest = read_manifest(tmp_path / "set")
-    assert manifest.mannequins == names and manifest.base == "base_mannequin"
+    assert manifest.mannequins == names and manifest.base == "base_mannequin" and manifest.name == "set"
+    assert manifest.provenance["built_by"] == "Blender: ElliMann > Build Reference Set"
+    assert manifest.provenance["labelled_against"] == names[0]
     assert len(load_reference_set(tmp_path / "set")) == 3
     assert "3 RMs in" in props.status
     # the user's objects are as they were

@@ -147,10 +147,12 @@ def body():
 def test_bad_meshes_one_line_each():
     v, f = body()
     assert "empty" in measure_body_mesh(np.zeros((0, 3)), np.zeros((0, 3), int)).problems[0]
+    # a mesh in a scene (no file, so no --up or --unit to name): the line says what to do to it
     millimetres = measure_body_mesh(v * 1000.0, f)
-    assert millimetres.values == {} and "millimetres" in millimetres.problems[0]
+    assert millimetres.values == {} and "units tall, not a person's height" in millimetres.problems[0]
+    assert "scale it to metres" in millimetres.problems[0]
     lying = measure_body_mesh(v[:, [2, 1, 0]], f)
-    assert lying.values == {} and "not upright" in lying.problems[0]
+    assert lying.values == {} and "lies down" in lying.problems[0] and "turn it to stand along Z" in lying.problems[0]
     upside_down = measure_body_mesh(v * [1.0, 1.0, -1.0], f)
     assert upside_down.values == {} and "head" in upside_down.problems[0]
 
@@ -265,7 +267,7 @@ def test_measure_a_body_mesh_on_the_command_line(tmp_path, capsys):
     code, out, err = run(["measure", str(path), "--unit", "mm"], capsys)
     assert_one_line_error(code, err, "toy.obj", "tall")
     code, out, err = run(["measure", str(path), "--up", "z"], capsys)
-    assert_one_line_error(code, err, "not upright")
+    assert_one_line_error(code, err, "lies down", "pass --up y")
 
 
 def test_measure_a_mannequin_prints_every_key(capsys):

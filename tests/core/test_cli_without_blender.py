@@ -8,6 +8,7 @@ import pathlib
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from devkit import synthetic
@@ -102,6 +103,20 @@ def test_posed_core_formats_run_without_blender(tmp_path):
     assert code == 0, stderr
 
 
+def test_obj_rest_and_posed_are_written_without_blender_standing_in_y_up_axes(tmp_path):
+    """One OBJ convention (Y up, -Z forward, as Blender imports it): rest, posed and cushioned files all stand
+    with their height along Y and their feet at y = 0."""
+    for argv, out in ((["-o"], "rest.obj"), (["--pose", "t_pose", "-o"], "t.obj"), (["--cushions", "-o"], "c.obj")):
+        code, _, stderr = without_blender("synth", *REQUEST, *argv, str(tmp_path / out))
+        assert code == 0, stderr
+        text = (tmp_path / out).read_text()
+        assert "Y up, -Z forward" in text.splitlines()[0]
+        points = np.array([line.split()[1:] for line in text.splitlines() if line.startswith("v ")], dtype=float)
+        extent = np.ptp(points, axis=0)
+        assert extent[1] == pytest.approx(1.65, abs=0.01) and extent[1] > 1.5 * extent[2], out  # upright along Y
+        assert abs(points[:, 1].min()) < 0.01, out  # feet on the floor y = 0
+
+
 @pytest.mark.parametrize(
     "argv",
     [
@@ -127,7 +142,6 @@ def test_help_runs_without_blender(argv):
     [
         (["synth", *REQUEST, "-o", "{tmp}/w.blend"], "writing {tmp}/w.blend"),
         (["synth", *REQUEST, "-o", "{tmp}/w.glb"], "writing {tmp}/w.glb"),
-        (["synth", *REQUEST, "-o", "{tmp}/w.obj"], "writing {tmp}/w.obj"),
         (["batch", "{tmp}/in.csv", "-o", "{tmp}/out", "--format", "json,blend"], "--format blend"),
         (["measure", "{tmp}/w.blend"], "reading {tmp}/w.blend"),
         (["synth", *REQUEST, "--pose", "walk", "-o", "{tmp}/w.glb"], "writing {tmp}/w.glb"),

@@ -11,7 +11,7 @@ from devkit.toy import make_toy_mannequin
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.fitting.body_mesh import BodyMesh, connectivity_fingerprint, from_polygons, read_obj
 from ellimann_addon.core.fitting.reference_build import ReferenceBuildError, central_body, validate_inputs
-from ellimann_addon.core.geometry.mesh import icosphere
+from ellimann_addon.core.geometry.mesh import from_scene_axes, icosphere
 from ellimann_addon.core.mannequin.traces import FitSettings, PartTrace
 
 TARGETS = {"a": (150, 32, 86, 64, 84), "b": (170, 31, 85, 64, 85), "c": (160, 43, 117, 104, 117)}
@@ -112,7 +112,7 @@ def test_an_obj_with_quads_reads_as_triangles_with_the_quads_fingerprint(tmp_pat
         "".join(f"v {x} {y} {z}\n" for x, y, z in corners)
         + "".join("f " + " ".join(f"{i}/1" for i in q) + "\n" for q in quads)
     )
-    body = read_obj(path)
+    body = read_obj(path, up="z")
     assert body.name == "cube" and body.faces.shape == (12, 3)
     assert body.edges_crc == connectivity_fingerprint([[i - 1 for i in q] for q in quads])
 
@@ -212,3 +212,65 @@ def test_voxel_iou_of_a_ball_in_a_ball_is_their_volume_ratio_and_of_a_ball_with_
     assert voxel_iou(ball(0.05), grid=grid) == pytest.approx(0.125, abs=0.01)
     assert voxel_iou(ball(0.05, x=0.5), grid=grid) == 0.0
     assert voxel_iou(ball(0.05), 0.1 * vertices, faces) == pytest.approx(0.125, abs=0.02)  # from the mesh
+
+
+# ------------------------------------------------------------------ axes: OBJ is Y up
+
+
+def _y_up_copy(body, path):
+    """``body`` written as Blender exports an OBJ (Y up, -Z forward)."""
+    path.write_text(
+        "".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in from_scene_axes(body.vertices))
+        + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in body.faces)
+    )
+    return path
+
+
+def test_a_body_exported_from_blender_reads_as_the_same_body_given_with_up_z(tmp_path):
+    from tools.build_reference import DEFAULT_REFMODELS
+
+    z_up = read_obj(DEFAULT_REFMODELS / "average.obj", up="z")
+    y_up = read_obj(_y_up_copy(z_up, tmp_path / "average.obj"))
+    assert np.array_equal(y_up.vertices, z_up.vertices) and np.array_equal(y_up.faces, z_up.faces)
+    assert y_up.edges_crc == z_up.edges_crc
+    in_cm = tmp_path / "cm.obj"
+    in_cm.write_text(
+        "".join(f"v {x * 100:.17g} {y * 100:.17g} {z * 100:.17g}\n" for x, y, z in z_up.vertices)
+        + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in z_up.faces)
+    )
+    assert np.allclose(read_obj(in_cm, up="z", unit="cm").vertices, z_up.vertices, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "change, words",
+    [
+        ("z up read as y", ["average.obj", "lies down", "pass --up z"]),
+        ("millimetres", ["average.obj", "1590 m tall", "pass --unit mm"]),
+        ("upside down", ["average.obj", "stands on its head"]),
+    ],
+)
+def test_a_body_in_the_wrong_axes_or_unit_is_refused_in_one_line_before_fitting(tmp_path, capsys, change, words):
+    from tools.build_reference import DEFAULT_REFMODELS
+
+    body = read_obj(DEFAULT_REFMODELS / "average.obj", up="z")
+    vertices = {
+        "z up read as y": body.vertices,
+        "millimetres": body.vertices,
+        "upside down": body.vertices * [1, 1, -1],
+    }
+    scale = 1000.0 if change == "millimetres" else 1.0
+    points = vertices[change] * scale if change == "z up read as y" else from_scene_axes(vertices[change] * scale)
+    faces = body.faces[:, ::-1] if change == "upside down" else body.faces  # a mirror turns the winding
+    (tmp_path / "average.obj").write_text(
+        "".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in points)
+        + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in faces)
+    )
+    others = [_y_up_copy(body, tmp_path / f"{name}.obj") for name in ("b", "c")]
+    base = tmp_path / "base.json"
+    _base(body).save(base)
+    targets = tmp_path / "targets.csv"
+    targets.write_text("name,He,Sh,Br,Wa,Hi\naverage,159,43,117,104,117\nb,150,32,86,64,84\nc,170,31,85,64,85\n")
+    argv = ["references", "build", "--base", str(base), "--targets", str(targets), "-o", str(tmp_path / "set")]
+    code, _, err = run([*argv, "--bodies", str(tmp_path / "average.obj"), *map(str, others)], capsys)
+    assert_one_line_error(code, err, *words)
+    assert "Warning" not in err and not (tmp_path / "set").exists()

@@ -1,6 +1,6 @@
-"""``ellimann references build`` on three of the reference bodies: its RMs are the shipped ones (an RM
-depends only on its body, and the Average, nearest the three's mean, labels them as it labels the
-shipped five), ``references check`` passes, and the set synthesizes and measures exactly."""
+"""``ellimann references build`` on three of the reference bodies, exported as Blender writes OBJ (Y up): its
+RMs are the shipped ones (an RM depends only on its body, and the Average, nearest the three's mean, labels them
+as it labels the shipped five), ``references check`` passes, and the set synthesizes and measures exactly."""
 
 import numpy as np
 import pytest
@@ -8,6 +8,7 @@ import pytest
 from devkit.cli_runs import assert_one_line_error, run
 from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS
 from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.geometry.mesh import from_scene_axes
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, load_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize_batch
@@ -30,9 +31,23 @@ def _targets_csv(folder):
     return path
 
 
+def _as_blender_exports(body, path):
+    """``body`` written as Blender exports OBJ (Y up, -Z forward), the axes ``references build`` reads by default."""
+    path.write_text(
+        "".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in from_scene_axes(body.vertices))
+        + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in body.faces)
+    )
+    return str(path)
+
+
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
+    """The three bodies as Blender exports them (Y up): the RMs must be those the shipped set built from the same
+    bodies in ElliMann's Z-up axes."""
     folder = tmp_path_factory.mktemp("three")
+    exported = [
+        _as_blender_exports(read_obj(DEFAULT_REFMODELS / f"{n}.obj", up="z"), folder / f"{n}.obj") for n in THREE
+    ]
     args = [
         "references",
         "build",
@@ -41,7 +56,7 @@ def built(tmp_path_factory):
         "--targets",
         str(_targets_csv(folder)),
         "--bodies",
-        *(str(DEFAULT_REFMODELS / f"{n}.obj") for n in THREE),
+        *exported,
         "-o",
         str(folder / "set"),
         "--workers",
@@ -80,7 +95,7 @@ def test_check_passes_and_the_set_synthesizes_exactly(built, capsys):
 
 
 def test_a_body_with_shuffled_vertex_order_is_refused(tmp_path, capsys):
-    body = read_obj(DEFAULT_REFMODELS / "average.obj")
+    body = read_obj(DEFAULT_REFMODELS / "average.obj", up="z")
     order = np.random.default_rng(0).permutation(len(body.vertices))
     inverse = np.argsort(order)
     path = tmp_path / "average.obj"
@@ -100,6 +115,8 @@ def test_a_body_with_shuffled_vertex_order_is_refused(tmp_path, capsys):
             str(_targets_csv(tmp_path)),
             "--bodies",
             *bodies,
+            "--up",
+            "z",
             "-o",
             str(out),
         ],

@@ -1,7 +1,7 @@
-"""Every file Blender writes for ElliMann (.blend, .glb, .obj, .png), put in place atomically.
+"""Every file Blender writes for ElliMann (.blend, .glb, .png), put in place atomically (the core writes .obj).
 
 Two parts, one module: the glTF export with ElliMann's extras (``export_gltf``) and
-``write_mannequin``, which writes one mannequin to .blend, .glb and .obj from an empty scene (the
+``write_mannequin``, which writes one mannequin to .blend and .glb from an empty scene (the
 CLI's and scripts' writer). Every write goes through the one atomic writer,
 ``core.files.atomic_output`` (JSON and MJCF through ``core.files`` too), so a failed write never
 leaves a half-written file and every format gets the same permissions.
@@ -51,7 +51,7 @@ from ..bridge.built import built_objects, is_stale
 from ..bridge.convert import collection_to_mannequin, objects_recursive
 from ..bridge.selection import part_lookup
 from .chatter import blender_output
-from .scene import add_mannequin, empty_scene, shown_objects
+from .scene import add_mannequin, empty_scene
 
 # ------------------------------------------------------------------------------------------------ glTF
 
@@ -82,7 +82,8 @@ def part_extras(obj):
     return extras
 
 
-def scene_extras(mannequin):
+def scene_extras(mannequin, measured=None):
+    """The scene extras of ``mannequin``; ``measured``: its m_T ({key: cm}) if the caller holds it (else taken)."""
     out = {
         "format": EXTRAS_FORMAT,
         "version": EXTRAS_VERSION,
@@ -90,14 +91,14 @@ def scene_extras(mannequin):
         "role": mannequin.role,
         "units": "m (geometry), cm (measurements)",
         "up": "ElliMann data is Z-up, facing -Y; glTF nodes are Y-up as glTF requires",
-        "measured_cm": mannequin.measure(),
+        "measured_cm": {k: float(measured[k]) for k in MEASUREMENTS} if measured is not None else mannequin.measure(),
     }
     if mannequin.measurements:
         out["target_cm"] = {k: float(v) for k, v in mannequin.measurements.items()}
     return out
 
 
-def export_gltf(collection, path):
+def export_gltf(collection, path, mannequin=None, measured=None):
     """Write a mannequin collection (and its child collections) to a binary glTF (.glb), atomically
     (:func:`atomic_output`, like every file Blender writes for ElliMann).
 
@@ -108,14 +109,21 @@ def export_gltf(collection, path):
     (their ellipsoids moved since they were built: a live update, an undo or a reload can leave them
     so), and MannequinError (naming the parts) for a collection that is not a valid mannequin;
     nothing is written then, and the file is unchanged. Returns the path.
+
+    ``mannequin`` (and its m_T ``measured``, {key: cm}): the core mannequin the collection was just made from
+    (``write_mannequin``): its extras are written from it, without reading the collection back or measuring
+    again; without it (the export operator) the collection is read and checked.
     """
     path = os.fspath(path)
     if not path.lower().endswith(".glb"):
         raise ElliMannError(f"path: a glTF export is written as binary glTF and must end in .glb, got {path!r}")
     bpy.context.view_layer.update()  # matrix_world of objects a script just moved
-    mannequin = collection_to_mannequin(collection)
-    parts = part_lookup(collection)
-    stale = [c.name for c in built_objects(collection, "CUSHION") if is_stale(c, parts)]
+    if mannequin is None:
+        mannequin = collection_to_mannequin(collection)
+        parts = part_lookup(collection)
+        stale = [c.name for c in built_objects(collection, "CUSHION") if is_stale(c, parts)]
+    else:
+        stale = []  # its cushions were built from the mannequin a moment ago
     if stale:
         more = f" and {len(stale) - 1} more" if len(stale) > 1 else ""
         raise ElliMannError(
@@ -138,7 +146,7 @@ def export_gltf(collection, path):
         )
         if result != {"FINISHED"}:
             raise ElliMannError(f"path: Blender's glTF exporter did not finish ({result})")
-        _set_extras(temp, node_extras, scene_extras(mannequin))
+        _set_extras(temp, node_extras, scene_extras(mannequin, measured))
     return path
 
 
@@ -181,9 +189,9 @@ def read_glb_json(path):
 
 
 def write_mannequin(mannequin, paths, measured=None, cushions=False):
-    """Write one mannequin to every .blend, .glb and .obj in ``paths`` (format from the extension), all
-    from one empty scene. Returns the paths. (.json and MJCF need no Blender: ``core.formats.core_writers``; a posed
-    mannequin: ``services.posing``.)
+    """Write one mannequin to every .blend and .glb in ``paths`` (format from the extension), all
+    from one empty scene. Returns the paths. (.obj, .json and MJCF need no Blender: ``core.formats.core_writers``;
+    a posed mannequin: ``services.posing``.)
 
     ``cushions``: the files show the cushions instead of the ellipsoids they replace. A path of another
     kind raises ElliMannError before anything is written; an OSError names the file that failed
@@ -194,39 +202,26 @@ def write_mannequin(mannequin, paths, measured=None, cushions=False):
         empty_scene()
         collection = add_mannequin(mannequin, measured, cushions)
         for path in paths:
-            write_blender_file(path, collection)
+            write_blender_file(path, collection, mannequin, measured)
     return paths
 
 
 def checked_paths(paths):
-    """``paths`` as strings; ElliMannError naming the first that is not a .blend, .glb or .obj file."""
+    """``paths`` as strings; ElliMannError naming the first that is not a .blend or .glb file."""
     paths = [os.fspath(p) for p in paths]
     other = [p for p in paths if extension_of(p) not in BLENDER_FORMATS]
     if other:
-        raise ElliMannError(f"path: {other[0]!r} is not a .blend, .glb or .obj file")
+        raise ElliMannError(f"path: {other[0]!r} is not a .blend or .glb file (the core writes .obj, .json, .xml)")
     return paths
 
 
-def write_blender_file(path, collection):
-    """Write the scene holding ``collection`` to ``path`` (.blend, .glb or .obj by its extension), atomically."""
+def write_blender_file(path, collection, mannequin=None, measured=None):
+    """Write the scene holding ``collection`` to ``path`` (.blend or .glb by its extension), atomically;
+    ``mannequin`` and ``measured``: what the collection was made from, for the .glb's extras (:func:`export_gltf`)."""
     kind = extension_of(path)
     if kind == "glb":  # atomic itself; leaves out what renders do not show (ellipsoids a cushion replaces)
         with blender_output():
-            export_gltf(collection, path)
+            export_gltf(collection, path, mannequin, measured)
         return
     with atomic_output(path) as temp, blender_output():
-        if kind == "blend":
-            bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)
-        else:
-            _select_only(shown_objects(collection))
-            bpy.ops.wm.obj_export(
-                filepath=temp, export_selected_objects=True, export_materials=False, check_existing=False
-            )
-
-
-def _select_only(objects):
-    bpy.context.view_layer.update()  # give newly linked objects their view-layer bases before selecting
-    for obj in bpy.context.view_layer.objects:
-        obj.select_set(False)
-    for obj in objects:
-        obj.select_set(True)
+        bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)

@@ -16,9 +16,10 @@ from .rig import apply_motion, apply_pose, build_rig, check_rig
 from .scene import add_mannequin, empty_scene
 
 
-def write_posed(mannequin, frames, paths, cushions=False, fps=WALK_FPS):
+def write_posed(mannequin, frames, paths, cushions=False, fps=WALK_FPS, measured=None):
     """Write ``mannequin`` (at rest, with joints) posed by ``frames`` (core Poses, already within the limits:
-    one for a still pose, several for a looping motion at ``fps``) to every .blend, .glb and .obj in ``paths``.
+    one for a still pose, several for a looping motion at ``fps``) to every .blend and .glb in ``paths``;
+    ``measured``: its rest m_T ({key: cm}) for the .glb's extras, if the caller holds it.
 
     Raises ElliMannError before anything is written for a path of another kind, no frames, or a mannequin
     that cannot be rigged (no joints, a part without a bone). Returns the paths.
@@ -37,10 +38,10 @@ def write_posed(mannequin, frames, paths, cushions=False, fps=WALK_FPS):
     else:
         name = frames[0].name.split()[0] if frames[0].name else "motion"
         apply_motion(rig, frames, f"{collection.name} {name}", loop=True)
-        scene.render.fps, scene.render.fps_base = int(round(fps)), 1.0
+        scene.render.fps, scene.render.fps_base = int(round(fps or WALK_FPS)), 1.0
         scene.frame_start, scene.frame_end = 1, len(frames)
         scene.frame_set(1)
     bpy.context.view_layer.update()
     for path in paths:
-        write_blender_file(path, collection)
+        write_blender_file(path, collection, mannequin, measured)
     return paths

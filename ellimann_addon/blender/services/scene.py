@@ -21,21 +21,6 @@ def empty_scene():
     return bpy.context.scene
 
 
-def shown_objects(collection):
-    """What a file shows: cushions where there are any, ellipsoids for every part without a cushion."""
-    objects = objects_recursive(collection)
-    has_cushions = any(o.ellimann.kind == "CUSHION" for o in objects)
-    return [
-        o
-        for o in objects
-        if o.ellimann.is_part
-        and (
-            o.ellimann.kind == "CUSHION"
-            or (o.ellimann.kind == "ELLIPSOID" and not (has_cushions and o.ellimann.partner))
-        )
-    ]
-
-
 def add_mannequin(mannequin, measured=None, cushions=False):
     """The mannequin as a new collection in the current scene; with cushions, the paired ellipsoids are hidden."""
     collection = mannequin_to_collection(mannequin)

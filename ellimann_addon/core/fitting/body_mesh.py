@@ -12,7 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ElliMannError
-from ..geometry.mesh import is_closed_manifold
+from ..geometry.mesh import is_closed_manifold, to_scene_axes
+from ..measure.body import UNITS, check_mesh
 
 
 class BodyMeshError(ElliMannError):
@@ -75,15 +76,24 @@ def from_polygons(name, vertices, polygons):
     return body
 
 
-def read_obj(path):
+def read_obj(path, up="y", unit="m"):
     """The body mesh of an OBJ file (``v`` and ``f`` lines; polygons fan-triangulated; texture and normal
-    indices after '/' ignored; negative indices count from the end), named by the file's stem."""
+    indices after '/' ignored; negative indices count from the end), named by the file's stem, in ElliMann's
+    axes and metres. ``up``: the file's up axis ("y", as Blender writes OBJ, or "z"); ``unit``: its length unit.
+    BodyMeshError, in one line naming the option that fixes it, for a body that is not closed or does not
+    stand upright at a person's size in those axes and unit (``core.measure.body.check_mesh``)."""
     path = pathlib.Path(path)
+    _check_axes(up, unit)
     vertices, polygons = _obj_polygons(path)
+    vertices = to_scene_axes(vertices, up) * UNITS[unit]
     try:
-        return from_polygons(path.stem, vertices, polygons)
+        body = from_polygons(path.stem, vertices, polygons)
     except BodyMeshError as error:
-        raise BodyMeshError(f"{path}: {str(error).partition(': ')[2]}") from None
+        raise BodyMeshError(f"{path}: {str(error).removeprefix(path.stem + ': ')}") from None
+    problem = check_mesh(body.vertices, body.faces, up, unit)
+    if problem:
+        raise BodyMeshError(f"{path}: {problem.removesuffix('; nothing measured')}")
+    return body
 
 
 def _obj_polygons(path):
@@ -204,7 +214,6 @@ def hidden_vertices(vertices, faces, normals, candidates, reach=0.1, cell=0.01):
 # PLY (ASCII or binary little-endian) and STL (ASCII or binary) are read in their own axes (Z up, as
 # Blender's importers leave them).
 MESH_EXTENSIONS = (".obj", ".ply", ".stl")
-UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 UP_AXES = ("y", "z")
 
 
@@ -212,14 +221,13 @@ def read_body_mesh(path, up=None, unit="m"):
     """(vertices (V, 3) in metres, Z up; faces (F, 3) int64) of an .obj / .ply / .stl file.
 
     ``up``: the file's up axis ("y" or "z"; default "y" for OBJ as Blender imports it, "z" for PLY/STL);
-    ``unit``: the file's length unit (m, cm, mm)."""
+    ``unit``: the file's length unit (m, cm, mm). BodyMeshError for a body that does not stand upright at a
+    person's size in those axes and unit (``core.measure.body.check_mesh``)."""
     kind = os.path.splitext(path)[1].lower()
     if kind not in MESH_EXTENSIONS:
         raise BodyMeshError(f"{path}: a body mesh must be {', '.join(MESH_EXTENSIONS)}, got {kind or 'no extension'}")
-    if unit not in UNITS:
-        raise BodyMeshError(f"unit must be one of {', '.join(UNITS)}, got {unit!r}")
-    if up not in (None,) + UP_AXES:
-        raise BodyMeshError(f"up must be one of {', '.join(UP_AXES)}, got {up!r}")
+    _check_axes(up, unit)
+    up = up or ("y" if kind == ".obj" else "z")
     if kind == ".obj":
         vertices, polygons = _obj_polygons(path)
         faces = triangulate(polygons)
@@ -237,9 +245,18 @@ def read_body_mesh(path, up=None, unit="m"):
         raise BodyMeshError(f"{path}: a face refers to a vertex that does not exist")
     if not np.all(np.isfinite(vertices)):
         raise BodyMeshError(f"{path}: holds coordinates that are not finite numbers")
-    if (up or ("y" if kind == ".obj" else "z")) == "y":
-        vertices = np.stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]], axis=1)
-    return vertices * UNITS[unit], faces
+    vertices = to_scene_axes(vertices, up) * UNITS[unit]
+    problem = check_mesh(vertices, faces, up, unit)
+    if problem:
+        raise BodyMeshError(f"{path}: {problem}")
+    return vertices, faces
+
+
+def _check_axes(up, unit):
+    if unit not in UNITS:
+        raise BodyMeshError(f"unit must be one of {', '.join(UNITS)}, got {unit!r}")
+    if up not in (None,) + UP_AXES:
+        raise BodyMeshError(f"up must be one of {', '.join(UP_AXES)}, got {up!r}")
 
 
 def _parse_ply(raw):

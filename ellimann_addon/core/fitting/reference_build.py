@@ -9,11 +9,16 @@ mean) and each is checked: clean, every measurement within ``accept_tolerance`` 
 much of its body it fills (coverage, excess: core/geometry/volume.py). Deterministic: no randomness, fixed
 iteration counts and orders. Everything is checked before the first fit, so bad input costs nothing.
 
+What a build returns (BuiltReferenceSet) is the whole set: the RMs, the relabelled base and the manifest (name,
+sex, section heights, ranges from the targets, provenance), ready for ``write``; callers add only where the
+bodies came from.
+
 Joints: a body with a skeleton (``BodyMesh.joints``) gives its RM joints that go through every step the pieces
 go through: mirrored and registered with them, moved by the refinement as points fixed in their anchor parts
 (core.mannequin.joints.follow_pieces), translated by the cleaning.
 """
 
+import csv
 import math
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -22,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..constants import ABSURD_LIMITS, MEASUREMENTS
-from ..errors import ElliMannError
+from ..errors import ElliMannError, one_line
 from ..geometry.frames import is_rotation
 from ..geometry.volume import GRID_SPACING, BodyVolume, fill_shares
 from ..mannequin.clean import (
@@ -36,19 +41,25 @@ from ..mannequin.clean import (
 )
 from ..mannequin.joints import anchor_indices, follow_pieces
 from ..measure.tailor import as_dict, section_heights
+from ..synthesis.manifest import STEM, Manifest, targets_range, write_reference_set
 from ..synthesis.refine import FACTOR_LIMITS, refine
 from .body_mesh import mesh_problem
 from .mannequin_fit import BuildCancelledError, FitConstants, fit_mannequin
 
 __all__ = [
+    "BASE_STEM",
     "BuildCancelledError",
+    "BuiltReferenceSet",
     "BuildSettings",
     "BuildReport",
     "ReferenceBuildError",
     "build_reference_set",
+    "read_targets",
+    "traced_mesh",
     "validate_inputs",
 ]
 MIN_BODIES = 3
+BASE_STEM = "base_mannequin"  # the base's file in a built set, unless the caller names it
 
 
 class ReferenceBuildError(ElliMannError):
@@ -88,6 +99,45 @@ class BuildReport:
         return key, self.errors[stem][key]
 
 
+@dataclass
+class BuiltReferenceSet:
+    """A built set: ``mannequins`` ({stem: RM}, each of the set), ``base`` (relabelled against the reference RM,
+    saved as ``manifest.base``), ``manifest`` and the build's ``report``."""
+
+    mannequins: dict
+    base: object
+    manifest: Manifest
+    report: BuildReport
+
+    @classmethod
+    def assemble(cls, rms, report, targets, name, sex=None, base_stem=BASE_STEM, provenance=None):
+        """The set of the cleaned ``rms`` ({stem: RM}) and ``report`` (its base relabelled): each made the set's
+        (``reference_set`` = ``name``), and their manifest, its ranges the targets' min-max."""
+        stems = list(rms)
+        manifest = Manifest(
+            name=name,
+            mannequins=stems,
+            sex=sex,
+            base=base_stem,
+            section_fractions=dict(report.base.section_fractions),
+            ranges_cm=targets_range({stem: targets[stem] for stem in stems}),
+            targets_cm={stem: dict(targets[stem]) for stem in stems},
+            provenance={**(provenance or {}), "labelled_against": report.reference},
+        )
+        mannequins = {stem: rm.copy(reference_set=name) for stem, rm in rms.items()}
+        return cls(mannequins, report.base.copy(reference_set=name), manifest, report)
+
+    def write(self, folder):
+        """Write the set into ``folder`` (each file atomically, the manifest last); returns the paths."""
+        return write_reference_set(folder, self.mannequins, self.manifest, base=self.base)
+
+
+def traced_mesh(base):
+    """{traced_mesh, vertex_count}: the mesh ``base``'s selections were traced on, for a manifest's provenance."""
+    first = next(iter(base.traces.values()))
+    return {"traced_mesh": first.mesh, "vertex_count": first.vertex_count}
+
+
 def display_name(stem):
     """'small_chubby' -> 'Small Chubby'."""
     return " ".join(word.capitalize() for word in stem.replace("-", "_").split("_") if word)
@@ -95,6 +145,46 @@ def display_name(stem):
 
 def _traced_parts(topology):
     return [part.name for part in topology if part.side != "R"]
+
+
+def read_targets(path):
+    """{name: {He, Sh, Br, Wa, Hi: cm}} from a CSV with a 'name' column and a column per measurement (or
+    target_He, ...); rows without values (a traced body that is no RM) are left out. ReferenceBuildError
+    naming the file, the line and the field."""
+    try:
+        with open(path, encoding="utf-8-sig", newline="") as stream:
+            rows = list(csv.DictReader(stream))
+    except (OSError, UnicodeDecodeError, csv.Error) as error:
+        raise ReferenceBuildError(f"{path}: cannot be read ({one_line(error)})") from None
+    if not rows or "name" not in rows[0]:
+        raise ReferenceBuildError(f"{path}: needs a header with a 'name' column and {', '.join(MEASUREMENTS)}")
+    columns = {}
+    for key in MEASUREMENTS:
+        column = next((c for c in (key, f"target_{key}") if c in rows[0]), None)
+        if column is None:
+            raise ReferenceBuildError(f"{path}: has no {key} column (cm)")
+        columns[key] = column
+    targets = {}
+    for line, row in enumerate(rows, 2):
+        name = (row.get("name") or "").strip()
+        values = {key: (row.get(column) or "").strip() for key, column in columns.items()}
+        if not name or not any(values.values()):
+            continue  # a body without targets (e.g. the traced one) is no RM
+        if name in targets:
+            raise ReferenceBuildError(f"{path}: line {line}: '{name}' has a second row")
+        try:
+            targets[name] = {key: float(value) for key, value in values.items()}
+        except ValueError:
+            bad = next(key for key, value in values.items() if not _is_number(value))
+            raise ReferenceBuildError(f"{path}: line {line}: {bad}={values[bad]!r} is not a number (cm)") from None
+    return targets
+
+
+def _is_number(text):
+    try:
+        return math.isfinite(float(text))
+    except ValueError:
+        return False
 
 
 def validate_inputs(base, bodies, targets):
@@ -267,7 +357,20 @@ def _kept(base):
     return [base.traces[part.name].fit.kept if part.name in base.traces else None for part in base.topology]
 
 
-def build_reference_set(base, bodies, targets, progress=None, cancel=None, settings=None, reference=None, workers=1):
+def build_reference_set(
+    base,
+    bodies,
+    targets,
+    progress=None,
+    cancel=None,
+    settings=None,
+    reference=None,
+    workers=1,
+    name=None,
+    sex=None,
+    base_stem=BASE_STEM,
+    provenance=None,
+):
     """N Reference Mannequins from ``base`` (a Mannequin with traces) and ``bodies`` (BodyMesh, N >= 3).
 
     ``targets``: {body name: {He, Sh, Br, Wa, Hi: cm}}; ``progress(fraction, text)`` is called as the
@@ -275,14 +378,19 @@ def build_reference_set(base, bodies, targets, progress=None, cancel=None, setti
     ``reference``: the body whose RM the others' axes are labelled against (default: the one nearest
     the targets' mean); ``workers``: processes fitting bodies at once (each body is fitted alike whichever
     process fits it, so the result does not depend on it; with more than one, ``cancel`` is polled between
-    bodies). Returns ({body name: RM}, BuildReport). Raises ReferenceBuildError (one line) before any work
-    for bad input, or when an RM cannot meet its targets.
+    bodies). ``name`` (default: the base's set's), ``sex``, ``base_stem`` (the base's file) and ``provenance``
+    (where the base and bodies came from; the build adds the RM it labelled against) go into the manifest.
+    Returns a BuiltReferenceSet. Raises ReferenceBuildError (one line) before any work for bad input, or when an
+    RM cannot meet its targets.
     """
     # by default measured at the base's section heights (its own set's): the fit keeps clear of them and
     # the refinement meets the targets at them
     settings = settings or BuildSettings(fit=FitConstants(section_fractions=dict(base.section_fractions)))
     validate_inputs(base, bodies, targets)
     names = [body.name for body in bodies]
+    name = name or base.reference_set
+    if not STEM.match(base_stem) or base_stem in names:
+        raise ReferenceBuildError(f"base_stem: '{base_stem}' must be letters, digits, _ . - and no body's name")
     reference = reference or central_body(names, targets)
     if reference not in names:
         raise ReferenceBuildError(f"reference: '{reference}' is not one of the bodies ({', '.join(names)})")
@@ -303,39 +411,39 @@ def build_reference_set(base, bodies, targets, progress=None, cancel=None, setti
             for k, future in enumerate(as_completed(futures)):
                 if cancel is not None and cancel():
                     raise BuildCancelledError()
-                name, *result = future.result()
-                fitted[name] = result
-                tell(k + 1, f"fitted {name} ({k + 1} of {len(bodies)})")
+                stem, *result = future.result()
+                fitted[stem] = result
+                tell(k + 1, f"fitted {stem} ({k + 1} of {len(bodies)})")
         finally:  # a failed or cancelled build does not wait for the bodies still being fitted
             pool.shutdown(wait=False, cancel_futures=True)
     else:
         for k, job in enumerate(jobs):
             tell(k, f"fitting {job[1].name} ({k + 1} of {len(bodies)})")
-            name, *result = _fit_body(*job, cancel=cancel)
-            fitted[name] = result
+            stem, *result = _fit_body(*job, cancel=cancel)
+            fitted[stem] = result
     adjusted = []
-    for name in names:
-        report.shifts[name], report.fitted[name], rm, report.factors[name] = fitted[name]
+    for stem in names:
+        report.shifts[stem], report.fitted[stem], rm, report.factors[stem] = fitted[stem]
         adjusted.append(rm)
     report.seconds["fit and refine"] = time.perf_counter() - started
 
     cleaned = clean(adjusted, reference_index=names.index(reference))
     rms = dict(zip(names, cleaned))
-    for name, before in zip(names, adjusted):
+    for stem, before in zip(names, adjusted):
         # cleaning a symmetric mannequin only translates it
-        report.shifts[name] = report.shifts[name] + (rms[name].center - before.center).mean(axis=0)
+        report.shifts[stem] = report.shifts[stem] + (rms[stem].center - before.center).mean(axis=0)
     report.base = relabel(base, rms[reference])
-    for name, rm in rms.items():
-        report.errors[name] = relative_errors(rm.measure(), targets[name])
-        key, error = report.worst(name)
+    for stem, rm in rms.items():
+        report.errors[stem] = relative_errors(rm.measure(), targets[stem])
+        key, error = report.worst(stem)
         if abs(error) > settings.accept_tolerance:
             raise ReferenceBuildError(
-                f"{name}: after cleaning m_T {key} is off its target by {error:.3%} (accepted "
+                f"{stem}: after cleaning m_T {key} is off its target by {error:.3%} (accepted "
                 f"{settings.accept_tolerance:.1%})"
             )
         problems = cleanliness_problems(rm.check())
         if problems:
-            raise ReferenceBuildError(f"{name}: {'; '.join(problems)}")
+            raise ReferenceBuildError(f"{stem}: {'; '.join(problems)}")
     if settings.check_spacing:
         tell(len(bodies), "checking how each RM fills its body")
         started = time.perf_counter()
@@ -346,4 +454,4 @@ def build_reference_set(base, bodies, targets, progress=None, cancel=None, setti
             report.fill[body.name] = fill_shares(volume.grid(settings.check_spacing), rms[body.name])
         report.seconds["coverage check"] = time.perf_counter() - started
     tell(steps, "built")
-    return rms, report
+    return BuiltReferenceSet.assemble(rms, report, targets, name, sex, base_stem, provenance)

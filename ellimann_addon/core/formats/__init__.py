@@ -1,8 +1,9 @@
 """File formats ElliMann writes without Blender, and the table of every format (floor 5: everything below).
 
-- core_writers: JSON and MJCF mannequin files by extension
+- core_writers: OBJ, JSON and MJCF mannequin files by extension
 - mjcf: MJCF (MuJoCo) of a mannequin's convex pieces
 - mjcf_articulated: MJCF of a mannequin with joints: an articulated body, poses as keyframes
+- obj: Wavefront OBJ of a mannequin's pieces, rest or posed, Y up
 - npz_bundle: a whole batch in one compressed .npz, and its loader
 - posed_files: posed .json, .xml and .obj; reading a pose file
 - table: the one table of output formats (extension, writer, needs Blender)

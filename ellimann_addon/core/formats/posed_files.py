@@ -4,23 +4,19 @@
   plus a ``pose`` section: ``{"version": 1, "name", "fps" (motions), "frames": [Pose.to_dict(), ...]}``; a still
   pose is one frame, the walk cycle its frames.
 - ``.xml``: the articulated MJCF (``core.formats.mjcf_articulated``), the pose's frames as keyframes.
-- ``.obj``: the posed pieces, one object each (ellipsoids as icospheres, cushions as their hull meshes, those
-  across a joint in two halves, ``core.pose.posed_pieces``); a still pose only (OBJ holds no animation).
+- ``.obj``: the posed pieces (``core.formats.obj``, Y up as every OBJ ElliMann writes); a still pose only (OBJ
+  holds no animation).
 
 :func:`read_pose` reads a pose file: such a ``.json`` (its ``pose`` section) or a bare ``Pose.to_dict``.
 """
 
 import json
 
-import numpy as np
-
-from ..constants import CUSHION_LEVEL, UNIT_SPHERE_LEVEL
 from ..errors import ElliMannError
 from ..files import atomic_write_text
-from ..geometry.mesh import icosphere
 from ..pose.kinematics import Pose
-from ..pose.posed_pieces import PosingRig
 from .mjcf_articulated import write_articulated_mjcf
+from .obj import write_obj
 from .table import FORMATS, format_of
 
 POSE_SECTION_VERSION = 1
@@ -60,33 +56,6 @@ def read_pose(path):
     return [Pose.from_dict(frame) for frame in section["frames"]]
 
 
-def obj_text(mannequin, pose, cushions=False):
-    """Wavefront OBJ of the pieces of ``mannequin`` in ``pose``, one object (``o``) per piece."""
-    body = PosingRig(mannequin, cushions=cushions, subdivisions=CUSHION_LEVEL).pose(pose)
-    posed = body.mannequin
-    sphere, sphere_faces = icosphere(UNIT_SPHERE_LEVEL)
-    pieces = [
-        (
-            posed.topology.names[i],
-            np.einsum("ij,vj->vi", posed.rotation[i] * posed.semi_axes[i], sphere) + posed.center[i],
-            sphere_faces,
-        )
-        for i in posed.topology.single_parts(cushions)
-    ]
-    pieces += [(mesh.name, mesh.vertices, mesh.faces) for mesh in body.cushions]
-    lines = [
-        f"# ElliMann mannequin '{mannequin.name}' in pose '{pose.name}' (metres, Z up, facing -Y); measurements "
-        "are the rest pose's"
-    ]
-    start = 1
-    for name, vertices, faces in pieces:
-        lines.append(f"o {name}")
-        lines += [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in vertices]
-        lines += [f"f {a + start} {b + start} {c + start}" for a, b, c in faces]
-        start += len(vertices)
-    return "\n".join(lines) + "\n"
-
-
 def write_posed(mannequin, frames, path, cushions=False, fps=None):
     """Write ``mannequin`` in ``frames`` (a list of Pose; the walk cycle's frames, or one pose) to a .json, .xml
     or .obj, atomically. ElliMannError (nothing written) for another format or an animation in a .obj."""
@@ -106,5 +75,5 @@ def write_posed(mannequin, frames, path, cushions=False, fps=None):
     elif kind.name == "mjcf":
         write_articulated_mjcf(mannequin, path, frames, cushions)
     else:
-        atomic_write_text(path, obj_text(mannequin, frames[0], cushions))
+        write_obj(mannequin, path, frames[0], cushions)
     return path

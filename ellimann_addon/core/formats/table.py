@@ -1,5 +1,5 @@
 """The mannequin file formats, in one table: each format's name (``--format``), its file extension, who writes
-it (the core: JSON and MJCF, ``core.formats.core_writers``; Blender: .blend, .glb, .obj,
+it (the core: OBJ, JSON and MJCF, ``core.formats.core_writers``; Blender: .blend and .glb,
 ``blender.services.files.write_mannequin``)
 and so whether it needs the bpy module. The command line, the writers and the export operator read it."""
 
@@ -30,13 +30,13 @@ FORMATS = {
     for f in (
         Format("blend", "blend", "blender", "Blender file", "blender", True),
         Format("glb", "glb", "blender", "binary glTF with ElliMann's extras", "blender", True),
-        Format("obj", "obj", "blender", "Wavefront OBJ", "core", False),
+        Format("obj", "obj", "core", "Wavefront OBJ (Y up)", "core", False),
         Format("json", "json", "core", "ElliMann's mannequin JSON", "core", True),
         Format("mjcf", "xml", "core", "MJCF, for MuJoCo", "core", True),
     )
 }
-CORE_FORMATS = tuple(name for name, f in FORMATS.items() if not f.needs_blender)  # json, mjcf
-BLENDER_FORMATS = tuple(name for name, f in FORMATS.items() if f.needs_blender)  # blend, glb, obj
+CORE_FORMATS = tuple(name for name, f in FORMATS.items() if not f.needs_blender)  # obj, json, mjcf
+BLENDER_FORMATS = tuple(name for name, f in FORMATS.items() if f.needs_blender)  # blend, glb
 EXTENSIONS = {name: f.extension for name, f in FORMATS.items()}  # format -> file extension
 
 

@@ -1,4 +1,4 @@
-"""Triangle-mesh helpers in numpy: icosphere, volume, manifold and convexity checks, plane sections."""
+"""Triangle-mesh helpers in numpy: icosphere, volume, manifold and convexity checks, plane sections, file axes."""
 
 import numpy as np
 
@@ -266,3 +266,23 @@ def in_plane(vertices, origin, normal):
     first /= np.linalg.norm(first)
     frame = np.stack([first, np.cross(normal, first), normal])  # rows: the new axes
     return (np.asarray(vertices, float) - origin) @ frame.T, frame
+
+
+# Mesh files' axes: ElliMann's scene is Z up, facing -Y; OBJ files are Y up, -Z forward, as Blender reads and
+# writes them.
+
+
+def to_scene_axes(vertices, up):
+    """File coordinates (V, 3) in ElliMann's axes: a Y-up file's (x, y, z) is the scene's (x, -z, y)."""
+    vertices = np.asarray(vertices, dtype=float).reshape(-1, 3)
+    if up == "y":
+        return np.stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]], axis=1)
+    return vertices
+
+
+def from_scene_axes(vertices, up="y"):
+    """The inverse of :func:`to_scene_axes`: scene points (V, 3) as a ``up``-up file holds them."""
+    vertices = np.asarray(vertices, dtype=float).reshape(-1, 3)
+    if up == "y":
+        return np.stack([vertices[:, 0], vertices[:, 2], -vertices[:, 1]], axis=1)
+    return vertices

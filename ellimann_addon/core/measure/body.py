@@ -235,31 +235,49 @@ def _within(points, hull, margin):
     return np.all(points @ normal.T - offset <= margin, axis=1)
 
 
-def check_mesh(vertices, faces):
-    """Problems that stop every measurement (None if none): empty, wrong unit, lying, upside down."""
+UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}  # a mesh file's length units (core.fitting.body_mesh reads them)
+
+
+def check_mesh(vertices, faces, up=None, unit=None):
+    """What stops every measurement of a body mesh (metres, Z up), in one line (None if nothing): empty, lying,
+    not a person's height, upside down. ``up`` and ``unit``: the options it was read with (core.fitting.body_mesh),
+    if any, so the line names the option that fixes it (None: a mesh in a scene, turned or scaled instead)."""
     if len(vertices) == 0 or len(faces) == 0:
         return "the mesh is empty (no triangles): nothing can be measured"
     extent = np.ptp(vertices, axis=0)
-    tall = float(extent[2])
+    longest = int(np.argmax(extent))
+    read = f"read with --up {up}, " if up else ""
+    if extent[2] < 0.8 * extent[longest]:  # lying: a standing A-pose is at most 0.7 as wide as tall, a T-pose's
+        # arm span is about its height (humans: 0.95-1.06), a body lying on its side is 0.6 as tall as long
+        file_axis = {("y", 1): "z", ("z", 1): "y"}.get((up, longest))
+        if up is None:
+            fix = "turn it to stand along Z"
+        else:
+            fix = f"pass --up {file_axis}" if file_axis else "give the file's up axis (--up y or z)"
+        return (
+            f"the body lies down ({read}it is {extent[longest]:.2f} m long along {'XYZ'[longest]} and "
+            f"{extent[2]:.2f} m tall): {fix}; nothing measured"
+        )
     low, high = HEIGHT_RANGE_M
-    if tall > high:
-        unit = "millimetres" if tall / 1000.0 <= high else "an unknown unit"
+    if not low <= extent[2] <= high:
+        given = extent[2] / UNITS.get(unit, 1.0)
+        fits = [name for name, scale in UNITS.items() if low <= given * scale <= high]
+        if unit is None:
+            fix = "scale it to metres" if fits else "scale it to a person's size"
+        else:
+            fix = f"pass --unit {fits[0]}" if fits else "scale it to a person's size"
         return (
-            f"the body is {tall:.4g} units tall: not metres (in {unit}? give the unit); He must be "
-            f"{low}-{high} m; nothing measured"
+            f"the body is {given:.4g} {unit or 'units'} tall, not a person's height ({low:g} to {high:g} m): {fix}; "
+            "nothing measured"
         )
-    if extent[2] < max(extent[0], extent[1]):
-        return (
-            f"the body is not upright (Z extent {tall:.3f} m, X {extent[0]:.3f} m, Y {extent[1]:.3f} m): "
-            "lying or on its side (give the up axis); nothing measured"
-        )
-    if tall < low:
-        return f"the body is {tall:.3f} m tall: He must be {low}-{high} m (is the unit right?); nothing measured"
-    bottom = vertices[:, 2].min()
+    bottom, tall = vertices[:, 2].min(), extent[2]
     soles = vertices[vertices[:, 2] < bottom + 0.03 * tall]
     crown = vertices[vertices[:, 2] > bottom + 0.97 * tall]
     if np.ptp(soles[:, 0]) < np.ptp(crown[:, 0]):
-        return "the body stands on its head (its narrow end, the crown, is at the bottom); nothing measured"
+        return (
+            f"the body stands on its head ({read}its narrow end, the crown, is at the bottom): turn it over; "
+            "nothing measured"
+        )
     return None
 
 

@@ -13,17 +13,22 @@ import threading
 import bpy
 from bpy.props import IntProperty
 
-from ....core.constants import ABSURD_LIMITS, MEASUREMENTS
+from ....core.constants import MEASUREMENTS
 from ....core.errors import ElliMannError, MannequinError
-from ....core.fitting.reference_build import BuildCancelledError, build_reference_set, validate_inputs
-from ....core.synthesis.manifest import MANIFEST_FILE, Manifest, targets_range, write_reference_set
+from ....core.fitting.reference_build import (
+    BASE_STEM,
+    BuildCancelledError,
+    build_reference_set,
+    traced_mesh,
+    validate_inputs,
+)
+from ....core.synthesis.manifest import MANIFEST_FILE
 from ... import ids
 from ...bridge.bodies import body_mesh
 from ...bridge.convert import collection_to_mannequin, mannequin_to_collection, new_collection
 from ..base import ElliMannOperator, OperatorError, cancel
 
 TIMER_SECONDS = 0.25
-BASE_STEM = "base_mannequin"
 
 
 def stem_of(name):
@@ -66,36 +71,30 @@ class Request:
         self.name = props.set_name.strip() or self.folder.name
         self.sex = None if props.sex == "NONE" else props.sex
 
-    def manifest(self, report):
-        stems = [body.name for body in self.bodies]
-        first = next(iter(self.base.traces.values()))
-        return Manifest(
+    def build(self, progress=None, cancel_flag=None):
+        return build_reference_set(
+            self.base,
+            self.bodies,
+            self.targets,
+            progress=progress,
+            cancel=cancel_flag,
             name=self.name,
-            mannequins=stems,
             sex=self.sex,
-            base=BASE_STEM,
-            section_fractions=dict(self.base.section_fractions),
-            ranges_cm=targets_range(self.targets),
-            absurd_limits_cm={k: list(v) for k, v in ABSURD_LIMITS.items()},
-            targets_cm=self.targets,
+            base_stem=BASE_STEM,
             provenance={
                 "built_by": "Blender: ElliMann > Build Reference Set",
-                "base": {"collection": self.base.name, "traced_mesh": first.mesh, "vertex_count": first.vertex_count},
-                "bodies": {s: {"object": s} for s in stems},
-                "labelled_against": report.reference,
+                "base": {"collection": self.base.name, **traced_mesh(self.base)},
+                "bodies": {body.name: {"object": body.name} for body in self.bodies},
             },
         )
 
-    def build(self, progress=None, cancel_flag=None):
-        return build_reference_set(self.base, self.bodies, self.targets, progress=progress, cancel=cancel_flag)
 
-
-def finish(operator, context, request, rms, report):
-    """Write the set and load it into a new collection (one child collection per RM); report the outcome."""
-    manifest = request.manifest(report)
-    rms = {stem: rm.copy(reference_set=manifest.name) for stem, rm in rms.items()}  # they are the set's now
+def finish(operator, context, request, built):
+    """Write the set (a core BuiltReferenceSet) and load it into a new collection (one child collection per RM);
+    report the outcome."""
+    rms, report, manifest = built.mannequins, built.report, built.manifest
     try:
-        write_reference_set(request.folder, rms, manifest, base=report.base.copy(reference_set=manifest.name))
+        built.write(request.folder)
     except OSError as error:
         return cancel(operator, f"Cannot write the reference set to {request.folder}: {error}")
     parent = new_collection(f"{manifest.name} (reference set)")
@@ -129,14 +128,12 @@ class ELLIMANN_OT_build_reference_set(ElliMannOperator, bpy.types.Operator):
         window_manager = context.window_manager
         window_manager.progress_begin(0, 100)
         try:
-            rms, report = request.build(
-                progress=lambda fraction, _text: window_manager.progress_update(int(100 * fraction))
-            )
+            built = request.build(progress=lambda fraction, _text: window_manager.progress_update(int(100 * fraction)))
         except ElliMannError as error:
             raise OperatorError(f"Cannot build: {error}") from error
         finally:
             window_manager.progress_end()
-        return finish(self, context, request, rms, report)
+        return finish(self, context, request, built)
 
     def invoke(self, context, event):
         try:
@@ -181,7 +178,7 @@ class ELLIMANN_OT_build_reference_set(ElliMannOperator, bpy.types.Operator):
         if error is not None:
             props.status = f"failed: {error}"
             return cancel(self, f"Cannot build: {error}")
-        return finish(self, context, self._request, *self._state["result"])
+        return finish(self, context, self._request, self._state["result"])
 
 
 class ELLIMANN_OT_add_reference_bodies(ElliMannOperator, bpy.types.Operator):
