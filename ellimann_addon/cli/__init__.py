@@ -7,12 +7,13 @@ Subcommands, a module each: ``synth`` (one mannequin), ``batch`` (a CSV of measu
 in a pose), ``measure`` (m_T of a file), ``demo`` (the paper's Table 2.5 mannequins with a report and a line-up
 picture), ``drape`` (a garment on a mannequin with Blender's cloth simulation), ``references`` (build or check
 a reference set) and ``population`` (rows sampled from a survey's statistics, for ``batch``); ``distributed`` runs
-``batch --dask``; ``common`` holds what they share. This package needs numpy only: Blender (the bpy module and
-``ellimann_addon.blender``) is imported only when a .blend/.glb/.obj file, a drape or a picture is involved, and
-a command that needs it without it is refused in one line. What Blender prints is captured (``chatter``) and
-shown only with ``--verbose``. User mistakes end with a one-line reason and a non-zero exit code: 1 for bad input
-or a failed row, 2 for a malformed command line, 3 when exact mode missed a request (the files are written), 130
-when interrupted (Ctrl-C).
+``batch --dask``; what they share is in ``output`` (printed lines, exit codes), ``arguments`` (parser pieces),
+``writing`` (files, the output folder) and ``reporting`` (the report CSV). This package needs numpy only: Blender
+(the bpy module and ``ellimann_addon.blender``) is imported only when a .blend or .glb file, a drape or a picture
+is involved, and a command that needs it without it is refused in one line. What Blender prints is captured
+(``chatter``) and shown only with ``--verbose``. User mistakes end with a one-line reason and a non-zero exit code:
+1 for bad input or a failed row, 2 for a malformed command line, 3 when exact mode missed a request (the files are
+written), 130 when interrupted (Ctrl-C).
 """
 
 import argparse
@@ -21,7 +22,8 @@ import sys
 
 from ..core.errors import ElliMannError
 from . import batch, demo, drape, measure, population, pose, references, synth
-from .common import INTERRUPTED, MISSED, PROG, UsageError, blender_available, no_blender, one_line, say
+from .output import INTERRUPTED, MISSED, PROG, UsageError, one_line, say
+from .writing import blender_available, no_blender
 
 __all__ = ["INTERRUPTED", "MISSED", "PROG", "UsageError", "build_parser", "main", "main_exit"]
 SUBCOMMANDS = (synth, batch, pose, measure, demo, drape, references, population)

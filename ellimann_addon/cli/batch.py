@@ -21,8 +21,8 @@ from ..core.synthesis.batch import CHUNK, synthesize_chunk
 from ..core.synthesis.extra_refine import extra_request_problems, meet_extra
 from ..core.synthesis.refine import EXACT_TOLERANCE
 from ..core.synthesis.request import validate_request
-from . import common, distributed
-from .common import PROG, UsageError
+from . import arguments, distributed, output, reporting, writing
+from .output import PROG, UsageError
 
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,99}$")
 MAX_WARNING_LINES = 20  # range warnings printed before the rest go to the report only (a population has thousands)
@@ -70,8 +70,8 @@ def add_parser(commands):
         help="skip rows whose files (every --format) are already in DIR and whole, e.g. after an "
         "interrupted run with the same CSV and options; without it every row is written again",
     )
-    common.add_synthesis_options(batch)
-    common.add_pose_option(batch)
+    arguments.add_synthesis_options(batch)
+    arguments.add_pose_option(batch)
     batch.set_defaults(run=run, blender=needs_blender)
 
 
@@ -142,7 +142,7 @@ def read_rows(path, reference_of):
             try:
                 reference = reference_of(chosen)
             except ReferenceSetError as error:
-                raise MeasurementError("references", common.one_line(error)) from None
+                raise MeasurementError("references", output.one_line(error)) from None
             values = []
             for key in MEASUREMENTS:
                 cell = record[columns[key]].strip() if columns[key] < len(record) else ""
@@ -198,19 +198,19 @@ def name_rows(rows):
 
 def run(args):
     formats = parse_formats(args.format)
-    pose_file = common.check_pose_argument(args, formats)
+    pose_file = arguments.check_pose_argument(args, formats)
     shard, shards = parse_shard(args.shard)
-    sets = {"": common.references(args)}  # the command's set, read once, and each other set a row names
+    sets = {"": arguments.references(args)}  # the command's set, read once, and each other set a row names
 
     def reference_of(chosen):
         if chosen not in sets:
-            sets[chosen] = common.references(args, chosen)
+            sets[chosen] = arguments.references(args, chosen)
         return sets[chosen]
 
     rows = read_rows(args.csv, reference_of)
     if not rows:
         raise UsageError(f"{args.csv} has a header but no rows")
-    options = common.synthesis_options(args)
+    options = arguments.synthesis_options(args)
     rows = name_rows(rows)  # over the whole CSV, so every shard agrees on which rows are bad
     mine = [row for index, row in enumerate(rows) if index % shards == shard - 1]
     cluster = distributed.connect(args.dask) if args.dask else None  # before anything is written
@@ -222,26 +222,26 @@ def run(args):
 
 
 def _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file):
-    common.output_folder(args.output, "batch")
+    writing.output_folder(args.output, "batch")
     suffix = "" if shards == 1 else f"-{shard}-of-{shards}"
     report = Report(os.path.join(args.output, f"report{suffix}.csv"))
     jobs, shown = [], 0
     for line, name, values, error, warnings, reference, extra in mine:
         if error is not None:
-            common.say(f"{PROG} batch: line {line}: skipped: {error}")
-            report.add(common.report_row(line, name, "error", error, values))
+            output.say(f"{PROG} batch: line {line}: skipped: {error}")
+            report.add(reporting.report_row(line, name, "error", error, values))
             continue
         for warning in warnings:
             shown += 1
             if shown <= MAX_WARNING_LINES:
-                common.say(f"{PROG} batch: line {line}: warning: {warning}")
+                output.say(f"{PROG} batch: line {line}: warning: {warning}")
         jobs.append((line, name, values, warnings, extra, reference))
     if shown > MAX_WARNING_LINES:
-        common.say(
+        output.say(
             f"{PROG} batch: {shown - MAX_WARNING_LINES} more warning(s) of requests outside the reference "
             f"range; every row's are in {report.path}"
         )
-    progress = common.Progress(len(jobs), "batch", quiet=args.quiet)
+    progress = output.Progress(len(jobs), "batch", quiet=args.quiet)
     # one core batch per reference set (in the order the sets first appear), in chunks
     groups = {}
     for job in jobs:
@@ -287,18 +287,18 @@ def _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file):
     except KeyboardInterrupt:
         progress.done()
         report.finish()
-        common.say(
+        output.say(
             f"{PROG} batch: interrupted: {report.count('ok', 'missed')} of {len(mine)} rows done, report "
             f"{report.path}; run it again with --resume to finish"
         )
-        return common.INTERRUPTED
+        return output.INTERRUPTED
     except BaseException:
         report._close()  # the partial report stays for --resume; its file is not left open
         raise
     progress.done()
     report.finish()
     done, failed, missed = report.count("ok", "missed"), report.count("error"), report.count("missed")
-    common.say(
+    output.say(
         f"{PROG} batch: {done} of {len(mine)} mannequins written to {args.output}"
         + (f" ({report.count('kept')} already complete, kept)" if args.resume else "")
         + (f" (shard {shard}/{shards} of {len(rows)} rows)" if shards > 1 else "")
@@ -306,14 +306,14 @@ def _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file):
         file=sys.stdout,
     )
     if failed:
-        common.say(f"{PROG} batch: error: {failed} row(s) failed; see {report.path}")
+        output.say(f"{PROG} batch: error: {failed} row(s) failed; see {report.path}")
         return 1
     if missed:
-        common.say(
+        output.say(
             f"{PROG} batch: warning: exact mode missed the request of {missed} row(s) by more than "
             f"{EXACT_TOLERANCE * 100:g}%; see {report.path}"
         )
-        return common.MISSED
+        return output.MISSED
     return 0
 
 
@@ -325,9 +325,9 @@ def _row(
     measurements is deformed to meet them too (exact mode; the report's message gives what they came to; the
     batch file holds the five's mannequin)."""
     if result.errors[i] is not None:
-        common.say(f"{PROG} batch: line {line}: failed: {result.errors[i]}")
-        return common.report_row(line, name, "error", result.errors[i], values)
-    paths = [os.path.join(args.output, f"{name}.{common.extension(kind)}") for kind in formats if kind != NPZ]
+        output.say(f"{PROG} batch: line {line}: failed: {result.errors[i]}")
+        return reporting.report_row(line, name, "error", result.errors[i], values)
+    paths = [os.path.join(args.output, f"{name}.{writing.extension(kind)}") for kind in formats if kind != NPZ]
     notes = list(warnings)
     mannequin, measured = result.mannequin(i, name, values), result.measured[i]
     if extra and args.mode == "exact":
@@ -337,30 +337,30 @@ def _row(
         notes += [f"exact mode missed {text}" for text in missed_extra]
     elif extra:
         notes.append("the extra measurements are met in exact mode only (IDW gives the reference set's)")
-    misses = common.misses(measured, values) if args.mode == "exact" else []  # = not result.converged[i]
+    misses = reporting.misses(measured, values) if args.mode == "exact" else []  # = not result.converged[i]
     if misses:
-        notes.append(common.missed_text(misses))
-        common.say(f"{PROG} batch: line {line}: warning: {common.missed_text(misses)}")
+        notes.append(reporting.missed_text(misses))
+        output.say(f"{PROG} batch: line {line}: warning: {reporting.missed_text(misses)}")
     status = "missed" if misses else "ok"
     listed = paths + ([bundle.path] if bundle is not None else [])
     if bundle is not None:
         bundle.add(chunk, name, values, result, i)
     if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths) and paths:
-        row = common.report_row(
+        row = reporting.report_row(
             line, name, status, "; ".join(notes + ["kept (--resume)"]), values, measured, listed, references
         )
         row["kept"] = True
         return row
     try:
         if paths:
-            frames = common.pose_frames(args, mannequin, pose_file)
-            common.write(mannequin, paths, as_dict(measured), args.cushions, frames, args.fps)
+            frames = arguments.pose_frames(args, mannequin, pose_file)
+            writing.write(mannequin, paths, as_dict(measured), args.cushions, frames, args.fps)
     except (ElliMannError, OSError, RuntimeError) as error:
-        common.say(f"{PROG} batch: line {line}: failed: {common.one_line(error)}")
+        output.say(f"{PROG} batch: line {line}: failed: {output.one_line(error)}")
         if bundle is not None:
             bundle.drop(chunk, name)
-        return common.report_row(line, name, "error", common.one_line(error), values)
-    return common.report_row(line, name, status, "; ".join(notes), values, measured, listed, references)
+        return reporting.report_row(line, name, "error", output.one_line(error), values)
+    return reporting.report_row(line, name, status, "; ".join(notes), values, measured, listed, references)
 
 
 class Bundle:
@@ -398,7 +398,7 @@ class Bundle:
         joints = None
         if rows and all(result.joints is not None for _, _, result, _ in rows):
             joints = np.array([result.joints[i] for _, _, result, i in rows]).reshape(len(rows), len(JOINT_NAMES), 3)
-        with common.writing(self.path):
+        with writing.writing(self.path):
             write_batch_file(
                 self.path,
                 batch_arrays(
@@ -422,10 +422,10 @@ class Report:
         self.path, self.rows = path, []
         root, extension = os.path.splitext(path)
         self.partial = f"{root}.partial{extension}"
-        with common.writing(self.partial):
+        with writing.writing(self.partial):
             self.stream = open(self.partial, "w", newline="", encoding="utf-8")
         self.writer = csv.DictWriter(
-            self.stream, fieldnames=common.REPORT_COLUMNS, lineterminator="\n", extrasaction="ignore"
+            self.stream, fieldnames=reporting.REPORT_COLUMNS, lineterminator="\n", extrasaction="ignore"
         )
         self._append(self.writer.writeheader)
 
@@ -456,7 +456,7 @@ class Report:
     def finish(self):
         self._close()
         self.rows.sort(key=lambda row: row["line"])
-        with common.writing(self.path):
-            atomic_write_text(self.path, common.report_csv(self.rows))
+        with writing.writing(self.path):
+            atomic_write_text(self.path, reporting.report_csv(self.rows))
         with contextlib.suppress(OSError):
             os.unlink(self.partial)

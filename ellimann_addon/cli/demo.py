@@ -7,8 +7,8 @@ import sys
 from ..core.constants import MEASUREMENTS, TABLE_2_5
 from ..core.measure.tailor import as_dict
 from ..core.synthesis.options import PAPER
-from . import common
-from .common import PROG
+from . import arguments, output, reporting, writing
+from .output import PROG
 
 
 def add_parser(commands):
@@ -20,7 +20,7 @@ def add_parser(commands):
     )
     demo.add_argument("-o", "--output", required=True, metavar="DIR")
     demo.add_argument("--no-picture", dest="picture", action="store_false", help="skip the line-up render")
-    common.add_synthesis_options(demo)
+    arguments.add_synthesis_options(demo)
     demo.set_defaults(run=run, blender=needs_blender)
 
 
@@ -32,42 +32,42 @@ def needs_blender(args):
 def run(args):
     from ..core.synthesis.synthesize import synthesize_batch
 
-    reference = common.references(args)
+    reference = arguments.references(args)
     out = args.output
-    common.output_folder(out, "demo")
-    result = synthesize_batch(reference, [list(row) for row in TABLE_2_5], common.synthesis_options(args))
+    writing.output_folder(out, "demo")
+    result = synthesize_batch(reference, [list(row) for row in TABLE_2_5], arguments.synthesis_options(args))
     rows, mannequins, missed = [], [], 0
     for i in range(len(result)):
         name = f"table_2_5_{i + 1:02d}"
         mannequin = result.mannequin(i)
         paths = [os.path.join(out, f"{name}.{kind}") for kind in ("blend", "json")]
-        common.write(mannequin, paths, as_dict(result.measured[i]), args.cushions)
-        misses = common.misses(result.measured[i], result.requests[i]) if args.mode == "exact" else []
+        writing.write(mannequin, paths, as_dict(result.measured[i]), args.cushions)
+        misses = reporting.misses(result.measured[i], result.requests[i]) if args.mode == "exact" else []
         if misses:
             missed += 1
-            common.say(f"{PROG} demo: {name}: warning: {common.missed_text(misses)}")
+            output.say(f"{PROG} demo: {name}: warning: {reporting.missed_text(misses)}")
         rows.append(
-            common.report_row(
+            reporting.report_row(
                 i + 1,
                 name,
                 "missed" if misses else "ok",
-                "; ".join([mannequin.name] + ([common.missed_text(misses)] if misses else [])),
+                "; ".join([mannequin.name] + ([reporting.missed_text(misses)] if misses else [])),
                 result.requests[i],
                 result.measured[i],
                 paths,
             )
         )
         mannequins.append(mannequin)
-        common.say(f"{PROG} demo: wrote {name} ({mannequin.name})")
+        output.say(f"{PROG} demo: wrote {name} ({mannequin.name})")
     for name, text in (
-        ("report.csv", common.report_csv(rows)),
+        ("report.csv", reporting.report_csv(rows)),
         ("report.md", report_markdown(result, reference, args)),
     ):
-        common.write_text(os.path.join(out, name), text)
+        writing.write_text(os.path.join(out, name), text)
     if args.picture:
         from ..blender.services.render import render_lineup
 
-        with common.writing(os.path.join(out, "lineup.png")):
+        with writing.writing(os.path.join(out, "lineup.png")):
             render_lineup(
                 mannequins,
                 os.path.join(out, "lineup.png"),
@@ -75,19 +75,19 @@ def run(args):
                 cushions=args.cushions,
             )
     error = result.relative_error()
-    common.say(
+    output.say(
         f"{PROG} demo: {len(rows)} mannequins in {out} ({args.mode}); m_T error mean {error.mean():.3f}%, "
         f"max {error.max():.3f}%; see {os.path.join(out, 'report.md')}",
         file=sys.stdout,
     )
-    return common.MISSED if missed else 0
+    return output.MISSED if missed else 0
 
 
 def report_markdown(result, reference, args):
     """Requested vs m_T per mannequin, and the error summary beside the paper's IDW."""
     from ..core.synthesis.synthesize import synthesize_batch
 
-    paper = common.synthesis_options(args) == PAPER
+    paper = arguments.synthesis_options(args) == PAPER
     idw = result if paper else synthesize_batch(reference, result.requests, PAPER)
     error, idw_error = result.relative_error(), idw.relative_error()
     lines = [

@@ -11,7 +11,7 @@ synthesis give the same bits), so the files are the same.
 import logging
 import re
 
-from .common import UsageError, one_line
+from .output import UsageError, one_line
 
 RETRIES = 2  # more attempts of a failed chunk (a worker lost, a transient error)
 CONNECT_TIMEOUT = "10s"

@@ -14,9 +14,9 @@ from ..core.geometry.ellipsoid import bounds
 from ..core.pose.kinematics import require_joints
 from ..core.pose.motion import clamped_motion
 from ..core.pose.standard import POSE_NAMES
-from . import common
-from .common import PROG, UsageError
+from . import arguments, output, writing
 from .measure import load_blend_mannequin, load_json_mannequin
+from .output import PROG, UsageError
 
 
 def add_parser(commands):
@@ -40,7 +40,10 @@ def add_parser(commands):
         help=DRAPE["cushions"].help.format(default_text="cushions" if defaults.cushions else "every ellipsoid"),
     )
     drape.add_argument(
-        "--edge", type=common.number, metavar="CM", help=DRAPE["edge"].help.format(default_cm=defaults.edge * CM_PER_M)
+        "--edge",
+        type=arguments.number,
+        metavar="CM",
+        help=DRAPE["edge"].help.format(default_cm=defaults.edge * CM_PER_M),
     )
     drape.add_argument(
         "--pose",
@@ -52,7 +55,7 @@ def add_parser(commands):
     drape.add_argument("--collection", help="the mannequin collection in a .blend holding several (.blend only)")
     drape.add_argument("-o", "--output", required=True, metavar="OUT.blend")
     drape.add_argument("--render", metavar="OUT.png", help="also a Workbench picture of the last frame")
-    common.add_verbose(drape)
+    arguments.add_verbose(drape)
     drape.set_defaults(run=run, blender=needs_blender)
 
 
@@ -77,7 +80,7 @@ def run(args):
         raise UsageError(f"{args.mannequin}: no such file")
     if kind == ".json":
         mannequin = load_json_mannequin(args.mannequin)
-    bpy = common.ensure_registered("drape")
+    bpy = writing.ensure_registered("drape")
     from ..blender.services.chatter import blender_output
     from ..blender.services.drape import WARN_CLOTH_VERTICES, check_cloth_size, drape
     from ..blender.services.scene import add_mannequin, empty_scene
@@ -94,16 +97,16 @@ def run(args):
         motion, loop = motion_of(args, mannequin)
     vertices, size = check_cloth_size(mannequin, args.garment, settings)  # refuses a cloth too large to drape
     if vertices > WARN_CLOTH_VERTICES:
-        common.say(
+        output.say(
             f"{PROG} drape: warning: the cloth will have about {vertices:,} vertices and need about "
             f"{size / 1e9:.1f} GB; it is slow (a larger --edge is faster)"
         )
     moving = f" ({args.pose})" if motion else ""
-    common.say(
+    output.say(
         f"{PROG} drape: {args.garment} on '{mannequin.name}'{moving}, {settings.frames} frames, cloth edge "
         f"{settings.edge * CM_PER_M:g} cm, colliding with {'cushions' if settings.cushions else 'ellipsoids'}"
     )
-    progress = common.Progress(
+    progress = output.Progress(
         settings.frames,
         "drape",
         every=max(10, settings.frames // 20),  # 10 frames, 5% past 200
@@ -120,17 +123,17 @@ def run(args):
             result = drape(mannequin, args.garment, settings, progress=frame_done, motion=motion, loop=loop)
         finally:
             progress.done()
-        with common.writing(args.output), atomic_output(args.output) as temp:
+        with writing.writing(args.output), atomic_output(args.output) as temp:
             bpy.ops.wm.save_as_mainfile(filepath=temp, copy=True, check_existing=False)
-    common.say(f"wrote {args.output}: {result.garment.name} on '{mannequin.name}', {result.summary()}", file=sys.stdout)
+    output.say(f"wrote {args.output}: {result.garment.name} on '{mannequin.name}', {result.summary()}", file=sys.stdout)
     if args.render:
         from ..blender.services.render import render_view
 
         body = result.body
         low, high = bounds(body.rotation, body.center, body.semi_axes)
-        with common.writing(args.render):
+        with writing.writing(args.render):
             render_view(args.render, low.min(axis=0), high.max(axis=0))
-        common.say(f"wrote {args.render}", file=sys.stdout)
+        output.say(f"wrote {args.render}", file=sys.stdout)
     return 0
 
 

@@ -12,8 +12,8 @@ from ..core.fitting.body_mesh import MESH_EXTENSIONS, BodyMeshError, read_body_m
 from ..core.mannequin.model import Mannequin
 from ..core.measure.body import ALL_MEASUREMENTS, measure_body_mesh
 from ..core.measure.extra import EXTRA_LABELS, mannequin_extra_measurements
-from . import common
-from .common import UsageError
+from . import arguments, output, writing
+from .output import UsageError
 
 LABELS = {**MEASUREMENT_LABELS, **EXTRA_LABELS}
 
@@ -33,15 +33,15 @@ def add_parser(commands):
         help='print {"He": …, "Sh": …, "Br": …, "Wa": …, "Hi": …, "neck": …, …} (a body mesh: '
         "only the measurements that could be taken)",
     )
-    common.add_mesh_axes(measure, "a body mesh")
+    arguments.add_mesh_axes(measure, "a body mesh")
     measure.add_argument("--collection", help="the mannequin collection to measure in a .blend holding several")
-    common.add_references(
+    arguments.add_references(
         measure,
         "measure at the section heights of this reference set instead of those the "
         "mannequin records (its own set's; female for files that record none)",
         shipped="female or male",
     )
-    common.add_verbose(measure)
+    arguments.add_verbose(measure)
     measure.set_defaults(run=run, blender=needs_blender)
 
 
@@ -60,7 +60,7 @@ def run(args):
         if not values:
             raise UsageError(f"{path}: {problems[0]}")
         for problem in problems:
-            common.say(f"{common.PROG} measure: warning: {path}: {problem}")
+            output.say(f"{output.PROG} measure: warning: {path}: {problem}")
         _print(values, args.json, path, f"{path}: body mesh")
         return 0
     if kind == ".json":
@@ -72,7 +72,7 @@ def run(args):
             f"FILE must be a .json or .blend mannequin or a {'/'.join(MESH_EXTENSIONS)} body mesh, got {path!r}"
         )
     if args.references:
-        reference = common.references(args)
+        reference = arguments.references(args)
         mannequin = mannequin.copy(reference_set=reference.name, section_fractions=reference.section_fractions)
     values = dict(mannequin.measure())
     values.update(mannequin_extra_measurements(mannequin))
@@ -85,8 +85,8 @@ def measure_mesh_file(path, args):
     try:
         vertices, faces = read_body_mesh(path, args.up, args.unit)
     except BodyMeshError as error:
-        raise UsageError(common.one_line(error)) from None
-    fractions = common.references(args).section_fractions if args.references else None
+        raise UsageError(output.one_line(error)) from None
+    fractions = arguments.references(args).section_fractions if args.references else None
     result = measure_body_mesh(vertices, faces, fractions)
     return result.values, result.problems
 
@@ -96,15 +96,15 @@ def _print(values, as_json, path, title):
     arm or leg pieces) is left out with a warning."""
     five = [values[key] for key in MEASUREMENTS if key in values]
     if not all(math.isfinite(value) for value in five):
-        raise UsageError(f"{path}: m_T is not finite ({common.format_me(five)} cm)")
+        raise UsageError(f"{path}: m_T is not finite ({output.format_me(five)} cm)")
     lost = [key for key in ALL_MEASUREMENTS if key in values and not math.isfinite(values[key])]
     if lost:
-        common.say(f"{common.PROG} measure: warning: {path}: {', '.join(lost)} cannot be taken (no such pieces)")
+        output.say(f"{output.PROG} measure: warning: {path}: {', '.join(lost)} cannot be taken (no such pieces)")
     keys = [key for key in ALL_MEASUREMENTS if key in values and key not in lost]
     if as_json:
         print(json.dumps({key: round(values[key], 4) for key in keys}))
     else:
-        common.say(title, file=sys.stdout)
+        output.say(title, file=sys.stdout)
         for key in keys:
             print(f"  {key} {LABELS[key]:<17} {values[key]:9.2f} cm")
 
@@ -114,12 +114,12 @@ def load_json_mannequin(path):
     try:
         return Mannequin.load(path)
     except MannequinError as error:
-        text = common.one_line(error)
+        text = output.one_line(error)
         raise UsageError(text if path in text else f"{path}: {text}") from None
 
 
 def load_blend_mannequin(path, collection_name=None):
-    bpy = common.ensure_registered("reading a .blend file")
+    bpy = writing.ensure_registered("reading a .blend file")
     from ..blender.bridge.convert import collection_to_mannequin, mannequin_collections
     from ..blender.services.chatter import blender_output
 
@@ -127,7 +127,7 @@ def load_blend_mannequin(path, collection_name=None):
         with blender_output():
             bpy.ops.wm.open_mainfile(filepath=os.path.abspath(path), load_ui=False)
     except RuntimeError as error:
-        raise UsageError(f"{path}: Blender cannot open it ({common.one_line(error)})") from None
+        raise UsageError(f"{path}: Blender cannot open it ({output.one_line(error)})") from None
     candidates = [c for c in mannequin_collections() if c.ellimann.is_mannequin]
     if collection_name:
         candidates = [c for c in candidates if c.name == collection_name]

@@ -9,8 +9,8 @@ import sys
 
 from ..core.constants import MEASUREMENTS
 from ..core.synthesis.population import MAX_SAMPLES, load_population, shipped_populations
-from . import batch, common
-from .common import PROG, UsageError
+from . import arguments, batch, output, writing
+from .output import PROG, UsageError
 
 
 def add_parser(commands):
@@ -47,8 +47,8 @@ def add_parser(commands):
         "--format", default="npz", help="with --synthesize: batch's output formats (default npz, one file for all)"
     )
     population.add_argument("--dask", metavar="ADDRESS", help="with --synthesize: batch's --dask")
-    common.add_synthesis_options(population)
-    common.add_pose_option(population)  # with --synthesize: batch's --pose
+    arguments.add_synthesis_options(population)
+    arguments.add_pose_option(population)  # with --synthesize: batch's --pose
     population.set_defaults(run=run, blender=needs_blender)
 
 
@@ -68,14 +68,14 @@ def run(args):
             "the plausible limits); nothing written"
         )
     if refused:
-        common.say(
+        output.say(
             f"{PROG} population: refused {refused} of {len(rows)} sampled rows outside what a body can be "
             "(a value <= 0 cm or outside the plausible limits)"
         )
     keys = list(population.keys)
     columns = range(len(keys)) if args.extras else [keys.index(key) for key in MEASUREMENTS]
-    common.write_text(args.output, population_csv([keys[c] for c in columns], rows[:, list(columns)], accepted))
-    common.say(
+    writing.write_text(args.output, population_csv([keys[c] for c in columns], rows[:, list(columns)], accepted))
+    output.say(
         f"{PROG} population: wrote {len(rows) - refused} rows sampled from {population.name} (seed "
         f"{args.seed}) to {args.output}",
         file=sys.stdout,

@@ -4,8 +4,8 @@ import sys
 
 from ..core.errors import MannequinError
 from ..core.formats.table import FORMATS, format_of
-from . import common
-from .common import PROG, UsageError
+from . import arguments, output, writing
+from .output import PROG, UsageError
 
 
 def add_parser(commands):
@@ -27,8 +27,8 @@ def add_parser(commands):
     pose.add_argument(
         "--cushions", action="store_true", help="cushions instead of their ellipsoids (split at the joints they cross)"
     )
-    common.add_verbose(pose)
-    common.add_pose_option(pose)
+    arguments.add_verbose(pose)
+    arguments.add_pose_option(pose)
     pose.set_defaults(run=run, blender=needs_blender)
 
 
@@ -40,18 +40,18 @@ def needs_blender(args):
 def run(args):
     from ..core.mannequin.model import Mannequin
 
-    kind = common.output_kind(args.output)
+    kind = writing.output_kind(args.output)
     if args.pose is None:
         raise UsageError(f"--pose is required: one of the standard poses or a pose .json (see {PROG} pose --help)")
     if format_of(args.input) is not FORMATS["json"]:
         raise UsageError(f"IN must be a mannequin .json file, got {args.input!r}")
-    pose_file = common.check_pose_argument(args, [kind])
+    pose_file = arguments.check_pose_argument(args, [kind])
     try:
         mannequin = Mannequin.load(args.input)
     except MannequinError as error:
         raise UsageError(f"{args.input}: {error}") from None
-    frames = common.pose_frames(args, mannequin, pose_file)
-    common.write(mannequin, [args.output], None, args.cushions, frames, args.fps)
+    frames = arguments.pose_frames(args, mannequin, pose_file)
+    writing.write(mannequin, [args.output], None, args.cushions, frames, args.fps)
     count = f" ({len(frames)} frames)" if len(frames) > 1 else ""
-    common.say(f"wrote {args.output}: '{mannequin.name}' in pose {args.pose}{count}", file=sys.stdout)
+    output.say(f"wrote {args.output}: '{mannequin.name}' in pose {args.pose}{count}", file=sys.stdout)
     return 0

@@ -20,9 +20,9 @@ from ..core.fitting.reference_build import (
 from ..core.mannequin.clean import asymmetry
 from ..core.synthesis.manifest import STEM, read_manifest
 from ..core.synthesis.reference_set import load_reference_set
-from . import common
-from .common import PROG, UsageError
+from . import arguments, output, writing
 from .measure import load_json_mannequin
+from .output import PROG, UsageError
 
 ACCEPT = 5e-3  # what ``check`` lets an RM's m_T differ from its targets by (the builder's accept tolerance)
 
@@ -56,7 +56,7 @@ def add_parser(commands):
         metavar="BODY.obj",
         help="N >= 3 body meshes; each file's stem names its Reference Mannequin",
     )
-    common.add_mesh_axes(build, "--bodies", default_up="y")
+    arguments.add_mesh_axes(build, "--bodies", default_up="y")
     build.add_argument(
         "--targets",
         required=True,
@@ -79,7 +79,7 @@ def add_parser(commands):
         metavar="STEM",
         help="the body whose RM the others' axes are labelled against (default: the one nearest the targets' mean)",
     )
-    common.add_verbose(build)
+    arguments.add_verbose(build)
     build.set_defaults(run=run_build, blender=lambda args: None)
     check = actions.add_parser(
         "check",
@@ -87,7 +87,7 @@ def add_parser(commands):
         description="Validity, ranges, symmetry and how each RM meets its targets.",
     )
     check.add_argument("folder", metavar="DIR")
-    common.add_verbose(check)
+    arguments.add_verbose(check)
     check.set_defaults(run=run_check, blender=lambda args: None)
 
 
@@ -109,12 +109,12 @@ def run_build(args):
     try:
         bodies = [read_obj(path, args.up, args.unit) for path in args.bodies]
     except BodyMeshError as error:
-        raise UsageError(common.one_line(error)) from None
+        raise UsageError(output.one_line(error)) from None
     validate_inputs(base, bodies, targets)  # before the folder is made: bad input writes nothing
-    common.output_folder(str(out), "references build")
+    writing.output_folder(str(out), "references build")
 
     def progress(fraction, text):
-        common.say(f"{PROG} references build: {fraction:4.0%} {text}", file=sys.stderr)
+        output.say(f"{PROG} references build: {fraction:4.0%} {text}", file=sys.stderr)
 
     built = build_reference_set(
         base,
@@ -135,7 +135,7 @@ def run_build(args):
             "bodies_read_as": {"up": args.up, "unit": args.unit},
         },
     )
-    with common.writing(str(out), folder=True):
+    with writing.writing(str(out), folder=True):
         built.write(out)
     report = built.report
     for stem in stems:
@@ -198,5 +198,5 @@ def run_check(args):
     for line in lines:
         print(line)
     for problem in problems:
-        common.say(f"{PROG} references check: error: {problem}")
+        output.say(f"{PROG} references check: error: {problem}")
     return 1 if problems else 0

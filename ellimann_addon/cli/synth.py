@@ -8,8 +8,8 @@ from ..core.errors import ElliMannError
 from ..core.formats.table import FORMATS
 from ..core.measure.extra import EXTRA_ABSURD_LIMITS, EXTRA_LABELS, EXTRA_MEASUREMENTS
 from ..core.synthesis.request import relative_error, validate_request
-from . import common
-from .common import PROG, UsageError
+from . import arguments, output, reporting, writing
+from .output import PROG, UsageError
 
 
 def add_parser(commands):
@@ -24,7 +24,7 @@ def add_parser(commands):
         synth.add_argument(
             f"--{key.lower()}",
             dest=key,
-            type=common.number,
+            type=arguments.number,
             metavar="CM",
             help=f"{MEASUREMENT_LABELS[key]} (the female set's reference range {low:g}-{high:g}; "
             "required unless --from)",
@@ -34,7 +34,7 @@ def add_parser(commands):
         synth.add_argument(
             f"--{key.replace('_', '-')}",
             dest=key,
-            type=common.number,
+            type=arguments.number,
             metavar="CM",
             help=f"{EXTRA_LABELS[key]} ({low:g}-{high:g}; optional: met in exact mode, otherwise the reference set's)",
         )
@@ -45,7 +45,7 @@ def add_parser(commands):
         help="a body mesh (.obj, .ply, .stl; upright A-pose): measure it and synthesize with every "
         "measurement found (a measurement given as an option wins)",
     )
-    common.add_mesh_axes(synth, "--from")
+    arguments.add_mesh_axes(synth, "--from")
     synth.add_argument(
         "-o",
         "--output",
@@ -54,8 +54,8 @@ def add_parser(commands):
         help="output file: .blend, .glb, .obj, .json (ElliMann's mannequin JSON) or .xml (MJCF, for MuJoCo)",
     )
     synth.add_argument("--name", help="mannequin name (default: 'ElliMann He-Sh-Br-Wa-Hi')")
-    common.add_synthesis_options(synth)
-    common.add_pose_option(synth)
+    arguments.add_synthesis_options(synth)
+    arguments.add_pose_option(synth)
     synth.set_defaults(run=run, blender=needs_blender)
 
 
@@ -67,7 +67,7 @@ def needs_blender(args):
 
 def _kind_or_none(path):
     try:
-        return common.output_kind(path)
+        return writing.output_kind(path)
     except UsageError:
         return None
 
@@ -82,8 +82,8 @@ def _wanted(args):
         if not found:
             raise UsageError(f"{args.from_mesh}: {problems[0]}")
         for problem in problems:
-            common.say(f"{PROG} synth: warning: {args.from_mesh}: {problem}")
-        common.say(
+            output.say(f"{PROG} synth: warning: {args.from_mesh}: {problem}")
+        output.say(
             f"{args.from_mesh}: measured " + ", ".join(f"{key} {value:.2f}" for key, value in found.items()),
             file=sys.stdout,
         )
@@ -102,25 +102,25 @@ def _wanted(args):
 def run(args):
     from ..core.synthesis.synthesize import synthesize_extra
 
-    kind = common.output_kind(args.output)
-    pose_file = common.check_pose_argument(args, [kind])
+    kind = writing.output_kind(args.output)
+    pose_file = arguments.check_pose_argument(args, [kind])
     five, extra = _wanted(args)
     request = [five[key] for key in MEASUREMENTS]
-    reference = common.references(args)
+    reference = arguments.references(args)
     validate_request(request, reference.ranges, reference.absurd_limits)  # refused before any work; its warnings
     # come back from synthesis with the others
-    options = common.synthesis_options(args, args.name)
+    options = arguments.synthesis_options(args, args.name)
     try:
         mannequin, measured, warnings = synthesize_extra(reference, five, extra, options)
     except ElliMannError as error:
-        raise UsageError(common.one_line(error)) from None
+        raise UsageError(output.one_line(error)) from None
     achieved = [measured[key] for key in MEASUREMENTS]
-    misses = common.misses(achieved, request) if args.mode == "exact" else []
+    misses = reporting.misses(achieved, request) if args.mode == "exact" else []
     missed_extra = [line for line in warnings if line.startswith("exact mode missed")]
-    for warning in warnings + ([common.missed_text(misses)] if misses else []):
-        common.say(f"{PROG} synth: warning: {warning}")
-    frames = common.pose_frames(args, mannequin, pose_file)
-    common.write(
+    for warning in warnings + ([reporting.missed_text(misses)] if misses else []):
+        output.say(f"{PROG} synth: warning: {warning}")
+    frames = arguments.pose_frames(args, mannequin, pose_file)
+    writing.write(
         mannequin,
         [args.output],
         {key: measured[key] for key in MEASUREMENTS},
@@ -131,9 +131,9 @@ def run(args):
     error = relative_error(achieved, request).max()
     posed = f" in pose {args.pose}" if args.pose else ""
     extra_line = "; " + ", ".join(f"{key} {measured[key]:.2f}" for key in EXTRA_MEASUREMENTS) + " cm" if extra else ""
-    common.say(
-        f"wrote {args.output}: '{mannequin.name}'{posed} ({args.mode}), m_T {common.format_me(achieved)} cm, "
+    output.say(
+        f"wrote {args.output}: '{mannequin.name}'{posed} ({args.mode}), m_T {output.format_me(achieved)} cm, "
         f"max error {error:.3f}%{extra_line}",
         file=sys.stdout,
     )
-    return common.MISSED if misses or missed_extra else 0
+    return output.MISSED if misses or missed_extra else 0

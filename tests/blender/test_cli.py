@@ -19,8 +19,8 @@ from devkit import synthetic
 from devkit.cli_runs import assert_one_line_error, python_m, run
 from ellimann_addon import cli
 from ellimann_addon.blender.services.files import EXTRAS_KEY, read_glb_json
-from ellimann_addon.cli import common
 from ellimann_addon.cli import drape as drape_cli
+from ellimann_addon.cli import writing
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.drape.settings import DrapeSettings
 from ellimann_addon.core.mannequin.model import Mannequin
@@ -644,7 +644,7 @@ def test_a_batch_row_blender_fails_to_write_is_reported_and_the_batch_goes_on(
 
 
 def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_path, capsys, references, monkeypatch):
-    real, calls = common.write, []
+    real, calls = writing.write, []
 
     def interrupted_on_the_second_row(*args):
         calls.append(args)
@@ -652,7 +652,7 @@ def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_
             raise KeyboardInterrupt
         return real(*args)
 
-    monkeypatch.setattr(common, "write", interrupted_on_the_second_row)
+    monkeypatch.setattr(writing, "write", interrupted_on_the_second_row)
     source = write_csv(tmp_path / "in.csv", GOOD_ROWS + [(160, 40, "abc", 90, 100, "bad")])
     out = tmp_path / "out"
     code, stdout, err = run(["batch", source, "-o", str(out), "--references", references], capsys)
@@ -664,7 +664,7 @@ def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_
     assert [(r["line"], r["status"]) for r in read_report(out / "report.csv")] == [("2", "ok"), ("5", "error")]
     assert sorted(p.name for p in out.iterdir()) == ["average.json", "report.csv"]
     first = (out / "average.json").stat()
-    monkeypatch.setattr(common, "write", real)
+    monkeypatch.setattr(writing, "write", real)
     code, stdout, err = run(["batch", source, "-o", str(out), "--resume", "--references", references], capsys)
     assert code == 1 and "3 of 4 mannequins written" in stdout and "(1 already complete, kept)" in stdout
     assert (out / "average.json").stat().st_ino == first.st_ino  # kept, not written again
@@ -674,16 +674,16 @@ def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_
 
 KILLED_RUN = """
 import os, signal, sys, tempfile
-from ellimann_addon.cli import common, main
+from ellimann_addon.cli import writing, main
 from ellimann_addon.core.files import temp_prefix
-real, calls = common.write, []
+real, calls = writing.write, []
 def killed_on_the_third_row(mannequin, paths, *args):
     calls.append(paths)
     if len(calls) == 3:  # killed while writing: a temporary is on disk
         tempfile.mkstemp(prefix=temp_prefix(), suffix=".tmp", dir=os.path.dirname(paths[0]))
         os.kill(os.getpid(), signal.SIGKILL)
     return real(mannequin, paths, *args)
-common.write = killed_on_the_third_row
+writing.write = killed_on_the_third_row
 from ellimann_addon.blender.services import teardown
 teardown.exit_with(main({argv!r}))
 """

@@ -16,7 +16,7 @@ import pytest
 
 from devkit import synthetic
 from devkit.cli_runs import assert_one_line_error, run
-from ellimann_addon.cli import common, distributed
+from ellimann_addon.cli import distributed, output
 from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
 from ellimann_addon.core.formats.npz_bundle import BatchFileError, load_batch_file, read_batch_file
 from ellimann_addon.core.mannequin.model import Mannequin
@@ -184,23 +184,23 @@ def test_a_malformed_address_is_one_line(tmp_path, capsys, references, address):
 
 def test_progress_shows_count_rate_and_time_left_and_is_quiet_with_q(monkeypatch):
     stream = io.StringIO()
-    monkeypatch.setattr(common.sys, "stderr", stream)
+    monkeypatch.setattr(output.sys, "stderr", stream)
     clock = iter(range(100))
-    monkeypatch.setattr(common.time, "perf_counter", lambda: float(next(clock)))
-    progress = common.Progress(40, "batch")  # starts at t = 0; each step is a second later
+    monkeypatch.setattr(output.time, "perf_counter", lambda: float(next(clock)))
+    progress = output.Progress(40, "batch")  # starts at t = 0; each step is a second later
     for i in range(40):
         progress.step(f"row {i}")
     lines = stream.getvalue().splitlines()
     assert len(lines) == 20  # every 5% in a log
     assert lines[0] == "ellimann batch: 2/40 (1.0/s, 38 s left) row 1"
     assert lines[-1].startswith("ellimann batch: 40/40 (1.0/s, 0 s left)")
-    quiet = common.Progress(40, "batch", quiet=True)
+    quiet = output.Progress(40, "batch", quiet=True)
     stream.truncate(0)
     for _ in range(40):
         quiet.step("row")
     quiet.done()
     assert stream.getvalue().strip("\x00") == ""
-    assert common.duration(3725) == "1 h 2 min" and common.duration(75) == "1 min 15 s"
+    assert output.duration(3725) == "1 h 2 min" and output.duration(75) == "1 min 15 s"
 
 
 GRID = np.array(list(itertools.product(*[quartile_points(key) for key in MEASUREMENTS])))

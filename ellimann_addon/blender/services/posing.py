@@ -1,7 +1,7 @@
 """Posed mannequins in Blender files: the armature, every piece bound to its bone, in a pose or moving.
 
 ``write_posed`` is what the command line calls for ``--pose`` with .blend and .glb outputs
-(``cli.common.write_posed``; .json, MJCF and .obj come from ``core.formats.posed_files``): from an empty scene,
+(``cli.writing.write_posed``; .json, MJCF and .obj come from ``core.formats.posed_files``): from an empty scene,
 the rest mannequin, its armature (``services.rig``), one pose or a looping motion as an action on the
 timeline (the walk), then each file through ``services.files`` (atomically). A .blend opens posed (or
 playing the walk); a .glb is a skinned glTF in that pose with the motion as an animation.
