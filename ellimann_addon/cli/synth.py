@@ -111,7 +111,7 @@ def run(args):
     # come back from synthesis with the others
     options = arguments.synthesis_options(args, args.name)
     try:
-        mannequin, measured, warnings = synthesize_extra(reference, five, extra, options)
+        mannequin, measured, warnings = synthesize_extra(reference, five, extra, options, measure_extra=False)
     except ElliMannError as error:
         raise UsageError(output.one_line(error)) from None
     achieved = [measured[key] for key in MEASUREMENTS]

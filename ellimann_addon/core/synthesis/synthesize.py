@@ -267,10 +267,11 @@ def synthesize(reference, request, options=None, **fields):
     return batch.mannequin(0, options.name), as_dict(batch.measured[0]), warnings
 
 
-def synthesize_extra(reference, request, extra, options=None):
+def synthesize_extra(reference, request, extra, options=None, measure_extra=True):
     """One mannequin meeting the five of ``request`` (dict, cm) and the given ``extra`` measurements (exact mode;
-    IDW leaves the extra ones as the reference set gives them). Returns (Mannequin, measured {all: cm},
-    warnings); raises ExtraRequestError for a contradiction."""
+    IDW leaves the extra ones as the reference set gives them). Returns (Mannequin, measured {the five, the extra
+    ones: cm}, warnings); raises ExtraRequestError for a contradiction. ``measure_extra=False``: without any
+    ``extra`` given, measured holds the five alone (the extra ones cost more than an exact synthesis)."""
     problems = extra_request_problems(request, extra)
     if problems:
         raise ExtraRequestError(problems[0])
@@ -278,7 +279,7 @@ def synthesize_extra(reference, request, extra, options=None):
     if extra and getattr(options, "mode", "exact") == "exact":
         mannequin, measured, misses = meet_extra(mannequin, extra)
         warnings += [f"exact mode missed {line}" for line in misses]
-    else:
+    elif extra or measure_extra:
         measured = dict(measured, **mannequin_extra_measurements(mannequin))
         if extra:
             warnings.append("the extra measurements are met in exact mode only (IDW gives the reference set's)")
