@@ -7,9 +7,9 @@ machine); those within the female set's ranges L are synthesized in exact mode i
 up to a few), the largest error of any converged row, and the throughput (wall and CPU, one process).
 Also the two requests the issue found missing (He 167.1, Sh 48.06 or 49.0, Br 98.98, Wa 81.81, Hi 103.24).
 
-``python -m bench.bench_exact_population [ROWS] [--before COMMIT]`` (default 1,000,000 rows: several minutes on
-one core). ``--before``: the first BEFORE_ROWS of those requests also through COMMIT's code (a temporary git worktree, a
-process of its own), for its misses and throughput on the same requests.
+``python -m bench.bench_exact_population [ROWS] [--before COMMIT [--before-rows N]]`` (default 1,000,000 rows:
+several minutes on one core). ``--before``: the first N (BEFORE_ROWS) of those requests also through COMMIT's code
+(a temporary git worktree, a process of its own), for its misses and throughput on the same requests.
 """
 
 import json
@@ -84,8 +84,9 @@ def show(title, figures):
         print(f"    row {index}: {values}: {MEASUREMENTS[worst]} off by {error[worst]:.3f} %")
 
 
-def before(commit, rows):
-    """The first ``rows`` requests through ``commit``'s code (a worktree and a process of its own): its figures."""
+def before(commit, rows, count):
+    """The first ``count`` requests (of ``rows`` drawn) through ``commit``'s code (a worktree and a process of its
+    own): its figures."""
     with tempfile.TemporaryDirectory(prefix="ellimann-bench-exact-") as scratch:
         tree = pathlib.Path(scratch) / commit
         made = subprocess.run(
@@ -96,7 +97,7 @@ def before(commit, rows):
             return None
         try:
             done = subprocess.run(
-                [sys.executable, str(pathlib.Path(__file__).resolve()), "--child", str(rows)],
+                [sys.executable, str(pathlib.Path(__file__).resolve()), "--child", str(rows), str(count)],
                 cwd=str(tree),
                 env=dict(os.environ, PYTHONPATH=str(tree)),
                 capture_output=True,
@@ -108,7 +109,7 @@ def before(commit, rows):
     return json.loads(lines[-1]) if lines else None
 
 
-def run(rows=ROWS, commit=None):
+def run(rows=ROWS, commit=None, before_rows=BEFORE_ROWS):
     from ellimann_addon.core.synthesis.shipped import named_reference_set
     from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 
@@ -126,26 +127,32 @@ def run(rows=ROWS, commit=None):
     now = synthesize_all(requests, progress=progress)
     show("now", now)
     if commit:
-        count = min(len(requests), BEFORE_ROWS)
-        old = before(commit, rows)
+        count = min(len(requests), before_rows)
+        old = before(commit, rows, count)
         if old is not None:
             show(f"{commit} (the first {old['requests']:,} of the same requests)", old)
-            same = synthesize_all(requests[:count])
-            show(f"now (the same {count:,})", same)
+            same = now if count == len(requests) else synthesize_all(requests[:count])
+            if same is not now:
+                show(f"now (the same {count:,})", same)
             print(f"  {commit} / now, CPU time on the same requests: {old['cpu s'] / same['cpu s']:.2f}x")
 
 
-def child(rows):
+def child(rows, count):
     requests, _, _ = within_ranges(rows)
-    figures = synthesize_all(requests[:BEFORE_ROWS])
+    figures = synthesize_all(requests[:count])
     sys.stdout.write(json.dumps(figures) + "\n")
 
 
 if __name__ == "__main__":
     arguments = sys.argv[1:]
     if arguments[:1] == ["--child"]:
-        child(int(arguments[1]))
+        child(int(arguments[1]), int(arguments[2]))
     else:
-        commit = arguments[arguments.index("--before") + 1] if "--before" in arguments else None
-        numbers = [a for a in arguments if a.isdigit()]
-        run(int(numbers[0]) if numbers else ROWS, commit)
+
+        def option(name, default):
+            return arguments[arguments.index(name) + 1] if name in arguments else default
+
+        commit, before_rows = option("--before", None), int(option("--before-rows", BEFORE_ROWS))
+        named = {commit, str(before_rows)}
+        numbers = [a for a in arguments if a.isdigit() and a not in named]
+        run(int(numbers[0]) if numbers else ROWS, commit, before_rows)

@@ -17,13 +17,6 @@ from ellimann_addon.core.pose.posed_pieces import clipped_vertices
 from ellimann_addon.core.synthesis import synthesize as core_synthesis
 
 
-@pytest.fixture(autouse=True)
-def no_settle_timer_left():
-    yield
-    if bpy.app.timers.is_registered(live._settle_timer):
-        bpy.app.timers.unregister(live._settle_timer)
-
-
 @pytest.fixture
 def props():
     props = bpy.context.scene.ellimann_synthesis
