@@ -13,6 +13,7 @@ from ellimann_addon.blender.services.rig import split_sources
 from ellimann_addon.core.constants import CUSHION_LEVEL, MEASUREMENTS
 from ellimann_addon.core.geometry.cushion import cushion_vertices
 from ellimann_addon.core.geometry.mesh import convexity_defect, icosphere_level, is_closed_manifold
+from ellimann_addon.core.mannequin.skeleton import JOINT_NAMES
 from ellimann_addon.core.pose.posed_pieces import clipped_vertices
 from ellimann_addon.core.synthesis import synthesize as core_synthesis
 
@@ -140,3 +141,26 @@ def test_a_follower_runs_once_a_step_after_the_pieces_moved_with_the_budget_left
         assert placed == pytest.approx(wanted, abs=1e-6)  # the pieces had moved when it ran
         assert seconds_left < live.LIVE_STEP_BUDGET
     assert seen[1][3] < seen[2][3]
+
+
+def test_add_armature_after_live_updates_fits_the_moved_joints_and_cuts_each_cushion_once(props):
+    """Live steps leave the bones where Synthesize put them; Add Armature rigs the mannequin again at its moved
+    joints, and the cushions it had cut are cut once, from their whole hull: as a fresh Synthesize cuts them."""
+    props.output = "CUSHIONS"
+    assert bpy.ops.ellimann.synthesize_mannequin() == {"FINISHED"}
+    target = props.target
+    props.live = True
+    props.he = 166.0
+    props.live = False
+    bpy.context.view_layer.objects.active = convert.ellipsoid_objects(target)[0]
+    assert bpy.ops.ellimann.add_armature() == {"FINISHED"}
+    rig = convert.rig_object(target)
+    joints = convert.read_joints(target)
+    heads = np.array([rig.data.bones[name].head_local for name in JOINT_NAMES])
+    np.testing.assert_allclose(heads, joints, atol=1e-6)
+    assert bpy.ops.ellimann.synthesize_mannequin() == {"FINISHED"}  # the same request, from scratch
+    fresh = {(o.ellimann.part_name, o.ellimann.partner): o for o in built_objects(props.target, "CUSHION")}
+    for obj in built_objects(target, "CUSHION"):
+        twin = fresh[obj.ellimann.part_name, obj.ellimann.partner]
+        assert (split_sources(obj.data) is None) == (split_sources(twin.data) is None)
+        np.testing.assert_allclose(convert.mesh_vertices(obj.data), convert.mesh_vertices(twin.data), atol=1e-6)

@@ -18,6 +18,7 @@ import numpy as np
 from mathutils import Matrix, Vector
 
 from ...core.errors import ElliMannError
+from ...core.geometry.cushion import cushion_meshes
 from ...core.geometry.mesh import icosphere_level
 from ...core.mannequin.skeleton import (
     JOINT_INDEX,
@@ -242,6 +243,8 @@ def bind_cushions(collection, mannequin, rig=None):
         if joint is None:
             _set_weights(cushion, {first_bone: np.ones(len(cushion.data.vertices))})
         else:
+            if cushion.data.get(HULL_LEVEL_KEY) is not None:  # cut before (a rig built again): the whole hull first
+                _whole_hull(cushion, mannequin, (topology.index[first], topology.index[second]))
             _split_at_joint(
                 cushion,
                 joints[joint],
@@ -281,6 +284,19 @@ def _split_at_joint(cushion, point, toward, first_bone, second_bone):
         bpy.data.meshes.remove(old)
     mesh.name = cushion.name
     _set_weights(cushion, weights)
+
+
+def _whole_hull(cushion, mannequin, pair):
+    """Give a cushion that was cut at its joint the whole hull of its pair back, at the level it was cut from."""
+    ((vertices, faces),) = cushion_meshes(
+        [tuple((mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i]) for i in pair)],
+        int(cushion.data[HULL_LEVEL_KEY]),
+    )
+    inverse = np.linalg.inv(np.array(cushion.matrix_world))
+    old = cushion.data
+    cushion.data = mesh_from_arrays(old.name, vertices @ inverse[:3, :3].T + inverse[:3, 3], faces)
+    if old.users == 0:
+        bpy.data.meshes.remove(old)
 
 
 def split_sources(mesh):
