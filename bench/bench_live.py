@@ -10,7 +10,8 @@ for it. Printed: the median ms of each case per tree over all rounds, wall and C
 the mercy of other work on a shared machine), and each older tree's median over this tree's. Each tree uses its
 own shipped Reference Mannequins (eb01e27's had no joints, so no armature).
 
-``python -m bench.bench_live [COMMIT ...]`` (default: eb01e27, the last commit before the posing work).
+``python -m bench.bench_live [COMMIT ...]`` (default: eb01e27, from before the posing work and the extra
+measurements: the commit issue 26 measured the step against).
 """
 
 import json
