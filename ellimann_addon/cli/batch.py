@@ -353,7 +353,7 @@ def _row(
         return row
     try:
         if paths:
-            frames = arguments.pose_frames(args, mannequin, pose_file)
+            frames = arguments.pose_frames(args, mannequin, pose_file, notes)
             writing.write(mannequin, paths, as_dict(measured), args.cushions, frames, args.fps)
     except (ElliMannError, OSError, RuntimeError) as error:
         output.say(f"{PROG} batch: line {line}: failed: {output.one_line(error)}")

@@ -28,6 +28,7 @@ from ...core.mannequin.skeleton import (
     part_bones,
 )
 from ...core.pose import bones as core_bones
+from ...core.pose.bone_match import PREFERRED_CHILD
 from ...core.pose.kinematics import require_joints
 from ...core.pose.motion import clamped_motion, loop_drift
 from ...core.pose.posed_pieces import clip_convex_mesh
@@ -35,8 +36,6 @@ from ...core.pose.standard import WALK_FPS
 from ..bridge.built import built_objects
 from ..bridge.convert import RIG_KEY, ellipsoid_objects, mesh_from_arrays, rig_object, unit_sphere_mesh, world_triangles
 
-# The bone of a joint with several children points at this one (the spine's, not a hip's or a collar's).
-PREFERRED_CHILD = {JOINT_INDEX["Pelvis"]: JOINT_INDEX["Spine1"], JOINT_INDEX["Spine3"]: JOINT_INDEX["Neck"]}
 FREE_RANGE = 2 * np.pi - 1e-9  # an axis whose range spans a whole turn gets no limit (the root)
 MODIFIER_NAME = "ElliMann Rig"
 CONSTRAINT_NAME = "ElliMann Limits"

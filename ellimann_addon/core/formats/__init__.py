@@ -1,5 +1,6 @@
 """File formats ElliMann writes without Blender, and the table of every format (floor 5: everything below).
 
+- bvh: BVH motion-capture clips read with numpy, their units said, their bones matched
 - core_writers: OBJ, JSON and MJCF mannequin files by extension
 - mjcf: MJCF (MuJoCo) of a mannequin's convex pieces
 - mjcf_articulated: MJCF of a mannequin with joints: an articulated body, poses as keyframes
