@@ -210,6 +210,22 @@ RIGS = {
         ],
     ),
 }
+RIGS["unreal5"] = dict(
+    RIGS["unreal"],
+    bones=[
+        ("root", None, None, ("Pelvis", "floor")),
+        ("pelvis", "root", "Pelvis", "Pelvis"),
+        ("spine_01", "pelvis", "Spine1", "Spine1"),
+        ("spine_02", "spine_01", None, ("Spine1", "Spine2", 0.5)),
+        ("spine_03", "spine_02", "Spine2", "Spine2"),
+        ("spine_04", "spine_03", None, ("Spine2", "Spine3", 0.5)),
+        ("spine_05", "spine_04", "Spine3", "Spine3"),
+        ("neck_01", "spine_05", "Neck", "Neck"),
+        ("neck_02", "neck_01", None, ("Neck", "Head", 0.5)),
+        ("head", "neck_02", "Head", "Head"),
+        *[b if b[1] != "spine_03" else (b[0], "spine_05", b[2], b[3]) for b in RIGS["unreal"]["bones"][7:]],
+    ],
+)
 RIGS["smplx"] = dict(
     RIGS["smpl"],
     bones=[b for b in RIGS["smpl"]["bones"] if not b[0].endswith("_hand")]

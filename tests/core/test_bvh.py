@@ -167,6 +167,10 @@ def test_the_feet_against_the_floor_are_said_and_held_on_request(average, tmp_pa
     posed_lowest = clips_lowest(average, held.poses)
     assert np.abs(posed_lowest).max() < 1e-9
     assert held.floor_line() == "feet: held on the floor in every frame (the root moved by up to 5.0 cm)"
+    clip.positions[0] = clip.heads[0] + np.array([0.0, 0.0, 0.03]) * (np.arange(8) == 5)[:, None]
+    read = read_bvh(bvh.write_bvh(tmp_path / "jump.bvh", clip))
+    line = clip_onto(average, read.motion, read.match).floor_line()
+    assert line == "feet: over the clip the lowest foot floats up to 3.0 cm above the floor (frame 6)"
 
 
 def clips_lowest(mannequin, poses):
@@ -300,6 +304,6 @@ def test_a_clip_without_a_known_limb_is_refused_naming_its_bones():
         match_bones(["Wurzel", "Bein", "Fuss"], [-1, 0, 1], source="unknown.bvh")
     assert str(refused.value) == (
         "bones: no limb recognised among the 3 bones of unknown.bvh (Wurzel, Bein, Fuss): no listed rig's names "
-        "(biovision, cmu, mixamo, lafan1, makehuman, smpl, unreal, rokoko, unreal5) and no side and part in a name "
+        "(biovision, cmu, mixamo, lafan1, makehuman, smpl, unreal5, unreal, rokoko) and no side and part in a name "
         "(LeftUpLeg, thigh_l, upperarm.L, ...)"
     )

@@ -108,7 +108,8 @@ class ClipOnMannequin:
         if below > FLOOR_TOLERANCE:
             parts.append(f"sinks up to {100 * below:.1f} cm below the floor (frame {low + 1})")
         if above > FLOOR_TOLERANCE:
-            parts.append(f"floats up to {100 * above:.1f} cm above it (frame {high + 1})")
+            where = "it" if parts else "the floor"
+            parts.append(f"floats up to {100 * above:.1f} cm above {where} (frame {high + 1})")
         return f"feet: over the clip the lowest foot {' and '.join(parts)}{hint}"
 
 

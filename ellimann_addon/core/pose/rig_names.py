@@ -29,6 +29,17 @@ _MOTION_CAPTURE_LIMBS = {
     "{Side}Hand": "Wrist",
 }
 _MOTION_CAPTURE_SPINE = {"Hips": "Pelvis", "Spine": "Spine1", "Spine1": "Spine2", "Spine2": "Spine3"}
+_UNREAL_LIMBS = {
+    "thigh_{s}": "Hip",
+    "calf_{s}": "Knee",
+    "foot_{s}": "Ankle",
+    "ball_{s}": "Foot",
+    "clavicle_{s}": "Collar",
+    "upperarm_{s}": "Shoulder",
+    "lowerarm_{s}": "Elbow",
+    "hand_{s}": "Wrist",
+    "middle_01_{s}": "Hand",
+}
 _SMPL_JOINTS = ("Hip", "Knee", "Ankle", "Foot", "Collar", "Shoulder", "Elbow", "Wrist", "Hand")
 
 RIG_NAME_MAPS = {
@@ -108,27 +119,16 @@ RIG_NAME_MAPS = {
         **_sided({}, {f"{{side}}_{j.lower()}": j for j in _SMPL_JOINTS}),
         **_sided({}, {"{side}_middle1": "Hand"}),
     },
-    # Unreal's mannequin (UE4's three spine bones; UE5's five in "unreal5").
+    # Unreal's mannequins: UE5's Manny and Quinn (five spine bones, the clavicles on spine_05), UE4's (three).
+    "unreal5": _sided(
+        {"pelvis": "Pelvis", "spine_01": "Spine1", "spine_03": "Spine2", "spine_05": "Spine3"}
+        | {"neck_01": "Neck", "head": "Head"},
+        _UNREAL_LIMBS,
+    ),
     "unreal": _sided(
-        {
-            "pelvis": "Pelvis",
-            "spine_01": "Spine1",
-            "spine_02": "Spine2",
-            "spine_03": "Spine3",
-            "neck_01": "Neck",
-            "head": "Head",
-        },
-        {
-            "thigh_{s}": "Hip",
-            "calf_{s}": "Knee",
-            "foot_{s}": "Ankle",
-            "ball_{s}": "Foot",
-            "clavicle_{s}": "Collar",
-            "upperarm_{s}": "Shoulder",
-            "lowerarm_{s}": "Elbow",
-            "hand_{s}": "Wrist",
-            "middle_01_{s}": "Hand",
-        },
+        {"pelvis": "Pelvis", "spine_01": "Spine1", "spine_02": "Spine2", "spine_03": "Spine3"}
+        | {"neck_01": "Neck", "head": "Head"},
+        _UNREAL_LIMBS,
     ),
     # Rokoko Studio's actor (Hips, LeftThigh, LeftShin, ..., Spine1 to Spine4: the clavicles hang on Spine4).
     "rokoko": _sided(
@@ -146,12 +146,6 @@ RIG_NAME_MAPS = {
         },
     ),
 }
-RIG_NAME_MAPS["unreal5"] = {
-    **{k: v for k, v in RIG_NAME_MAPS["unreal"].items() if not k.startswith("spine_")},
-    "spine_01": "Spine1",
-    "spine_03": "Spine2",
-    "spine_05": "Spine3",
-}
 RIG_LABELS = {
     "biovision": "Biovision",
     "cmu": "CMU",
@@ -159,8 +153,8 @@ RIG_LABELS = {
     "lafan1": "LAFAN1",
     "makehuman": "MakeHuman/MPFB",
     "smpl": "SMPL/SMPL-X",
-    "unreal": "Unreal mannequin (UE4)",
     "unreal5": "Unreal mannequin (UE5)",
+    "unreal": "Unreal mannequin (UE4)",
     "rokoko": "Rokoko",
 }
 _FOLDED = {rig: {name.lower(): joint for name, joint in names.items()} for rig, names in RIG_NAME_MAPS.items()}

@@ -17,7 +17,7 @@ from ...services.rig import apply_motion
 from ..base import MannequinOperator, OperatorError, mannequin_or_cancel, plural
 from .operators import has_rig
 
-SHOWN_LINES = 12  # lines of the last import the panel shows (the Info log has them all)
+SHOWN_LINES = 12  # lines of the last import the panel shows (the Info log has them in full)
 
 
 def motion_onto(collection, path, rig="auto", keep_on_floor=False):
@@ -36,6 +36,24 @@ def import_lines(clip, onto):
     warnings += onto.clamp_lines()
     hint = "; Keep on Floor holds it on the floor" if not onto.held else ""
     return warnings, [*clip.lines()[1:], onto.floor_line(hint)]
+
+
+def panel_lines(clip, onto):
+    """The outcome of an import, short enough for the sidebar: what will not bend, each clamp, what was not
+    placed, the joints without a bone, where the feet went."""
+    match, lines = clip.match, []
+    lines += [f"will not bend: {joint} (between {a} and {b})" for joint, (a, b) in match.stiff.items()]
+    lines += [
+        f"{c.joint} {c.axis}: {c.frames}/{c.total} frames, worst {c.worst:.0f}\u00b0 (frame {c.frame}), "
+        f"range {c.low:.0f} to {c.high:.0f}"
+        for c in onto.clamps
+        if not c.slight
+    ]
+    lines += [f"not placed: {', '.join(match.unplaced)}"] if match.unplaced else []
+    lines += [f"no bone: {', '.join(match.unsourced)}"] if match.unsourced else []
+    low, high = onto.lowest.min(), onto.lowest.max()
+    feet = f"feet: {100 * low:+.1f} to {100 * high:+.1f} cm from the floor"
+    return lines + [feet + (" (held on it)" if onto.held else "")]
 
 
 class ELLIMANN_OT_import_bvh(MannequinOperator, ImportHelper, bpy.types.Operator):
@@ -78,7 +96,7 @@ class ELLIMANN_OT_import_bvh(MannequinOperator, ImportHelper, bpy.types.Operator
             + (f"; {plural(len(clamped), 'joint')} clamped" if clamped else "")
             + (f"; will not bend: {stiff}" if stiff else "")
         )
-        props.status = "\n".join([f"{name}: {outcome}", *warnings, *information][:SHOWN_LINES])
+        props.status = "\n".join([f"{name}: {outcome}", *panel_lines(clip, onto)][:SHOWN_LINES])
         self.report(
             {"WARNING" if warnings else "INFO"},
             f"Imported '{name}' onto '{collection.name}' as action '{action.name}': {outcome}",
