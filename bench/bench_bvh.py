@@ -5,11 +5,10 @@ and the memory a frame takes (tracemalloc, 600 frames against 200) beside the es
 
 import tempfile
 import time
-import tracemalloc
 from pathlib import Path
 
 from devkit import bvh, clips
-from ellimann_addon.core.formats.bvh import bytes_needed, read_bvh
+from ellimann_addon.core.formats.bvh import read_bvh
 from ellimann_addon.core.formats.posed_files import write_posed
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.pose.clip import clip_onto
@@ -46,19 +45,10 @@ def run():
             f"{core / importer:.2f}x its time"
         )
         print(f"  Import BVH operator end to end   {operator:6.2f} s")
-    peaks = []
-    for frames in (200, 600):
-        small = bvh.write_bvh(folder / "small.bvh", clips.convention_clip("mixamo", average.joints, frames=frames))
-        tracemalloc.start()
-        read = read_bvh(small)
-        write_posed(average, clip_onto(average, read.motion, read.match).poses, folder / "small.json")
-        peaks.append(tracemalloc.get_traced_memory()[1])
-        tracemalloc.stop()
-    channels = sum(3 + 3 * (i in clip.positions) for i in range(len(clip.names)))
-    estimate = (bytes_needed(600, channels, len(clip.names)) - bytes_needed(200, channels, len(clip.names))) / 400
+    measured, estimated = clips.bytes_per_frame("mixamo", average, folder)
     print(
-        f"  memory a frame (read, retarget, .json): {(peaks[1] - peaks[0]) / 400 / 1e3:.1f} KB measured, "
-        f"{estimate / 1e3:.1f} KB estimated"
+        f"  memory a frame (read, retarget, .json): {measured / 1e3:.1f} KB measured, "
+        f"{estimated / 1e3:.1f} KB estimated"
     )
 
 

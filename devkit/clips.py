@@ -8,7 +8,7 @@ and the right elbow over-straightens (beyond their limits, to be clamped).
 
 import numpy as np
 
-from devkit.bvh import Clip, axis_rotation, mirrored, rotation_x
+from devkit.bvh import Clip, axis_rotation, mirrored, rotation_x, write_bvh
 from ellimann_addon.core.mannequin.skeleton import JOINT_INDEX, JOINT_NAMES, PARENTS
 from ellimann_addon.core.pose.kinematics import forward_kinematics
 from ellimann_addon.core.pose.standard import attention, t_pose
@@ -391,3 +391,28 @@ def convention_clip(convention, joints, frames=24, seed=1, mirror=False, stretch
         twin_indices(names),
     )
     return mirrored(clip) if mirror else clip
+
+
+def bytes_per_frame(convention, mannequin, folder, counts=(200, 600)):
+    """(measured, estimated) bytes a frame takes to read a clip of ``convention``, retarget it onto ``mannequin``
+    and write it as .json: the peaks tracemalloc sees at two lengths, and core.formats.bvh.bytes_needed's."""
+    import tracemalloc
+    from pathlib import Path
+
+    from ellimann_addon.core.formats.bvh import bytes_needed, read_bvh
+    from ellimann_addon.core.formats.posed_files import write_posed
+    from ellimann_addon.core.pose.clip import clip_onto
+
+    peaks, sizes = [], []
+    for frames in counts:
+        clip = convention_clip(convention, mannequin.joints, frames=frames)
+        path = write_bvh(Path(folder) / "memory.bvh", clip)
+        tracemalloc.start()
+        read = read_bvh(path)
+        write_posed(mannequin, clip_onto(mannequin, read.motion, read.match).poses, Path(folder) / "memory.json")
+        peaks.append(tracemalloc.get_traced_memory()[1])
+        tracemalloc.stop()
+        channels = 3 * len(clip.names) + 3 * len(clip.positions)
+        sizes.append(bytes_needed(frames, channels, len(read.motion.names)))
+    span = counts[1] - counts[0]
+    return (peaks[1] - peaks[0]) / span, (sizes[1] - sizes[0]) / span

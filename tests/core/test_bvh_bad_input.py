@@ -127,22 +127,8 @@ def test_a_clip_too_long_for_the_memory_is_refused_from_its_header(good, tmp_pat
 def test_the_estimate_per_frame_covers_what_a_frame_takes(tmp_path):
     """What tracemalloc sees reading, retargeting and writing a clip to .json, 600 frames against 200: the
     estimate per frame is above it and within four times it."""
-    import tracemalloc
-
-    from ellimann_addon.core.formats.posed_files import write_posed
-    from ellimann_addon.core.pose.clip import clip_onto
-
     average = Mannequin.load(REFERENCE_FOLDER / "average.json")
-    peaks = []
-    for frames in (200, 600):
-        path = bvh.write_bvh(tmp_path / "long.bvh", clips.convention_clip("lafan1", average.joints, frames=frames))
-        tracemalloc.start()
-        read = read_bvh(path)
-        write_posed(average, clip_onto(average, read.motion, read.match).poses, tmp_path / "long.json")
-        peaks.append(tracemalloc.get_traced_memory()[1])
-        tracemalloc.stop()
-    measured = (peaks[1] - peaks[0]) / 400
-    estimated = (bytes_needed(600, 69, 22) - bytes_needed(200, 69, 22)) / 400
+    measured, estimated = clips.bytes_per_frame("lafan1", average, tmp_path)
     assert measured < estimated < 4 * measured, (measured, estimated)
 
 
