@@ -186,3 +186,22 @@ def test_a_clip_writes_a_skinned_glb_with_its_animation_and_a_blend_with_its_act
     assert action.name.endswith("walk.bvh") and all(len(c.keyframe_points) == 12 for c in action_fcurves(action, rig))
     assert not any(m.type == "CYCLES" for c in action_fcurves(action, rig) for m in c.modifiers)
     assert (bpy.context.scene.frame_start, bpy.context.scene.frame_end) == (1, 12)
+
+
+def test_the_command_line_writes_a_clip_to_blend_and_glb(average, tmp_path, capsys):
+    from devkit.cli_runs import run
+
+    clip = bvh.write_bvh(tmp_path / "walk.bvh", clips.convention_clip("lafan1", average.joints, frames=10))
+    rest = tmp_path / "rest.json"
+    average.save(rest)
+    for out in ("walk.blend", "walk.glb"):
+        code, stdout, _ = run(
+            ["pose", str(rest), "--pose", str(clip), "--fps", "20", "-o", str(tmp_path / out)], capsys
+        )
+        assert code == 0 and "(7 frames)" in stdout  # 10 frames at 30 fps: 0.3 s, 7 frames at 20
+    doc, binary = gltf_skin.read_glb(tmp_path / "walk.glb")
+    times = gltf_skin.accessor(doc, binary, doc["animations"][0]["samplers"][0]["input"]).ravel()
+    assert len(times) == 7 and times[-1] - times[0] == pytest.approx(0.3, abs=1e-4)
+    bpy.ops.wm.open_mainfile(filepath=str(tmp_path / "walk.blend"))
+    scene = bpy.context.scene
+    assert (scene.frame_end, scene.render.fps / scene.render.fps_base) == (7, pytest.approx(20.0))
