@@ -20,13 +20,15 @@ from .operators import has_rig
 SHOWN_LINES = 12  # lines of the last import the panel shows (the Info log has them in full)
 
 
-def motion_onto(collection, path, rig="auto", keep_on_floor=False):
+def motion_onto(collection, path, rig="auto", keep_on_floor=False, progress=lambda step: None):
     """(the clip read, its ``core.pose.clip.ClipOnMannequin`` on a mannequin collection); ElliMannError (nothing
-    changed) for a file that is not a clip ElliMann can use or a mannequin without joints."""
+    changed) for a file that is not a clip ElliMann can use or a mannequin without joints. ``progress(1)`` once
+    the clip is read."""
     mannequin = mannequin_or_cancel(collection)
     if mannequin.joints is None:
         raise ElliMannError(f"joints: '{collection.name}' has no joints (rig it again: Add Armature)")
     clip = read_bvh(path, rig)
+    progress(1)
     return clip, clip_onto(mannequin, clip.motion, clip.match, keep_on_floor, clip.name)
 
 
@@ -72,14 +74,21 @@ class ELLIMANN_OT_import_bvh(MannequinOperator, ImportHelper, bpy.types.Operator
         return hasattr(context.scene, "ellimann_pose") and has_rig(context)
 
     def run(self, context, collection):
-        props = context.scene.ellimann_pose
+        props, window_manager = context.scene.ellimann_pose, context.window_manager
+        window_manager.progress_begin(0, 3)  # read, retargeted, baked
         try:
-            clip, onto = motion_onto(collection, self.filepath, props.rig, props.keep_on_floor)
-        except ElliMannError as error:
-            raise OperatorError(f"Cannot import onto '{collection.name}': {error}") from error
+            try:
+                clip, onto = motion_onto(
+                    collection, self.filepath, props.rig, props.keep_on_floor, window_manager.progress_update
+                )
+            except ElliMannError as error:
+                raise OperatorError(f"Cannot import onto '{collection.name}': {error}") from error
+            window_manager.progress_update(2)
+            name = os.path.splitext(clip.name)[0]
+            action = apply_motion(rig_object(collection), onto.poses, name)
+        finally:
+            window_manager.progress_end()
         scene = context.scene
-        name = os.path.splitext(clip.name)[0]
-        action = apply_motion(rig_object(collection), onto.poses, name)
         scene.render.fps = max(1, round(clip.motion.fps))
         scene.render.fps_base = scene.render.fps / clip.motion.fps
         scene.frame_start, scene.frame_end = 1, len(onto.poses)
