@@ -4,7 +4,8 @@ code before the batch streamed.
 
 Rows: ``ellimann population --stats ansur2_female --seed 1`` (the first N rows of one draw, so every count is a
 prefix of the largest). Each batch runs in a child process (``python -m ellimann_addon``, from the tree's root);
-its peak resident memory is the child's ``ru_maxrss`` (``os.wait4``), its time the wall clock. Memory flat in
+its peak resident memory is the child's ``ru_maxrss`` (``os.wait4`` in a small launcher process), its time the
+wall clock. Memory flat in
 the row count means the largest batch's peak within a few times the smallest's; the ratios are printed against
 the first run of this tree.
 
@@ -13,13 +14,13 @@ the first run of this tree.
 """
 
 import argparse
+import itertools
 import os
 import pathlib
 import shutil
 import subprocess
 import sys
 import tempfile
-import time
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
@@ -31,26 +32,36 @@ def people(path, rows):
     return path
 
 
+# Run in a small interpreter of its own, which starts the batch and reports the batch's rusage: a process started
+# straight from this one would count this one's memory in its peak (Linux carries the memory high-water mark of the
+# process image an exec replaces, and subprocess may share this process's until the exec).
+LAUNCHER = """
+import os, subprocess, sys, time
+start = time.perf_counter()
+child = subprocess.Popen(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+_, status, usage = os.wait4(child.pid, 0)
+print(time.perf_counter() - start, usage.ru_maxrss, os.waitstatus_to_exitcode(status))
+"""
+
+
 def measured_batch(tree, csv_path, out, mode):
     """(seconds, peak resident memory in bytes, exit code) of one batch run by ``tree``'s code in a child process."""
     shutil.rmtree(out, ignore_errors=True)
     command = [sys.executable, "-m", "ellimann_addon", "batch", str(csv_path), "-o", str(out), "--format", "npz"]
-    start = time.perf_counter()
-    child = subprocess.Popen(
-        [*command, "--mode", mode, "-q"], cwd=tree, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    done = subprocess.run(
+        [sys.executable, "-c", LAUNCHER, *command, "--mode", mode, "-q"], cwd=tree, capture_output=True, text=True
     )
-    _, status, usage = os.wait4(child.pid, 0)
-    seconds = time.perf_counter() - start
-    child.returncode = os.waitstatus_to_exitcode(status)
-    return seconds, usage.ru_maxrss * 1024, child.returncode
+    seconds, kilobytes, code = done.stdout.split()
+    return float(seconds), int(kilobytes) * 1024, int(code)  # Linux gives ru_maxrss in KiB
 
 
 def run(rows=(2_000, 20_000), mode="exact", old=None, old_rows=None, keep=None):
     folder = pathlib.Path(keep or tempfile.mkdtemp(prefix="ellimann-bench-batch-"))
     folder.mkdir(parents=True, exist_ok=True)
     largest = max([*rows, *(old_rows or ())])
-    source = people(folder / f"people-{largest}.csv", largest)
-    lines = source.read_text().splitlines(keepends=True)
+    source = folder / f"people-{largest}.csv"
+    if not source.exists():
+        people(source, largest)
     trees = [("this tree", ROOT, rows)] + ([("--old", pathlib.Path(old), old_rows or rows)] if old else [])
     print(f"batch --format npz --mode {mode}, ANSUR II female seed 1; {os.cpu_count()} cores, load {_load()}")
     print(f"{'code':<10} {'rows':>9} {'wall s':>8} {'ms/row':>7} {'peak GB':>8} {'x first':>8} {'exit':>5}")
@@ -59,8 +70,9 @@ def run(rows=(2_000, 20_000), mode="exact", old=None, old_rows=None, keep=None):
         for label, tree, counts in trees:
             for count in counts:
                 csv_path = folder / f"people-{count}.csv"
-                if not csv_path.exists():
-                    csv_path.write_text("".join(lines[: count + 1]))
+                if not csv_path.exists():  # the first rows of the largest draw, streamed
+                    with source.open() as lines, csv_path.open("w") as prefix:
+                        prefix.writelines(itertools.islice(lines, count + 1))
                 seconds, peak, code = measured_batch(tree, csv_path, folder / "out", mode)
                 first = first or peak
                 print(

@@ -78,11 +78,10 @@ def test_a_file_that_is_not_a_batch_is_refused_naming_the_field(tmp_path):
         load_batch_file(tmp_path / "cut.npz")
 
 
-def test_the_command_line_imports_dask_only_for_dask():
-    code = (
-        "import sys, ellimann_addon.cli as cli; cli.build_parser(); "
-        "print(sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')))"
-    )
+def loaded_by(statement, where):
+    """The modules ``statement`` loads (in a fresh interpreter at the repository's root) that ``where(name)``
+    picks, sorted."""
+    code = f"import sys; {statement}; print(sorted(m for m in sys.modules if ({where})(m)))"
     done = subprocess.run(
         [sys.executable, "-c", code],
         capture_output=True,
@@ -90,7 +89,12 @@ def test_the_command_line_imports_dask_only_for_dask():
         check=True,
         cwd=os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
     )
-    assert done.stdout.strip() == "[]"
+    return done.stdout.strip()
+
+
+def test_the_command_line_imports_dask_only_for_dask():
+    dask = "lambda m: m.split('.')[0] in ('dask', 'distributed')"
+    assert loaded_by("import ellimann_addon.cli as cli; cli.build_parser()", dask) == "[]"
 
 
 def test_dask_local_cluster_writes_the_serial_files_byte_for_byte(tmp_path, capsys, references):
@@ -343,18 +347,8 @@ def test_a_batch_streams_in_the_csvs_order_across_chunks_and_reference_sets(tmp_
 
 
 def test_the_dask_worker_imports_the_core_only():
-    code = (
-        "import sys, ellimann_addon.core.synthesis.batch; "
-        "print(sorted(m for m in sys.modules if m.startswith('ellimann_addon.') and '.core' not in m))"
-    )
-    done = subprocess.run(
-        [sys.executable, "-c", code],
-        capture_output=True,
-        text=True,
-        check=True,
-        cwd=os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
-    )
-    assert done.stdout.strip() == "[]"
+    outside_core = "lambda m: m.startswith('ellimann_addon.') and not m.startswith('ellimann_addon.core')"
+    assert loaded_by("import ellimann_addon.core.synthesis.batch", outside_core) == "[]"
 
 
 def test_batch_meets_extra_measurements_as_synth_does_and_reports_each(tmp_path, capsys):

@@ -46,22 +46,8 @@ _ORDER = (  # the archive's entries, in order (joints and joint_names only where
     "joints",
     "joint_names",
 )
-_REQUIRED = (
-    "format",
-    "version",
-    "names",
-    "requests_cm",
-    "measured_cm",
-    "factors",
-    "converged",
-    "rotation",
-    "center",
-    "semi_axes",
-    "measurement_keys",
-    "part_names",
-    "topology_json",
-    "mode",
-)
+_OPTIONAL = ("joints", "joint_names")
+_REQUIRED = tuple(key for key in _ORDER if key not in _OPTIONAL)
 
 
 def batch_arrays(
