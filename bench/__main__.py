@@ -19,6 +19,7 @@ BENCHES = (
     "bench_scan_held_out",
     "bench_extra",
     "bench_bvh",
+    "bench_batch",
 )
 
 

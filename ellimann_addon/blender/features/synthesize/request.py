@@ -40,10 +40,12 @@ def extra_of(props):
 
 def synthesize_request(props, extra=None):
     """(Mannequin, measured {the five and the extra ones: cm}, warnings) of the panel's request; ``extra``
-    overrides the panel's extra measurements (a body's, for Synthesize from Mesh)."""
-    return synthesize_extra(
+    overrides the panel's extra measurements (a body's, for Synthesize from Mesh). What exact mode missed is one of
+    the warnings."""
+    result = synthesize_extra(
         reference_of(props), request_of(props), extra_of(props) if extra is None else extra, options_of(props)
     )
+    return result.mannequin, result.measured, result.warnings
 
 
 def options_of(props):
