@@ -20,6 +20,8 @@ BENCHES = (
     "bench_scan",
     "bench_scan_held_out",
     "bench_extra",
+    "bench_bvh",
+    "bench_batch",
 )
 
 

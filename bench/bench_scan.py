@@ -40,9 +40,9 @@ def twin_overlaps(reference, body, found):
     five, extra = split_measurements(found)
     iou, missed = [], []
     for given in ({}, extra):
-        mannequin, _, warnings = synthesize_extra(reference, five, given)
-        missed += [line.split()[3] for line in warnings if line.startswith("exact mode missed")]
-        iou.append(overlap(mannequin, body))
+        result = synthesize_extra(reference, five, given)
+        missed += [miss.key for miss in result.missed]
+        iou.append(overlap(result.mannequin, body))
     return iou[0], iou[1], missed
 
 
@@ -65,7 +65,7 @@ def run():
         gains.append(all_iou - five_iou)
         alone = []
         for key, value in extra.items():
-            mannequin, _, _ = synthesize_extra(reference, five, {key: value})
+            mannequin = synthesize_extra(reference, five, {key: value}).mannequin
             alone.append(f"{key} {overlap(mannequin, body) - five_iou:+.3f}")
         print(
             f"{name:<17} {statistics.median(times):9.2f} {worst:22.3f} {five_iou:9.3f} {all_iou:8.3f} "

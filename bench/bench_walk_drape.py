@@ -24,8 +24,9 @@ from ellimann_addon.core.drape.colliders import collision_pieces, triangle_count
 from ellimann_addon.core.drape.fit_metrics import BodyPieces, fit_statistics, mesh_distance
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.mannequin.model import Mannequin
-from ellimann_addon.core.mannequin.skeleton import JOINT_NAMES, RIG_NAME_MAPS
+from ellimann_addon.core.mannequin.skeleton import JOINT_NAMES
 from ellimann_addon.core.pose.motion import clamped_motion
+from ellimann_addon.core.pose.rig_names import RIG_NAME_MAPS
 from ellimann_addon.core.synthesis.synthesize import REFERENCE_FOLDER
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]

@@ -6,7 +6,8 @@ holds), not captured from a window.
     .venv/bin/python -m tools.panel_picture references --out docs/images/reference_set_panel.png
 
 ``references``: the Reference Set panel with the shipped Base Mannequin and the five reference bodies
-of ../shared/refmodels typed with their Table 2.3 targets.
+of ../shared/refmodels typed with their Table 2.3 targets. ``pose``: the Pose panel of the Average RM after
+Import BVH of devkit.clips' CMU-named test clip.
 """
 
 import argparse
@@ -175,9 +176,26 @@ def references_scene(refmodels):
     props.progress = 0.62
 
 
+def pose_scene():
+    """The Average RM rigged, devkit.clips' CMU test clip imported onto it (the operator's own path)."""
+    import bpy
+
+    from devkit import bvh, clips
+    from ellimann_addon.blender.services.scene import add_mannequin
+    from ellimann_addon.core.mannequin.model import Mannequin
+    from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
+
+    average = Mannequin.load(REFERENCE_FOLDER / "average.json")
+    collection = add_mannequin(average)
+    bpy.context.view_layer.objects.active = next(iter(collection.objects))
+    bpy.ops.ellimann.add_armature()
+    path = pathlib.Path(tempfile.mkdtemp(prefix="ellimann-panel-")) / "cmu_walk.bvh"
+    bpy.ops.ellimann.import_bvh(filepath=str(bvh.write_bvh(path, clips.convention_clip("cmu", average.joints))))
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m tools.panel_picture", description=__doc__.splitlines()[0])
-    parser.add_argument("panel", choices=("references",))
+    parser.add_argument("panel", choices=("references", "pose"))
     parser.add_argument("--out", type=pathlib.Path, required=True)
     parser.add_argument("--refmodels", type=pathlib.Path, default=REPO.parent / "shared" / "refmodels")
     args = parser.parse_args(argv)
@@ -190,8 +208,14 @@ def main(argv=None):
 
     ellimann_addon.register()
     bpy.ops.wm.read_homefile(use_empty=True)
-    references_scene(args.refmodels)
-    draw("Reference Set", draw_panel(ELLIMANN_PT_references, recorder=tagged_recorder()).log, args.out)
+    if args.panel == "pose":
+        from ellimann_addon.blender.features.pose.panel import ELLIMANN_PT_pose
+
+        pose_scene()
+        draw("Pose", draw_panel(ELLIMANN_PT_pose, recorder=tagged_recorder()).log, args.out)
+    else:
+        references_scene(args.refmodels)
+        draw("Reference Set", draw_panel(ELLIMANN_PT_references, recorder=tagged_recorder()).log, args.out)
     print(f"wrote {args.out}")
     exit_with(0)
 

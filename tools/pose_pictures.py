@@ -2,10 +2,14 @@
 
     python -m tools.pose_pictures poses OUT.png [--mannequin RM.json]   # the five standard poses side by side
     python -m tools.pose_pictures walk-drape OUT.png [--frames N]        # a frame of the tube dress on the walk
+    python -m tools.pose_pictures clip OUT.png                           # a BVH clip, beside Blender's import of it
 
 Each mannequin is rigged and posed the way the Pose panel does it (``services.rig``; the walk shown at its
 frame 7, mid-stride); the walking drape is ``services.drape`` with the walk as its motion, three of its
-frames side by side, seen from the side.
+frames side by side, seen from the side. The clip is devkit.clips' Biovision-named test clip (18 bones, inches,
+arms hanging at rest): at four of its frames the mannequin following it (``core.pose.clip``, the Import BVH
+operator's path) beside a stick figure of Blender's own import of the clip (``import_anim.bvh``), scaled by the
+hip heights as the mannequin's root is.
 """
 
 import argparse
@@ -72,6 +76,64 @@ def walk_drape_picture(mannequin, path, frames=48, shown=(36, 42, 48), width=700
     return path
 
 
+def clip_picture(mannequin, path, shown=(1, 7, 13, 19), width=2000):
+    """The mannequin following the Biovision test clip at frames ``shown``, each beside Blender's import of it."""
+    from devkit import bvh, clips
+    from devkit.blender_bvh import blender_heads
+    from ellimann_addon.blender.services.rig import apply_pose
+    from ellimann_addon.core.formats.bvh import read_bvh
+    from ellimann_addon.core.pose.clip import clip_onto
+
+    with tempfile.TemporaryDirectory() as folder, blender_output():
+        clip_path = bvh.write_bvh(
+            pathlib.Path(folder) / "biovision.bvh", clips.convention_clip("biovision", mannequin.joints)
+        )
+        read = read_bvh(clip_path)
+        poses = clip_onto(mannequin, read.motion, read.match).poses
+        heads = blender_heads(clip_path) * read.unit
+        empty_scene()
+        pelvis = read.match.sources[0]
+        scale = (mannequin.joints[0, 2]) / (read.motion.rest_heads[pelvis, 2] - read.motion.rest_floor)
+        for index, frame in enumerate(shown):
+            x = 2 * SPACING * (index - (len(shown) - 1) / 2)
+            placed = mannequin.translated((x - 0.4, 0.0, 0.0))
+            placed.name = f"frame {frame}"
+            rig = build_rig(add_mannequin(placed, cushions=True), placed)
+            apply_pose(rig, poses[frame - 1])
+            figure = scale * (heads[frame - 1] - heads[0, pelvis] * (1.0, 1.0, 0.0)) + (
+                x + 0.5,
+                placed.joints[0, 1],
+                0.0,
+            )
+            _stick_figure(f"Blender's import, frame {frame}", figure, read.motion.parents)
+        half = SPACING * len(shown)
+        render_view(path, np.array([-half, -0.6, 0.0]), np.array([half, 0.6, 1.75]), width=width, azimuth=15.0)
+    return path
+
+
+def _stick_figure(name, heads, parents, thickness=0.02):
+    """A mesh of square rods from each bone's head to its parent's (a skeleton Workbench can draw)."""
+    vertices, faces = [], []
+    for child, parent in enumerate(parents):
+        if parent < 0:
+            continue
+        a, b = heads[parent], heads[child]
+        along = (b - a) / max(np.linalg.norm(b - a), 1e-9)
+        side = np.cross(along, [0.0, 0.0, 1.0] if abs(along[2]) < 0.9 else [1.0, 0.0, 0.0])
+        side = thickness * side / np.linalg.norm(side)
+        up = np.cross(along, side)
+        base = len(vertices)
+        for end in (a, b):
+            vertices += [end + side + up, end - side + up, end - side - up, end + side - up]
+        faces += [[base + k, base + (k + 1) % 4, base + 4 + (k + 1) % 4, base + 4 + k] for k in range(4)]
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([tuple(v) for v in vertices], [], faces)
+    obj = bpy.data.objects.new(name, mesh)
+    obj.color = (0.85, 0.25, 0.15, 1.0)
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
 def side_by_side(paths, out):
     """One PNG of equally sized PNGs in a row (through Blender's image API), written atomically."""
     images = [bpy.data.images.load(str(p)) for p in paths]
@@ -89,7 +151,7 @@ def side_by_side(paths, out):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m tools.pose_pictures", description=__doc__.splitlines()[0])
-    parser.add_argument("what", choices=("poses", "walk-drape"))
+    parser.add_argument("what", choices=("poses", "walk-drape", "clip"))
     parser.add_argument("out", metavar="OUT.png")
     parser.add_argument("--mannequin", default=str(REFERENCE_FOLDER / "average.json"))
     parser.add_argument("--frames", type=int, default=48)
@@ -98,6 +160,8 @@ def main(argv=None):
     mannequin = Mannequin.load(args.mannequin)
     if args.what == "poses":
         poses_picture(mannequin, args.out)
+    elif args.what == "clip":
+        clip_picture(mannequin, args.out)
     else:
         walk_drape_picture(mannequin, args.out, args.frames)
     print(f"wrote {args.out}")

@@ -1,32 +1,36 @@
 """``ellimann batch``: one mannequin per row of a measurements CSV, the files in every --format, and a report
-(requested vs measured) written row by row; --shard for a render farm, --resume after an interruption."""
+(requested vs measured) written row by row; --shard for a render farm, --resume after an interruption.
 
-import contextlib
-import csv
-import io
+A batch streams: the CSV is read a chunk of rows at a time (``batch_csv``), each chunk synthesized by the core
+(``core.synthesis.batch``; on Dask a bounded window of chunks in flight) and its results taken in the CSV's order
+into the files, the report and the .npz (``core.formats.npz_bundle.BatchFileWriter``), so memory stays flat in
+the row count."""
+
+import collections
 import os
 import re
 import sys
 
 import numpy as np
 
-from ..core.constants import MEASUREMENTS
-from ..core.errors import ElliMannError, MeasurementError, ReferenceSetError
-from ..core.files import atomic_write_text, incomplete
-from ..core.formats.table import FORMATS
+from ..core.errors import ElliMannError
+from ..core.files import incomplete
+from ..core.formats.npz_bundle import BatchFileWriter
+from ..core.formats.table import BATCH_FILE, FORMATS
 from ..core.mannequin.skeleton import JOINT_NAMES
 from ..core.measure.extra import EXTRA_MEASUREMENTS
 from ..core.measure.tailor import as_dict
-from ..core.synthesis.batch import CHUNK, synthesize_chunk
-from ..core.synthesis.extra_refine import extra_request_problems, meet_extra
+from ..core.synthesis.batch import by_reference_set, chunks, synthesize_chunk
+from ..core.synthesis.misses import missed_text, request_misses
 from ..core.synthesis.refine import EXACT_TOLERANCE
-from ..core.synthesis.request import validate_request
+from ..core.synthesis.synthesize import IDW_EXTRA_NOTE
 from . import arguments, distributed, output, reporting, writing
+from .batch_csv import MeasurementsCsv
 from .output import PROG, UsageError
 
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,99}$")
 MAX_WARNING_LINES = 20  # range warnings printed before the rest go to the report only (a population has thousands)
-NPZ = "npz"  # the batch's one-file format (core.formats.npz_bundle), written once at the end
+NPZ = BATCH_FILE.name  # the batch's one-file format (core.formats.npz_bundle), streamed as rows come
 
 
 def add_parser(commands):
@@ -51,7 +55,7 @@ def add_parser(commands):
         default="json",
         help=f"comma-separated output formats among {','.join(FORMATS)},npz (default json; mjcf "
         "writes NAME.xml; npz writes every mannequin of the batch into one compressed file "
-        "DIR/mannequins.npz, docs/batch_file.md)",
+        "DIR/mannequins.npz, docs/formats/batch_npz.md)",
     )
     batch.add_argument(
         "--dask",
@@ -102,104 +106,11 @@ def parse_formats(text):
     return list(dict.fromkeys(formats))
 
 
-def read_rows(path, reference_of):
-    """Rows of a measurements CSV: list of (line, name, values or None, error or None, warnings, reference).
-
-    ``reference_of(text)``: the ReferenceSet of a ``references`` cell ("" for the command's own), whose
-    ranges and limits the row is checked against; a cell naming no usable set is that row's error."""
-    try:
-        with open(path, newline="", encoding="utf-8-sig") as stream:
-            text = stream.read()
-    except UnicodeDecodeError:
-        raise UsageError(f"{path} is not a UTF-8 text CSV") from None
-    reader = csv.reader(io.StringIO(text))
-    header = next(reader, None)
-    if not header:
-        raise UsageError(f"{path} is empty; expected a header row He,Sh,Br,Wa,Hi[,name]")
-    columns = {}
-    for index, title in enumerate(header):
-        key = title.strip()
-        canonical = next(
-            (m for m in MEASUREMENTS + EXTRA_MEASUREMENTS + ("name", "references") if m.lower() == key.lower()), None
-        )
-        if canonical in columns:
-            raise UsageError(f"{path}: column {canonical} appears twice in the header")
-        if canonical:
-            columns[canonical] = index
-    missing = [m for m in MEASUREMENTS if m not in columns]
-    if missing:
-        raise UsageError(f"{path}: header lacks column(s) {', '.join(missing)}; expected He,Sh,Br,Wa,Hi[,name]")
-    rows = []
-    for line, record in enumerate(reader, start=2):
-        if not any(cell.strip() for cell in record):
-            continue
-        name, chosen = (
-            record[columns[c]].strip() if c in columns and columns[c] < len(record) else ""
-            for c in ("name", "references")
-        )
-        reference = None
-        try:
-            try:
-                reference = reference_of(chosen)
-            except ReferenceSetError as error:
-                raise MeasurementError("references", output.one_line(error)) from None
-            values = []
-            for key in MEASUREMENTS:
-                cell = record[columns[key]].strip() if columns[key] < len(record) else ""
-                if not cell:
-                    raise MeasurementError(key, "is empty")
-                try:
-                    values.append(float(cell))
-                except ValueError:
-                    raise MeasurementError(key, f"{cell!r} is not a number (cm)") from None
-            warnings = validate_request(values, reference.ranges, reference.absurd_limits)
-            extra = _extra_cells(record, columns)
-            problems = extra_request_problems(dict(zip(MEASUREMENTS, values)), extra)
-            if problems:
-                raise MeasurementError(problems[0].split(" ")[0], problems[0].split(" ", 1)[1])
-            if name and not NAME_PATTERN.match(name):
-                raise MeasurementError("name", f"{name!r} must be letters, digits, '.', '_' or '-' (a file name)")
-            rows.append((line, name, values, None, warnings, reference, extra))
-        except MeasurementError as error:
-            rows.append((line, name, None, str(error), [], reference, {}))
-    return rows
-
-
-def _extra_cells(record, columns):
-    """The extra measurements a row gives (an empty cell: not given, the reference set's)."""
-    extra = {}
-    for key in EXTRA_MEASUREMENTS:
-        cell = record[columns[key]].strip() if key in columns and columns[key] < len(record) else ""
-        if cell:
-            try:
-                extra[key] = float(cell)
-            except ValueError:
-                raise MeasurementError(key, f"{cell!r} is not a number (cm)") from None
-    return extra
-
-
-def name_rows(rows):
-    """Give every row its output name (``row-NNNNN`` from its line when the CSV has none) and refuse a row
-    whose name an earlier row already uses (letter case ignored: the files would clash on macOS and
-    Windows). Runs over the whole CSV before sharding, so every shard refuses the same rows."""
-    seen, named = {}, []
-    for line, name, values, error, warnings, reference, extra in rows:
-        name = name or f"row-{line - 1:05d}"
-        key = name.casefold()
-        if error is None and key in seen:
-            first_line, first_name = seen[key]
-            same = "" if first_name == name else f" (as {first_name!r}; file names ignore case on some systems)"
-            error = f"name: {name!r} is already used on line {first_line}{same}"
-        if error is None:
-            seen[key] = (line, name)
-        named.append((line, name, values, error, warnings, reference, extra))
-    return named
-
-
 def run(args):
     formats = parse_formats(args.format)
     pose_file = arguments.check_pose_argument(args, formats)
     shard, shards = parse_shard(args.shard)
+    options = arguments.synthesis_options(args).checked()  # once, before anything is written
     sets = {"": arguments.references(args)}  # the command's set, read once, and each other set a row names
 
     def reference_of(chosen):
@@ -207,101 +118,75 @@ def run(args):
             sets[chosen] = arguments.references(args, chosen)
         return sets[chosen]
 
-    rows = read_rows(args.csv, reference_of)
-    if not rows:
+    table = MeasurementsCsv(args.csv, shard, shards)  # the header checked and the rows counted
+    if not table.count:
         raise UsageError(f"{args.csv} has a header but no rows")
-    options = arguments.synthesis_options(args)
-    rows = name_rows(rows)  # over the whole CSV, so every shard agrees on which rows are bad
-    mine = [row for index, row in enumerate(rows) if index % shards == shard - 1]
     cluster = distributed.connect(args.dask) if args.dask else None  # before anything is written
     try:
-        return _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file)
+        return _run(args, formats, shard, shards, table, reference_of, options, cluster, pose_file)
     finally:
         if cluster is not None:
             cluster.close()
 
 
-def _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file):
+def _run(args, formats, shard, shards, table, reference_of, options, cluster, pose_file):
     writing.output_folder(args.output, "batch")
     suffix = "" if shards == 1 else f"-{shard}-of-{shards}"
-    report = Report(os.path.join(args.output, f"report{suffix}.csv"))
-    jobs, shown = [], 0
-    for line, name, values, error, warnings, reference, extra in mine:
-        if error is not None:
-            output.say(f"{PROG} batch: line {line}: skipped: {error}")
-            report.add(reporting.report_row(line, name, "error", error, values))
-            continue
-        for warning in warnings:
-            shown += 1
-            if shown <= MAX_WARNING_LINES:
-                output.say(f"{PROG} batch: line {line}: warning: {warning}")
-        jobs.append((line, name, values, warnings, extra, reference))
-    if shown > MAX_WARNING_LINES:
-        output.say(
-            f"{PROG} batch: {shown - MAX_WARNING_LINES} more warning(s) of requests outside the reference "
-            f"range; every row's are in {report.path}"
-        )
-    progress = output.Progress(len(jobs), "batch", quiet=args.quiet)
-    # one core batch per reference set (in the order the sets first appear), in chunks
-    groups = {}
-    for job in jobs:
-        groups.setdefault(id(job[-1]), []).append(job)
-    chunks = [group[start : start + CHUNK] for group in groups.values() for start in range(0, len(group), CHUNK)]
-    sets = [chunk[0][-1] for chunk in chunks]
-    requests = [[job[2] for job in chunk] for chunk in chunks]
-    bundles = {}  # one batch file per reference set: mannequins.npz, or mannequins-NAME.npz when a batch uses several
-    if NPZ in formats:
-        for reference in dict.fromkeys(sets):
-            tag = f"-{reference.name}" if len(groups) > 1 else ""
-            bundles[id(reference)] = Bundle(
-                os.path.join(args.output, f"mannequins{tag}{suffix}.npz"), reference.topology, args.mode
-            )
-    results = (
-        cluster.map(sets, requests, options)
-        if cluster is not None
-        else ((index, synthesize_chunk(sets[index], chunk, options)) for index, chunk in enumerate(requests))
-    )
+    report = reporting.Report(os.path.join(args.output, f"report{suffix}.csv"))
+    mine = len(range(shard - 1, table.count, shards))
+    progress = output.Progress(mine, "batch", quiet=args.quiet)
+    # one batch file per reference set: mannequins.npz, or mannequins-NAME.npz when the rows name several
+    bundles = Bundles(args.output, suffix, args.mode, len(table.references) > 1) if NPZ in formats else None
+    rows = (row for index, row in enumerate(table.rows(reference_of, NAME_PATTERN)) if index % shards == shard - 1)
+    reading, window = chunks(rows), collections.deque()  # chunks read and sent, in the CSV's order
+    announced = Announcer(report.path)
     try:
-        for index, result in results:
-            for i, (line, name, values, warnings, extra, reference) in enumerate(chunks[index]):
-                report.add(
-                    _row(
-                        args,
-                        formats,
-                        result,
-                        i,
-                        line,
-                        name,
-                        values,
-                        warnings,
-                        reference.name,
-                        bundles.get(id(reference)),
-                        index,
-                        pose_file,
-                        extra,
-                    )
-                )
-                progress.step(name)
-        for bundle in bundles.values():
-            bundle.write()
+        while True:
+            while len(window) < (cluster.window if cluster is not None else 1):
+                chunk = next(reading, None)
+                if chunk is None:
+                    break
+                announced.rows(chunk)
+                window.append(Chunk(chunk, options, cluster))
+            if not window:
+                break
+            chunk = window[0]
+            for row, (result, i) in chunk.outcomes():
+                report.add(_row(args, formats, result, i, row, bundles, pose_file))
+                chunk.done += 1
+                progress.step(row.name)
+            window.popleft()
+            if bundles is not None:
+                bundles.add(chunk)
+        if bundles is not None:
+            bundles.finish()
     except KeyboardInterrupt:
         progress.done()
+        for chunk in window:  # the refused rows read so far, after those done (the CSV's order holds)
+            for row in chunk.rows[chunk.done :]:
+                if row.error is not None:
+                    report.add(reporting.report_row(row.line, row.name, "error", row.error, row.values))
         report.finish()
+        if bundles is not None:
+            bundles.discard()
         output.say(
-            f"{PROG} batch: interrupted: {report.count('ok', 'missed')} of {len(mine)} rows done, report "
+            f"{PROG} batch: interrupted: {report.count('ok', 'missed')} of {mine} rows done, report "
             f"{report.path}; run it again with --resume to finish"
         )
         return output.INTERRUPTED
     except BaseException:
-        report._close()  # the partial report stays for --resume; its file is not left open
+        report.close()  # the partial report stays for --resume
+        if bundles is not None:
+            bundles.discard()
         raise
     progress.done()
+    announced.done()
     report.finish()
     done, failed, missed = report.count("ok", "missed"), report.count("error"), report.count("missed")
     output.say(
-        f"{PROG} batch: {done} of {len(mine)} mannequins written to {args.output}"
+        f"{PROG} batch: {done} of {mine} mannequins written to {args.output}"
         + (f" ({report.count('kept')} already complete, kept)" if args.resume else "")
-        + (f" (shard {shard}/{shards} of {len(rows)} rows)" if shards > 1 else "")
+        + (f" (shard {shard}/{shards} of {table.count} rows)" if shards > 1 else "")
         + f"; report {report.path}",
         file=sys.stdout,
     )
@@ -317,146 +202,163 @@ def _run(args, formats, shard, shards, rows, mine, options, cluster, pose_file):
     return 0
 
 
-def _row(
-    args, formats, result, i, line, name, values, warnings, references, bundle=None, chunk=0, pose_file=None, extra=None
-):
-    """Write (or, with --resume, keep) the files of one synthesized row, and add it to the batch file; its report
-    row. A failure is that row's: one line on stderr and status "error", and the batch goes on. A row with extra
-    measurements is deformed to meet them too (exact mode; the report's message gives what they came to; the
-    batch file holds the five's mannequin)."""
-    if result.errors[i] is not None:
-        output.say(f"{PROG} batch: line {line}: failed: {result.errors[i]}")
-        return reporting.report_row(line, name, "error", result.errors[i], values)
-    paths = [os.path.join(args.output, f"{name}.{writing.extension(kind)}") for kind in formats if kind != NPZ]
-    notes = list(warnings)
-    mannequin, measured = result.mannequin(i, name, values), result.measured[i]
-    if extra and args.mode == "exact":
-        mannequin, achieved, missed_extra = meet_extra(mannequin, extra)
-        measured = np.array([achieved[key] for key in MEASUREMENTS])
-        notes.append("extra: " + ", ".join(f"{key} {achieved[key]:.2f}" for key in extra))
-        notes += [f"exact mode missed {text}" for text in missed_extra]
-    elif extra:
-        notes.append("the extra measurements are met in exact mode only (IDW gives the reference set's)")
-    misses = reporting.misses(measured, values) if args.mode == "exact" else []  # = not result.converged[i]
-    if misses:
-        notes.append(reporting.missed_text(misses))
-        output.say(f"{PROG} batch: line {line}: warning: {reporting.missed_text(misses)}")
-    status = "missed" if misses else "ok"
-    listed = paths + ([bundle.path] if bundle is not None else [])
-    if bundle is not None:
-        bundle.add(chunk, name, values, result, i)
-    if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths) and paths:
-        row = reporting.report_row(
-            line, name, status, "; ".join(notes + ["kept (--resume)"]), values, measured, listed, references
-        )
-        row["kept"] = True
-        return row
-    try:
-        if paths:
-            frames = arguments.pose_frames(args, mannequin, pose_file)
-            writing.write(mannequin, paths, as_dict(measured), args.cushions, frames, args.fps)
-    except (ElliMannError, OSError, RuntimeError) as error:
-        output.say(f"{PROG} batch: line {line}: failed: {output.one_line(error)}")
-        if bundle is not None:
-            bundle.drop(chunk, name)
-        return reporting.report_row(line, name, "error", output.one_line(error), values)
-    return reporting.report_row(line, name, status, "; ".join(notes), values, measured, listed, references)
+class Announcer:
+    """The lines a chunk's rows get when they are read: a refused row's, and the first MAX_WARNING_LINES warnings
+    of requests outside the reference range (a population has thousands; the rest are in the report)."""
 
+    def __init__(self, report):
+        self.report, self.warnings = report, 0
 
-class Bundle:
-    """The rows of ``--format npz``, gathered by chunk (a Dask run finishes chunks in any order) and written
-    once, in the CSV's order, when the batch ends (``core.formats.npz_bundle``)."""
+    def rows(self, rows):
+        for row in rows:
+            if row.error is not None:
+                output.say(f"{PROG} batch: line {row.line}: skipped: {row.error}")
+                continue
+            for warning in row.warnings:
+                self.warnings += 1
+                if self.warnings <= MAX_WARNING_LINES:
+                    output.say(f"{PROG} batch: line {row.line}: warning: {warning}")
 
-    def __init__(self, path, topology, mode):
-        self.path, self.topology, self.mode = path, topology, mode
-        self.rows = {}  # chunk -> [(name, request, result, i)]
-
-    def add(self, chunk, name, values, result, i):
-        self.rows.setdefault(chunk, []).append((name, values, result, i))
-
-    def drop(self, chunk, name):
-        self.rows[chunk] = [row for row in self.rows.get(chunk, []) if row[0] != name]
-
-    def write(self):
-        from ..core.formats.npz_bundle import batch_arrays, write_batch_file
-
-        rows = [row for chunk in sorted(self.rows) for row in self.rows[chunk]]
-        parts = len(self.topology)
-        shapes = {
-            "rotation": (parts, 3, 3),
-            "center": (parts, 3),
-            "semi_axes": (parts, 3),
-            "measured": (5,),
-            "factors": (5,),
-            "converged": (),
-        }
-        arrays = {
-            key: np.array([getattr(result, key)[i] for _, _, result, i in rows]).reshape((len(rows),) + shape)
-            for key, shape in shapes.items()
-        }
-        requests = np.array([values for _, values, _, _ in rows], dtype=float).reshape(len(rows), 5)
-        joints = None
-        if rows and all(result.joints is not None for _, _, result, _ in rows):
-            joints = np.array([result.joints[i] for _, _, result, i in rows]).reshape(len(rows), len(JOINT_NAMES), 3)
-        with writing.writing(self.path):
-            write_batch_file(
-                self.path,
-                batch_arrays(
-                    self.topology,
-                    [row[0] for row in rows],
-                    requests,
-                    mode=self.mode,
-                    joints=joints,
-                    joint_names=JOINT_NAMES,
-                    **arrays,
-                ),
+    def done(self):
+        if self.warnings > MAX_WARNING_LINES:
+            output.say(
+                f"{PROG} batch: {self.warnings - MAX_WARNING_LINES} more warning(s) of requests outside the "
+                f"reference range; every row's are in {self.report}"
             )
 
 
-class Report:
-    """A batch report, written as rows finish: each row is appended to REPORT.partial.csv and flushed, so a
-    killed run leaves a record of what it did; :meth:`finish` writes REPORT.csv whole (sorted by line,
-    atomically) and removes the partial file."""
+class Chunk:
+    """Consecutive rows of the CSV and their synthesis: on the cluster, sent when read; serially, run when its
+    results are taken. ``done``: how many of its rows are reported."""
 
-    def __init__(self, path):
-        self.path, self.rows = path, []
-        root, extension = os.path.splitext(path)
-        self.partial = f"{root}.partial{extension}"
-        with writing.writing(self.partial):
-            self.stream = open(self.partial, "w", newline="", encoding="utf-8")
-        self.writer = csv.DictWriter(
-            self.stream, fieldnames=reporting.REPORT_COLUMNS, lineterminator="\n", extrasaction="ignore"
+    def __init__(self, rows, options, cluster):
+        self.rows, self.options, self.cluster, self.done = rows, options, cluster, 0
+        good = [position for position, row in enumerate(rows) if row.error is None]
+        self.groups = [
+            (reference, [good[k] for k in members])
+            for reference, members in by_reference_set([rows[position].reference for position in good])
+        ]
+        self.work = [
+            (reference, np.array([rows[p].values for p in members], dtype=float), [rows[p].extra for p in members])
+            for reference, members in self.groups
+        ]
+        self.submitted = cluster.submit(self.work, options) if cluster is not None else None
+
+    def outcomes(self):
+        """(row, (Synthesis, index) or (None, None) for a refused row), in the rows' order."""
+        if self.cluster is not None:
+            results = self.cluster.results(self.submitted)
+        else:
+            results = [
+                synthesize_chunk(reference, requests, self.options, extras) for reference, requests, extras in self.work
+            ]
+        where = [(None, None)] * len(self.rows)
+        for (_, members), result in zip(self.groups, results):
+            for i, position in enumerate(members):
+                where[position] = (result, i)
+        return list(zip(self.rows, where))
+
+
+def _row(args, formats, result, i, row, bundles=None, pose_file=None):
+    """Write (or, with --resume, keep) the files of one row, and mark it for the batch file; its report row. A
+    refused row (``result`` None) or a failure is that row's: one line on stderr and status "error", and the batch
+    goes on. A row that asks for extra measurements has them met (exact mode, ``core.synthesis.batch``), and the
+    report gives what each measurement asked came to."""
+    line, name, values, extra = row.line, row.name, row.values, row.extra
+    if result is None:
+        return reporting.report_row(line, name, "error", row.error, values)
+    if result.error(i) is not None:
+        output.say(f"{PROG} batch: line {line}: failed: {result.error(i)}")
+        return reporting.report_row(line, name, "error", result.error(i), values, extra=extra)
+    paths = [os.path.join(args.output, f"{name}.{writing.extension(kind)}") for kind in formats if kind != NPZ]
+    notes = list(row.warnings) + ([IDW_EXTRA_NOTE] if extra and args.mode != "exact" else [])
+    mannequin = result.mannequin(i, name)
+    measured = as_dict(result.measured[i])
+    if extra:
+        measured.update(
+            (key, float(value)) for key, value in zip(EXTRA_MEASUREMENTS, result.extra_measured[i]) if key in extra
         )
-        self._append(self.writer.writeheader)
-
-    def add(self, row):
-        self.rows.append(row)
-        self._append(lambda: self.writer.writerow(row))
-
-    def _append(self, write):
-        if self.stream is None:
-            return
+    missed = request_misses(measured, values, extra, args.mode)
+    if missed:
+        notes.append(missed_text(missed))
+        output.say(f"{PROG} batch: line {line}: warning: {missed_text(missed)}")
+    status = "missed" if missed else "ok"
+    bundle = bundles.path_of(row.reference) if bundles is not None else None
+    listed = paths + ([bundle] if bundle is not None else [])
+    references = row.reference.name
+    if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths) and paths:
+        report = reporting.report_row(
+            line, name, status, "; ".join(notes + ["kept (--resume)"]), values, measured, listed, references, extra
+        )
+        report["kept"] = True
+    else:
         try:
-            write()
-            self.stream.flush()
-        except OSError:  # the partial record is a courtesy; the report itself is written at the end
-            self._close()
+            if paths:
+                frames = arguments.pose_frames(args, mannequin, pose_file, notes)
+                writing.write(mannequin, paths, as_dict(result.measured[i]), args.cushions, frames, args.fps)
+        except (ElliMannError, OSError, RuntimeError) as error:
+            output.say(f"{PROG} batch: line {line}: failed: {output.one_line(error)}")
+            return reporting.report_row(line, name, "error", output.one_line(error), values, extra=extra)
+        report = reporting.report_row(line, name, status, "; ".join(notes), values, measured, listed, references, extra)
+    if bundles is not None:
+        bundles.mark(row.reference, result, i, name)
+    return report
 
-    def _close(self):
-        if self.stream is not None:
-            with contextlib.suppress(OSError):
-                self.stream.close()
-            self.stream = None
 
-    def count(self, *statuses):
-        if statuses == ("kept",):
-            return sum(1 for row in self.rows if row.get("kept"))
-        return sum(1 for row in self.rows if row["status"] in statuses)
+class Bundles:
+    """``--format npz``: one streamed batch file per reference set (``BatchFileWriter``), fed a chunk at a time
+    with the rows whose files were written, in the CSV's order."""
+
+    def __init__(self, folder, suffix, mode, tagged):
+        self.folder, self.suffix, self.mode, self.tagged = folder, suffix, mode, tagged
+        self.writers, self.marked = {}, []
+
+    def path_of(self, reference):
+        tag = f"-{reference.name}" if self.tagged else ""
+        return os.path.join(self.folder, f"mannequins{tag}{self.suffix}.npz")
+
+    def mark(self, reference, result, i, name):
+        self.marked.append((reference, result, i, name))
+
+    def add(self, chunk):
+        """The rows of ``chunk`` marked, into their files (the rows of one result at once); every reference set
+        the chunk synthesized from has its file, whether or not a row of it was written."""
+        for reference, _ in chunk.groups:
+            self._writer(reference)
+        runs = {}
+        for reference, result, i, name in self.marked:
+            runs.setdefault((id(reference), id(result)), (reference, result, [], []))
+            runs[id(reference), id(result)][2].append(i)
+            runs[id(reference), id(result)][3].append(name)
+        self.marked = []
+        for reference, result, rows, names in runs.values():
+            writer = self._writer(reference)
+            rows = np.array(rows)
+            with writing.writing(writer.path):
+                writer.add(
+                    names,
+                    result.requests[rows],
+                    result.measured[rows],
+                    result.factors[rows],
+                    result.converged[rows],
+                    result.rotation[rows],
+                    result.center[rows],
+                    result.semi_axes[rows],
+                    None if result.joints is None else result.joints[rows],
+                )
+
+    def _writer(self, reference):
+        if id(reference) not in self.writers:
+            path = self.path_of(reference)
+            with writing.writing(path):
+                self.writers[id(reference)] = BatchFileWriter(path, reference.topology, self.mode, JOINT_NAMES)
+        return self.writers[id(reference)]
 
     def finish(self):
-        self._close()
-        self.rows.sort(key=lambda row: row["line"])
-        with writing.writing(self.path):
-            atomic_write_text(self.path, reporting.report_csv(self.rows))
-        with contextlib.suppress(OSError):
-            os.unlink(self.partial)
+        for writer in self.writers.values():
+            with writing.writing(writer.path):
+                writer.finish()
+
+    def discard(self):
+        for writer in self.writers.values():
+            writer.discard()

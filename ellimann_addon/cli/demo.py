@@ -6,6 +6,7 @@ import sys
 
 from ..core.constants import MEASUREMENTS, TABLE_2_5
 from ..core.measure.tailor import as_dict
+from ..core.synthesis.misses import missed_text, request_misses
 from ..core.synthesis.options import PAPER
 from . import arguments, output, reporting, writing
 from .output import PROG
@@ -42,16 +43,16 @@ def run(args):
         mannequin = result.mannequin(i)
         paths = [os.path.join(out, f"{name}.{kind}") for kind in ("blend", "json")]
         writing.write(mannequin, paths, as_dict(result.measured[i]), args.cushions)
-        misses = reporting.misses(result.measured[i], result.requests[i]) if args.mode == "exact" else []
+        misses = request_misses(as_dict(result.measured[i]), result.requests[i], mode=args.mode)
         if misses:
             missed += 1
-            output.say(f"{PROG} demo: {name}: warning: {reporting.missed_text(misses)}")
+            output.say(f"{PROG} demo: {name}: warning: {missed_text(misses)}")
         rows.append(
             reporting.report_row(
                 i + 1,
                 name,
                 "missed" if misses else "ok",
-                "; ".join([mannequin.name] + ([reporting.missed_text(misses)] if misses else [])),
+                "; ".join([mannequin.name] + ([missed_text(misses)] if misses else [])),
                 result.requests[i],
                 result.measured[i],
                 paths,

@@ -1,11 +1,13 @@
 """``batch --dask``: the batch's chunks synthesized on a Dask cluster (dask.distributed, the command line's
 optional extra ``dask``; imported only here and only when asked, never inside Blender).
 
-The client (this process) reads the CSV, sends each chunk of requests to the cluster as one task, and writes
-every file itself as the chunks come back, so each file is written once, atomically, where the command runs.
-A task that fails is retried (``RETRIES``); a chunk that still fails is reported row by row and the others go
-on. Chunks are synthesized exactly as in a serial run (``batch.synthesize_chunk``: batched and one-at-a-time
-synthesis give the same bits), so the files are the same.
+The client (this process) reads the CSV, sends each chunk's rows to the cluster (one task per reference set in
+the chunk, ``core.synthesis.batch.synthesize_chunk``: the workers import the core only), keeps at most ``WINDOW``
+chunks in flight and takes their results back in the CSV's order, writing every file itself, so each file is
+written once, atomically, where the command runs, and memory stays flat in the row count. A task that fails is
+retried (``RETRIES``); a chunk that still fails is reported row by row and the others go on. Chunks are
+synthesized exactly as in a serial run (batched and one-at-a-time synthesis give the same bits), so the files are
+the same.
 """
 
 import logging
@@ -14,6 +16,7 @@ import re
 from .output import UsageError, one_line
 
 RETRIES = 2  # more attempts of a failed chunk (a worker lost, a transient error)
+WINDOW = 8  # chunks in flight at once: the workers kept busy, the results waiting to be written bounded
 CONNECT_TIMEOUT = "10s"
 _LOCAL = re.compile(r"local:(\d+)")
 MAX_LOCAL_WORKERS = 256
@@ -60,35 +63,44 @@ def connect(address):
 class Cluster:
     """A connected client (and the local cluster it started, if any)."""
 
+    window = WINDOW
+
     def __init__(self, client, local):
         self.client, self.local = client, local
+        self.shared = {}  # each reference set is sent once, not with every task
 
-    def map(self, references, requests, options):
-        """Synthesize each chunk of ``requests`` (a list of lists of 5 values) from its reference set
-        (``references``, one per chunk) on the cluster: yields (chunk index, ChunkResult) as chunks finish; a
-        chunk that failed every attempt comes back with every row's error set."""
-        from distributed import as_completed
+    def submit(self, groups, options):
+        """Send a chunk's groups of rows (``[(reference set, requests (k, 5), extras)]``) to the cluster; what
+        :meth:`results` takes."""
+        from ..core.synthesis.batch import synthesize_chunk
 
-        from ..core.synthesis.batch import ChunkResult, synthesize_chunk
+        futures = []
+        for reference, requests, extras in groups:
+            if id(reference) not in self.shared:
+                self.shared[id(reference)] = self.client.scatter(reference, broadcast=True)
+            futures.append(
+                self.client.submit(
+                    synthesize_chunk, self.shared[id(reference)], requests, options, extras, retries=RETRIES, pure=False
+                )
+            )
+        return groups, options, futures
 
-        shared = {}  # each reference set is sent once, not with every task
-        for reference in references:
-            if id(reference) not in shared:
-                shared[id(reference)] = self.client.scatter(reference, broadcast=True)
-        futures = [
-            self.client.submit(synthesize_chunk, shared[id(reference)], chunk, options, retries=RETRIES, pure=False)
-            for reference, chunk in zip(references, requests)
-        ]
-        index = {future.key: i for i, future in enumerate(futures)}
-        for future in as_completed(futures):
-            i = index[future.key]
+    def results(self, submitted):
+        """The Synthesis of each group :meth:`submit` sent, waiting for them; a group that failed every attempt comes
+        back with every row's error set."""
+        from ..core.synthesis.batch import failed_chunk
+
+        groups, options, futures = submitted
+        results = []
+        for (reference, requests, _), future in zip(groups, futures):
             try:
                 result = future.result()
             except Exception as error:  # noqa: BLE001 - the chunk's rows are reported, the other chunks go on
                 reason = f"its chunk failed on the Dask cluster after {RETRIES + 1} attempts: {one_line(error)}"
-                result = ChunkResult(None, [reason] * len(requests[i]), **dict.fromkeys(ChunkResult.FIELDS))
+                result = failed_chunk(reference, requests, [reason] * len(requests), options.mode)
             future.release()
-            yield i, result
+            results.append(result)
+        return results
 
     def close(self):
         self.client.close()

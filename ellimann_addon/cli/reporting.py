@@ -1,46 +1,35 @@
-"""The report CSV of ``synth --report`` and ``batch``: its columns, one row per mannequin (cells safe for
-spreadsheets and terminals), and what exact mode missed."""
+"""The report CSV of ``batch`` and ``demo``: its columns (requested, measured and error of each of the five and of
+the extra measurements a row asked for), one row per mannequin (cells safe for spreadsheets and terminals), and
+the batch's report written row by row as a batch streams."""
 
+import contextlib
 import csv
+import errno
 import io
-import math
+import os
 
 from ..core.constants import MEASUREMENTS
-from ..core.synthesis.refine import EXACT_TOLERANCE
+from ..core.measure.extra import EXTRA_MEASUREMENTS
 from ..core.synthesis.request import relative_error
 from .output import printable
+from .writing import writing
 
-
-def misses(measured, requested):
-    """The requested measurements exact mode missed by more than its tolerance (EXACT_TOLERANCE, the
-    criterion it stops at): [(key, m_T cm, requested cm, error %)]."""
-    return [
-        (key, float(m), float(r), abs(m - r) / r * 100.0)
-        for key, m, r in zip(MEASUREMENTS, measured, requested)
-        if abs(math.log(max(float(m), 1e-12) / float(r))) > EXACT_TOLERANCE
-    ]
-
-
-def missed_text(missed):
-    return (
-        "exact mode missed "
-        + ", ".join(f"{key} by {error:.2f}% (m_T {m:.2f} cm for {r:g} cm)" for key, m, r, error in missed)
-        + f" (tolerance {EXACT_TOLERANCE * 100:g}%; the file is the closest it found)"
-    )
-
-
+ALL_MEASUREMENTS = MEASUREMENTS + EXTRA_MEASUREMENTS
 REPORT_COLUMNS = (
     ["line", "name", "status", "message"]
-    + list(MEASUREMENTS)
-    + [f"{k}_measured" for k in MEASUREMENTS]
-    + [f"{k}_error_pct" for k in MEASUREMENTS]
+    + list(ALL_MEASUREMENTS)
+    + [f"{k}_measured" for k in ALL_MEASUREMENTS]
+    + [f"{k}_error_pct" for k in ALL_MEASUREMENTS]
     + ["files", "references"]
 )
 
 
-def report_row(line, name, status, message, requested=None, measured=None, paths=(), references=""):
-    """One report row; text from the CSV or messages is made safe for spreadsheets and terminals (:func:`cell`).
-    ``references``: the reference set the row was synthesized from (its name)."""
+def report_row(line, name, status, message, requested=None, measured=None, paths=(), references="", extra=None):
+    """One report row. ``requested``: the five (cm, MEASUREMENTS order) and ``extra`` the extra measurements asked
+    ({key: cm}); ``measured`` ({key: cm}, or the five's 5 values): what the mannequin measures, the five and those
+    extra ones. A measurement not asked for has empty cells. Text from the CSV or messages is made safe for
+    spreadsheets and terminals (:func:`cell`); ``references``: the reference set the row was synthesized from (its
+    name)."""
     row = {
         "line": line,
         "name": cell(name),
@@ -49,11 +38,18 @@ def report_row(line, name, status, message, requested=None, measured=None, paths
         "files": cell(" ".join(paths)),
         "references": cell(references),
     }
-    error = relative_error(measured, requested) if measured is not None else None
-    for i, key in enumerate(MEASUREMENTS):
-        row[key] = f"{requested[i]:g}" if requested is not None else ""
-        row[f"{key}_measured"] = f"{measured[i]:.4f}" if measured is not None else ""
-        row[f"{key}_error_pct"] = f"{error[i]:.4f}" if error is not None else ""
+    asked = dict(zip(MEASUREMENTS, requested)) if requested is not None else {}
+    asked.update(extra or {})
+    if measured is not None and not isinstance(measured, dict):
+        measured = dict(zip(MEASUREMENTS, measured))
+    for key in ALL_MEASUREMENTS:
+        row[key] = f"{asked[key]:g}" if key in asked else ""
+        row[f"{key}_measured"] = row[f"{key}_error_pct"] = ""
+    both = [key for key in asked if measured is not None and measured.get(key) is not None]
+    if both:
+        got = [measured[key] for key in both]
+        for key, value, error in zip(both, got, relative_error(got, [asked[key] for key in both])):
+            row[f"{key}_measured"], row[f"{key}_error_pct"] = f"{value:.4f}", f"{error:.4f}"
     return row
 
 
@@ -70,3 +66,51 @@ def report_csv(rows):
     writer.writeheader()
     writer.writerows(rows)
     return stream.getvalue()
+
+
+class Report:
+    """A batch report written as rows finish, in the CSV's order: each row is appended to REPORT.partial.csv and
+    flushed, so a killed run leaves a record of what it did, and nothing of it is held in memory; :meth:`finish`
+    makes the partial file REPORT.csv (checked whole, then one atomic rename). Counts the rows by status (and those
+    kept)."""
+
+    def __init__(self, path):
+        self.path, self.counts = path, {}
+        root, extension = os.path.splitext(path)
+        self.partial = f"{root}.partial{extension}"
+        with writing(self.partial):
+            self.stream = open(self.partial, "w", newline="", encoding="utf-8")
+        self.writer = csv.DictWriter(self.stream, fieldnames=REPORT_COLUMNS, lineterminator="\n", extrasaction="ignore")
+        self._append(self.writer.writeheader)
+
+    def add(self, row):
+        for status in (row["status"], "kept" if row.get("kept") else None):
+            if status is not None:
+                self.counts[status] = self.counts.get(status, 0) + 1
+        self._append(lambda: self.writer.writerow(row))
+
+    def _append(self, write):
+        with writing(self.partial):
+            write()
+            self.stream.flush()
+
+    def count(self, *statuses):
+        return sum(self.counts.get(status, 0) for status in statuses)
+
+    def finish(self):
+        """The partial file, on disk whole (every byte written reached it), renamed REPORT.csv."""
+        with writing(self.path):
+            self.stream.flush()
+            os.fsync(self.stream.fileno())
+            written, size = self.stream.buffer.tell(), os.fstat(self.stream.fileno()).st_size
+            self.close()
+            if size != written:
+                raise OSError(errno.EIO, f"the file written is incomplete: {size} of {written} bytes reached the disk")
+            os.replace(self.partial, self.path)
+
+    def close(self):
+        """Close the partial file, which stays (a run that failed: its record, and --resume picks up)."""
+        if self.stream is not None:
+            with contextlib.suppress(OSError):
+                self.stream.close()
+            self.stream = None

@@ -7,8 +7,8 @@ from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS, RANGES
 from ..core.errors import ElliMannError
 from ..core.formats.table import FORMATS
 from ..core.measure.extra import EXTRA_ABSURD_LIMITS, EXTRA_LABELS, EXTRA_MEASUREMENTS
-from ..core.synthesis.request import relative_error, validate_request
-from . import arguments, output, reporting, writing
+from ..core.synthesis.request import relative_error
+from . import arguments, output, writing
 from .output import PROG, UsageError
 
 
@@ -105,19 +105,14 @@ def run(args):
     kind = writing.output_kind(args.output)
     pose_file = arguments.check_pose_argument(args, [kind])
     five, extra = _wanted(args)
-    request = [five[key] for key in MEASUREMENTS]
     reference = arguments.references(args)
-    validate_request(request, reference.ranges, reference.absurd_limits)  # refused before any work; its warnings
-    # come back from synthesis with the others
-    options = arguments.synthesis_options(args, args.name)
-    try:
-        mannequin, measured, warnings = synthesize_extra(reference, five, extra, options, measure_extra=False)
+    try:  # the request is checked here, once, before any work (its warnings come back with the result)
+        options = arguments.synthesis_options(args, args.name)
+        result = synthesize_extra(reference, five, extra, options, measure_extra=False)
     except ElliMannError as error:
         raise UsageError(output.one_line(error)) from None
-    achieved = [measured[key] for key in MEASUREMENTS]
-    misses = reporting.misses(achieved, request) if args.mode == "exact" else []
-    missed_extra = [line for line in warnings if line.startswith("exact mode missed")]
-    for warning in warnings + ([reporting.missed_text(misses)] if misses else []):
+    mannequin, measured = result.mannequin, result.measured
+    for warning in result.warnings:
         output.say(f"{PROG} synth: warning: {warning}")
     frames = arguments.pose_frames(args, mannequin, pose_file)
     writing.write(
@@ -128,7 +123,8 @@ def run(args):
         frames,
         args.fps,
     )
-    error = relative_error(achieved, request).max()
+    achieved = [measured[key] for key in MEASUREMENTS]
+    error = relative_error(achieved, [five[key] for key in MEASUREMENTS]).max()
     posed = f" in pose {args.pose}" if args.pose else ""
     extra_line = "; " + ", ".join(f"{key} {measured[key]:.2f}" for key in EXTRA_MEASUREMENTS) + " cm" if extra else ""
     output.say(
@@ -136,4 +132,4 @@ def run(args):
         f"max error {error:.3f}%{extra_line}",
         file=sys.stdout,
     )
-    return output.MISSED if misses or missed_extra else 0
+    return output.MISSED if result.missed else 0

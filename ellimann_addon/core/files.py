@@ -28,18 +28,25 @@ def atomic_write_bytes(path, data):
     The temporary file is read back before the rename (its size, and for .json/.xml that it parses), so
     a write that the file system cut short raises OSError (``filename`` = ``path``) and leaves the target as it was.
     """
+    atomic_write_stream(path, lambda stream: stream.write(data))
+
+
+def atomic_write_stream(path, write):
+    """:func:`atomic_write_bytes` of what ``write(stream)`` writes into a binary file stream, piece by piece (a
+    file larger than memory): the temporary file is checked to hold every byte written, and to be whole."""
     path = os.fspath(path)
     folder = os.path.dirname(os.path.abspath(path))
     os.makedirs(folder, exist_ok=True)
     handle, temp = tempfile.mkstemp(prefix=temp_prefix(), suffix=".tmp", dir=folder)
     try:
         with os.fdopen(handle, "wb") as stream:
-            stream.write(data)
+            write(stream)
+            written = stream.tell()
             stream.flush()
             os.fsync(stream.fileno())
         problem = (
-            f"{os.path.getsize(temp)} of {len(data)} bytes reached the disk"
-            if os.path.getsize(temp) != len(data)
+            f"{os.path.getsize(temp)} of {written} bytes reached the disk"
+            if os.path.getsize(temp) != written
             else incomplete(temp, kind_of(path))
         )
         if problem:
@@ -223,6 +230,7 @@ def _npz(stream, size):
 
 
 _CHECKS = {"blend": _blend, "glb": _glb, "json": _json, "xml": _xml, "png": _png, "obj": _obj, "npz": _npz}
+CHECKED_KINDS = tuple(_CHECKS)  # the extensions :func:`incomplete` checks beyond "not empty"
 
 
 def disk_full(folder):

@@ -78,11 +78,10 @@ def test_a_file_that_is_not_a_batch_is_refused_naming_the_field(tmp_path):
         load_batch_file(tmp_path / "cut.npz")
 
 
-def test_the_command_line_imports_dask_only_for_dask():
-    code = (
-        "import sys, ellimann_addon.cli as cli; cli.build_parser(); "
-        "print(sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')))"
-    )
+def loaded_by(statement, where):
+    """The modules ``statement`` loads (in a fresh interpreter at the repository's root) that ``where(name)``
+    picks, sorted."""
+    code = f"import sys; {statement}; print(sorted(m for m in sys.modules if ({where})(m)))"
     done = subprocess.run(
         [sys.executable, "-c", code],
         capture_output=True,
@@ -90,7 +89,12 @@ def test_the_command_line_imports_dask_only_for_dask():
         check=True,
         cwd=os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
     )
-    assert done.stdout.strip() == "[]"
+    return done.stdout.strip()
+
+
+def test_the_command_line_imports_dask_only_for_dask():
+    dask = "lambda m: m.split('.')[0] in ('dask', 'distributed')"
+    assert loaded_by("import ellimann_addon.cli as cli; cli.build_parser()", dask) == "[]"
 
 
 def test_dask_local_cluster_writes_the_serial_files_byte_for_byte(tmp_path, capsys, references):
@@ -127,7 +131,7 @@ class FakeFuture:
 
 
 class FakeClient:
-    """Runs each chunk here; the second chunk fails as a worker would report it."""
+    """Runs each chunk here; the second task fails as a worker would report it."""
 
     def __init__(self):
         self.submitted = 0
@@ -135,29 +139,32 @@ class FakeClient:
     def scatter(self, value, broadcast):
         return value
 
-    def submit(self, function, reference, chunk, options, retries, pure):
+    def submit(self, function, reference, requests, options, extras, retries, pure):
         self.submitted += 1
         key = f"chunk-{self.submitted}"
         if self.submitted == 2:
             return FakeFuture(key, RuntimeError("worker lost"))
-        return FakeFuture(key, function(reference, chunk, options))
+        return FakeFuture(key, function(reference, requests, options, extras))
 
 
-def test_a_failed_chunk_is_reported_row_by_row_and_the_others_kept(monkeypatch, references):
-    import distributed as dask_distributed
-
-    monkeypatch.setattr(dask_distributed, "as_completed", lambda futures: list(reversed(futures)))
+def test_a_failed_chunk_is_reported_row_by_row_and_the_others_kept(references):
     from ellimann_addon.core.synthesis.reference_set import load_reference_set
     from ellimann_addon.core.synthesis.synthesize import SynthesisOptions
 
     reference = load_reference_set(references)
     chunks = [[[160, 40, 95, 80, 105]] * 2, [[165, 41, 100, 82, 110]] * 3, [[170, 42, 100, 85, 110]]]
-    results = dict(distributed.Cluster(FakeClient(), None).map([reference] * 3, chunks, SynthesisOptions()))
-    assert sorted(results) == [0, 1, 2]
+    cluster = distributed.Cluster(FakeClient(), None)
+    sent = [
+        cluster.submit([(reference, np.array(chunk, float), [{}] * len(chunk))], SynthesisOptions()) for chunk in chunks
+    ]
+    results = [cluster.results(submitted)[0] for submitted in reversed(sent)][::-1]  # taken in any order
     assert results[0].errors == [None, None] and results[2].errors == [None]
     assert len(results[1].errors) == 3 and all(
         "failed on the Dask cluster" in e and "worker lost" in e for e in results[1].errors
     )
+    assert np.isnan(results[1].center).all() and not results[1].converged.any()
+    alone = synthesize_batch(reference, chunks[2])
+    np.testing.assert_array_equal(results[2].center, alone.center)
 
 
 def test_an_unreachable_scheduler_is_one_line_and_nothing_written(tmp_path, capsys, monkeypatch, references):
@@ -226,18 +233,169 @@ def test_a_row_the_core_refuses_fails_alone_and_its_chunk_keeps_the_others(monke
     from ellimann_addon.core.synthesis import synthesize as synthesis
     from ellimann_addon.core.synthesis.reference_set import load_reference_set
 
-    real = synthesis.synthesize_batch
+    real = synthesis.synthesize_checked
 
-    def refusing(reference, requests, options=None, **fields):  # as check_plausible refuses a whole batch
+    def refusing(reference, requests, options, **fields):  # as check_plausible refuses a whole batch
         if any(values[0] == 161.0 for values in requests):
             raise ElliMannError("synthesis at He 161 cm gives an implausible mannequin")
         return real(reference, requests, options, **fields)
 
-    monkeypatch.setattr(chunking, "synthesize_batch", refusing)
+    monkeypatch.setattr(chunking, "synthesize_checked", refusing)
     reference = load_reference_set(references)
     chunk = [[160.0, 40, 95, 80, 105], [161.0, 40, 95, 80, 105], [162.0, 41, 96, 81, 106]]
     result = chunking.synthesize_chunk(reference, chunk, synthesis.SynthesisOptions())
     assert result.errors[0] is None and result.errors[2] is None and "implausible" in result.errors[1]
-    alone = real(reference, [chunk[0], chunk[2]])
+    alone = synthesis.synthesize_batch(reference, [chunk[0], chunk[2]])
     np.testing.assert_array_equal(result.center[[0, 2]], alone.center)
     assert np.isnan(result.center[1]).all() and not result.converged[1]
+
+
+# ------------------------------------------------------------------------------------------------ streaming
+
+
+def test_the_streamed_batch_file_is_the_whole_file_writers_bytes(tmp_path):
+    """BatchFileWriter (rows appended as they come, each array on disk) writes the bytes write_batch_file writes
+    for the same rows in one go: with joints, without, and with no row at all."""
+    from ellimann_addon.core.formats.npz_bundle import BatchFileWriter, batch_arrays, write_batch_file
+    from ellimann_addon.core.mannequin.skeleton import JOINT_NAMES
+    from ellimann_addon.core.synthesis.shipped import named_reference_set
+
+    for reference in (named_reference_set("female"), synthetic.make_reference_set()):
+        requests = np.array([[150.0 + i, 36 + i % 5, 95, 80, 100] for i in range(7)])
+        result = synthesize_batch(reference, requests, mode="idw")
+        names = [f"{'m' * (1 + i % 4)}{i}" for i in range(7)]  # names of several lengths: the str width is the longest
+        for count in (7, 0):
+            rows = slice(0, count)
+            joints = None if result.joints is None or not count else result.joints[rows]  # as the batch gave them
+            arrays = [result.requests, result.measured, result.factors, result.converged]
+            arrays += [result.rotation, result.center, result.semi_axes]
+            whole = write_batch_file(
+                tmp_path / "whole.npz",
+                batch_arrays(reference.topology, names[rows], *[a[rows] for a in arrays], "idw", joints, JOINT_NAMES),
+            )
+            writer = BatchFileWriter(tmp_path / "streamed.npz", reference.topology, "idw", JOINT_NAMES)
+            for part in (slice(0, min(count, 3)), slice(min(count, 3), count)):
+                if part.stop > part.start:
+                    writer.add(names[part], *[a[part] for a in arrays], None if joints is None else joints[part])
+            streamed = writer.finish()
+            assert open(streamed, "rb").read() == open(whole, "rb").read(), (reference.name, count)
+            assert sorted(p.name for p in tmp_path.iterdir()) == ["streamed.npz", "whole.npz"]  # no temporaries
+            assert ("joints" in read_batch_file(streamed)) == (count > 0 and result.joints is not None)
+
+
+def test_a_discarded_batch_file_leaves_nothing(tmp_path):
+    from ellimann_addon.core.formats.npz_bundle import BatchFileWriter
+
+    reference = synthetic.make_reference_set()
+    result = synthesize_batch(reference, [[160.0, 40, 95, 80, 105]], mode="idw")
+    writer = BatchFileWriter(tmp_path / "m.npz", reference.topology, "idw")
+    writer.add(
+        ["a"],
+        result.requests,
+        result.measured,
+        result.factors,
+        result.converged,
+        result.rotation,
+        result.center,
+        result.semi_axes,
+    )
+    assert len(list(tmp_path.iterdir())) == 1  # its rows, in a temporary folder beside the file
+    writer.discard()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_batch_streams_in_the_csvs_order_across_chunks_and_reference_sets(tmp_path, capsys, monkeypatch, references):
+    """Chunks of 3 rows, two reference sets taking turns, refused rows and a name used twice two chunks apart: the
+    report keeps the CSV's order, each set's batch file holds its rows in that order, and every mannequin is the
+    bits of its request synthesized alone."""
+    from ellimann_addon.core.synthesis import batch as chunking
+    from ellimann_addon.core.synthesis.shipped import named_reference_set
+
+    monkeypatch.setattr(chunking, "CHUNK", 3)
+    male = named_reference_set("male")
+    middle = {key: round(sum(male.ranges[key]) / 2, 2) for key in MEASUREMENTS}
+    lines = ["name,He,Sh,Br,Wa,Hi,references"]
+    for i in range(10):
+        if i % 2:
+            lines.append(f"m{i}," + ",".join(f"{middle[key] + i / 10:g}" for key in MEASUREMENTS) + ",male")
+        else:
+            lines.append(f"f{i},{160 + i},40,95,80,105,")
+    lines[4] = "f3,160,40,abc,80,105,"  # refused: not a number
+    lines[9] = "F0,161,40,95,80,105,"  # refused: f0's name, two chunks on
+    (tmp_path / "in.csv").write_text("\n".join(lines) + "\n")
+    out = tmp_path / "out"
+    code, _, err = run(
+        ["batch", str(tmp_path / "in.csv"), "-o", str(out), "--format", "json,npz", "--references", references], capsys
+    )
+    assert code == 1 and "line 5: skipped: Br: 'abc'" in err and "line 10: skipped: name: 'F0' is already used" in err
+    report = list(csv.DictReader((out / "report.csv").open(encoding="utf-8")))
+    assert [int(row["line"]) for row in report] == list(range(2, 12))
+    assert [row["status"] for row in report] == ["ok"] * 3 + ["error"] + ["ok"] * 4 + ["error", "ok"]
+    files = {"female": out / "mannequins-female.npz", "male": out / "mannequins-male.npz"}
+    assert sorted(p.name for p in out.iterdir() if p.suffix != ".json") == sorted(
+        [p.name for p in files.values()] + ["report.csv"]
+    )
+    for name, path in files.items():
+        expected = [row["name"] for row in report if row["status"] == "ok" and row["references"] == name]
+        loaded = load_batch_file(path)
+        assert [m.name for m in loaded] == expected
+        reference = male if name == "male" else load_reference_set(references)
+        for mannequin in loaded:
+            alone = synthesize_batch(reference, [[mannequin.measurements[key] for key in MEASUREMENTS]])
+            np.testing.assert_array_equal(mannequin.center, alone.center[0])
+            np.testing.assert_array_equal(Mannequin.load(out / f"{mannequin.name}.json").semi_axes, mannequin.semi_axes)
+
+
+def test_the_dask_worker_imports_the_core_only():
+    outside_core = "lambda m: m.startswith('ellimann_addon.') and not m.startswith('ellimann_addon.core')"
+    assert loaded_by("import ellimann_addon.core.synthesis.batch", outside_core) == "[]"
+
+
+def test_batch_meets_extra_measurements_as_synth_does_and_reports_each(tmp_path, capsys):
+    """A row's extra measurements are met by synth's own core function: the batch's file is synth's bit for bit, the
+    batch file holds that mannequin, and the report has requested, measured and error cells for every measurement
+    a row asked for; one out of reach is a miss (status, exit code 3, its line), as data."""
+    from ellimann_addon.cli import reporting
+    from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
+
+    slim = "148,31.11,84.97,63,83"
+    source = tmp_path / "in.csv"
+    source.write_text(
+        f"name,He,Sh,Br,Wa,Hi,neck,thigh,calf\nslim,{slim},29.68,43.85,\nplain,{slim},,,\nfar,{slim},,,82\n"
+    )
+    out = tmp_path / "out"
+    code, _, err = run(["batch", str(source), "-o", str(out), "--format", "json,npz", "-q"], capsys)
+    assert code == 3 and "line 4: warning: exact mode missed calf by" in err, err
+    report = list(csv.DictReader((out / "report.csv").open(encoding="utf-8")))
+    assert list(report[0]) == reporting.REPORT_COLUMNS
+    assert [row["status"] for row in report] == ["ok", "ok", "missed"]
+    slim_row, plain_row, far_row = report
+    assert (slim_row["neck"], slim_row["thigh"], slim_row["calf"]) == ("29.68", "43.85", "")
+    for key in ("neck", "thigh"):
+        assert abs(float(slim_row[f"{key}_measured"]) - float(slim_row[key])) <= 0.1
+        assert float(slim_row[f"{key}_error_pct"]) == pytest.approx(
+            abs(float(slim_row[f"{key}_measured"]) / float(slim_row[key]) - 1) * 100, abs=1e-3
+        )
+    assert all(plain_row[key] == plain_row[f"{key}_measured"] == "" for key in EXTRA_MEASUREMENTS)
+    assert far_row["calf"] == "82" and float(far_row["calf_error_pct"]) > 1 and "missed calf" in far_row["message"]
+    code, _, _ = run(
+        [
+            "synth",
+            *("--he 148 --sh 31.11 --br 84.97 --wa 63 --hi 83 --neck 29.68 --thigh 43.85".split()),
+            "-o",
+            str(tmp_path / "synth.json"),
+            "--name",
+            "slim",
+        ],
+        capsys,
+    )
+    assert code == 0
+    synthesized, batched = Mannequin.load(tmp_path / "synth.json"), Mannequin.load(out / "slim.json")
+    bundled = load_batch_file(out / "mannequins.npz")[0]
+    for key in ("rotation", "center", "semi_axes", "joints"):
+        np.testing.assert_array_equal(getattr(batched, key), getattr(synthesized, key))
+        np.testing.assert_array_equal(getattr(bundled, key), getattr(synthesized, key))
+    code, _, err = run(["batch", str(source), "-o", str(tmp_path / "idw"), "--mode", "idw", "-q"], capsys)
+    idw = list(csv.DictReader((tmp_path / "idw" / "report.csv").open(encoding="utf-8")))
+    assert code == 0 and [row["status"] for row in idw] == ["ok"] * 3
+    assert "met in exact mode only" in idw[0]["message"] and idw[0]["neck_measured"] != ""

@@ -1,13 +1,12 @@
-"""core.pose.bones (an armature's layout for a skeleton) and core.pose.retarget (motion from another rig), without
-Blender."""
+"""core.pose.bones (an armature's layout for a skeleton), the shortest rotations retargeting turns bones by and a
+drape's motion, without Blender (clips retargeted: test_motion_clips.py)."""
 
 import numpy as np
 import pytest
 
-from ellimann_addon.core.errors import ElliMannError
 from ellimann_addon.core.pose.bones import bone_axes, bone_limit, bone_rotations, layout_bones, root_location
 from ellimann_addon.core.pose.kinematics import axis_angle
-from ellimann_addon.core.pose.retarget import SourceMotion, retarget, shortest_rotation
+from ellimann_addon.core.pose.retarget import shortest_rotations
 
 AXES = np.eye(3)
 
@@ -82,48 +81,16 @@ def test_root_location_and_bone_rotations_invert_the_bone_frame():
     assert np.allclose(frame @ bone_rotations(frame[None], rotation[None])[0] @ frame.T, rotation)
 
 
-@pytest.mark.parametrize(
-    "a, b", [((1, 0, 0), (0, 1, 0)), ((0, 0, 1), (0, 0, -1)), ((1, 2, 3), (-3, 1, 0.5)), ((1, 0, 0), (1, 0, 0))]
-)
-def test_shortest_rotation(a, b):
-    rotation = shortest_rotation(a, b)
-    assert np.allclose(rotation @ (np.array(a) / np.linalg.norm(a)), np.array(b) / np.linalg.norm(b))
-    assert np.allclose(rotation.T @ rotation, np.eye(3)) and np.isclose(np.linalg.det(rotation), 1.0)
-
-
-def chain():
-    names = ["Root", "Mid", "Tip"]
-    joints = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, 0.5], [0.0, 0.0, 0.0]])
-    return names, joints, [-1, 0, 1]
-
-
-def test_a_source_resting_elsewhere_is_followed_by_bone_directions():
-    """A source whose rest bends the chain 90 degrees: at its own rest frame the target takes that bend."""
-    names, joints, parents = chain()
-    heads = np.array([[0.0, 0.0, 2.0], [0.0, 0.0, 1.0], [0.0, -1.0, 1.0]])  # Mid -> Tip points forward
-    motion = SourceMotion(
-        ["r", "m", "t"], heads, np.broadcast_to(np.eye(3), (1, 3, 3, 3)).copy(), heads[:1].copy(), 24.0
-    )
-    local, translation = retarget(motion, names, joints, parents, {"r": "Root", "m": "Mid", "t": "Tip"})
-    mid_direction = local[0, 0] @ local[0, 1] @ (joints[2] - joints[1])
-    assert np.allclose(mid_direction / np.linalg.norm(mid_direction), [0.0, -1.0, 0.0])
-    assert np.allclose(translation, 0.0)
-
-
-def test_the_root_moves_by_the_clip_scaled_to_the_hip_height():
-    names, joints, parents = chain()
-    heads = 2.0 * joints
-    rotations = np.broadcast_to(np.eye(3), (2, 3, 3, 3)).copy()
-    motion = SourceMotion(["r", "m", "t"], heads, rotations, np.array([heads[0], heads[0] + (0.0, -1.0, 0.0)]), 24.0)
-    _, translation = retarget(motion, names, joints, parents, {"r": "Root", "m": "Mid", "t": "Tip"})
-    assert np.allclose(translation, [[0.0, 0.0, 0.0], [0.0, -0.5, 0.0]])
-
-
-def test_no_known_bone_is_refused_naming_the_clips_bones():
-    names, joints, parents = chain()
-    motion = SourceMotion(["Wurzel"], joints[:1], np.eye(3)[None, None], joints[:1], 24.0)
-    with pytest.raises(ElliMannError, match=r"none of the clip's 1 bones \(Wurzel\)"):
-        retarget(motion, names, joints, parents, {"r": "Root"})
+def test_shortest_rotations():
+    a = np.array([(1, 0, 0), (0, 0, 1), (1, 2, 3), (1, 0, 0), (0, 2, 0), (0, 0, 0)], dtype=float)
+    b = np.array([(0, 1, 0), (0, 0, -1), (-3, 1, 0.5), (1, 0, 0), (0, -1, 0), (1, 0, 0)], dtype=float)
+    rotations = shortest_rotations(a, b)
+    for rotation, u, v in zip(rotations[:5], a, b):
+        assert np.allclose(rotation @ (u / np.linalg.norm(u)), v / np.linalg.norm(v))
+        assert np.allclose(rotation.T @ rotation, np.eye(3)) and np.isclose(np.linalg.det(rotation), 1.0)
+    assert np.allclose(rotations[5], np.eye(3))  # no direction: no turn
+    turned = shortest_rotations([1.0, 0.0, 0.0], [1.0, 1.0, 0.0])  # the least angle: about z only
+    assert np.allclose(turned, axis_angle([0.0, 0.0, 1.0], np.pi / 4))
 
 
 def test_a_drape_motion_starts_at_rest_reaches_the_pose_and_loops_with_the_drift():

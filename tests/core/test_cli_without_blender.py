@@ -103,6 +103,30 @@ def test_posed_core_formats_run_without_blender(tmp_path):
     assert code == 0, stderr
 
 
+def test_a_bvh_clip_is_read_retargeted_and_written_without_blender(tmp_path, references):
+    """--pose clip.bvh on synth, pose and batch to .json and MJCF: the clip read and retargeted by numpy alone."""
+    from devkit import bvh, clips
+    from ellimann_addon.core.mannequin.model import Mannequin
+    from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
+
+    joints = Mannequin.load(REFERENCE_FOLDER / "average.json").joints
+    clip = str(bvh.write_bvh(tmp_path / "clip.bvh", clips.convention_clip("mixamo", joints, frames=6)))
+    for out in ("c.json", "c.xml"):
+        code, stdout, stderr = without_blender("synth", *REQUEST, "--pose", clip, "-o", str(tmp_path / out))
+        assert code == 0 and "joints placed from 26 bones by Mixamo names" in stderr, stderr
+    code, stdout, stderr = without_blender(
+        "pose", str(tmp_path / "c.json"), "--pose", clip, "--fps", "60", "-o", str(tmp_path / "p.xml")
+    )
+    assert code == 0 and stdout.startswith(f"wrote {tmp_path / 'p.xml'}") and "(11 frames)" in stdout, stderr
+    source = tmp_path / "in.csv"
+    source.write_text("He,Sh,Br,Wa,Hi,name\n160,40,95,80,105,a\n", encoding="utf-8")
+    code, _, stderr = without_blender(
+        "batch", str(source), "-o", str(tmp_path / "out"), "--format", "json,mjcf", "--pose", clip
+    )
+    assert code == 0, stderr
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["a.json", "a.xml", "report.csv"]
+
+
 def test_obj_rest_and_posed_are_written_without_blender_standing_in_y_up_axes(tmp_path):
     """One OBJ convention (Y up, -Z forward, as Blender imports it): rest, posed and cushioned files all stand
     with their height along Y and their feet at y = 0."""

@@ -2,15 +2,15 @@
 
 ``write_posed`` is what the command line calls for ``--pose`` with .blend and .glb outputs
 (``cli.writing.write_posed``; .json, MJCF and .obj come from ``core.formats.posed_files``): from an empty scene,
-the rest mannequin, its armature (``services.rig``), one pose or a looping motion as an action on the
-timeline (the walk), then each file through ``services.files`` (atomically). A .blend opens posed (or
-playing the walk); a .glb is a skinned glTF in that pose with the motion as an animation.
+the rest mannequin, its armature (``services.rig``), one pose or a motion as an action on the timeline (the walk,
+looping; a clip, playing once), then each file through ``services.files`` (atomically). A .blend opens posed (or
+playing the motion); a .glb is a skinned glTF in that pose with the motion as an animation.
 """
 
 import bpy
 
 from ...core.errors import ElliMannError
-from ...core.pose.standard import WALK_FPS
+from ...core.pose.standard import MOTIONS, WALK_FPS
 from .files import checked_paths, write_blender_file
 from .rig import apply_motion, apply_pose, build_rig, check_rig
 from .scene import add_mannequin, empty_scene
@@ -18,7 +18,8 @@ from .scene import add_mannequin, empty_scene
 
 def write_posed(mannequin, frames, paths, cushions=False, fps=WALK_FPS, measured=None):
     """Write ``mannequin`` (at rest, with joints) posed by ``frames`` (core Poses, already within the limits:
-    one for a still pose, several for a looping motion at ``fps``) to every .blend and .glb in ``paths``;
+    one for a still pose, several for a motion at ``fps``: the walk loops, a clip named after its file plays
+    once) to every .blend and .glb in ``paths``;
     ``measured``: its rest m_T ({key: cm}) for the .glb's extras, if the caller holds it.
 
     Raises ElliMannError before anything is written for a path of another kind, no frames, or a mannequin
@@ -36,9 +37,11 @@ def write_posed(mannequin, frames, paths, cushions=False, fps=WALK_FPS, measured
     if len(frames) == 1:
         apply_pose(rig, frames[0])
     else:
-        name = frames[0].name.split()[0] if frames[0].name else "motion"
-        apply_motion(rig, frames, f"{collection.name} {name}", loop=True)
-        scene.render.fps, scene.render.fps_base = int(round(fps or WALK_FPS)), 1.0
+        name = frames[0].name.rsplit(" ", 1)[0] if frames[0].name else "motion"
+        apply_motion(rig, frames, f"{collection.name} {name}", loop=name in MOTIONS)
+        rate = fps or WALK_FPS
+        scene.render.fps = max(1, int(round(rate)))
+        scene.render.fps_base = scene.render.fps / rate
         scene.frame_start, scene.frame_end = 1, len(frames)
         scene.frame_set(1)
     bpy.context.view_layer.update()

@@ -1,10 +1,11 @@
 """File formats ElliMann writes without Blender, and the table of every format (floor 5: everything below).
 
+- bvh: BVH motion-capture clips read with numpy, their units said, their bones matched
 - core_writers: OBJ, JSON and MJCF mannequin files by extension
 - mjcf: MJCF (MuJoCo) of a mannequin's convex pieces
 - mjcf_articulated: MJCF of a mannequin with joints: an articulated body, poses as keyframes
 - obj: Wavefront OBJ of a mannequin's pieces, rest or posed, Y up
-- npz_bundle: a whole batch in one compressed .npz, and its loader
+- npz_bundle: a whole batch in one compressed .npz (streamed row by row, or in one go), and its loader
 - posed_files: posed .json, .xml and .obj; reading a pose file
-- table: the one table of output formats (extension, writer, needs Blender)
+- table: the one table of output formats (extension, writer, whole-file check, needs Blender)
 """

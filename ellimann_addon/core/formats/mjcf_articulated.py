@@ -28,7 +28,7 @@ from ..geometry.ellipsoid import volume as ellipsoid_volume
 from ..geometry.mesh import volume as mesh_volume
 from ..geometry.quaternion import rotation_to_quaternion
 from ..mannequin.skeleton import CHILDREN, HINGES, JOINT_NAMES, ROOT, joint_frames, limits
-from ..pose.kinematics import Pose, forward_kinematics, joint_angles, require_joints
+from ..pose.kinematics import Pose, forward_kinematics, require_joints, rotation_angles
 from ..pose.posed_pieces import PosingRig, union_volume
 from .mjcf import CUSHION_RGBA, FRICTION, SIDE_RGBA, SOLREF, TIMESTEP, format_numbers, summary_comment
 
@@ -187,8 +187,8 @@ def articulated_mjcf(
     add_body(ROOT, world)
     if poses:
         keys = ET.SubElement(root, "keyframe")
-        for pose in poses:
-            ET.SubElement(keys, "key", name=pose.name or "pose", qpos=format_numbers(pose_qpos(pose, joints)))
+        for pose, qpos in zip(poses, poses_qpos(poses, joints)):
+            ET.SubElement(keys, "key", name=pose.name or "pose", qpos=format_numbers(qpos))
     ET.indent(root, space="  ")
     return ET.tostring(root, encoding="unicode") + "\n"
 
@@ -209,18 +209,25 @@ def overlap_share(rig):
 def pose_qpos(pose, joints):
     """MuJoCo qpos of ``pose`` for :func:`articulated_mjcf`'s model: the root's position and quaternion, then
     each hinge's angle, in the order the bodies are nested (depth first, as MuJoCo numbers them)."""
-    world, _, posed = forward_kinematics(joints, pose.rotations, pose.translation)
-    angles = joint_angles(pose, joints)
-    values = list(posed[ROOT]) + list(rotation_to_quaternion(world[ROOT]))
+    return poses_qpos([pose], joints)[0]
+
+
+def poses_qpos(poses, joints):
+    """(F, n): :func:`pose_qpos` of each of ``poses``, computed together (a clip's thousands of frames)."""
+    rotations = np.stack([p.rotations for p in poses])
+    world, _, posed = forward_kinematics(joints, rotations, np.stack([p.translation for p in poses]))
+    angles = rotation_angles(rotations, joints)
+    hinges = []
 
     def visit(j):
         if j != ROOT:
-            values.extend(angles[j, k] for k in hinge_axes(JOINT_NAMES[j]))
+            hinges.extend((j, k) for k in hinge_axes(JOINT_NAMES[j]))
         for child in CHILDREN[j]:
             visit(child)
 
     visit(ROOT)
-    return np.array(values)
+    joint, axis = np.array(hinges).T
+    return np.concatenate([posed[:, ROOT], rotation_to_quaternion(world[:, ROOT]), angles[:, joint, axis]], axis=1)
 
 
 def write_articulated_mjcf(mannequin, path, poses=(), cushions=False):

@@ -26,7 +26,7 @@ def pose_section(frames, fps=None):
     """The JSON ``pose`` section of a list of poses (one for a still pose)."""
     section = {
         "version": POSE_SECTION_VERSION,
-        "name": frames[0].name.split(" ")[0] if frames else "",
+        "name": frames[0].name.rsplit(" ", 1)[0] if frames else "",
         "frames": [p.to_dict() for p in frames],
     }
     if fps is not None and len(frames) > 1:
@@ -66,7 +66,7 @@ def write_posed(mannequin, frames, path, cushions=False, fps=None):
     if len(frames) > 1 and not kind.animated:
         raise ElliMannError(
             f"pose: a .{kind.extension} file holds no animation; write the {len(frames)} frames "
-            f"of '{frames[0].name.split(' ')[0]}' to .json or .xml (keyframes), or pose a still pose"
+            f"of '{frames[0].name.rsplit(' ', 1)[0]}' to .json or .xml (keyframes), or pose a still pose"
         )
     if kind.name == "json":
         data = mannequin.to_dict()

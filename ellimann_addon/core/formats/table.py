@@ -1,7 +1,9 @@
 """The mannequin file formats, in one table: each format's name (``--format``), its file extension, who writes
 it (the core: OBJ, JSON and MJCF, ``core.formats.core_writers``; Blender: .blend and .glb,
-``blender.services.files.write_mannequin``)
-and so whether it needs the bpy module. The command line, the writers and the export operator read it."""
+``blender.services.files.write_mannequin``) and so whether it needs the bpy module, the function that writes it
+and what its whole-file check verifies (every file is written to a temporary name and put in place only once
+``core.files.incomplete`` finds it whole, so a write cut short never replaces a file). The command line, the
+writers and the export operator read it; the formats ElliMann defines have a page each in docs/formats/."""
 
 import os
 from dataclasses import dataclass
@@ -15,6 +17,8 @@ class Format:
     title: str  # what it is, for help texts
     posed_writer: str  # who writes it posed (``--pose``): "core" (core.formats.posed_files) or "blender"
     animated: bool  # holds an animation (the walk cycle)
+    written_by: str  # the function that writes it at rest (dotted, under ellimann_addon; posed: posed_files/posing)
+    whole_file: str  # what core.files.incomplete checks of it before it replaces anything
 
     @property
     def needs_blender(self):
@@ -25,16 +29,74 @@ class Format:
         return (self.posed_writer if posed else self.writer) == "blender"
 
 
+WHOLE_FILE_CHECK = "core.files.incomplete"  # the one whole-file check, by extension (``kind``)
 FORMATS = {
     f.name: f
     for f in (
-        Format("blend", "blend", "blender", "Blender file", "blender", True),
-        Format("glb", "glb", "blender", "binary glTF with ElliMann's extras", "blender", True),
-        Format("obj", "obj", "core", "Wavefront OBJ (Y up)", "core", False),
-        Format("json", "json", "core", "ElliMann's mannequin JSON", "core", True),
-        Format("mjcf", "xml", "core", "MJCF, for MuJoCo", "core", True),
+        Format(
+            "blend",
+            "blend",
+            "blender",
+            "Blender file",
+            "blender",
+            True,
+            "blender.services.files.write_blender_file",
+            "its block chain reaches the ENDB block (zstd: the frames its seek table lists; gzip: every block)",
+        ),
+        Format(
+            "glb",
+            "glb",
+            "blender",
+            "binary glTF with ElliMann's extras",
+            "blender",
+            True,
+            "blender.services.files.export_gltf",
+            "the length in its header is the file's and its chunks fill it",
+        ),
+        Format(
+            "obj",
+            "obj",
+            "core",
+            "Wavefront OBJ (Y up)",
+            "core",
+            False,
+            "core.formats.obj.write_obj",
+            "it ends with a complete line",
+        ),
+        Format(
+            "json",
+            "json",
+            "core",
+            "ElliMann's mannequin JSON",
+            "core",
+            True,
+            "core.mannequin.model.Mannequin.save",
+            "it parses as JSON (reading it, Mannequin.load checks every field)",
+        ),
+        Format(
+            "mjcf",
+            "xml",
+            "core",
+            "MJCF, for MuJoCo",
+            "core",
+            True,
+            "core.formats.mjcf.write_mjcf",
+            "it parses as XML",
+        ),
     )
 }
+# The batch's own one-file format (``batch --format npz``): every mannequin of a batch, not one per file, so not a
+# row of FORMATS (which synth, pose and the export operator write one mannequin to).
+BATCH_FILE = Format(
+    "npz",
+    "npz",
+    "core",
+    "every mannequin of a batch in one compressed NumPy archive",
+    "core",
+    False,
+    "core.formats.npz_bundle.BatchFileWriter",
+    "its zip directory reads (reading it, read_batch_file checks every array's shape)",
+)
 CORE_FORMATS = tuple(name for name, f in FORMATS.items() if not f.needs_blender)  # obj, json, mjcf
 BLENDER_FORMATS = tuple(name for name, f in FORMATS.items() if f.needs_blender)  # blend, glb
 EXTENSIONS = {name: f.extension for name, f in FORMATS.items()}  # format -> file extension

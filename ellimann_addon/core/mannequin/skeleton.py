@@ -1,5 +1,5 @@
-"""The skeleton of a mannequin: SMPL's 24 joints, which bone each part rides on, name maps of other rigs, the
-anatomical limits, and the mannequin JSON's ``joints`` section.
+"""The skeleton of a mannequin: SMPL's 24 joints, which bone each part rides on, the anatomical limits, and the
+mannequin JSON's ``joints`` section (other rigs' bone names: ``core.pose.rig_names``).
 
 Joint names and order are SMPL's (``JOINT_NAMES``, ``PARENTS``: Pelvis is the root). ``L_`` is the body's left,
 which is +X here. A joint's *bone* is the segment it rotates: the pieces on bone ``L_Elbow`` are the forearm's.
@@ -92,76 +92,6 @@ MAKEHUMAN_JOINTS = {
         )
     },
 }
-
-
-def _sided(central, sided):
-    """A rig's name map {their bone: SMPL joint} from central entries and per-side templates ('{Side}', '{S}')."""
-    out = dict(central)
-    for side, s in (("Left", "L"), ("Right", "R")):
-        for theirs, joint in sided.items():
-            out[theirs.format(Side=side, S=s, s=s.lower())] = f"{s}_{joint}"
-    return out
-
-
-# The limbs as the CMU motion-capture BVH conversions and Mixamo both name them (LeftUpLeg, RightForeArm, ...).
-_MOTION_CAPTURE_LIMBS = {
-    "{Side}UpLeg": "Hip",
-    "{Side}Leg": "Knee",
-    "{Side}Foot": "Ankle",
-    "{Side}ToeBase": "Foot",
-    "{Side}Shoulder": "Collar",
-    "{Side}Arm": "Shoulder",
-    "{Side}ForeArm": "Elbow",
-    "{Side}Hand": "Wrist",
-}
-# Other rigs' bone names -> SMPL joints (BVH and FBX motion onto a mannequin). A bone not listed is ignored.
-RIG_NAME_MAPS = {
-    "makehuman": _sided(
-        {
-            "root": "Pelvis",
-            "spine03": "Spine1",
-            "spine02": "Spine2",
-            "spine01": "Spine3",
-            "neck01": "Neck",
-            "head": "Head",
-        },
-        {
-            "upperleg01.{S}": "Hip",
-            "lowerleg01.{S}": "Knee",
-            "foot.{S}": "Ankle",
-            "toe3-1.{S}": "Foot",
-            "clavicle.{S}": "Collar",
-            "upperarm01.{S}": "Shoulder",
-            "lowerarm01.{S}": "Elbow",
-            "wrist.{S}": "Wrist",
-            "finger3-1.{S}": "Hand",
-        },
-    ),
-    # The CMU database's BVH conversions (Hips, LeftUpLeg, ..., LowerBack, Spine, Spine1).
-    "cmu": _sided(
-        {
-            "Hips": "Pelvis",
-            "LowerBack": "Spine1",
-            "Spine": "Spine2",
-            "Spine1": "Spine3",
-            "Neck": "Neck",
-            "Head": "Head",
-        },
-        {**_MOTION_CAPTURE_LIMBS, "{Side}FingerBase": "Hand"},
-    ),
-    # Mixamo, without its "mixamorig:" prefix (see joint_of_bone).
-    "mixamo": _sided(
-        {"Hips": "Pelvis", "Spine": "Spine1", "Spine1": "Spine2", "Spine2": "Spine3", "Neck": "Neck", "Head": "Head"},
-        {**_MOTION_CAPTURE_LIMBS, "{Side}HandMiddle1": "Hand"},
-    ),
-}
-
-
-def joint_of_bone(rig, bone):
-    """The SMPL joint a rig's bone drives, or None: ``rig`` a key of RIG_NAME_MAPS; a namespace prefix such as
-    Mixamo's 'mixamorig:' (or 'mixamorig1:') is ignored."""
-    names = RIG_NAME_MAPS[rig]
-    return names.get(bone) or names.get(bone.rpartition(":")[2])
 
 
 # The bone each part of a topology rides on, by the part's label (its name without number and side); a sided

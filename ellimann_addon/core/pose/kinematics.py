@@ -42,12 +42,11 @@ class Pose:
 
     def to_dict(self):
         """JSON: per joint its local rotation as intrinsic XYZ Euler angles in degrees (world-aligned axes)."""
+        angles = np.degrees(euler_xyz(self.rotations)).tolist()
         return {
             "name": self.name,
             "translation": self.translation.tolist(),
-            "euler_xyz_degrees": {
-                n: np.degrees(euler_xyz(self.rotations[i])).tolist() for i, n in enumerate(JOINT_NAMES)
-            },
+            "euler_xyz_degrees": dict(zip(JOINT_NAMES, angles)),
         }
 
     @classmethod
@@ -251,9 +250,14 @@ def joint_angles(pose, joints):
     the one within its limits (or nearer them), so ranges wider than 90 degrees about y (a shoulder's
     abduction) work, and each angle is taken nearest its range.
     """
+    return rotation_angles(pose.rotations, joints)
+
+
+def rotation_angles(rotations, joints):
+    """:func:`joint_angles` of local rotations (..., 24, 3, 3): (..., 24, 3) radians."""
     frames = joint_frames(joints)
     ranges = limits(joints)
-    principal = euler_xyz(np.swapaxes(frames, -1, -2) @ pose.rotations @ frames)
+    principal = euler_xyz(np.swapaxes(frames, -1, -2) @ rotations @ frames)
     other = principal + np.array([np.pi, 0.0, np.pi])
     other[..., 1] = np.pi - principal[..., 1]
     principal, other = _wrapped(principal, ranges), _wrapped(other, ranges)
@@ -288,9 +292,19 @@ def clamp_pose(pose, joints, frame=None):
     reports = limit_reports(pose, joints, frame)
     if not reports:
         return pose, []
+    return pose.copy(rotations=clamp_rotations(pose.rotations[None], joints)[0][0]), reports
+
+
+def clamp_rotations(rotations, joints):
+    """Local rotations (F, 24, 3, 3) of a sequence with every joint angle clamped into its range: (clamped
+    rotations, the angles before clamping (F, 24, 3) radians, where they were beyond (F, 24, 3) bool). A joint within
+    its range keeps its rotation exactly."""
     frames, ranges = joint_frames(joints), limits(joints)
-    angles = np.clip(joint_angles(pose, joints), ranges[..., 0], ranges[..., 1])
-    beyond = sorted({JOINT_NAMES.index(r.joint) for r in reports})  # the others keep their rotation exactly
-    rotations = pose.rotations.copy()
-    rotations[beyond] = frames[beyond] @ from_euler_xyz(angles[beyond]) @ np.swapaxes(frames[beyond], -1, -2)
-    return pose.copy(rotations=rotations), reports
+    angles = rotation_angles(rotations, joints)
+    beyond = (angles < ranges[..., 0] - LIMIT_TOLERANCE) | (angles > ranges[..., 1] + LIMIT_TOLERANCE)
+    out = np.array(rotations, dtype=float, copy=True)
+    frame, joint = np.nonzero(beyond.any(axis=-1))
+    if len(frame):
+        kept = np.clip(angles[frame, joint], ranges[joint, :, 0], ranges[joint, :, 1])
+        out[frame, joint] = frames[joint] @ from_euler_xyz(kept) @ np.swapaxes(frames[joint], -1, -2)
+    return out, angles, beyond

@@ -31,11 +31,11 @@ from ..measure.extra import (
     mannequin_extra_measurements,
 )
 from ..measure.tailor import tailor_measurements
+from .misses import MISS_CM, Miss
 from .refine import refine
 
 EXTRA_TOLERANCE_CM = 0.01  # every given extra measurement within 0.1 mm
 EXTRA_MAX_ROUNDS = 12
-MISS_CM = 0.1  # a given extra measurement further off than this (1 mm) is a miss
 FIVE_TOLERANCE_CM = 0.01  # a round that moves any of the five further than this is never the result
 EXTRA_FACTOR_LIMIT = 2.0  # no piece scaled beyond this or below its inverse (it would no longer look like itself)
 _MAX_LOG_STEP = 0.25
@@ -200,7 +200,9 @@ def _apply(key, factor, mannequin, rotation, center, semi, stretch, spread):
 
 def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXTRA_MAX_ROUNDS):
     """Deform a synthesized mannequin until its m_T meets its request (``mannequin.measurements``) and its
-    extra measurements meet ``extra`` {key: cm}. Returns (mannequin, measured {all keys: cm}, misses [lines]).
+    extra measurements meet ``extra`` {key: cm}. Returns (mannequin, measured {all keys: cm}, misses): the given
+    extra measurements off by more than MISS_CM and, where refine could not keep them, the five off by more than
+    FIVE_TOLERANCE_CM (a list of :class:`core.synthesis.misses.Miss`).
 
     All at once first; if that misses any, one measurement at a time (in EXTRA_MEASUREMENTS order), each kept
     only if it and those kept before are met with the five: one that the pieces cannot reach (or only by
@@ -242,8 +244,9 @@ def _all_measured(mannequin):
 
 
 def _misses(measured, extra):
+    """The given extra measurements further than MISS_CM from ``extra`` (:class:`core.synthesis.misses.Miss`)."""
     return [
-        f"{key} {measured[key]:.2f} cm, asked {extra[key]:.2f} (off by {measured[key] - extra[key]:+.2f} cm)"
+        Miss(key, measured[key], extra[key])
         for key in EXTRA_MEASUREMENTS
         if key in extra and abs(measured[key] - extra[key]) > MISS_CM
     ]
@@ -307,6 +310,10 @@ def _meet(mannequin, extra, tolerance_cm, max_rounds):
     _, current, values = best
     measured = _all_measured(current)
     misses = _misses(measured, extra)
-    if worst_miss(current, values)[0]:
-        misses.append("the five")
+    if worst_miss(current, values)[0]:  # what refine could not keep of the five, as misses too
+        misses += [
+            Miss(key, measured[key], mannequin.measurements[key])
+            for key in MEASUREMENTS
+            if abs(measured[key] - mannequin.measurements[key]) > FIVE_TOLERANCE_CM
+        ]
     return current, measured, misses

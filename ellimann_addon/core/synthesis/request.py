@@ -11,27 +11,34 @@ from .options import is_number
 
 
 def validate_request(me, ranges=None, limits=None):
-    """Check a request {He, Sh, Br, Wa, Hi} in cm (a dict, or a sequence in that order).
+    """Check a request {He, Sh, Br, Wa, Hi} in cm (a dict, or a sequence in that order); the warnings of
+    :func:`checked_request`."""
+    return checked_request(me, ranges, limits)[1]
+
+
+def checked_request(me, ranges=None, limits=None):
+    """A request {He, Sh, Br, Wa, Hi} in cm (a dict, or a sequence in that order), checked: ((5,) float array,
+    warnings).
 
     Raises MeasurementError naming the field for a missing key, a non-number, NaN/inf, a value
-    <= 0 or outside ``limits``. Returns a list of warnings for values outside the reference range L
+    <= 0 or outside ``limits``. The warnings are for values outside the reference range L
     (``ranges``; allowed: exact mode reaches them, IDW cannot leave the RMs' hull). ``ranges`` and ``limits``
     are the reference set's (``ReferenceSet.ranges``, ``.absurd_limits``); by default the female set's
     RANGES and ABSURD_LIMITS.
     """
-    values = _request_values(me)
+    values = request_values(me)
     ranges, limits = ranges or RANGES, limits or ABSURD_LIMITS
     warnings = []
     for key, value in zip(MEASUREMENTS, values):
         low, high = limits[key]
-        accepted = f"accepted range {low:g}-{high:g} cm"
-        if not is_number(value):
-            raise MeasurementError(key, f"must be a number in cm, got {value!r} ({accepted})")
-        if not math.isfinite(value):
-            raise MeasurementError(key, f"must be a finite number, got {value!r} ({accepted})")
-        if value <= 0:
-            raise MeasurementError(key, f"must be > 0, got {value:g} ({accepted})")
-        if not low <= value <= high:
+        if not (is_number(value) and value > 0 and low <= value <= high):  # NaN fails too; the message says which
+            accepted = f"accepted range {low:g}-{high:g} cm"
+            if not is_number(value):
+                raise MeasurementError(key, f"must be a number in cm, got {value!r} ({accepted})")
+            if not math.isfinite(value):
+                raise MeasurementError(key, f"must be a finite number, got {value!r} ({accepted})")
+            if value <= 0:
+                raise MeasurementError(key, f"must be > 0, got {value:g} ({accepted})")
             raise MeasurementError(key, f"{value:g} cm is not a plausible value ({accepted})")
         lo, hi = ranges[key]
         if value < lo or value > hi:
@@ -42,10 +49,12 @@ def validate_request(me, ranges=None, limits=None):
                 f"({100.0 * by / bound:.1f}%): the paper's IDW stays inside the range, proportional "
                 "IDW and exact mode extrapolate"
             )
-    return warnings
+    return np.array(values, dtype=float), warnings
 
 
-def _request_values(me):
+def request_values(me):
+    """The five values of a request (dict or sequence), in the order of MEASUREMENTS, unchecked; MeasurementError
+    for a missing or unknown key or a wrong count."""
     if isinstance(me, dict):
         missing = [key for key in MEASUREMENTS if key not in me]
         if missing:
@@ -67,15 +76,14 @@ def _request_values(me):
 
 
 def request_array(me, ranges=None, limits=None):
-    """Validated request as a (5,) float array (warnings dropped; use validate_request to see them)."""
-    validate_request(me, ranges, limits)
-    return np.array(_request_values(me), dtype=float)
+    """Validated request as a (5,) float array (warnings dropped; :func:`checked_request` gives both)."""
+    return checked_request(me, ranges, limits)[0]
 
 
 def mannequin_name(me):
-    """'ElliMann 159-43-117-104-117': the name of a synthesized mannequin, from its request."""
-    values = request_array(me)
-    return "ElliMann " + "-".join(f"{v:.6g}" for v in values)
+    """'ElliMann 159-43-117-104-117': the name of a synthesized mannequin, from its request (checked where it
+    entered)."""
+    return "ElliMann " + "-".join(f"{float(v):.6g}" for v in request_values(me))
 
 
 def relative_error(measured, requested, signed=False):

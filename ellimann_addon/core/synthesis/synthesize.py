@@ -50,6 +50,7 @@ their names importable from here.
 """
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -61,6 +62,7 @@ from ..measure.extra import mannequin_extra_measurements
 from ..measure.tailor import as_dict, followed_measurements, tailor_measurements
 from .extra_refine import ExtraRequestError, extra_request_problems, meet_extra
 from .idw import idw_weights, interpolate, interpolate_joints
+from .misses import missed_text, request_misses
 from .options import (
     DEFAULT_NORMALIZE,
     DEFAULT_POWER,
@@ -74,7 +76,14 @@ from .options import (
 )
 from .reference_set import REFERENCE_FOLDER, REFERENCE_NAMES, ReferenceSet, cached_reference_set, load_reference_set
 from .refine import EXACT_MAX_ITERATIONS, EXACT_TOLERANCE, FACTOR_LIMITS, Refinement, deform, refine
-from .request import mannequin_name, relative_error, request_array, validate_request, validate_requests
+from .request import (
+    checked_request,
+    mannequin_name,
+    relative_error,
+    request_array,
+    validate_request,
+    validate_requests,
+)
 
 __all__ = [
     "DEFAULT_NORMALIZE",
@@ -93,6 +102,7 @@ __all__ = [
     "Refinement",
     "Synthesis",
     "SynthesisOptions",
+    "Synthesized",
     "cached_reference_set",
     "check_options",
     "check_plausible",
@@ -101,12 +111,15 @@ __all__ = [
     "interpolate",
     "load_reference_set",
     "mannequin_name",
+    "meet_extra_request",
     "options_of",
     "refine",
     "relative_error",
     "request_array",
     "synthesize",
     "synthesize_batch",
+    "synthesize_checked",
+    "synthesize_extra",
     "validate_request",
     "validate_requests",
 ]
@@ -128,9 +141,17 @@ class Synthesis:
     reference_set: str = FEMALE_SET  # the name of the set they come from
     section_fractions: dict = None  # the set's section heights (None: SECTION_FRACTIONS)
     joints: np.ndarray = None  # (B, 24, 3) rest joints (core.mannequin.joints), None if the RMs have none
+    errors: list = None  # per row: None, or why that row failed (its arrays are then NaN); None: none failed
+    # (B, 6) cm: the extra measurements (EXTRA_MEASUREMENTS order) of the rows that asked for some, NaN elsewhere
+    # (core.synthesis.batch.synthesize_chunk); None: no row asked
+    extra_measured: np.ndarray = None
 
     def __len__(self):
         return len(self.requests)
+
+    def error(self, i):
+        """Why row ``i`` failed, or None."""
+        return None if self.errors is None else self.errors[i]
 
     def mannequin(self, i, name=None):
         me = as_dict(self.requests[i])
@@ -197,11 +218,18 @@ def synthesize_batch(reference, requests, options=None, *, measure=True, toleran
 
     ``options``: a SynthesisOptions (default: exact mode, ``options.SYNTHESIS``); keywords mode=, metric=,
     power=, normalize= replace its fields. The paper's method is ``mode="idw", normalize="none"`` (with the
-    default raw metric and p = 2; ``options.PAPER``).
+    default raw metric and p = 2; ``options.PAPER``). The requests and options are checked here, where they enter
+    (:func:`synthesize_checked` takes them checked).
     """
     options = options_of(options, **fields).checked()
-    mode = options.mode
     requests = validate_requests(requests, reference.ranges, reference.absurd_limits)
+    return synthesize_checked(reference, requests, options, measure=measure, tolerance=tolerance)
+
+
+def synthesize_checked(reference, requests, options, *, measure=True, tolerance=EXACT_TOLERANCE):
+    """:func:`synthesize_batch` of requests (B, 5) float array and options already checked where they entered
+    (``validate_requests`` or ``checked_request``; ``SynthesisOptions.checked``)."""
+    mode = options.mode
     weights = idw_weights(reference, requests, options.metric, options.power)  # for the pieces and the joints alike
     rotation, center, semi_axes = interpolate(
         reference, requests, options.metric, options.power, options.normalize, weights
@@ -258,29 +286,57 @@ def synthesize_batch(reference, requests, options=None, *, measure=True, toleran
 def synthesize(reference, request, options=None, **fields):
     """One mannequin from a request (dict or 5 numbers, cm), named ``options.name`` (default: from the request).
     ``options`` and keywords as :func:`synthesize_batch`'s. Returns (Mannequin, measured dict, warnings)."""
-    options = options_of(options, **fields)
-    warnings = validate_request(request, reference.ranges, reference.absurd_limits)
-    batch = synthesize_batch(reference, [request_array(request, reference.ranges, reference.absurd_limits)], options)
+    options = options_of(options, **fields).checked()
+    values, warnings = checked_request(request, reference.ranges, reference.absurd_limits)
+    batch = synthesize_checked(reference, values[None], options)
     if not batch.converged[0]:
         worst = MEASUREMENTS[int(np.argmax(batch.relative_error()[0]))]
         warnings.append(f"exact mode did not fully converge: {worst} is off by {batch.relative_error()[0].max():.2f}%")
     return batch.mannequin(0, options.name), as_dict(batch.measured[0]), warnings
 
 
+class Synthesized(NamedTuple):
+    """One mannequin as :func:`synthesize_extra` gives it."""
+
+    mannequin: Mannequin
+    measured: dict  # {the five and the six extra measurements: cm}, what the mannequin measures (the five alone
+    # when none was given and measure_extra is False)
+    warnings: list  # lines to show: requests outside the reference range, what exact mode missed (one line)
+    missed: list  # what exact mode missed, as data (core.synthesis.misses.Miss); empty in IDW, which promises none
+
+
+IDW_EXTRA_NOTE = "the extra measurements are met in exact mode only (IDW gives the reference set's)"
+
+
 def synthesize_extra(reference, request, extra, options=None, measure_extra=True):
-    """One mannequin meeting the five of ``request`` (dict, cm) and the given ``extra`` measurements (exact mode;
-    IDW leaves the extra ones as the reference set gives them). Returns (Mannequin, measured {the five, the extra
-    ones: cm}, warnings); raises ExtraRequestError for a contradiction. ``measure_extra=False``: without any
-    ``extra`` given, measured holds the five alone (the extra ones cost more than an exact synthesis)."""
-    problems = extra_request_problems(request, extra)
+    """One mannequin meeting the five of ``request`` (dict or 5 values, cm) and the given ``extra`` measurements
+    ({key: cm}; exact mode; IDW leaves the extra ones as the reference set gives them): a :class:`Synthesized`.
+    The request is checked here, once (MeasurementError naming the field); ExtraRequestError for extra ones out
+    of their limits or contradicting the five. ``measure_extra=False``: with no ``extra`` given, the five alone are
+    measured (the six cost more than an exact synthesis; the panel and ``synth`` show no others)."""
+    options = options_of(options).checked()
+    values, warnings = checked_request(request, reference.ranges, reference.absurd_limits)
+    problems = extra_request_problems(as_dict(values), extra)
     if problems:
         raise ExtraRequestError(problems[0])
-    mannequin, measured, warnings = synthesize(reference, request, options)
-    if extra and getattr(options, "mode", "exact") == "exact":
-        mannequin, measured, misses = meet_extra(mannequin, extra)
-        warnings += [f"exact mode missed {line}" for line in misses]
-    elif extra or measure_extra:
-        measured = dict(measured, **mannequin_extra_measurements(mannequin))
-        if extra:
-            warnings.append("the extra measurements are met in exact mode only (IDW gives the reference set's)")
-    return mannequin, measured, warnings
+    batch = synthesize_checked(reference, values[None], options)
+    mannequin, measured, note = meet_extra_request(
+        batch.mannequin(0, options.name), as_dict(batch.measured[0]), extra, options.mode, measure_extra
+    )
+    missed = request_misses(measured, values, extra, options.mode)
+    warnings += ([note] if note else []) + ([missed_text(missed)] if missed else [])
+    return Synthesized(mannequin, measured, warnings, missed)
+
+
+def meet_extra_request(mannequin, measured, extra, mode, measure_extra=True):
+    """The extra measurements of a synthesized ``mannequin`` (m_T ``measured`` {the five: cm}): in exact mode, the
+    ``extra`` ones given met (``meet_extra``); otherwise (or with none given) as the reference set gives them.
+    Returns (mannequin, measured {the five and the six: cm}, a note for the user or None). What ``synth``, the
+    panel and each row of ``batch`` run (core.synthesis.batch.synthesize_chunk). ``measure_extra=False``: with
+    none given, ``measured`` as it is (the five)."""
+    if extra and mode == "exact":
+        mannequin, measured, _ = meet_extra(mannequin, extra)  # its misses: judged by request_misses, as for all
+        return mannequin, measured, None
+    if not (extra or measure_extra):
+        return mannequin, measured, None
+    return mannequin, dict(measured, **mannequin_extra_measurements(mannequin)), IDW_EXTRA_NOTE if extra else None

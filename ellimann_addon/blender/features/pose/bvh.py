@@ -1,5 +1,6 @@
-"""Import BVH Motion: a clip read by Blender's BVH importer, mapped by bone names onto the active mannequin's
-armature as an action; joint angles beyond their limits are clamped and reported by joint and frame."""
+"""Import BVH Motion: a clip read and matched by the core (``core.formats.bvh``: numpy, the same path as the command
+line's ``--pose clip.bvh``), retargeted onto the active mannequin's armature as an action; what was not placed,
+the joints that will not bend, the clamps per joint and where the feet went are reported and shown in the panel."""
 
 import os
 
@@ -8,55 +9,57 @@ from bpy.props import StringProperty
 from bpy_extras.io_utils import ImportHelper
 
 from ....core.errors import ElliMannError
-from ....core.mannequin.skeleton import JOINT_NAMES, PARENTS, RIG_NAME_MAPS, joint_of_bone
-from ....core.pose.kinematics import Pose, clamp_pose
-from ....core.pose.retarget import retarget
+from ....core.formats.bvh import read_bvh
+from ....core.pose.clip import clip_onto
 from ... import ids
-from ...bridge.convert import read_joints, rig_object
-from ...services.bvh import bvh_header, sample_bvh
-from ...services.rig import PREFERRED_CHILD, apply_motion
-from ..base import MannequinOperator, OperatorError, plural
+from ...bridge.convert import rig_object
+from ...services.rig import apply_motion
+from ..base import MannequinOperator, OperatorError, mannequin_or_cancel, plural
 from .operators import has_rig
-from .props import RIG_LABELS
 
-SHOWN_REPORTS = 5  # clamped angles listed one by one in the Info log; the rest are counted
-
-
-def name_map(bone_names, rig="AUTO"):
-    """(rig key, {clip bone: SMPL joint}) for the clip's bones: ``rig``'s map, or with AUTO the map that
-    knows most of them (the first in RIG_NAME_MAPS on a tie)."""
-    keys = list(RIG_NAME_MAPS) if rig == "AUTO" else [rig]
-    found = {key: {b: joint_of_bone(key, b) for b in bone_names if joint_of_bone(key, b)} for key in keys}
-    best = max(keys, key=lambda key: len(found[key]))
-    return best, found[best]
+SHOWN_LINES = 12  # lines of the last import the panel shows (the Info log has them in full)
 
 
-def motion_onto(collection, path, rig="AUTO"):
-    """(core poses, clamp reports, rig key, clip) of a BVH clip on a mannequin collection; ElliMannError
-    (nothing changed) for a file that is not a BVH clip or whose bones no map knows."""
-    joints = read_joints(collection)
-    if joints is None:
+def motion_onto(collection, path, rig="auto", keep_on_floor=False, progress=lambda step: None):
+    """(the clip read, its ``core.pose.clip.ClipOnMannequin`` on a mannequin collection); ElliMannError (nothing
+    changed) for a file that is not a clip ElliMann can use or a mannequin without joints. ``progress(1)`` once
+    the clip is read."""
+    mannequin = mannequin_or_cancel(collection)
+    if mannequin.joints is None:
         raise ElliMannError(f"joints: '{collection.name}' has no joints (rig it again: Add Armature)")
-    names, _ = bvh_header(path)
-    key, mapping = name_map(names, rig)
-    if not mapping:
-        shown = ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
-        which = "any of the maps (MakeHuman/CMU, Mixamo)" if rig == "AUTO" else f"the {RIG_LABELS.get(rig, rig)} map"
-        raise ElliMannError(
-            f"bones: none of the {len(names)} bones of {os.path.basename(path)} ({shown}) is in {which}"
-        )
-    clip = sample_bvh(path)
-    rotations, translations = retarget(clip, JOINT_NAMES, joints, PARENTS, mapping, PREFERRED_CHILD)
-    poses, reports = [], []
-    for frame, (rotation, translation) in enumerate(zip(rotations, translations), start=1):
-        pose, found = clamp_pose(Pose(rotation, translation, name=f"frame {frame}"), joints, frame=frame)
-        poses.append(pose)
-        reports += found
-    return poses, reports, key, clip
+    clip = read_bvh(path, rig)
+    progress(1)
+    return clip, clip_onto(mannequin, clip.motion, clip.match, keep_on_floor, clip.name)
+
+
+def import_lines(clip, onto):
+    """(warnings, information): what the import says beyond its one-line result."""
+    warnings = [line for line in [clip.match.stiff_line()] if line]
+    warnings += onto.clamp_lines()
+    hint = "; Keep on Floor holds it on the floor" if not onto.held else ""
+    return warnings, [*clip.lines()[1:], onto.floor_line(hint)]
+
+
+def panel_lines(clip, onto):
+    """The outcome of an import, short enough for the sidebar: what will not bend, each clamp, what was not
+    placed, the joints without a bone, where the feet went."""
+    match, lines = clip.match, []
+    lines += [f"will not bend: {joint} (between {a} and {b})" for joint, (a, b) in match.stiff.items()]
+    lines += [
+        f"{c.joint} {c.axis}: {c.frames}/{c.total} frames, worst {c.worst:.0f}\u00b0 (frame {c.frame}), "
+        f"range {c.low:.0f} to {c.high:.0f}"
+        for c in onto.clamps
+        if not c.slight
+    ]
+    lines += [f"not placed: {', '.join(match.unplaced)}"] if match.unplaced else []
+    lines += [f"no bone: {', '.join(match.unsourced)}"] if match.unsourced else []
+    low, high = onto.lowest.min(), onto.lowest.max()
+    feet = f"feet: {100 * low:+.1f} to {100 * high:+.1f} cm from the floor"
+    return lines + [feet + (" (held on it)" if onto.held else "")]
 
 
 class ELLIMANN_OT_import_bvh(MannequinOperator, ImportHelper, bpy.types.Operator):
-    """Import a BVH clip onto the active mannequin's armature by bone names, clamping and reporting passed limits"""
+    """Import a BVH clip (any common rig's bone names) onto the active mannequin's armature, clamping passed limits"""
 
     bl_idname = ids.IMPORT_BVH
     bl_label = "Import BVH Motion"
@@ -71,27 +74,41 @@ class ELLIMANN_OT_import_bvh(MannequinOperator, ImportHelper, bpy.types.Operator
         return hasattr(context.scene, "ellimann_pose") and has_rig(context)
 
     def run(self, context, collection):
-        props = context.scene.ellimann_pose
+        props, window_manager = context.scene.ellimann_pose, context.window_manager
+        window_manager.progress_begin(0, 3)  # read, retargeted, baked
         try:
-            poses, reports, key, clip = motion_onto(collection, self.filepath, props.rig)
-        except ElliMannError as error:
-            raise OperatorError(f"Cannot import onto '{collection.name}': {error}") from error
+            try:
+                clip, onto = motion_onto(
+                    collection, self.filepath, props.rig, props.keep_on_floor, window_manager.progress_update
+                )
+            except ElliMannError as error:
+                raise OperatorError(f"Cannot import onto '{collection.name}': {error}") from error
+            window_manager.progress_update(2)
+            name = os.path.splitext(clip.name)[0]
+            action = apply_motion(rig_object(collection), onto.poses, name)
+        finally:
+            window_manager.progress_end()
         scene = context.scene
-        name = os.path.splitext(os.path.basename(self.filepath))[0]
-        action = apply_motion(rig_object(collection), poses, name)
-        scene.render.fps, scene.render.fps_base = max(1, round(clip.fps)), 1.0
-        scene.frame_start, scene.frame_end = 1, len(poses)
+        scene.render.fps = max(1, round(clip.motion.fps))
+        scene.render.fps_base = scene.render.fps / clip.motion.fps
+        scene.frame_start, scene.frame_end = 1, len(onto.poses)
         scene.frame_set(1)
-        for report in reports[:SHOWN_REPORTS]:
-            self.report({"WARNING"}, f"clamped: {report}")
-        clamped = f"; {plural(len(reports), 'joint angle')} clamped to the limits" if reports else ""
-        if reports:
-            clamped += f" (first: {reports[0]})"
-        props.status = f"{name}: {len(poses)} frames ({RIG_LABELS.get(key, key)} names){clamped}"
+        warnings, information = import_lines(clip, onto)
+        for line in information:
+            self.report({"INFO"}, line)
+        for line in warnings:
+            self.report({"WARNING"}, line)
+        stiff = ", ".join(clip.match.stiff)
+        clamped = {c.joint for c in onto.clamps if not c.slight}
+        outcome = (
+            f"{len(onto.poses)} frames, {clip.match.label}"
+            + (f"; {plural(len(clamped), 'joint')} clamped" if clamped else "")
+            + (f"; will not bend: {stiff}" if stiff else "")
+        )
+        props.status = "\n".join([f"{name}: {outcome}", *panel_lines(clip, onto)][:SHOWN_LINES])
         self.report(
-            {"INFO"},
-            f"Imported '{name}' onto '{collection.name}' as action '{action.name}': "
-            f"{len(poses)} frames, {RIG_LABELS.get(key, key)} bone names{clamped}",
+            {"WARNING" if warnings else "INFO"},
+            f"Imported '{name}' onto '{collection.name}' as action '{action.name}': {outcome}",
         )
         return {"FINISHED"}
 

@@ -44,8 +44,11 @@ class ELLIMANN_PT_pose(SubPanel, bpy.types.Panel):
         row = layout.row(align=True)
         row.prop(props, "rig", text="")
         row.operator(ids.IMPORT_BVH, icon="IMPORT", text="Import BVH")
+        layout.prop(props, "keep_on_floor")
         if props.status:
-            layout.label(text=props.status, icon="INFO")
+            box = layout.box()
+            for number, line in enumerate(props.status.splitlines()):
+                box.label(text=line, icon="INFO" if number == 0 else "BLANK1")
         layout.label(text="Measurements are the rest pose's", icon="INFO")
 
 

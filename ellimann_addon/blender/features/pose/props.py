@@ -1,15 +1,15 @@
-"""The Pose feature's scene settings, ``Scene.ellimann_pose``: the rig a BVH clip's bone names come from and
-the outcome of the last pose or import."""
+"""The Pose feature's scene settings, ``Scene.ellimann_pose``: the rig a BVH clip's bone names come from, whether
+its feet are held on the floor, and the outcome of the last pose or import."""
 
 import bpy
-from bpy.props import EnumProperty, PointerProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, PointerProperty, StringProperty
 
-from ....core.mannequin.skeleton import RIG_NAME_MAPS
+from ....core.pose.bone_match import AUTO
+from ....core.pose.rig_names import RIG_LABELS, RIG_NAME_MAPS
 
-RIG_LABELS = {"makehuman": "MakeHuman", "cmu": "CMU", "mixamo": "Mixamo"}
 RIG_ITEMS = (
-    ("AUTO", "Automatic", "The bone-name map that knows most of the clip's bones"),
-    *((key, RIG_LABELS.get(key, key), f"{RIG_LABELS.get(key, key)} bone names") for key in RIG_NAME_MAPS),
+    (AUTO, "Automatic", "The listed rig that places most joints, or the bones' own names and hierarchy"),
+    *((key, RIG_LABELS[key], f"{RIG_LABELS[key]} bone names") for key in RIG_NAME_MAPS),
 )
 
 
@@ -19,8 +19,13 @@ class ELLIMANN_PG_pose(bpy.types.PropertyGroup):
     rig: EnumProperty(
         name="Bone Names",
         items=RIG_ITEMS,
-        default="AUTO",
+        default=AUTO,
         description="Whose bone names a BVH clip uses (mapped onto the mannequin's SMPL joints)",
+    )
+    keep_on_floor: BoolProperty(
+        name="Keep on Floor",
+        default=False,
+        description="Hold the lowest foot on the floor in every frame of a BVH clip (the root lifted or lowered)",
     )
     status: StringProperty(name="Last Pose", description="Outcome of the last pose or motion import")
 

@@ -54,7 +54,7 @@ class ELLIMANN_OT_synthesize_from_mesh(ElliMannOperator, bpy.types.Operator):
                 )
             five, extra = split_measurements(values)
             try:
-                mannequin, measured, warnings = synthesize_extra(reference, five, extra, options_of(props))
+                mannequin, measured, warnings, _ = synthesize_extra(reference, five, extra, options_of(props))
             except ElliMannError as error:
                 raise OperatorError(str(error)) from None
             # beside the body (a synthesized mannequin stands at x = 0): moved in the core, joints and all
