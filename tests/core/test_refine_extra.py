@@ -30,7 +30,7 @@ FIVE_RELATIVE = 1e-5  # the five's exact-mode tolerance (0.001 %)
 # The five and the six of two of ../shared/refmodels' bodies as measured as meshes (docs/measurements.md).
 SLIM = dict(zip(MEASUREMENTS, (148.0, 31.11, 84.97, 63.0, 83.0)))
 SLIM_EXTRA = {
-    "neck": 29.68,
+    "neck": 27.59,
     "upper_arm": 19.95,
     "thigh": 43.85,
     "calf": 32.30,
@@ -39,7 +39,7 @@ SLIM_EXTRA = {
 }
 TALL = dict(zip(MEASUREMENTS, (170.99, 30.22, 83.98, 62.99, 84.01)))
 TALL_EXTRA = {
-    "neck": 31.17,
+    "neck": 29.03,
     "upper_arm": 19.50,
     "thigh": 43.55,
     "calf": 35.17,
@@ -48,7 +48,7 @@ TALL_EXTRA = {
 }
 HEAVY = dict(zip(MEASUREMENTS, (148.64, 47.69, 144.41, 138.79, 152.08)))
 HEAVY_EXTRA = {
-    "neck": 42.64,
+    "neck": 36.95,
     "upper_arm": 26.12,
     "thigh": 86.13,
     "calf": 47.40,
@@ -212,17 +212,19 @@ def test_widening_scales_a_piece_across_at_most_by_the_factor_limit(reference):
 
 
 def test_a_heavy_neck_is_met_by_a_set_that_has_not_seen_the_body(reference):
-    """The shipped set without small_chubby's RM starts her neck at some 23 cm where 42.64 is asked: a factor
-    near 2 that the neck piece, cut off its middle, takes only partly each way. A limit on the measurement's
-    factor stopped it at 39 cm and the start was returned, the neck missed; each piece's own limit lets it
-    reach (bench_scan_held_out: small_chubby, tall_chubby and average missed their neck so)."""
+    """The shipped set without small_chubby's RM starts her neck at some 24 cm where 42.64 is asked (her level
+    neck before issue 26; square to the neck she measures 36.95): a factor near 2 that the neck piece, cut off its
+    middle, takes only partly each way. A limit on the measurement's factor stopped it at 39 cm and the start was
+    returned, the neck missed; each piece's own limit lets it reach (bench_scan_held_out: small_chubby,
+    tall_chubby and average missed their neck so)."""
+    asked = 42.64
     keep = [i for i, name in enumerate(reference.names) if name != "small_chubby"]
     four = ReferenceSet([reference.mannequins[i] for i in keep], names=[reference.names[i] for i in keep])
     start, start_measured, _ = synthesize_extra(four, HEAVY, {})
-    assert start_measured["neck"] < 0.6 * HEAVY_EXTRA["neck"]  # the case: far below what is asked
-    mannequin, measured, warnings = synthesize_extra(four, HEAVY, {"neck": HEAVY_EXTRA["neck"]})
+    assert start_measured["neck"] < 0.6 * asked  # the case: far below what is asked
+    mannequin, measured, warnings = synthesize_extra(four, HEAVY, {"neck": asked})
     assert not [line for line in warnings if "missed" in line], warnings
-    assert abs(measured["neck"] - HEAVY_EXTRA["neck"]) <= MISS_CM, measured["neck"]
+    assert abs(measured["neck"] - asked) <= MISS_CM, measured["neck"]
     assert all(abs(measured[key] / value - 1.0) <= FIVE_RELATIVE for key, value in HEAVY.items())
     ratio = mannequin.semi_axes / start.semi_axes  # the neck nearly doubled, as asked, but no piece beyond the limit
     assert 1.0 / EXTRA_FACTOR_LIMIT <= ratio.min() and ratio.max() <= EXTRA_FACTOR_LIMIT, (ratio.min(), ratio.max())

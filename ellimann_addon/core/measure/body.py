@@ -22,6 +22,7 @@ from ..geometry.mesh import (
     polygon_perimeter,
     section_segments,
 )
+from .band_search import extreme_over_band
 from .extra import (
     CALF_BAND,
     CROTCH_FLOOR,
@@ -31,13 +32,20 @@ from .extra import (
     SIDES,
     THIGH_DROP,
     UPPER_ARM_FRACTION,
-    extreme_over_band,
 )
+from .neck import NECK_TILT_DEFAULT, neck_band, neck_frame, tightest_tilt
 
 ARM_SCAN_STEP = 0.005  # He between the sections that find the arms
 ARM_MARGIN = 0.01  # m beyond the body's run before a vertex counts as an arm's
 HEIGHT_RANGE_M = (0.5, 2.5)  # a standing adult or child in metres
 NECK_SAMPLES = 96  # the neck's band (0.12 He) every 2 mm or so: a mannequin's pieces may pinch between them
+NECK_STEPS = 20  # then golden section: the bracket of two cells narrows below a micrometre
+# Finding the tilt a tape settles at: the neck found once at NECK_TILT_DEFAULT on a coarse grid, then at every tilt
+# tried the smallest section within NECK_WINDOW He of it along the axis, by golden section (then the whole band
+# at the tilt found): a few hundred sections in all, not a whole band search per tilt.
+NECK_FIRST_SAMPLES, NECK_FIRST_STEPS = 24, 10
+NECK_WINDOW = 0.02  # He either side: on the six reference bodies the neck's height moves 0.01 He over 0-45 degrees
+NECK_WINDOW_STEPS = 8  # its bracket (0.027 He) narrows to 0.001 He
 ALL_MEASUREMENTS = MEASUREMENTS + EXTRA_MEASUREMENTS
 
 
@@ -49,6 +57,7 @@ class BodyMeasurement:
     values: dict = field(default_factory=dict)
     problems: list = field(default_factory=list)
     sections: dict = field(default_factory=dict)  # key: (k, 3) points where it is taken (loops, a line, a point)
+    neck_tilt: float = float("nan")  # radians forward: the neck's axis the neck was measured square to
 
     @property
     def missing(self):
@@ -281,8 +290,10 @@ def check_mesh(vertices, faces, up=None, unit=None):
     return None
 
 
-def measure_body_mesh(vertices, faces, fractions=None):
-    """Measure an upright A-pose body mesh (metres, Z up, facing -Y): a BodyMeasurement."""
+def measure_body_mesh(vertices, faces, fractions=None, neck_tilt=None):
+    """Measure an upright A-pose body mesh (metres, Z up, facing -Y): a BodyMeasurement. ``neck_tilt``: the
+    neck's forward tilt (radians) when it is known (a mannequin's own mesh or skin: its own tilt); by default
+    the tilt a tape drawn tight settles at (core.measure.neck)."""
     vertices, faces = np.asarray(vertices, float).reshape(-1, 3), np.asarray(faces, np.int64).reshape(-1, 3)
     result = BodyMeasurement()
     fatal = check_mesh(vertices, faces)
@@ -344,18 +355,13 @@ def measure_body_mesh(vertices, faces, fractions=None):
             "no crotch (the legs are not apart at the mid-plane): crotch_height, thigh and calf cannot be taken"
         )
 
-    def neck(heights):
-        girths = np.array([hull_girth(body.section(z)[0].reshape(-1, 2))[0] for z in heights])
-        return np.where(girths > 0.0, girths, np.inf)  # a height with no section is no neck
-
-    values["neck"], z_neck = extreme_over_band(
-        neck, *(body.at(f) for f in NECK_BAND), False, samples=NECK_SAMPLES, where=True
-    )
-    if np.isfinite(values["neck"]):
-        result.sections["neck"] = _at_height(hull_girth(body.section(z_neck)[0].reshape(-1, 2))[1], z_neck)
-    else:
-        del values["neck"]
-        result.problems.append("no neck: the sections between 0.80 and 0.92 He are empty; neck cannot be taken")
+    values["neck"], result.neck_tilt, result.sections["neck"] = body_neck(body, neck_tilt)
+    if not np.isfinite(values["neck"]):
+        del values["neck"], result.sections["neck"]
+        result.problems.append(
+            f"no neck: the sections crossing the neck's axis between {NECK_BAND[0]:.2f} and {NECK_BAND[1]:.2f} He "
+            "are empty; neck cannot be taken"
+        )
 
     if arms_found:
         lengths, girths = [], []
@@ -381,6 +387,72 @@ def measure_body_mesh(vertices, faces, fractions=None):
             values.pop(key, None)
     result.values = {key: float(values[key]) * CM_PER_M for key in ALL_MEASUREMENTS if key in values}
     return result
+
+
+class NeckSlices:
+    """A body mesh's sections square to a neck axis leaning forward by ``tilt`` (radians) from ``origin``: the
+    triangles that the band's planes can cross, in the axis's frame (StandingBody's sections, turned)."""
+
+    def __init__(self, body, tilt, origin):
+        self.frame, self.origin = neck_frame(tilt), origin
+        self.band = neck_band(body.height, tilt)
+        self.vertices = (body.vertices - origin) @ self.frame.T
+        along = self.vertices[body.faces, 2]
+        low, high = along.min(axis=1), along.max(axis=1)
+        rows = np.nonzero((low < self.band[1]) & (high >= self.band[0]))[0]
+        self.faces, self.low, self.high = body.faces[rows], low[rows], high[rows]
+
+    def hull(self, offset):
+        """(girth m, hull (k, 2) in the plane) of the section at ``offset`` along the axis."""
+        crossed = (self.low < offset) & (self.high >= offset)
+        return hull_girth(section_segments(self.vertices, self.faces[crossed], offset)[0].reshape(-1, 2))
+
+    def girths(self, offsets):
+        girths = np.array([self.hull(offset)[0] for offset in np.ravel(offsets)])
+        return np.where(girths > 0.0, girths, np.inf)  # an empty section is no neck
+
+    def smallest(self, low=None, high=None, samples=NECK_SAMPLES, steps=NECK_STEPS):
+        """(smallest girth m, its offset) over the band, or over [low, high] within it."""
+        low = self.band[0] if low is None else max(self.band[0], low)
+        high = self.band[1] if high is None else min(self.band[1], high)
+        return extreme_over_band(self.girths, low, high, False, samples=samples, where=True, steps=steps)
+
+    def loop(self, offset):
+        """The section's hull at ``offset`` as world points (k, 3)."""
+        hull = self.hull(offset)[1]
+        return self.origin + np.c_[hull, np.full(len(hull), offset)] @ self.frame
+
+
+def neck_origin(body):
+    """The neck axis's point at the soles' height (MannequinLandmarks.neck_origin on a mesh)."""
+    segments, _ = body.section(body.at(np.mean(NECK_BAND)))
+    y = segments[:, :, 1] if len(segments) else body.vertices[:, 1]
+    return np.array([0.0, 0.5 * (y.min() + y.max()), body.bottom])
+
+
+def body_neck(body, tilt=None):
+    """(neck girth m, tilt radians, its loop (k, 3)) of a StandingBody: the smallest section square to the neck's
+    axis leaning forward by ``tilt``, by default the tilt at which that is smallest (a tape drawn tight)."""
+    origin = neck_origin(body)
+    if tilt is None:
+        first = np.radians(NECK_TILT_DEFAULT)
+        _, offset = NeckSlices(body, first, origin).smallest(samples=NECK_FIRST_SAMPLES, steps=NECK_FIRST_STEPS)
+        height, window = offset / np.cos(first), NECK_WINDOW * body.height  # along the axis, above the soles
+
+        def smallest(tilts):
+            return np.array(
+                [
+                    NeckSlices(body, t, origin).smallest(
+                        height * np.cos(t) - window, height * np.cos(t) + window, 4, NECK_WINDOW_STEPS
+                    )[0]
+                    for t in np.ravel(tilts)
+                ]
+            )
+
+        _, tilt = tightest_tilt(smallest)
+    slices = NeckSlices(body, tilt, origin)
+    girth, offset = slices.smallest()
+    return girth, float(tilt), slices.loop(offset) if np.isfinite(girth) else np.zeros((0, 3))
 
 
 def _at_height(hull, z):
