@@ -72,11 +72,6 @@ class MannequinLandmarksBefore:
         centre, k, hit = section_at_height(self.rotation[None], self.center[None], self.semi[None], heights[:, None])
         return hull_perimeter(centre, k, hit & mask[None])
 
-    def nonzero_girths_at(self, heights, mask):
-        """As girths_at, with infinity where the section is empty (a smallest girth never lies there)."""
-        girths = self.girths_at(heights, mask)
-        return np.where(girths > 0.0, girths, np.inf)
-
     def crotch(self):
         """Height (m above the soles) of the lowest point of the body on the plane x = x_c, above CROTCH_FLOOR."""
         rotation, center = _permuted(self.rotation, self.center - [self.mid_x, 0.0, 0.0], (1, 2, 0))

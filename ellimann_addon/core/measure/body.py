@@ -44,7 +44,8 @@ NECK_STEPS = 20  # then golden section: the bracket of two cells narrows below a
 # tried the smallest section within NECK_WINDOW He of it along the axis, by golden section (then the whole band
 # at the tilt found): a few hundred sections in all, not a whole band search per tilt.
 NECK_FIRST_SAMPLES, NECK_FIRST_STEPS = 24, 10
-NECK_WINDOW = 0.02  # He either side: on the six reference bodies the neck's height moves 0.01 He over 0-45 degrees
+NECK_WINDOW = 0.02  # He either side (the six bodies' smallest section lies within 0.012 He of its place at 20 degrees
+# at every tilt from 0 to 45; the window is always centred inside the band)
 NECK_WINDOW_STEPS = 8  # its bracket (0.027 He) narrows to 0.001 He
 ALL_MEASUREMENTS = MEASUREMENTS + EXTRA_MEASUREMENTS
 

@@ -23,7 +23,7 @@ import numpy as np
 from .band_search import extreme_over_band
 
 NECK_BAND = (0.80, 0.92)  # fractions of He where the cut crosses the neck's axis
-NECK_TILT_RANGE = (-10.0, 50.0)  # degrees forward from vertical: the tilts tried on a body without joints
+NECK_TILT_RANGE = (-10.0, 50.0)  # degrees forward from vertical: the tilts a tape is tried at on a body mesh
 NECK_TILT_SAMPLES = 7  # tilts tried over that range (every 10 degrees) before the best is refined
 NECK_TILT_STEPS = 8  # golden-section steps on the tilt: its bracket (20 degrees) narrows to 0.4 degree
 NECK_TILT_DEFAULT = 20.0  # degrees: a mannequin without joints (the six reference bodies' neck joints: 19.4-21.8)
