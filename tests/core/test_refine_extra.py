@@ -13,11 +13,15 @@ from ellimann_addon.core.measure.extra import (
     THIGH_DROP,
     MannequinLandmarks,
     mannequin_extra_measurements,
+    mannequin_neck,
+    neck_plane,
 )
 from ellimann_addon.core.synthesis.extra_refine import (
     EXTRA_FACTOR_LIMIT,
     MISS_CM,
+    NECK_TIP,
     ExtraRequestError,
+    _apply,
     _section_rows,
     _widen_at,
     extra_request_problems,
@@ -209,6 +213,32 @@ def test_widening_scales_a_piece_across_at_most_by_the_factor_limit(reference):
     assert (grown - before < 0.5 * (free - before)).all()
     _widen_at(rotation, center, semi, z, legs, 0.9, 2.0, np.zeros(len(center)), spread)
     assert (spread[rows] < limit).all()
+
+
+def test_the_neck_widens_square_to_the_neck_and_leaves_the_tips_it_cuts(reference):
+    """The heavy body's neck section (square to the neck) cuts the face, the neck piece and the trapezius tips:
+    widening it changes the face and the neck, not the trapezius (lengthened from a tip, a piece ran up the neck:
+    held-out tall_slim's upper back did, its smallest section jumped to the head and the head was narrowed to
+    0.72 to meet it)."""
+    mannequin = synthesize_extra(reference, HEAVY, {})[0]
+    names = [part.name for part in mannequin.topology]
+    frame, origin, offset = neck_plane(mannequin)
+    rows, cut, _ = _section_rows(
+        frame @ mannequin.rotation,
+        (mannequin.center - origin) @ frame.T,
+        mannequin.semi_axes,
+        offset,
+        np.ones(len(names), bool),
+    )
+    tips = rows[np.abs(cut) >= NECK_TIP]
+    assert {names[i] for i in tips} == {"10.a Trapezius.L", "10.a Trapezius.R"}
+    rotation, center, semi = mannequin.rotation, mannequin.center.copy(), mannequin.semi_axes.copy()
+    zeros = np.zeros(len(names))
+    _apply("neck", 1.2, mannequin, rotation, center, semi, zeros.copy(), zeros.copy())
+    changed = np.nonzero(np.any(semi != mannequin.semi_axes, axis=1) | np.any(center != mannequin.center, axis=1))[0]
+    assert {names[i] for i in changed} == {"1.b Face", "2.a Neck"}
+    before, after = mannequin_neck(mannequin)[0], mannequin_neck(mannequin.copy(center=center, semi_axes=semi))[0]
+    assert after > 1.05 * before
 
 
 def test_a_heavy_neck_is_met_by_a_set_that_has_not_seen_the_body(reference):

@@ -42,10 +42,11 @@ NECK_SAMPLES = 96  # the neck's band (0.12 He) every 2 mm or so: a mannequin's p
 NECK_STEPS = 20  # then golden section: the bracket of two cells narrows below a micrometre
 # Finding the tilt a tape settles at: the neck found once at NECK_TILT_DEFAULT on a coarse grid, then at every tilt
 # tried the smallest section within NECK_WINDOW He of it along the axis, by golden section (then the whole band
-# at the tilt found): a few hundred sections in all, not a whole band search per tilt.
+# at the tilt found): some 390 sections in all, not a whole band search per tilt. The window: the six bodies'
+# smallest section lies within 0.012 He of its place at 20 degrees at every tilt from 0 to 45 (and the window is
+# always centred inside the band).
 NECK_FIRST_SAMPLES, NECK_FIRST_STEPS = 24, 10
-NECK_WINDOW = 0.02  # He either side (the six bodies' smallest section lies within 0.012 He of its place at 20 degrees
-# at every tilt from 0 to 45; the window is always centred inside the band)
+NECK_WINDOW = 0.02  # He either side
 NECK_WINDOW_STEPS = 8  # its bracket (0.027 He) narrows to 0.001 He
 ALL_MEASUREMENTS = MEASUREMENTS + EXTRA_MEASUREMENTS
 

@@ -12,8 +12,8 @@ Measurements (cm):
 - thigh: one leg's girth at ``THIGH_DROP`` He below the crotch (the gluteal fold);
 - calf: the largest girth of one leg between ``CALF_BAND`` of the crotch height;
 - neck: the smallest girth of the whole section square to the neck's axis, among the planes crossing the axis
-  between ``NECK_BAND`` He (``core.measure.neck``: the axis leans forward by the Neck -> Head joints' tilt, or
-  without joints by the tilt whose smallest section is smallest);
+  between ``NECK_BAND`` He (``core.measure.neck``: the axis leans forward as the Neck -> Head joints do, by
+  ``NECK_TILT_DEFAULT`` without joints; a body mesh's by the tilt a tape drawn tight settles at);
 - arm_length: shoulder point to fingertip (straight, the arm as it hangs in the A-pose);
 - upper_arm: the arm's girth across its axis (shoulder point to fingertip) at ``UPPER_ARM_FRACTION`` of it.
 A girth is the perimeter of the convex hull of a section (a tape measure), as m_T's; both legs or arms are

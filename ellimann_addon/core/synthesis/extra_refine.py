@@ -42,6 +42,7 @@ _MAX_LOG_STEP = 0.25
 # How much of a girth's factor lengthens a piece cut off its middle (times |cut|), per measurement: measured by
 # bench_scan (twin vs body IoU); more on the neck moves its smallest girth up into the head instead.
 _LENGTHEN_SHARE = {"neck": 1.0, "thigh": 2.0, "calf": 2.0, "upper_arm": 2.0}
+NECK_TIP = 0.9  # a piece the neck's section cuts beyond this (of its half-length from its middle) is left as it is
 
 
 class ExtraRequestError(ElliMannError):
@@ -151,11 +152,13 @@ def _apply(key, factor, mannequin, rotation, center, semi, stretch, spread):
     region = np.array([part.region for part in topology])
     if key == "neck":  # the section square to the neck where it is smallest, as the upper arm's in its own frame
         frame, origin, offset = neck_plane(mannequin.copy(center=center, semi_axes=semi))
-        everything = np.ones(len(region), bool)
         neck_rotation, neck_center = frame @ rotation, (center - origin) @ frame.T
-        rows = _section_rows(neck_rotation, neck_center, semi, offset, everything)[0]
-        _widen_at(neck_rotation, neck_center, semi, offset, everything, factor, _LENGTHEN_SHARE[key], stretch, spread)
-        center[rows] = neck_center[rows] @ frame + origin  # the pieces it cuts (the others keep their bits)
+        rows, cut, _ = _section_rows(neck_rotation, neck_center, semi, offset, np.ones(len(region), bool))
+        # a piece cut at its tip adds next to nothing to the section; lengthened, its tip runs up the neck
+        widened = np.zeros(len(region), bool)
+        widened[rows[np.abs(cut) < NECK_TIP] if (np.abs(cut) < NECK_TIP).any() else rows] = True
+        _widen_at(neck_rotation, neck_center, semi, offset, widened, factor, _LENGTHEN_SHARE[key], stretch, spread)
+        center[widened] = neck_center[widened] @ frame + origin  # the pieces widened (the others keep their bits)
     elif key in ("thigh", "calf"):
         legs = marks.leg_mask("L") | marks.leg_mask("R")
         crotch = marks.crotch()
