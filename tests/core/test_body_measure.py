@@ -354,6 +354,29 @@ def test_measure_a_body_mesh_on_the_command_line(tmp_path, capsys):
     assert_one_line_error(code, err, "lies down", "pass --up y")
 
 
+def test_measure_a_mesh_square_to_a_given_neck_tilt(tmp_path, capsys):
+    """--neck-tilt DEG measures the neck square to that axis (the prism neck: its polygon at 20 degrees, more
+    level); out of range, not a number, or for a mannequin file: one line naming the option, nothing printed."""
+    path = tmp_path / "neck.obj"
+    v, f = tilted_neck_body()
+    path.write_text(
+        "".join(f"v {x} {y} {z}\n" for x, y, z in v) + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in f)
+    )
+    polygon = 100 * 2 * 64 * 0.04 * np.sin(np.pi / 64)
+    neck = {}
+    for tilt in ("20", "0"):
+        code, out, err = run(["measure", str(path), "--up", "z", "--json", "--neck-tilt", tilt], capsys)
+        assert code == 0, err
+        neck[tilt] = json.loads(out)["neck"]
+    assert neck["20"] == pytest.approx(polygon, abs=1e-4) and neck["0"] > 1.02 * polygon
+    for bad in ("75", "-50", "nan"):
+        code, out, err = run(["measure", str(path), "--up", "z", "--neck-tilt", bad], capsys)
+        assert_one_line_error(code, err, "--neck-tilt must be -45 to 60 degrees")
+        assert out == ""
+    code, out, err = run(["measure", str(reference_folder("female") / "average.json"), "--neck-tilt", "20"], capsys)
+    assert_one_line_error(code, err, "--neck-tilt is for a body mesh")
+
+
 def test_measure_a_mannequin_prints_every_key(capsys):
     code, out, _ = run(["measure", str(reference_folder("female") / "average.json"), "--json"], capsys)
     assert code == 0 and list(json.loads(out)) == list(MEASUREMENTS + EXTRA_MEASUREMENTS)
