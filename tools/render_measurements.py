@@ -20,10 +20,11 @@ import ellimann_addon
 from ellimann_addon.blender.bridge.convert import mannequin_to_collection
 from ellimann_addon.blender.services.teardown import exit_with
 from ellimann_addon.core.fitting.body_mesh import read_obj
-from ellimann_addon.core.geometry.mesh import icosphere
+from ellimann_addon.core.geometry.mesh import hull_girth, icosphere
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.measure.band_search import extreme_over_band
-from ellimann_addon.core.measure.body import NECK_SAMPLES, StandingBody, body_neck, hull_girth, measure_body_mesh
+from ellimann_addon.core.measure.body import StandingBody, measure_body_mesh
+from ellimann_addon.core.measure.body_neck import NECK_SAMPLES, body_neck
 from ellimann_addon.core.measure.extra import mannequin_tilt
 from ellimann_addon.core.measure.neck import NECK_BAND
 from ellimann_addon.core.synthesis.shipped import reference_folder

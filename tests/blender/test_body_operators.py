@@ -93,7 +93,7 @@ def test_a_mannequins_exported_obj_measures_as_the_mannequin(tmp_path, capsys):
         assert code == 0, err
     closed_form = json.loads(run(["measure", str(tmp_path / "m.json"), "--json"], capsys)[1])
     tilt = np.degrees(mannequin_tilt(Mannequin.load(tmp_path / "m.json")))
-    code, out, err = run(["measure", str(tmp_path / "m.obj"), "--json", "--neck-tilt", repr(tilt)], capsys)
+    code, out, err = run(["measure", str(tmp_path / "m.obj"), "--json", f"--neck-tilt={float(tilt)!r}"], capsys)
     assert code == 0, err
     mesh = json.loads(out)
     assert set(mesh) == set(closed_form)
