@@ -167,7 +167,7 @@ def bodies():
     )
     totals = [0.0, 0.0]
     for name in BODIES:
-        mesh = read_obj(TRACING_FOLDER / f"{name}.obj")
+        mesh = read_obj(TRACING_FOLDER / f"{name}.obj", up="z")
         with every_triangle_cut():
             before, old = best_time(lambda m=mesh: body_measure.measure_body_mesh(m.vertices, m.faces), repeat=2)
         now, new = best_time(lambda m=mesh: body_measure.measure_body_mesh(m.vertices, m.faces), repeat=2)

@@ -52,7 +52,7 @@ def run():
     print(f"{'body':<17} {'measure s':>9} {'max |five - README| cm':>22} {'IoU five':>9} {'IoU all':>8} {'gain':>6}")
     gains = []
     for name in BODIES:
-        body = read_obj(TRACING_FOLDER / f"{name}.obj")
+        body = read_obj(TRACING_FOLDER / f"{name}.obj", up="z")
         times = []
         for _ in range(3):
             start = time.perf_counter()

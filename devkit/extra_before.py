@@ -1,23 +1,26 @@
 """The extra measurements of a mannequin as ``core.measure.extra`` computed them before they were made faster
 (each band searched apart by golden section, one hull_perimeter call per step; the arm's tip by a second
-bisection): tests check the two agree, ``bench.bench_extra`` times both in one run."""
+bisection; the neck, square to its axis since issue 26, by golden section too): tests check the two agree,
+``bench.bench_extra`` times both in one run."""
 
 import numpy as np
 
 from ellimann_addon.core.constants import CM_PER_M
 from ellimann_addon.core.geometry.ellipsoid import axis_extent, section_at_height
+from ellimann_addon.core.measure.band_search import extreme_over_band
 from ellimann_addon.core.measure.extra import (
     CALF_BAND,
     CROTCH_FLOOR,
     EXTRA_MEASUREMENTS,
     MID_PLANE_HEIGHT,
-    NECK_BAND,
     SIDES,
     THIGH_DROP,
     UPPER_ARM_FRACTION,
+    MannequinLandmarks,
     _permuted,
-    extreme_over_band,
+    mannequin_tilt,
 )
+from ellimann_addon.core.measure.neck import neck_band, neck_frame
 from ellimann_addon.core.measure.tailor import hull_perimeter, section_heights
 
 
@@ -68,11 +71,6 @@ class MannequinLandmarksBefore:
         heights = np.asarray(heights, float)
         centre, k, hit = section_at_height(self.rotation[None], self.center[None], self.semi[None], heights[:, None])
         return hull_perimeter(centre, k, hit & mask[None])
-
-    def nonzero_girths_at(self, heights, mask):
-        """As girths_at, with infinity where the section is empty (a smallest girth never lies there)."""
-        girths = self.girths_at(heights, mask)
-        return np.where(girths > 0.0, girths, np.inf)
 
     def crotch(self):
         """Height (m above the soles) of the lowest point of the body on the plane x = x_c, above CROTCH_FLOOR."""
@@ -150,12 +148,22 @@ def mannequin_extra_measurements_before(mannequin):
         )
     else:
         out["thigh"] = out["calf"] = np.nan
-    neck_mask = np.ones(len(marks.girth), bool)  # the whole section: no arm reaches the neck's band apart
+    # the whole section square to the neck's axis (the core's tilt and origin: the search is what is compared)
+    frame, origin = neck_frame(mannequin_tilt(mannequin)), MannequinLandmarks(mannequin).neck_origin()
+    rotation, center = frame @ marks.rotation, (marks.center - origin) @ frame.T
+    half = axis_extent(rotation, marks.semi, 2)
+
+    def neck_girths(offsets):
+        offsets = np.asarray(offsets, float)
+        centre, k, hit = section_at_height(rotation[None], center[None], marks.semi[None], offsets[:, None])
+        girths = hull_perimeter(centre, k, hit)
+        return np.where(girths > 0.0, girths, np.inf)
+
     out["neck"] = extreme_over_band(
-        lambda z: marks.nonzero_girths_at(z, neck_mask),
-        *(marks.at(f) for f in NECK_BAND),
+        neck_girths,
+        *neck_band(marks.height, mannequin_tilt(mannequin)),
         False,
-        marks.piece_ends(neck_mask),
+        np.concatenate([center[:, 2] - half, center[:, 2] + half]),
     )
     out["neck"] = out["neck"] if np.isfinite(out["neck"]) else np.nan  # no piece in the neck's band: no neck
     if marks.arm.any() and all((marks.arm & (marks.side == side)).any() for side in SIDES):

@@ -16,6 +16,7 @@ from . import arguments, output, writing
 from .output import UsageError
 
 LABELS = {**MEASUREMENT_LABELS, **EXTRA_LABELS}
+NECK_TILT_LIMITS = (-45.0, 60.0)  # degrees forward: what --neck-tilt accepts
 
 
 def add_parser(commands):
@@ -34,6 +35,14 @@ def add_parser(commands):
         "only the measurements that could be taken)",
     )
     arguments.add_mesh_axes(measure, "a body mesh")
+    measure.add_argument(
+        "--neck-tilt",
+        type=float,
+        metavar="DEG",
+        help="a body mesh: measure the neck square to an axis leaning DEG forward from vertical, "
+        f"{NECK_TILT_LIMITS[0]:g} to {NECK_TILT_LIMITS[1]:g} (a mannequin's exported pieces: its joints' tilt); "
+        "default: the tilt a tape drawn tight round the neck settles at",
+    )
     measure.add_argument("--collection", help="the mannequin collection to measure in a .blend holding several")
     arguments.add_references(
         measure,
@@ -55,6 +64,12 @@ def run(args):
     kind = os.path.splitext(path)[1].lower()
     if not os.path.isfile(path):
         raise UsageError(f"{path}: no such file")
+    if args.neck_tilt is not None:
+        low, high = NECK_TILT_LIMITS
+        if kind not in MESH_EXTENSIONS:
+            raise UsageError(f"--neck-tilt is for a body mesh: a mannequin's neck leans as its joints do ({path})")
+        if not (math.isfinite(args.neck_tilt) and low <= args.neck_tilt <= high):
+            raise UsageError(f"--neck-tilt must be {low:g} to {high:g} degrees, got {args.neck_tilt:g}")
     if kind in MESH_EXTENSIONS:
         values, problems = measure_mesh_file(path, args)
         if not values:
@@ -87,7 +102,8 @@ def measure_mesh_file(path, args):
     except BodyMeshError as error:
         raise UsageError(output.one_line(error)) from None
     fractions = arguments.references(args).section_fractions if args.references else None
-    result = measure_body_mesh(vertices, faces, fractions)
+    tilt = getattr(args, "neck_tilt", None)  # measure's own option (synth --from has none)
+    result = measure_body_mesh(vertices, faces, fractions, None if tilt is None else math.radians(tilt))
     return result.values, result.problems
 
 

@@ -1,4 +1,4 @@
-"""The extra measurements' smooth band search (core.measure.extra.extremes_over_bands) against known extremes,
+"""The extra measurements' smooth band search (core.measure.band_search.extremes_over_bands) against known extremes,
 and the mannequin's measurements against main's (devkit.extra_before: golden section per band) on the shipped
 sets and synthesized mannequins: the same values (1e-6 cm), the same local extremes."""
 
@@ -10,15 +10,17 @@ import pytest
 from devkit.extra_before import MannequinLandmarksBefore, _farthest_distance, mannequin_extra_measurements_before
 from devkit.toy import make_toy_mannequin
 from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
+from ellimann_addon.core.mannequin.skeleton import JOINT_NAMES
+from ellimann_addon.core.measure.band_search import extreme_over_band, extremes_over_bands
 from ellimann_addon.core.measure.extra import (
     EXTRA_MEASUREMENTS,
     SIDES,
     MannequinLandmarks,
     _farthest_points,
-    extremes_over_bands,
     mannequin_extra_measurements,
     split_measurements,
 )
+from ellimann_addon.core.measure.neck import HEAD_JOINT, NECK_JOINT, joint_tilt, neck_frame
 from ellimann_addon.core.synthesis import synthesize as synthesis
 from ellimann_addon.core.synthesis.shipped import FEMALE_SET, MALE_SET, named_reference_set
 
@@ -57,6 +59,24 @@ def test_smooth_extremes_kinks_jumps_and_square_roots():
     assert extremes[2] == pytest.approx(1.125, abs=1e-9)  # 1 + s - 2 s^2 at s = 1/4
     assert extremes[3] == pytest.approx(1.0, abs=1e-9)
     assert at_points == pytest.approx([1.0, 0.6711], abs=1e-12)
+
+
+def test_every_local_dip_refined_when_asked():
+    """Two dips of near-equal depth, the grid's best sample beside the shallower one: refining only that cell
+    finds the shallower dip; refining beside every local minimum of the grid finds the deeper one."""
+    dips = lambda t: np.minimum((t - 0.2) ** 2, (t - 0.75) ** 2 - 0.001)  # noqa: E731
+    assert extreme_over_band(dips, 0.0, 1.0, False, samples=7) == pytest.approx(0.0, abs=1e-9)
+    value, where = extreme_over_band(dips, 0.0, 1.0, False, samples=7, where=True, every=True)
+    assert value == pytest.approx(-0.001, abs=1e-9) and where == pytest.approx(0.75, abs=1e-4)
+
+
+def test_the_neck_joints_are_smpls():
+    """core.measure (a floor below the skeleton) names the Neck and Head joints by their index."""
+    assert (JOINT_NAMES[NECK_JOINT], JOINT_NAMES[HEAD_JOINT]) == ("Neck", "Head")
+    frame = neck_frame(np.radians(20.0))
+    assert np.allclose(frame @ frame.T, np.eye(3), atol=1e-15) and np.linalg.det(frame) == pytest.approx(1.0)
+    assert frame[2] == pytest.approx([0.0, -np.sin(np.radians(20.0)), np.cos(np.radians(20.0))])  # leaning to -Y
+    assert joint_tilt(None) is None
 
 
 def test_an_empty_band_and_no_bands():

@@ -196,6 +196,14 @@ def polygon_perimeter(polygon):
     return float(np.linalg.norm(polygon - np.roll(polygon, -1, axis=0), axis=1).sum())
 
 
+def hull_girth(points):
+    """(perimeter, hull (h, 2)) of the convex hull of 2-D points (a tape round them; 0 for fewer than three)."""
+    if len(points) < 3:
+        return 0.0, np.zeros((0, 2))
+    hull = convex_hull_2d(points)
+    return (polygon_perimeter(hull) if len(hull) >= 3 else 0.0), hull
+
+
 def boundary_edges(faces):
     """(k, 2) edges used by exactly one triangle (a closed surface has none)."""
     edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)

@@ -18,10 +18,12 @@ from ..geometry.mesh import (
     boundary_edges,
     connected_labels,
     convex_hull_2d,
+    hull_girth,
     in_plane,
-    polygon_perimeter,
     section_segments,
 )
+from .band_search import extreme_over_band
+from .body_neck import body_neck
 from .extra import (
     CALF_BAND,
     CROTCH_FLOOR,
@@ -31,13 +33,11 @@ from .extra import (
     SIDES,
     THIGH_DROP,
     UPPER_ARM_FRACTION,
-    extreme_over_band,
 )
 
 ARM_SCAN_STEP = 0.005  # He between the sections that find the arms
 ARM_MARGIN = 0.01  # m beyond the body's run before a vertex counts as an arm's
 HEIGHT_RANGE_M = (0.5, 2.5)  # a standing adult or child in metres
-NECK_SAMPLES = 96  # the neck's band (0.12 He) every 2 mm or so: a mannequin's pieces may pinch between them
 ALL_MEASUREMENTS = MEASUREMENTS + EXTRA_MEASUREMENTS
 
 
@@ -49,18 +49,11 @@ class BodyMeasurement:
     values: dict = field(default_factory=dict)
     problems: list = field(default_factory=list)
     sections: dict = field(default_factory=dict)  # key: (k, 3) points where it is taken (loops, a line, a point)
+    neck_tilt: float = float("nan")  # radians forward: the neck's axis the neck was measured square to
 
     @property
     def missing(self):
         return [key for key in ALL_MEASUREMENTS if key not in self.values]
-
-
-def hull_girth(points):
-    """Perimeter (m) of the convex hull of 2-D points (0 for fewer than three)."""
-    if len(points) < 3:
-        return 0.0, np.zeros((0, 2))
-    hull = convex_hull_2d(points)
-    return (polygon_perimeter(hull) if len(hull) >= 3 else 0.0), hull
 
 
 def _inside(points, segments):
@@ -281,8 +274,10 @@ def check_mesh(vertices, faces, up=None, unit=None):
     return None
 
 
-def measure_body_mesh(vertices, faces, fractions=None):
-    """Measure an upright A-pose body mesh (metres, Z up, facing -Y): a BodyMeasurement."""
+def measure_body_mesh(vertices, faces, fractions=None, neck_tilt=None):
+    """Measure an upright A-pose body mesh (metres, Z up, facing -Y): a BodyMeasurement. ``neck_tilt``: the
+    neck's forward tilt (radians) when it is known (a mannequin's own mesh or skin: its own tilt); by default
+    the tilt a tape drawn tight settles at (core.measure.neck)."""
     vertices, faces = np.asarray(vertices, float).reshape(-1, 3), np.asarray(faces, np.int64).reshape(-1, 3)
     result = BodyMeasurement()
     fatal = check_mesh(vertices, faces)
@@ -344,18 +339,13 @@ def measure_body_mesh(vertices, faces, fractions=None):
             "no crotch (the legs are not apart at the mid-plane): crotch_height, thigh and calf cannot be taken"
         )
 
-    def neck(heights):
-        girths = np.array([hull_girth(body.section(z)[0].reshape(-1, 2))[0] for z in heights])
-        return np.where(girths > 0.0, girths, np.inf)  # a height with no section is no neck
-
-    values["neck"], z_neck = extreme_over_band(
-        neck, *(body.at(f) for f in NECK_BAND), False, samples=NECK_SAMPLES, where=True
-    )
-    if np.isfinite(values["neck"]):
-        result.sections["neck"] = _at_height(hull_girth(body.section(z_neck)[0].reshape(-1, 2))[1], z_neck)
-    else:
-        del values["neck"]
-        result.problems.append("no neck: the sections between 0.80 and 0.92 He are empty; neck cannot be taken")
+    values["neck"], result.neck_tilt, result.sections["neck"] = body_neck(body, neck_tilt)
+    if not np.isfinite(values["neck"]):
+        del values["neck"], result.sections["neck"]
+        result.problems.append(
+            f"no neck: the sections crossing the neck's axis between {NECK_BAND[0]:.2f} and {NECK_BAND[1]:.2f} He "
+            "are empty; neck cannot be taken"
+        )
 
     if arms_found:
         lengths, girths = [], []

@@ -23,12 +23,12 @@ from ..measure.extra import (
     EXTRA_GIRTHS,
     EXTRA_LABELS,
     EXTRA_MEASUREMENTS,
-    NECK_BAND,
     SIDES,
     THIGH_DROP,
     UPPER_ARM_FRACTION,
     MannequinLandmarks,
     mannequin_extra_measurements,
+    neck_plane,
 )
 from ..measure.tailor import tailor_measurements
 from .misses import MISS_CM, Miss
@@ -42,6 +42,7 @@ _MAX_LOG_STEP = 0.25
 # How much of a girth's factor lengthens a piece cut off its middle (times |cut|), per measurement: measured by
 # bench_scan (twin vs body IoU); more on the neck moves its smallest girth up into the head instead.
 _LENGTHEN_SHARE = {"neck": 1.0, "thigh": 2.0, "calf": 2.0, "upper_arm": 2.0}
+NECK_TIP = 0.9  # a piece the neck's section cuts beyond this (of its half-length from its middle) is left as it is
 
 
 class ExtraRequestError(ElliMannError):
@@ -149,12 +150,15 @@ def _apply(key, factor, mannequin, rotation, center, semi, stretch, spread):
     marks = MannequinLandmarks(mannequin.copy(center=center, semi_axes=semi))
     topology = mannequin.topology
     region = np.array([part.region for part in topology])
-    if key == "neck":  # at the height of the smallest girth, on a grid over the band (enough to pick the pieces)
-        everything = np.ones(len(region), bool)
-        heights = marks.bottom + np.linspace(*NECK_BAND, 48) * marks.height
-        girths = marks.girths_at(heights, everything)
-        z = heights[int(np.argmin(np.where(girths > 0.0, girths, np.inf)))]  # an empty section is no minimum
-        _widen_at(rotation, center, semi, z, everything, factor, _LENGTHEN_SHARE[key], stretch, spread)
+    if key == "neck":  # the section square to the neck where it is smallest, as the upper arm's in its own frame
+        frame, origin, offset = neck_plane(mannequin.copy(center=center, semi_axes=semi))
+        neck_rotation, neck_center = frame @ rotation, (center - origin) @ frame.T
+        rows, cut, _ = _section_rows(neck_rotation, neck_center, semi, offset, np.ones(len(region), bool))
+        # a piece cut at its tip adds next to nothing to the section; lengthened, its tip runs up the neck
+        widened = np.zeros(len(region), bool)
+        widened[rows[np.abs(cut) < NECK_TIP] if (np.abs(cut) < NECK_TIP).any() else rows] = True
+        _widen_at(neck_rotation, neck_center, semi, offset, widened, factor, _LENGTHEN_SHARE[key], stretch, spread)
+        center[widened] = neck_center[widened] @ frame + origin  # the pieces widened (the others keep their bits)
     elif key in ("thigh", "calf"):
         legs = marks.leg_mask("L") | marks.leg_mask("R")
         crotch = marks.crotch()
@@ -206,17 +210,8 @@ def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXT
 
     All at once first; if that misses any, one measurement at a time (in EXTRA_MEASUREMENTS order), each kept
     only if it and those kept before are met with the five: one that the pieces cannot reach (or only by
-    giving up the five) is left where the reference set puts it, and named in the misses."""
-    final, measured, misses = _extra_pieces(mannequin, extra, tolerance_cm, max_rounds)
-    if final.joints is not None:  # the joints ride on their anchor pieces, as through the five's refinement
-        before = (mannequin.rotation, mannequin.center, mannequin.semi_axes)
-        after = (final.rotation, final.center, final.semi_axes)
-        final = final.copy(joints=follow_pieces(mannequin.joints, anchor_indices(mannequin.topology), before, after))
-    return final, measured, misses
-
-
-def _extra_pieces(mannequin, extra, tolerance_cm, max_rounds):
-    """meet_extra's pieces (the joints left where they were)."""
+    giving up the five) is left where the reference set puts it, and named in the misses. The joints ride on
+    their anchor pieces in every measured round (the neck is measured square to their tilt)."""
     result = _meet(mannequin, extra, tolerance_cm, max_rounds)
     if not result[2]:
         return result
@@ -266,8 +261,14 @@ def _meet(mannequin, extra, tolerance_cm, max_rounds):
     girth = mannequin.topology.girth_mask
     fractions = mannequin.section_fractions
 
+    anchors = None if mannequin.joints is None else anchor_indices(mannequin.topology)
+    start = (mannequin.rotation, mannequin.center, mannequin.semi_axes)
+
     def measure():  # a snapshot: the arrays go on being deformed in place
-        current = mannequin.copy(rotation=rotation.copy(), center=center.copy(), semi_axes=semi.copy())
+        arrays = (rotation.copy(), center.copy(), semi.copy())
+        # the joints ride on their anchor pieces (as through the five's refinement): the neck's tilt is theirs
+        joints = None if anchors is None else follow_pieces(mannequin.joints, anchors, start, arrays)
+        current = mannequin.copy(rotation=arrays[0], center=arrays[1], semi_axes=arrays[2], joints=joints)
         return current, mannequin_extra_measurements(current)
 
     def worst_miss(current, values):
