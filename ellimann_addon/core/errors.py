@@ -29,7 +29,8 @@ class Problem:
     message: str
 
     def __str__(self):
-        where = f"'{self.ellipsoid}' " if self.ellipsoid else ""
+        # repr, so that a name holding a newline or a quote still gives a one-line message
+        where = f"{self.ellipsoid!r} " if self.ellipsoid else ""
         return f"{where}{self.field}: {self.message}"
 
 

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from devkit import synthetic
@@ -362,6 +362,7 @@ def _loads_or_refuses(data):
 
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(path=st.sampled_from(PATHS), value=JSON)
+@example(path=("ellipsoids", 6, "name"), value="\n")  # once gave a two-line message
 def test_garbage_anywhere_in_a_mannequin_never_raises_anything_else(path, value):
     _loads_or_refuses(_replace(GOOD, path, value))
 
