@@ -1,4 +1,4 @@
-"""File formats ElliMann writes without Blender, and the table of every format (floor 5: everything below).
+"""File formats ElliMann writes without Blender, and the table of every format (floor 6: everything below).
 
 - core_writers: OBJ, JSON and MJCF mannequin files by extension
 - mjcf: MJCF (MuJoCo) of a mannequin's convex pieces
