@@ -10,6 +10,8 @@ import sys
 BENCHES = (
     "bench_core",
     "bench_synthesis",
+    "bench_live",
+    "bench_exact_population",
     "bench_male",
     "bench_pose",
     "bench_drape",

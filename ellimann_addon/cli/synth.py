@@ -107,7 +107,8 @@ def run(args):
     five, extra = _wanted(args)
     reference = arguments.references(args)
     try:  # the request is checked here, once, before any work (its warnings come back with the result)
-        result = synthesize_extra(reference, five, extra, arguments.synthesis_options(args, args.name))
+        options = arguments.synthesis_options(args, args.name)
+        result = synthesize_extra(reference, five, extra, options, measure_extra=False)
     except ElliMannError as error:
         raise UsageError(output.one_line(error)) from None
     mannequin, measured = result.mannequin, result.measured

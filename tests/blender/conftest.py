@@ -35,6 +35,16 @@ def toy_collection(toy):
     return collection
 
 
+@pytest.fixture(autouse=True)
+def no_settle_timer_left():
+    """Live updates leave the settle timer registered; it must not fire in a later test."""
+    yield
+    from ellimann_addon.blender.features.synthesize import live
+
+    if bpy.app.timers.is_registered(live._settle_timer):
+        bpy.app.timers.unregister(live._settle_timer)
+
+
 _exit_status = {}
 
 

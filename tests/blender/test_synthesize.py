@@ -37,14 +37,6 @@ def folder(tmp_path_factory):
     return str(synthetic.write_reference_folder(tmp_path_factory.mktemp("rm")))
 
 
-@pytest.fixture(autouse=True)
-def no_settle_timer_left():
-    """Live updates leave the settle timer registered; it must not fire in a later test."""
-    yield
-    if bpy.app.timers.is_registered(live._settle_timer):
-        bpy.app.timers.unregister(live._settle_timer)
-
-
 @pytest.fixture
 def props(folder):
     props = bpy.context.scene.ellimann_synthesis

@@ -11,7 +11,13 @@ from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.mannequin.skeleton import JOINT_INDEX, cross_joint_pairs, joint_frames
 from ellimann_addon.core.pose import kinematics as kinematics
 from ellimann_addon.core.pose import standard as poses
-from ellimann_addon.core.pose.posed_pieces import PosingRig, clip_convex_mesh, split_cushion_names, union_volume
+from ellimann_addon.core.pose.posed_pieces import (
+    PosingRig,
+    clip_convex_mesh,
+    clipped_vertices,
+    split_cushion_names,
+    union_volume,
+)
 from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
 LEVEL = 3  # cushion resolution of these checks
@@ -56,6 +62,40 @@ def test_clipping_a_closed_convex_mesh_gives_two_closed_convex_halves_of_its_vol
     assert np.isclose(sum(volume(v, f) for v, f in halves), volume(vertices, faces), rtol=1e-12)
     assert clip_convex_mesh(vertices, faces, point + [0, 0, 1.0], normal)[0] is vertices  # all on one side
     assert clip_convex_mesh(vertices, faces, point - [0, 0, 1.0], normal) is None
+
+
+def test_a_clipped_part_follows_its_mesh_through_any_affine_map():
+    """clip_convex_mesh's sources: each vertex is its mesh's own, a point at a fixed share of the edge it cuts, or
+    the cap's centre. Cutting commutes with an affine map (shares along edges and the signed distances' ratios
+    are kept), so the part cut from the mapped mesh by the mapped plane is clipped_vertices of the mapped mesh."""
+    ((vertices, faces),) = cushion_meshes(
+        [
+            (
+                (np.eye(3), np.zeros(3), np.array([0.1, 0.05, 0.2])),
+                (np.eye(3), np.array([0.0, 0.0, 0.3]), np.array([0.06, 0.05, 0.1])),
+            )
+        ],
+        3,
+    )
+    point, normal = np.array([0.01, 0.0, 0.2]), np.array([0.1, 0.2, 1.0])
+    matrix = np.array([[1.2, 0.1, 0.0], [-0.05, 0.9, 0.2], [0.0, 0.1, 1.4]])
+    shift = np.array([0.3, -0.2, 0.1])
+    for n in (normal, -normal):
+        part, part_faces, sources = clip_convex_mesh(vertices, faces, point, n, sources=True)
+        plain = clip_convex_mesh(vertices, faces, point, n)
+        np.testing.assert_array_equal(part, plain[0])
+        np.testing.assert_array_equal(part_faces, plain[1])
+        first, second, share = sources
+        own, centre = (first == second) & (first >= 0), first < 0
+        assert centre.sum() == 1 and np.all(share[own] == 0.0) and np.all((share > 0.0) & (share < 1.0) | own | centre)
+        np.testing.assert_allclose(clipped_vertices(vertices, sources), part, atol=1e-15)
+        moved = vertices @ matrix.T + shift
+        cut = clip_convex_mesh(moved, faces, point @ matrix.T + shift, np.linalg.solve(matrix.T, n))
+        side = ~np.isin(part_faces, np.flatnonzero(centre)).any(axis=1)  # the cap's fan may start elsewhere
+        np.testing.assert_array_equal(cut[1][side], part_faces[side])
+        np.testing.assert_allclose(clipped_vertices(moved, sources), cut[0], atol=1e-12)
+    whole, _, (first, second, share) = clip_convex_mesh(vertices, faces, point + [0, 0, 1.0], normal, sources=True)
+    assert whole is vertices and np.array_equal(first, np.arange(len(vertices))) and np.array_equal(first, second)
 
 
 def test_the_rig_splits_exactly_the_cushions_across_joints(average, rig):

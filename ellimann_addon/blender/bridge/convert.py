@@ -65,6 +65,13 @@ def mesh_vertices(mesh):
     return co.reshape(-1, 3).astype(float)
 
 
+def write_mesh_vertices(mesh, vertices):
+    """Move a mesh's vertices to ``vertices`` (V, 3), local space, same count: through its ``position`` attribute
+    (about 30x faster than ``vertices.foreach_set("co")``, which live updates would spend most of their time in)."""
+    mesh.attributes["position"].data.foreach_set("vector", np.ascontiguousarray(vertices, dtype=np.float32).ravel())
+    mesh.update()
+
+
 def world_triangles(obj):
     """(vertices (V, 3) in world space, triangles (T, 3)) of a mesh object."""
     mesh = obj.data

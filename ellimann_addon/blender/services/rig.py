@@ -18,6 +18,8 @@ import numpy as np
 from mathutils import Matrix, Vector
 
 from ...core.errors import ElliMannError
+from ...core.geometry.cushion import cushion_meshes
+from ...core.geometry.mesh import icosphere_level
 from ...core.mannequin.skeleton import (
     JOINT_INDEX,
     JOINT_NAMES,
@@ -40,6 +42,8 @@ FREE_RANGE = 2 * np.pi - 1e-9  # an axis whose range spans a whole turn gets no 
 MODIFIER_NAME = "ElliMann Rig"
 CONSTRAINT_NAME = "ElliMann Limits"
 UNIT_SPHERE_BONE_KEY = "ellimann_unit_sphere_bone"  # on a per-bone copy of the unit sphere: the bone's name
+HULL_LEVEL_KEY = "ellimann_hull_level"  # on a cushion's halves: the icosphere level of the hull they were cut from
+SOURCE_ATTRIBUTES = ("ellimann_hull_first", "ellimann_hull_second", "ellimann_hull_share")  # where each vertex is
 
 
 # ------------------------------------------------------------------------------------------------ lookups
@@ -238,6 +242,8 @@ def bind_cushions(collection, mannequin, rig=None):
         if joint is None:
             _set_weights(cushion, {first_bone: np.ones(len(cushion.data.vertices))})
         else:
+            if cushion.data.get(HULL_LEVEL_KEY) is not None:  # cut before (a rig built again): the whole hull first
+                _whole_hull(cushion, mannequin, (topology.index[first], topology.index[second]))
             _split_at_joint(
                 cushion,
                 joints[joint],
@@ -250,9 +256,13 @@ def bind_cushions(collection, mannequin, rig=None):
 
 def _split_at_joint(cushion, point, toward, first_bone, second_bone):
     """Replace a cushion's mesh by its two halves either side of the plane through ``point`` normal to
-    ``toward`` (world), one vertex group each."""
+    ``toward`` (world), one vertex group each. A hull at an icosphere level (as built) keeps where each half's
+    vertices come from (:func:`split_sources`), so that live updates move the halves in place."""
     vertices, faces = world_triangles(cushion)
-    halves = [clip_convex_mesh(vertices, faces, point, normal) for normal in (toward, -np.asarray(toward))]
+    level = icosphere_level(len(vertices)) if cushion.data.get(HULL_LEVEL_KEY) is None else None
+    halves = [
+        clip_convex_mesh(vertices, faces, point, normal, sources=True) for normal in (toward, -np.asarray(toward))
+    ]
     kept = [(half, bone) for half, bone in zip(halves, (first_bone, second_bone)) if half is not None]
     sizes = [len(half[0]) for half, _ in kept]
     owner = np.repeat(np.arange(len(kept)), sizes)
@@ -263,11 +273,42 @@ def _split_at_joint(cushion, point, toward, first_bone, second_bone):
     old = cushion.data
     mesh = mesh_from_arrays(old.name, local, faces)
     mesh.shade_smooth()
+    if level is not None:
+        sources = [np.concatenate(column) for column in zip(*(half[2] for half, _ in kept))]
+        for name, kind, values in zip(SOURCE_ATTRIBUTES, ("INT", "INT", "FLOAT"), sources):
+            mesh.attributes.new(name, kind, "POINT").data.foreach_set("value", values)
+        mesh[HULL_LEVEL_KEY] = level
     cushion.data = mesh
     if old.users == 0:
         bpy.data.meshes.remove(old)
     mesh.name = cushion.name
     _set_weights(cushion, weights)
+
+
+def _whole_hull(cushion, mannequin, pair):
+    """Give a cushion that was cut at its joint the whole hull of its pair back, at the level it was cut from."""
+    ((vertices, faces),) = cushion_meshes(
+        [tuple((mannequin.rotation[i], mannequin.center[i], mannequin.semi_axes[i]) for i in pair)],
+        int(cushion.data[HULL_LEVEL_KEY]),
+    )
+    inverse = np.linalg.inv(np.array(cushion.matrix_world))
+    old = cushion.data
+    cushion.data = mesh_from_arrays(old.name, vertices @ inverse[:3, :3].T + inverse[:3, 3], faces)
+    if old.users == 0:
+        bpy.data.meshes.remove(old)
+
+
+def split_sources(mesh):
+    """(the icosphere level of the hull a split cushion was cut from, the sources of its vertices as
+    ``core.pose.posed_pieces.clipped_vertices`` takes them), or None for a mesh that is not such halves."""
+    level = mesh.get(HULL_LEVEL_KEY)
+    if level is None or any(name not in mesh.attributes for name in SOURCE_ATTRIBUTES):
+        return None
+    count = len(mesh.vertices)
+    columns = [np.empty(count, dtype=np.int32), np.empty(count, dtype=np.int32), np.empty(count, dtype=np.float32)]
+    for name, column in zip(SOURCE_ATTRIBUTES, columns):
+        mesh.attributes[name].data.foreach_get("value", column)
+    return int(level), (columns[0], columns[1], columns[2].astype(float))
 
 
 def remove_rig(collection):

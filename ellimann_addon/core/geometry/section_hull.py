@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .ellipse_support import compact_sections, curvature_radii
+from .ellipse_support import compact_sections, curvature_radii, support_2d_with_derivative
 from .elliptic import elliptic_e
 
 CELLS = 32  # grid directions over the circle, which find the outermost ellipses
@@ -205,8 +205,8 @@ def hull_perimeter(centre, k, active, warm=None, structure=False):
     ``structure=True`` returns (perimeters, :class:`HullStructure`). ``warm``: the structure of the same sections a
     moment ago, the ellipses having moved a little since: each kink is solved again by Newton from where it was and
     nothing is searched, so an ellipse that has risen above the others since would be missed (for the steps of a
-    refinement, not for a result); a section whose kinks do not follow (one does not converge, two swap, an
-    outermost ellipse is no longer cut, the section's symmetry changed) is measured from scratch.
+    refinement, not for a result); a section whose kinks do not follow (one does not converge or lands on a crossing
+    the wrong way round, two swap or meet, an outermost ellipse is no longer cut, the symmetry changed) is searched.
     """
     centre, k, active = np.asarray(centre, float), np.asarray(k, float), np.asarray(active, bool)
     sections = centre.shape[0]
@@ -286,8 +286,10 @@ def _follow(centre, k, used, mirrored, warm):
     c, s = np.cos(theta), np.sin(theta)
     size = coefficients.root(index[0], c, s) + coefficients.root(index[1], c, s)
     miss = np.abs(coefficients.support(index[0], c, s) - coefficients.support(index[1], c, s)) > KINK_TOLERANCE * size
+    # Supports crossing more than once: Newton may land on a crossing the wrong way round, or on another kink.
+    miss |= np.subtract(*(support_2d_with_derivative(centre[i], k[i], theta)[1] for i in index)) > 0.0
     ok[sec[miss]] = False
-    swapped = (sec[1:] == sec[:-1]) & (theta[1:] < theta[:-1])
+    swapped = (sec[1:] == sec[:-1]) & (theta[1:] <= theta[:-1])
     ok[sec[1:][swapped]] = False
     return ~ok, (warm.first, sec, theta, after)
 

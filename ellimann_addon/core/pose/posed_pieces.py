@@ -40,20 +40,26 @@ class PosedBody(NamedTuple):
     cushions: list
 
 
-def clip_convex_mesh(vertices, faces, point, normal):
+def clip_convex_mesh(vertices, faces, point, normal, sources=False):
     """The part of a closed convex mesh on the side (x - point) . normal <= 0, closed by a flat cap:
     (vertices, faces) wound outward, or None if nothing of it lies on that side. The whole mesh if it lies
-    entirely on that side."""
+    entirely on that side.
+
+    ``sources=True`` adds where each vertex comes from, (first (V,), second (V,), share (V,)): the vertex is
+    (1 - share) vertices[first] + share vertices[second] (an own vertex: first = second, share 0; a cut point: the
+    edge it cuts), and first = second = -1 for the cap's centre, the mean of the cut points (:func:`clipped_vertices`
+    moves the part with its mesh)."""
     vertices = np.asarray(vertices, dtype=float)
     normal = np.asarray(normal, dtype=float) / np.linalg.norm(normal)
     side = (vertices - point) @ normal
     inside = side <= 0.0
+    own = np.arange(len(vertices))
     if not inside.any():
         return None
     if inside.all():
-        return vertices, np.asarray(faces)
+        return (vertices, np.asarray(faces)) + ((own, own, np.zeros(len(own))),) * sources
     keep = faces[inside[faces].all(axis=1)]
-    new_points, crossing = [], {}
+    new_points, crossing, edges = [], {}, []
 
     def cut(a, b):  # the point where edge a-b (a inside, b outside) meets the plane, shared by both faces
         key = (a, b) if a < b else (b, a)
@@ -61,6 +67,7 @@ def clip_convex_mesh(vertices, faces, point, normal):
             t = side[a] / (side[a] - side[b])
             crossing[key] = len(vertices) + len(new_points)
             new_points.append(vertices[a] + t * (vertices[b] - vertices[a]))
+            edges.append((a, b, t))
         return crossing[key]
 
     clipped = []
@@ -87,7 +94,25 @@ def clip_convex_mesh(vertices, faces, point, normal):
     cap = np.column_stack([np.full(len(ring), centre_index), ring, np.roll(ring, -1)])
     all_faces = np.concatenate([keep, np.array(clipped, dtype=int).reshape(-1, 3), cap])
     used, remapped = np.unique(all_faces, return_inverse=True)
-    return points[used], remapped.reshape(-1, 3)
+    if not sources:
+        return points[used], remapped.reshape(-1, 3)
+    cut_first, cut_second, cut_share = (np.array(column) for column in zip(*edges))
+    first, second = (np.concatenate([own, column, [-1]]) for column in (cut_first, cut_second))
+    share = np.concatenate([np.zeros(len(own)), cut_share, [0.0]])
+    return points[used], remapped.reshape(-1, 3), (first[used], second[used], share[used])
+
+
+def clipped_vertices(vertices, sources):
+    """The vertices of a part :func:`clip_convex_mesh` made (with its ``sources``) after the mesh it was cut from
+    moved to ``vertices`` (same order): each cut point stays at its share of its edge, the cap's centre at the cut
+    points' mean. (The cut no longer lies on the plane it was made on: a preview until the part is cut again.)"""
+    first, second, share = sources
+    vertices = np.asarray(vertices, dtype=float)
+    out = vertices[first] + share[:, None] * (vertices[second] - vertices[first])
+    centre, cut = first < 0, first != second
+    if centre.any():
+        out[centre] = out[cut & ~centre].mean(axis=0)
+    return out
 
 
 class PosingRig:

@@ -232,7 +232,9 @@ def refine(
 
     The steps far from the target are measured by following the girth sections' structure from the step before
     (cheaper; exact as long as no hidden piece surfaces); whatever a mannequin's last measurement, the one
-    returned, and the convergence it shows, is m_T's.
+    returned, and the convergence it shows, is m_T's. A step that fails to lower |r| never ends the search on a
+    followed measurement: the mannequin it was judged against is measured exactly, and its later steps too (a wrong
+    followed value kept as the one to beat would fail every step after it; issue 26).
     """
     girth = topology.girth_mask
     targets = np.atleast_2d(np.asarray(targets, dtype=float))
@@ -244,6 +246,7 @@ def refine(
     x = np.zeros((len(targets), count))
     current = measured.copy()
     exact = np.ones(len(targets), dtype=bool)  # current[b] is m_T's, not a followed measurement
+    trusted = np.ones(len(targets), dtype=bool)  # its steps may follow the structure (until that once misled it)
     residual = np.log(np.maximum(current, 1e-12) / targets)
     if jacobian is None:
         jacobian = np.zeros((len(targets), count, count))
@@ -274,19 +277,20 @@ def refine(
             continue
         iterations += 1
         stale = todo[(age[todo] < 0) | (age[todo] >= _JACOBIAN_REFRESH)]
-        if len(stale):
-            jacobian[stale] = fd_jacobian(
-                basis,
-                rows=stale,
-                rotation=rotation,
-                center=center,
-                semi_axes=semi_axes,
-                x=x,
-                base=np.log(np.maximum(current[stale], 1e-12)),
-                girth=girth,
-                structure=structure.take(_girth_sections(stale)),
-            )
-            age[stale] = 0
+        for rows in (stale[trusted[stale]], stale[~trusted[stale]]):
+            if len(rows):
+                jacobian[rows] = fd_jacobian(
+                    basis,
+                    rows=rows,
+                    rotation=rotation,
+                    center=center,
+                    semi_axes=semi_axes,
+                    x=x,
+                    base=np.log(np.maximum(current[rows], 1e-12)),
+                    girth=girth,
+                    structure=structure.take(_girth_sections(rows)) if trusted[rows[0]] else None,
+                )
+        age[stale] = 0
         j = jacobian[todo]
         mask = free[todo]
         reduced = j * mask[:, :, None] * mask[:, None, :]
@@ -298,7 +302,7 @@ def refine(
         wanted = x[todo] + np.clip(step, -_MAX_STEP, _MAX_STEP)
         new_x = np.clip(wanted, lo, hi)
         c, d = deform(basis.take(todo), center[todo], semi_axes[todo], np.exp(new_x))
-        follow = np.abs(residual[todo]).max(axis=1) > _FOLLOW_ABOVE
+        follow = (np.abs(residual[todo]).max(axis=1) > _FOLLOW_ABOVE) & trusted[todo]
         m = np.empty((len(todo), count))
         found = [None, None]
         for followed in (False, True):
@@ -331,6 +335,16 @@ def refine(
                     _girth_sections(todo[rows][kept]), found[followed].take(_girth_sections(np.nonzero(kept)[0]))
                 )
         free[keep] &= new_x[better] == wanted[better]
+        # A step judged against a followed measurement may have failed only because that measurement was wrong (a
+        # hidden piece has surfaced since): the mannequin is measured exactly, and its steps from then on too.
+        recheck = todo[~better & ~exact[todo]]
+        if len(recheck):
+            current[recheck], found_now = followed_measurements(
+                rotation[recheck], out_center[recheck], out_semi[recheck], girth, basis.fractions
+            )
+            residual[recheck] = np.log(np.maximum(current[recheck], 1e-12) / targets[recheck])
+            exact[recheck], trusted[recheck] = True, False
+            structure = structure.replaced(_girth_sections(recheck), found_now)
     converged = np.abs(residual).max(axis=1) <= tolerance
     return Refinement(out_center, out_semi, current, np.exp(x), iterations, converged)
 

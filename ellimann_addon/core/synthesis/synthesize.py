@@ -299,7 +299,8 @@ class Synthesized(NamedTuple):
     """One mannequin as :func:`synthesize_extra` gives it."""
 
     mannequin: Mannequin
-    measured: dict  # {the five and the six extra measurements: cm}, what the mannequin measures
+    measured: dict  # {the five and the six extra measurements: cm}, what the mannequin measures (the five alone
+    # when none was given and measure_extra is False)
     warnings: list  # lines to show: requests outside the reference range, what exact mode missed (one line)
     missed: list  # what exact mode missed, as data (core.synthesis.misses.Miss); empty in IDW, which promises none
 
@@ -307,11 +308,12 @@ class Synthesized(NamedTuple):
 IDW_EXTRA_NOTE = "the extra measurements are met in exact mode only (IDW gives the reference set's)"
 
 
-def synthesize_extra(reference, request, extra, options=None):
+def synthesize_extra(reference, request, extra, options=None, measure_extra=True):
     """One mannequin meeting the five of ``request`` (dict or 5 values, cm) and the given ``extra`` measurements
     ({key: cm}; exact mode; IDW leaves the extra ones as the reference set gives them): a :class:`Synthesized`.
     The request is checked here, once (MeasurementError naming the field); ExtraRequestError for extra ones out
-    of their limits or contradicting the five."""
+    of their limits or contradicting the five. ``measure_extra=False``: with no ``extra`` given, the five alone are
+    measured (the six cost more than an exact synthesis; the panel and ``synth`` show no others)."""
     options = options_of(options).checked()
     values, warnings = checked_request(request, reference.ranges, reference.absurd_limits)
     problems = extra_request_problems(as_dict(values), extra)
@@ -319,19 +321,22 @@ def synthesize_extra(reference, request, extra, options=None):
         raise ExtraRequestError(problems[0])
     batch = synthesize_checked(reference, values[None], options)
     mannequin, measured, note = meet_extra_request(
-        batch.mannequin(0, options.name), as_dict(batch.measured[0]), extra, options.mode
+        batch.mannequin(0, options.name), as_dict(batch.measured[0]), extra, options.mode, measure_extra
     )
     missed = request_misses(measured, values, extra, options.mode)
     warnings += ([note] if note else []) + ([missed_text(missed)] if missed else [])
     return Synthesized(mannequin, measured, warnings, missed)
 
 
-def meet_extra_request(mannequin, measured, extra, mode):
+def meet_extra_request(mannequin, measured, extra, mode, measure_extra=True):
     """The extra measurements of a synthesized ``mannequin`` (m_T ``measured`` {the five: cm}): in exact mode, the
     ``extra`` ones given met (``meet_extra``); otherwise (or with none given) as the reference set gives them.
     Returns (mannequin, measured {the five and the six: cm}, a note for the user or None). What ``synth``, the
-    panel and each row of ``batch`` run (core.synthesis.batch.synthesize_chunk)."""
+    panel and each row of ``batch`` run (core.synthesis.batch.synthesize_chunk). ``measure_extra=False``: with
+    none given, ``measured`` as it is (the five)."""
     if extra and mode == "exact":
         mannequin, measured, _ = meet_extra(mannequin, extra)  # its misses: judged by request_misses, as for all
+        return mannequin, measured, None
+    if not (extra or measure_extra):
         return mannequin, measured, None
     return mannequin, dict(measured, **mannequin_extra_measurements(mannequin)), IDW_EXTRA_NOTE if extra else None

@@ -1,10 +1,13 @@
 """Live updates of the Synthesize feature: the last synthesized mannequin follows the request in place.
 
-Live updates with cushions keep up with a dragged slider by moving the existing cushion meshes:
-their vertices are rewritten in place (``core.geometry.cushion.cushion_vertices``, every pair in one
-vectorised call; same vertex order at the same resolution) and their faces kept. Those faces were
-made convex for the previous ellipsoids, so the cushions count as out of date until the fields
-have been still for ``LIVE_SETTLE_SECONDS``; a timer then rebuilds them exactly (``settle_live``).
+A live step synthesizes the request (the extra measurements only when one is given: the panel shows the five)
+and moves what is there. Cushions keep up with a dragged slider by moving the existing cushion meshes: their
+vertices are rewritten in place (``core.geometry.cushion.cushion_vertices``, every pair in one vectorised call;
+same vertex order at the same resolution) and their faces kept; a cushion the armature cut in two at a joint
+(``services.rig``) keeps its halves, whose vertices follow the hull's (``core.pose.posed_pieces.clipped_vertices``).
+Those faces were made convex for the previous ellipsoids, so the cushions count as out of date until the fields
+have been still for ``LIVE_SETTLE_SECONDS``; a timer then rebuilds them exactly (``settle_live``), and cuts them
+again. What follows the pieces (a preview skin) hooks in at :func:`pieces_moved`, with the step's budget left.
 Blender records a slider's undo step when it is released, before that timer, and a file may be
 saved before it too: undo, redo and opening a file can bring moved cushions back, so handlers
 (``settle_restored``) start the timer again whenever a live target's cushions are out of date.
@@ -24,16 +27,20 @@ from ....core.constants import CUSHION_LEVEL, LIVE_CUSHION_LEVEL
 from ....core.errors import ElliMannError
 from ....core.geometry.cushion import cushion_vertices
 from ....core.geometry.mesh import icosphere_level
+from ....core.pose.posed_pieces import clipped_vertices
 from ...bridge.built import built_objects, is_stale
-from ...bridge.convert import update_collection_geometry, write_measured
+from ...bridge.convert import update_collection_geometry, write_measured, write_mesh_vertices
 from ...bridge.selection import part_lookup
 from ...services.cushions import rigid_frame
+from ...services.rig import split_sources
 from ...services.scene import refresh_cushions
 from .request import synthesize_request
 
 LIVE_SETTLE_SECONDS = 0.5  # fields still this long: the live target's cushions are rebuilt exactly
 LIVE_NAME_KEY = "ellimann_live_name"  # on a live target: the name live updates last gave it
 
+LIVE_STEP_BUDGET = 0.050  # s: a live step with what follows its pieces (pieces_moved), e.g. a preview skin
+_followers = []  # called by every live step after its pieces moved (add_follower)
 _held = {"depth": 0, "changed": False}  # live updates held back while a preset sets its fields
 _settling = {"scenes": set()}  # names of the scenes whose live targets wait for exact cushions
 
@@ -70,7 +77,7 @@ def live_update(scene):
         return None
     start = time.perf_counter()
     try:
-        mannequin, measured, warnings = synthesize_request(props)
+        mannequin, measured, warnings = synthesize_request(props, measure_extra=False)
         update_collection_geometry(target, mannequin)
         write_measured(target, measured)
         cushions = built_objects(target, "CUSHION")
@@ -80,6 +87,7 @@ def live_update(scene):
             else:  # rebuilt exactly once; afterwards they move in place
                 refresh_cushions(target, min(_level(cushions), LIVE_CUSHION_LEVEL), scene_view_layer(scene))
         rename_live_target(target, mannequin.name)
+        pieces_moved(scene, target, mannequin, start)
     except ElliMannError as error:
         props.status = f"Live update failed: {error}"
         return None
@@ -89,19 +97,48 @@ def live_update(scene):
     return seconds
 
 
+def add_follower(follower):
+    """Run ``follower(scene, target, mannequin, seconds_left)`` in every live step once the pieces have moved
+    (:func:`pieces_moved`); e.g. a preview skin over them."""
+    if follower not in _followers:
+        _followers.append(follower)
+
+
+def remove_follower(follower):
+    if follower in _followers:
+        _followers.remove(follower)
+
+
+def pieces_moved(scene, target, mannequin, started):
+    """The seam between a live step and what follows its pieces: called once per step, after the ellipsoids and
+    the cushions (their halves on a rig too) have moved to ``mannequin``. Each follower gets the seconds left of
+    LIVE_STEP_BUDGET (``started``: the step's perf_counter at its start) and is expected to keep within them
+    (a coarser preview, or leave the rest to the settle timer)."""
+    for follower in list(_followers):
+        follower(scene, target, mannequin, LIVE_STEP_BUDGET - (time.perf_counter() - started))
+
+
 def _level(cushions):
     """The resolution most of the cushions have (CUSHION_LEVEL if none is an icosphere's)."""
-    levels = [icosphere_level(len(o.data.vertices)) for o in cushions if o.type == "MESH"]
+    levels = [_hull_level(o)[0] for o in cushions if o.type == "MESH"]
     levels = [level for level in levels if level is not None]
     return max(set(levels), key=levels.count) if levels else CUSHION_LEVEL
+
+
+def _hull_level(cushion):
+    """(the icosphere level of a cushion's hull, the sources of its halves if a rig cut it in two, else None);
+    level None: neither a hull as built nor halves of one."""
+    split = split_sources(cushion.data)
+    return split if split is not None else (icosphere_level(len(cushion.data.vertices)), None)
 
 
 def move_cushions(mannequin, cushions):
     """Move the built cushions onto ``mannequin``'s ellipsoids by rewriting their vertices in place.
 
-    Needs one cushion per pair, each with a mesh of its own at an icosphere resolution (as
-    build_cushions makes them); returns False, changing nothing, otherwise. The faces are kept, so
-    the cushions stay out of date (``built.is_stale``) until :func:`settle_live` rebuilds them.
+    Needs one cushion per pair, each with a mesh of its own: a hull at an icosphere resolution (as build_cushions
+    makes them) or the two halves a rig cut it into (``services.rig``: each half's vertices follow the hull's,
+    ``clipped_vertices``); returns False, changing nothing, otherwise. The faces are kept, so the cushions stay out
+    of date (``built.is_stale``) until :func:`settle_live` rebuilds them (and cuts them again).
     """
     topology = mannequin.topology
     pairs = np.asarray(topology.cushion_pairs, dtype=int).reshape(-1, 2)
@@ -109,16 +146,17 @@ def move_cushions(mannequin, cushions):
     objects = [by_pair.get((topology.names[i], topology.names[j])) for i, j in pairs]
     if len(cushions) != len(pairs) or any(o is None or o.type != "MESH" or o.data.users != 1 for o in objects):
         return False
-    levels = [icosphere_level(len(o.data.vertices)) for o in objects]
-    if None in levels:
+    hulls = [_hull_level(o) for o in objects]
+    if any(level is None for level, _ in hulls):
         return False
-    for level in set(levels):
-        rows = [k for k, found in enumerate(levels) if found == level]
+    for level in {level for level, _ in hulls}:
+        rows = [k for k, (found, _) in enumerate(hulls) if found == level]
         local = cushion_vertices(mannequin.rotation, mannequin.center, mannequin.semi_axes, pairs[rows], level)
-        for k, vertices in zip(rows, local.astype(np.float32)):
-            obj, first = objects[k], pairs[k, 0]
-            obj.data.vertices.foreach_set("co", vertices.ravel())
-            obj.data.update()
+        for k, vertices in zip(rows, local):
+            obj, first, sources = objects[k], pairs[k, 0], hulls[k][1]
+            if sources is not None:
+                vertices = clipped_vertices(vertices, sources)
+            write_mesh_vertices(obj.data, vertices)
             obj.matrix_world = rigid_frame(mannequin.rotation[first], mannequin.center[first])
     return True
 

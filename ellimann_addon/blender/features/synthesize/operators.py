@@ -28,7 +28,7 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
     def execute(self, context):
         props = context.scene.ellimann_synthesis
         try:
-            mannequin, measured, warnings = synthesize_request(props)
+            mannequin, measured, warnings = synthesize_request(props, measure_extra=False)
             five = {key: measured[key] for key in MEASUREMENTS}
             if mannequin.joints is not None:
                 check_rig(mannequin)  # before the scene changes

@@ -38,13 +38,13 @@ def extra_of(props):
     return {key: float(getattr(props, key)) for key in EXTRA_MEASUREMENTS if getattr(props, f"use_{key}")}
 
 
-def synthesize_request(props, extra=None):
+def synthesize_request(props, extra=None, measure_extra=True):
     """(Mannequin, measured {the five and the extra ones: cm}, warnings) of the panel's request; ``extra``
     overrides the panel's extra measurements (a body's, for Synthesize from Mesh). What exact mode missed is one of
-    the warnings."""
-    result = synthesize_extra(
-        reference_of(props), request_of(props), extra_of(props) if extra is None else extra, options_of(props)
-    )
+    the warnings. ``measure_extra=False``: the extra measurements only when some are given (the panel shows no
+    others)."""
+    given = extra_of(props) if extra is None else extra
+    result = synthesize_extra(reference_of(props), request_of(props), given, options_of(props), measure_extra)
     return result.mannequin, result.measured, result.warnings
 
 
