@@ -15,6 +15,7 @@ import numpy as np
 from ..errors import ElliMannError
 from ..geometry.mesh import connected_labels, directed_edges, volume
 from ..measure.body import measure_body_mesh
+from ..pose.kinematics import bone_matrices, require_joints
 from .contour import marching_cubes
 from .field import FADE, blend_pairs, blend_widths, sample_field
 from .settings import SkinSettings, check_skin_size
@@ -47,6 +48,13 @@ class Skin:
         motions = piece_motions(self.mannequin, moved)
         vertices = follow_pieces(self.vertices, self.pieces, self.weights, motions)
         return Skin(moved, vertices, self.faces, self.pieces, self.weights, self.settings)
+
+    def posed(self, pose):
+        """The skin's vertices (V, 3) in ``pose`` (a core.pose.kinematics.Pose): linear-blend skinning with
+        :meth:`bones`, as glTF and Blender's Armature modifier apply it. ElliMannError without joints."""
+        matrices = bone_matrices(require_joints(self.mannequin), pose)[:, :3, :]
+        bones, weights = self.bones()
+        return follow_pieces(self.vertices, bones, weights, matrices)
 
     def measure(self, fractions=None):
         """The skin measured as any body mesh (core.measure.body): a BodyMeasurement at the mannequin's section

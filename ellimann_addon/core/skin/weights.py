@@ -70,6 +70,7 @@ def piece_motions(rest, moved):
 
 
 def follow_pieces(vertices, pieces, weights, motions):
-    """Skin vertices (V, 3) moved by their pieces' affine ``motions`` (n, 3, 4), blended by weight."""
+    """Skin vertices (V, 3) moved by their pieces' (or bones') affine ``motions`` (n, 3, 4), blended by
+    ``weights`` (V, 4) of ``pieces`` (V, 4)."""
     blended = np.einsum("vk,vkij->vij", weights, motions[pieces])
     return np.einsum("vij,vj->vi", blended[:, :, :3], vertices) + blended[:, :, 3]
