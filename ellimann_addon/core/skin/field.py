@@ -10,8 +10,9 @@ skin holds every piece, and it adds at most k / 4 where two surfaces cross. Piec
 arm beside the torso, the two thighs, a hand at the hip) meet in a plain crease, with no webbing.
 
 Sampling: the field on a coarse grid (``COARSE`` times the spacing) decides which coarse cells can hold the
-surface (some corner nearer than the cell's reach); only their nodes are sampled at the fine spacing, the
-others take the coarse cell's sign. The meshing gets the same values it would from the whole grid.
+surface (some corner nearer than the cell's reach); only their nodes are sampled at half the spacing, which
+decides the same for its cells, down to the spacing asked for; the others take their cell's sign. The meshing
+gets the same values it would from the whole grid.
 """
 
 from dataclasses import dataclass
@@ -21,7 +22,7 @@ import numpy as np
 from ..geometry.ellipsoid import bounds
 from ..mannequin.skeleton import PARENTS, part_bones
 
-COARSE = 2  # fine nodes per coarse cell edge
+COARSE = 4  # fine nodes per coarse cell edge (a power of 2)
 LIPSCHITZ = 1.5  # bound on the field's slope used to rule a coarse cell out (the bound's slope is 1 at a surface)
 FAR = 1.0  # m: the value of fine nodes no piece is near (only its sign is used)
 POWER = 4.0
@@ -52,15 +53,16 @@ class Grid:
 
 def piece_distance(points, rotation, center, semi_axes):
     """Signed distance bound (k,) of ``points`` (k, 3) to one ellipsoid: negative inside, exact on its surface."""
-    local = (points - center) @ rotation
-    k0 = np.sqrt(np.einsum("ij,ij->i", local / semi_axes, local / semi_axes))
-    scaled = local / semi_axes**2
+    scaled = (points - center) @ (rotation / semi_axes)  # q / D, q the point in the ellipsoid's frame
+    k0 = np.sqrt(np.einsum("ij,ij->i", scaled, scaled))
+    scaled /= semi_axes
     k1 = np.sqrt(np.einsum("ij,ij->i", scaled, scaled))
     with np.errstate(divide="ignore", invalid="ignore"):
         distance = k0 * (k0 - 1.0) / k1
     # no point of an ellipsoid is deeper than its smallest semi-axis: the bound's steep dive near the centre
     # (towards minus the largest one) is cut there
-    return np.maximum(np.where(k1 > 0.0, distance, -semi_axes.min()), -semi_axes.min())
+    deepest = -semi_axes.min()
+    return np.maximum(np.where(k1 > 0.0, distance, deepest), deepest)
 
 
 def blend_amount(a, b, width):
@@ -168,32 +170,58 @@ class PieceField:
 
     def field(self, grid, marked, reach):
         """The field (grid.shape) on the ``marked`` nodes where a piece comes within ``reach``, FAR elsewhere;
-        and the nearest piece of each node (flat, -1 where none is near)."""
-        values, nearest_piece = self._combine(grid.size, lambda lo, hi: _box_nodes(grid, marked, lo, hi), reach)
+        and the nearest piece of each node (flat, -1 where none is near or not marked)."""
+        nodes = np.flatnonzero(marked)
+        found, nearest = self.sampled(grid, marked, nodes, reach)
+        values = np.full(grid.size, FAR)
+        values[nodes] = found
+        nearest_piece = np.full(grid.size, -1, dtype=np.int32)
+        nearest_piece[nodes] = nearest
         return values.reshape(grid.shape), nearest_piece
+
+    def sampled(self, grid, marked, nodes, reach):
+        """The field and the nearest piece at the ``marked`` nodes of ``grid`` only, given as ``nodes`` (their
+        flat indices, ascending): two arrays as long as ``nodes``."""
+        slot = np.full(grid.size, -1, dtype=np.int64)
+        slot[nodes] = np.arange(len(nodes))
+
+        def select(lo, hi):
+            flat, points = _box_nodes(grid, marked, lo, hi)
+            return slot[flat], points
+
+        return self._combine(len(nodes), select, reach)
 
     def at(self, points, reach):
         """The field at ``points`` (k, 3) where a piece comes within ``reach`` (FAR elsewhere), and the nearest
         piece of each (-1 where none is near): for a few scattered points (every box is a mask over them)."""
 
-        def inside(lo, hi):
-            rows = np.flatnonzero(np.all((points >= lo) & (points <= hi), axis=1))
-            return rows, points[rows]
+        order = np.argsort(points[:, 0], kind="stable")  # _combine needs the nodes' x to ascend with them
+        ordered = points[order]
 
-        return self._combine(len(points), inside, reach)
+        def inside(lo, hi):
+            rows = np.flatnonzero(np.all((ordered >= lo) & (ordered <= hi), axis=1))
+            return rows, ordered[rows]
+
+        values, nearest = self._combine(len(points), inside, reach)
+        back = np.empty_like(order)
+        back[order] = np.arange(len(order))
+        return values[back], nearest[back]
 
     def _combine(self, size, select, reach):
-        """The field on ``size`` nodes, those in a box given by ``select(lo, hi)`` -> (ascending nodes, points)."""
+        """The field on ``size`` nodes, those in a box given by ``select(lo, hi)`` -> (ascending nodes, points);
+        the nodes' x must ascend with them (a grid's flat order, or points sorted by x)."""
         flat = np.full(size, FAR)
         nearest_piece = np.full(size, -1, dtype=np.int32)
-        near = []  # each piece's nodes (ascending) and its distances there
+        near = []  # each piece's nodes (ascending), their points and its distances there
         for i in range(len(self.center)):
             margin = FADE * self.margin[i] + reach
             nodes, points = select(self.lo[i] - margin, self.hi[i] + margin)
             distance = self.distance(i, points)
-            nearest_piece[nodes[distance < flat[nodes]]] = i
-            flat[nodes] = np.minimum(flat[nodes], distance)
-            near.append((nodes, distance))
+            current = flat[nodes]
+            closer = distance < current
+            nearest_piece[nodes[closer]] = i
+            flat[nodes] = np.where(closer, distance, current)
+            near.append((nodes, points, distance))
         nearest = flat.copy()  # the plain minimum over every piece
         # Each pair's fillet (the polynomial smooth minimum's) reaches below the plain minimum by some depth; the
         # pairs' depths are joined by a POWER-norm: their maximum where one pair blends, smooth where two meet.
@@ -201,21 +229,30 @@ class PieceField:
         for (i, j), width in zip(self.pairs, self.widths):
             if width <= 0.0:  # a plain union
                 continue
-            margin_i, margin_j = FADE * self.margin[i] + reach, FADE * self.margin[j] + reach
-            lo = np.maximum(self.lo[i] - margin_i, self.lo[j] - margin_j)
-            hi = np.minimum(self.hi[i] + margin_i, self.hi[j] + margin_j)
-            nodes, _ = select(lo, hi)  # where both pieces' distances are known
-            if len(nodes):
-                (nodes_i, d_i), (nodes_j, d_j) = near[i], near[j]
-                a, b = d_i[np.searchsorted(nodes_i, nodes)], d_j[np.searchsorted(nodes_j, nodes)]
-                # faded out between FULL and FADE widths from the farther piece, so that the field stays
-                # continuous where the nodes whose distances are known end
-                fade = _smoothstep((FADE * width - np.maximum(a, b)) / ((FADE - FULL) * width))
-                lowered = fade * blend_amount(a, b, width)
-                # how far the pair's fillet reaches below the front; its onset rounded over a span that vanishes
-                # with the fillet, so that a pair whose pieces do not meet adds nothing
-                reach_below = _soft_positive(lowered - (np.minimum(a, b) - nearest[nodes]), ONSET * lowered)
-                power[nodes] += reach_below**POWER
+            if len(near[j][0]) < len(near[i][0]):
+                i, j = j, i
+            (nodes_i, points_i, d_i), (nodes_j, points_j, d_j) = near[i], near[j]
+            if not len(nodes_j):
+                continue
+            # the nodes both pieces have, among those of the smaller list within the other's x range (the nodes
+            # ascend, so x does too)
+            first, last = np.searchsorted(points_i[:, 0], (points_j[0, 0], points_j[-1, 0]), side="left"), None
+            first, last = first[0], np.searchsorted(points_i[:, 0], points_j[-1, 0], side="right")
+            candidates = nodes_i[first:last]
+            position = np.minimum(np.searchsorted(nodes_j, candidates), len(nodes_j) - 1)
+            shared = np.flatnonzero(nodes_j[position] == candidates)
+            rows = first + shared
+            a, b = d_i[rows], d_j[position[shared]]
+            blending = np.abs(a - b) < width  # elsewhere the fillet is nil
+            nodes, a, b = nodes_i[rows[blending]], a[blending], b[blending]
+            # faded out between FULL and FADE widths from the farther piece, so that the field stays
+            # continuous where the nodes whose distances are known end
+            fade = _smoothstep((FADE * width - np.maximum(a, b)) / ((FADE - FULL) * width))
+            lowered = fade * blend_amount(a, b, width)
+            # how far the pair's fillet reaches below the front; its onset rounded over a span that vanishes
+            # with the fillet, so that a pair whose pieces do not meet adds nothing
+            reach_below = _soft_positive(lowered - (np.minimum(a, b) - nearest[nodes]), ONSET * lowered)
+            power[nodes] += reach_below**POWER
         flat -= power ** (1.0 / POWER)
         return flat, nearest_piece
 
@@ -233,36 +270,54 @@ def _box_nodes(grid, marked, lo, hi):
 
 def sample_field(rotation, center, semi_axes, pairs, widths, spacing):
     """The field on the fine grid: (values (nx, ny, nz), Grid, the nearest piece of each node (flat, -1: none
-    near)). Nodes of coarse cells the surface cannot cross hold +-FAR (their cell's sign); the others the field."""
+    near)). Levels from COARSE times the spacing down, each half the last: a level samples only the nodes of the
+    cells the level above found the surface may cross; the other nodes hold +-FAR (their cell's sign)."""
     pieces = PieceField(rotation, center, semi_axes, pairs, widths)
     grid = field_grid(rotation, center, semi_axes, spacing, FADE * max(widths, default=0.0))
-    coarse_shape = tuple((n - 1) // COARSE + 1 for n in grid.shape)
-    coarse = Grid(grid.origin, spacing * COARSE, coarse_shape)
-    reach = LIPSCHITZ * np.sqrt(3.0) / 2.0 * coarse.spacing  # a crossing lies this near a corner of its cell
-    coarse_values = pieces.field(coarse, np.ones(coarse_shape, dtype=bool), reach)[0]
-    near = np.abs(coarse_values) < reach
-    cx, cy, cz = coarse_shape
-    active = np.zeros((cx - 1, cy - 1, cz - 1), dtype=bool)
-    inside = coarse_values[:-1, :-1, :-1] < 0.0
+    step = COARSE
+    level = Grid(grid.origin, spacing * step, tuple((n - 1) // step + 1 for n in grid.shape))
+    marked = np.ones(level.shape, dtype=bool)
+    sign = np.ones(level.shape)  # the sign of the nodes not sampled (none at the coarsest level)
+    while True:
+        nodes = np.flatnonzero(marked)
+        # LIPSCHITZ * sqrt(3) * spacing: the most a node beside a crossing can hold
+        found, nearest = pieces.sampled(level, marked, nodes, LIPSCHITZ * np.sqrt(3.0) * level.spacing)
+        values = sign * FAR
+        values.reshape(-1)[nodes] = found
+        if step == 1:
+            nearest_piece = np.full(grid.size, -1, dtype=np.int32)
+            nearest_piece[nodes] = nearest
+            return values, grid, nearest_piece
+        active, inside = _crossable_cells(values, LIPSCHITZ * np.sqrt(3.0) / 2.0 * level.spacing)
+        step //= 2
+        level = Grid(grid.origin, spacing * step, tuple((n - 1) // step + 1 for n in grid.shape))
+        marked = _cell_nodes(_halved(active))
+        sign = np.where(_halved(inside), -1.0, 1.0)
+
+
+def _crossable_cells(values, reach):
+    """(cells the surface may cross: a corner nearer than ``reach`` (a crossing lies that near a corner of its
+    cell) or corners of both signs; each cell's sign, its first corner's)."""
+    nx, ny, nz = values.shape
+    near = np.abs(values) < reach
+    inside = values[:-1, :-1, :-1] < 0.0
+    active = np.zeros((nx - 1, ny - 1, nz - 1), dtype=bool)
     for dx in (0, 1):
         for dy in (0, 1):
             for dz in (0, 1):
-                corner = (slice(dx, cx - 1 + dx), slice(dy, cy - 1 + dy), slice(dz, cz - 1 + dz))
-                active |= near[corner] | ((coarse_values[corner] < 0.0) != inside)
-    marked = _cell_nodes(_upsample(active))
-    # LIPSCHITZ * sqrt(3) * spacing: the most a node beside a crossing can hold
-    values, nearest_piece = pieces.field(grid, marked, LIPSCHITZ * np.sqrt(3.0) * spacing)
-    return np.where(marked, values, np.where(_upsample(inside), -FAR, FAR)), grid, nearest_piece
+                corner = (slice(dx, nx - 1 + dx), slice(dy, ny - 1 + dy), slice(dz, nz - 1 + dz))
+                active |= near[corner] | ((values[corner] < 0.0) != inside)
+    return active, inside
 
 
-def _upsample(cells):
-    """Coarse cells (a, b, c) as the fine cells they hold, plus one node layer: (a, b, c) * COARSE + 1."""
-    fine = cells.repeat(COARSE, axis=0).repeat(COARSE, axis=1).repeat(COARSE, axis=2)
+def _halved(cells):
+    """Cells (a, b, c) as the cells of half their size they hold, plus one node layer: (2a + 1, 2b + 1, 2c + 1)."""
+    fine = cells.repeat(2, axis=0).repeat(2, axis=1).repeat(2, axis=2)
     return np.pad(fine, ((0, 1), (0, 1), (0, 1)), mode="edge")
 
 
 def _cell_nodes(cells):
-    """Nodes that are a corner of a marked fine cell (``cells`` padded by one node layer as ``_upsample``)."""
+    """Nodes that are a corner of a marked cell (``cells`` padded by one node layer, as ``_halved`` gives)."""
     nodes = cells.copy()
     nodes[1:] |= cells[:-1]
     nodes[:, 1:] |= nodes[:, :-1].copy()
