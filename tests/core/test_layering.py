@@ -139,7 +139,8 @@ FLOORS = {
     "pose": 4,
     "drape": 4,
     "fitting": 5,
-    "formats": 5,
+    "skin": 5,
+    "formats": 6,
 }
 
 

@@ -1,4 +1,4 @@
-"""File formats ElliMann writes without Blender, and the table of every format (floor 5: everything below).
+"""File formats ElliMann writes without Blender, and the table of every format (floor 6: everything below).
 
 - bvh: BVH motion-capture clips read with numpy, their units said, their bones matched
 - core_writers: OBJ, JSON and MJCF mannequin files by extension

@@ -244,25 +244,27 @@ def section_segments(vertices, faces, height, with_edges=False):
 
 
 def connected_labels(count, pairs):
-    """Component label (0..c-1) of each of ``count`` nodes joined by ``pairs`` (k, 2): minimum-label
-    propagation with pointer jumping (numpy only)."""
-    label = np.arange(count)
+    """Component label (0..c-1, in order of each component's smallest node) of each of ``count`` nodes joined by
+    ``pairs`` (k, 2), numpy only: rounds of hooking each edge's larger root under its smaller one, then pointer
+    jumping to the roots; the edges already inside one component are dropped each round."""
+    parent = np.arange(count)
     pairs = np.asarray(pairs, np.int64).reshape(-1, 2)
-    while True:
-        low = np.minimum(label[pairs[:, 0]], label[pairs[:, 1]])
-        new = label.copy()
-        np.minimum.at(new, pairs[:, 0], low)
-        np.minimum.at(new, pairs[:, 1], low)
-        new = new[new]
-        while True:
-            jumped = new[new]
-            if np.array_equal(jumped, new):
-                break
-            new = jumped
-        if np.array_equal(new, label):
+    while len(pairs):
+        first, second = parent[pairs[:, 0]], parent[pairs[:, 1]]
+        apart = first != second
+        pairs, first, second = pairs[apart], first[apart], second[apart]
+        if not len(pairs):
             break
-        label = new
-    return np.unique(label, return_inverse=True)[1].reshape(-1)
+        high, low = np.maximum(first, second), np.minimum(first, second)
+        order = np.argsort(high, kind="stable")
+        roots, starts = np.unique(high[order], return_index=True)
+        parent[roots] = np.minimum(parent[roots], np.minimum.reduceat(low[order], starts))
+        while True:
+            jumped = parent[parent]
+            if np.array_equal(jumped, parent):
+                break
+            parent = jumped
+    return np.unique(parent, return_inverse=True)[1].reshape(-1)
 
 
 def in_plane(vertices, origin, normal):

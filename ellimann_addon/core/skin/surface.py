@@ -1,0 +1,113 @@
+"""A mannequin's skin: one closed, 2-manifold, consistently wound triangle mesh over its pieces, smooth where
+neighbours meet (the field of ``core.skin.field``, meshed by ``core.skin.contour``), with the weights by which it
+follows its pieces and bones (``core.skin.weights``).
+
+The pieces stay the mannequin's truth for collisions and m_T; the skin is for the eye, for export and for
+draping on a smooth body. Cavities the pieces enclose (a pocket between the trunk's ellipsoids) are filled: only
+the outer surface is kept. A body that falls apart into several outer surfaces (a piece that touches no other)
+is refused, naming the pieces of the loose part.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ElliMannError
+from ..geometry.mesh import connected_labels, directed_edges, volume
+from ..measure.body import measure_body_mesh
+from ..pose.kinematics import bone_matrices, require_joints
+from .contour import marching_cubes
+from .field import FADE, blend_pairs, blend_widths, sample_field
+from .settings import SkinSettings, check_skin_size
+from .weights import bone_weights, follow_pieces, piece_motions, piece_weights
+
+
+class SkinError(ElliMannError):
+    """A skin that cannot be made (a voxel too fine or too coarse, a body in several parts), in one line."""
+
+
+@dataclass
+class Skin:
+    """The skin of ``mannequin`` (the pieces it was made from): vertices (V, 3) m, faces (F, 3) counter-clockwise
+    from outside; each vertex's pieces (V, 4) and their weights (V, 4); how it was made (``settings``)."""
+
+    mannequin: object
+    vertices: np.ndarray
+    faces: np.ndarray
+    pieces: np.ndarray
+    weights: np.ndarray
+    settings: SkinSettings
+
+    def bones(self):
+        """(bones (V, 4), weights (V, 4)): linear-blend skinning weights on the SMPL joints."""
+        return bone_weights(self.mannequin.topology, self.pieces, self.weights)
+
+    def following(self, moved):
+        """This skin moved with its pieces to ``moved`` (the same topology, e.g. the next step of a slider),
+        without a new surface: a preview until the skin is made again."""
+        motions = piece_motions(self.mannequin, moved)
+        vertices = follow_pieces(self.vertices, self.pieces, self.weights, motions)
+        return Skin(moved, vertices, self.faces, self.pieces, self.weights, self.settings)
+
+    def posed(self, pose):
+        """The skin's vertices (V, 3) in ``pose`` (a core.pose.kinematics.Pose): linear-blend skinning with
+        :meth:`bones`, as glTF and Blender's Armature modifier apply it. ElliMannError without joints."""
+        matrices = bone_matrices(require_joints(self.mannequin), pose)[:, :3, :]
+        bones, weights = self.bones()
+        return follow_pieces(self.vertices, bones, weights, matrices)
+
+    def measure(self, fractions=None):
+        """The skin measured as any body mesh (core.measure.body): a BodyMeasurement at the mannequin's section
+        heights (``fractions``, default its own)."""
+        return measure_body_mesh(self.vertices, self.faces, fractions or self.mannequin.section_fractions)
+
+    @property
+    def volume(self):
+        return volume(self.vertices, self.faces)
+
+
+def build_skin(mannequin, settings=None):
+    """The skin of ``mannequin`` (rest or posed) at ``settings`` (default: the final level). SkinError (one
+    line, before any work where it can be told) for a voxel too fine for memory or too coarse for its thinnest
+    piece, or a body whose outer surface falls apart."""
+    settings = settings or SkinSettings()
+    pairs = blend_pairs(mannequin.topology)
+    widths = blend_widths(mannequin.semi_axes, pairs, settings.blend)
+    try:
+        check_skin_size(mannequin, settings, FADE * max(widths, default=0.0) + 2.0 * settings.voxel)
+    except ElliMannError as error:
+        raise SkinError(str(error)) from None
+    arrays = (mannequin.rotation, mannequin.center, mannequin.semi_axes)
+    values, grid, nearest = sample_field(*arrays, pairs, widths, settings.voxel)
+    vertices, faces, inner = marching_cubes(values, grid.origin, grid.spacing)
+    vertices, faces, inner = outer_surface(vertices, faces, inner, nearest, mannequin.topology.names)
+    owner = nearest[inner]
+    pieces, weights = piece_weights(vertices, owner, *arrays, pairs, widths)
+    return Skin(mannequin, vertices, faces, pieces, weights, settings)
+
+
+def outer_surface(vertices, faces, inner, nearest, names):
+    """The mesh's outer surface: cavities (components wound inwards, negative volume) dropped; SkinError if more
+    than one outer component remains, naming the pieces of the smaller ones."""
+    if len(faces) == 0:
+        raise SkinError("skin: the pieces make no surface at this voxel")
+    edges = directed_edges(faces)
+    label = connected_labels(len(vertices), edges)
+    face_label = label[faces[:, 0]]
+    count = face_label.max() + 1
+    corners = vertices[faces]
+    signed = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])) / 6.0
+    volumes = np.bincount(face_label, weights=signed, minlength=count)
+    outer = np.flatnonzero(volumes > 0.0)
+    if len(outer) > 1:
+        main = outer[np.argmax(volumes[outer])]
+        loose = sorted({names[nearest[inner[v]]] for v in np.flatnonzero(np.isin(label, outer[outer != main]))})
+        raise SkinError(
+            f"skin: the body falls apart: {', '.join(loose[:4])}{' and more' if len(loose) > 4 else ''} "
+            "touch no other piece (the skin must be one closed surface)"
+        )
+    keep_faces = face_label == outer[0]
+    kept = np.flatnonzero(label == outer[0])
+    remap = np.full(len(vertices), -1)
+    remap[kept] = np.arange(len(kept))
+    return vertices[kept], remap[faces[keep_faces]], inner[kept]
