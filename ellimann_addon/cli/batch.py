@@ -350,6 +350,8 @@ def _write_row(args, paths, mannequin, measured, request, extra, pose_file, note
     put in ``measured``) and dropped once written. Returns the ``skinning.Skinned``, or None."""
     skinned = None
     if args.skin_settings is not None:
+        if args.pose is not None:  # before the skin is made (a row of another reference set)
+            skinning.require_joints_for_skin(mannequin, f"the {mannequin.reference_set} set's")
         skinned = skinning.make_skin(mannequin, args.skin_settings, args.mode, request, extra)
         mannequin = skinned.mannequin
         measured.update(skinned.pieces)

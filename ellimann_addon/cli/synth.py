@@ -107,6 +107,21 @@ def _wanted(args):
     )
 
 
+def _skin_request(args, settings, extra):
+    """The extra measurements to meet: with --skin in exact mode, those a --from body gave that the skin cannot meet
+    yet are left to the reference set (said in a line); one given as an option is refused before any work."""
+    if settings is not None and args.mode == "exact" and args.from_mesh:
+        found = [key for key in extra if getattr(args, key) is None and key not in skinning.SKIN_EXACT]
+        if found:
+            output.say(
+                f"{PROG} synth: warning: --skin in exact mode meets {', '.join(skinning.SKIN_EXACT)} on the skin; "
+                f"{args.from_mesh}'s {', '.join(found)} are left to the reference set"
+            )
+            extra = {key: value for key, value in extra.items() if key not in found}
+    skinning.check_skin_request(settings, args.mode, extra)
+    return extra
+
+
 def run(args):
     from ..core.synthesis.synthesize import synthesize_extra
 
@@ -114,7 +129,7 @@ def run(args):
     pose_file = arguments.check_pose_argument(args, [kind])
     settings = skinning.skin_settings(args)
     five, extra = _wanted(args)
-    skinning.check_skin_request(settings, args.mode, extra)
+    extra = _skin_request(args, settings, extra)
     reference = arguments.references(args)
     try:  # the request is checked here, once, before any work (its warnings come back with the result)
         options = arguments.synthesis_options(args, args.name)
@@ -212,4 +227,4 @@ def _result(args, mannequin, five, extra, measured, skinned, missed):
             "faces": len(skin.faces),
             "volume_l": skin.volume * 1000.0,
         }
-    return out
+    return json.loads(json.dumps(out), parse_constant=lambda constant: None)  # NaN (not taken): null

@@ -138,6 +138,19 @@ def test_bad_skin_input_is_refused_in_one_line_before_any_work(tmp_path, inputs,
     assert stdout == "" and sorted(p.name for p in tmp_path.iterdir()) == before  # nothing written, no folder made
 
 
+def test_a_body_s_extra_measurements_are_left_to_the_reference_set_in_exact_mode_on_the_skin(idw, tmp_path, capsys):
+    """synth --from BODY --skin in exact mode: the body's extra measurements (which the skin cannot meet yet) are
+    dropped with a line, not refused; the voxel refused next shows the request got that far, nothing written."""
+    body = idw.folder / "w.obj"
+    code, stdout, stderr = run(
+        ["synth", "--from", str(body), "--skin", "--skin-voxel", "20", "-o", str(tmp_path / "x.obj")], capsys
+    )
+    warning, error = stderr.strip().splitlines()
+    assert code == 1 and "w.obj's neck, upper_arm, thigh, calf, crotch_height, arm_length are left" in warning
+    assert error.startswith("ellimann synth: error: --skin-voxel: ") and "too thin for 20 mm" in error
+    assert not list(tmp_path.iterdir())
+
+
 # ------------------------------------------------------------------------------------------------ files
 
 
@@ -161,6 +174,22 @@ def test_measure_of_the_skin_s_obj_agrees_with_what_synth_reported(idw, capsys):
         assert measured[key] == pytest.approx(reported[key], abs=2e-4), key  # measure --json rounds to 1e-4 cm
     pieces = idw.result["measured"]
     assert any(abs(reported[key] - pieces[key]) > 0.5 for key in MEASUREMENTS)  # the skin is not the pieces
+
+
+def test_in_idw_a_body_s_extra_measurements_are_measured_on_the_skin_beside_the_pieces(idw, tmp_path, capsys):
+    body = idw.folder / "w.obj"
+    argv = ["synth", "--from", str(body), *PREVIEW, "--mode", "idw", "-o", str(tmp_path / "t.json"), "--json"]
+    code, stdout, stderr = run(argv, capsys)
+    assert code == 0 and stderr.startswith(f"{body}: measured He "), stderr  # --json: stdout holds the JSON alone
+    result = json.loads(stdout)
+    skin, pieces = result["skin"]["measured"], result["measured"]
+    assert (
+        list(skin)
+        == list(pieces)
+        == [*MEASUREMENTS, "neck", "upper_arm", "thigh", "calf", "crotch_height", "arm_length"]
+    )
+    assert all(isinstance(skin[key], float) for key in skin)
+    assert skin["thigh"] - pieces["thigh"] > 0.5  # the skin over the thigh's pieces
 
 
 def test_the_json_records_how_the_skin_was_made_and_pose_makes_the_same_skin_again(idw, tmp_path, capsys):
