@@ -218,7 +218,7 @@ def _run(args, formats, shard, shards, table, reference_of, options, cluster, po
     if missed:
         tolerance = f"{EXACT_TOLERANCE * 100:g}%"
         if args.skin_settings is not None:
-            tolerance = f"{skinning.MESH_TOLERANCE_CM * 10:g} mm on the skin"
+            tolerance = f"{skinning.mesh_tolerance_cm() * 10:g} mm on the skin"
         output.say(
             f"{PROG} batch: warning: exact mode missed the request of {missed} row(s) by more than {tolerance}; "
             f"see {report.path}"

@@ -64,7 +64,9 @@ def run(args):
                 f"{PROG} pose: {args.input} records its skin at {skinning.describe(recorded)}; made at "
                 f"{skinning.describe(settings)} as asked (another voxel or blend measures a little differently)"
             )
-        skin = skinning.build_skin(mannequin, settings)
+        from ..core.skin.surface import build_skin
+
+        skin = build_skin(mannequin, settings)
     writing.write(mannequin, [args.output], None, args.cushions, frames, args.fps, skin=skin)
     count = f" ({len(frames)} frames)" if len(frames) > 1 else ""
     made = f", with its {skinning.describe(settings)}" if skin is not None else ""

@@ -27,6 +27,13 @@ REPORT_COLUMNS = (
     + [f"{k}_skin_error_pct" for k in ALL_MEASUREMENTS]
 )
 
+# the result columns, empty until a row has them
+EMPTY_RESULTS = {
+    column: ""
+    for column in REPORT_COLUMNS[REPORT_COLUMNS.index("He_measured") :]
+    if column not in ("files", "references")
+}
+
 
 def report_row(
     line,
@@ -61,16 +68,16 @@ def report_row(
         measured = dict(zip(MEASUREMENTS, measured))
     for key in ALL_MEASUREMENTS:
         row[key] = f"{asked[key]:g}" if key in asked else ""
-    for suffix, values in (("measured", measured), ("skin", skin_measured)):
-        errors = "error_pct" if suffix == "measured" else "skin_error_pct"
-        for key in ALL_MEASUREMENTS:
-            row[f"{key}_{suffix}"] = row[f"{key}_{errors}"] = ""
+    row.update(EMPTY_RESULTS)
+    for suffix, errors, values in (("measured", "error_pct", measured), ("skin", "skin_error_pct", skin_measured)):
         both = [key for key in asked if values is not None and values.get(key) is not None]
+        if not both:
+            continue
         got = [values[key] for key in both]
-        for key, value, error in zip(both, got, relative_error(got, [asked[key] for key in both]) if both else []):
+        for key, value, error in zip(both, got, relative_error(got, [asked[key] for key in both])):
             row[f"{key}_{suffix}"], row[f"{key}_{errors}"] = f"{value:.4f}", f"{error:.4f}"
-    row["skin_voxel_mm"] = f"{skin_settings.voxel_mm:g}" if skin_settings is not None else ""
-    row["skin_blend"] = f"{skin_settings.blend:g}" if skin_settings is not None else ""
+    if skin_settings is not None:
+        row["skin_voxel_mm"], row["skin_blend"] = f"{skin_settings.voxel_mm:g}", f"{skin_settings.blend:g}"
     return row
 
 

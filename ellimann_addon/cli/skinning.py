@@ -3,7 +3,8 @@ synthesis options are from ``SYNTHESIS``), what they turn into, the checks made 
 for a mannequin: in exact mode its pieces refined until the skin measures the request (``core.skin.exact``), in
 IDW the skin of the pieces as they are; the skin's measurements (on its mesh) reported beside the pieces' m_T.
 
-A skin is made per mannequin and dropped once its files are written: a batch's memory stays flat."""
+A skin is made per mannequin and dropped once its files are written: a batch's memory stays flat. The skin's core is
+imported only when a skin is asked: a command without --skin starts as fast as before."""
 
 import math
 from dataclasses import dataclass
@@ -11,10 +12,7 @@ from dataclasses import dataclass
 from ..core.constants import MEASUREMENTS
 from ..core.errors import ElliMannError
 from ..core.measure.extra import EXTRA_MEASUREMENTS
-from ..core.skin.exact import MESH_TOLERANCE_CM, exact_skin
-from ..core.skin.measure import mesh_measurements
 from ..core.skin.settings import LEVELS, SKIN, SkinSettings
-from ..core.skin.surface import SkinError, build_skin, check_skin
 from .arguments import number
 from .output import UsageError, one_line
 
@@ -105,6 +103,8 @@ def check_skin_request(settings, mode, extra, source="asked"):
 def check_skins_fit(settings, mannequins):
     """Refuse, before any work, a voxel too fine for memory or too coarse for a piece of any of ``mannequins`` (a
     synthesized one, a file's, or a reference set's for a batch): the core's line, naming --skin-voxel."""
+    from ..core.skin.surface import SkinError, check_skin  # the skin's core, imported when a skin is asked
+
     if settings is None:
         return
     for mannequin in mannequins:
@@ -136,7 +136,7 @@ class Skinned:
         return [
             (key, self.measured[key], request[key])
             for key in SKIN_EXACT
-            if abs(self.measured[key] - request[key]) > MESH_TOLERANCE_CM
+            if abs(self.measured[key] - request[key]) > mesh_tolerance_cm()
         ]
 
 
@@ -145,6 +145,10 @@ def make_skin(mannequin, settings, mode, request, extra=None):
     ``request`` ({He..Hi: cm}), else the skin of the pieces as they are. ``extra``: the extra measurements asked
     ({key: cm}), measured on the skin by the body-mesh measurer (IDW: exact mode refuses them first,
     :func:`check_skin_request`). SkinError (one line) if the skin cannot be made."""
+    from ..core.skin.exact import exact_skin
+    from ..core.skin.measure import mesh_measurements
+    from ..core.skin.surface import build_skin
+
     if mode == "exact":
         result = exact_skin(mannequin, settings, {key: request[key] for key in MEASUREMENTS})
         skinned = Skinned(
@@ -171,7 +175,7 @@ def missed_text(missed, rounds):
     return (
         "exact mode on the skin missed "
         + ", ".join(f"{key} by {got - want:+.2f} cm (skin {got:.2f} cm for {want:g} cm)" for key, got, want in missed)
-        + f" (tolerance {MESH_TOLERANCE_CM * 10:g} mm on its mesh; the closest skin found in {rounds} rounds)"
+        + f" (tolerance {mesh_tolerance_cm() * 10:g} mm on its mesh; the closest skin found in {rounds} rounds)"
     )
 
 
@@ -183,3 +187,10 @@ def require_joints_for_skin(mannequin, what):
             f"--pose with --skin: {label} ({what}) has no joints, so neither it nor its skin can be posed: "
             "synthesize it again from a reference set with joints (the shipped sets have them)"
         )
+
+
+def mesh_tolerance_cm():
+    """What exact mode on the skin promises on its mesh (``core.skin.exact.MESH_TOLERANCE_CM``), cm."""
+    from ..core.skin.exact import MESH_TOLERANCE_CM
+
+    return MESH_TOLERANCE_CM
