@@ -41,14 +41,15 @@ def mannequin_pieces(mannequin, pose=None, cushions=False):
     return pieces + [(mesh.name, mesh.vertices, mesh.faces) for mesh in cushion_meshes]
 
 
-def obj_text(pieces, title):
-    """OBJ text of ``pieces`` ([(name, vertices in ElliMann's axes, faces)]), its first line ``# title (axes)``."""
+def obj_text(pieces, title, smooth=False):
+    """OBJ text of ``pieces`` ([(name, vertices in ElliMann's axes, faces)]), its first line ``# title (axes)``;
+    ``smooth``: each object in smoothing group 1 (importers shade it smooth, as a skin is)."""
     parts = [f"# {title} ({AXES})\n"]
     start = 1
     for name, vertices, faces in pieces:
         faces = np.asarray(faces, dtype=np.int64)
         # one format string per block: a skin's 100k vertices in a fraction of a second, not seconds line by line
-        parts.append(f"o {name}\n")
+        parts.append(f"o {name}\n" + ("s 1\n" if smooth else ""))
         parts.append(("v %.9g %.9g %.9g\n" * len(vertices)) % tuple(from_scene_axes(vertices).ravel().tolist()))
         parts.append(("f %d %d %d\n" * len(faces)) % tuple((faces + start).ravel().tolist()))
         start += len(vertices)
@@ -79,5 +80,5 @@ def write_skin_obj(skin, path, pose=None):
     skinning, ``Skin.posed``), to an .obj, atomically."""
     vertices = skin.vertices if pose is None else skin.posed(pose)
     name = f"{skin.mannequin.name or 'mannequin'} skin"
-    atomic_write_text(path, obj_text([(name, vertices, skin.faces)], skin_title(skin, pose)))
+    atomic_write_text(path, obj_text([(name, vertices, skin.faces)], skin_title(skin, pose), smooth=True))
     return path
