@@ -8,6 +8,7 @@ traced over); several slots stand side by side along X for a line-up.
     python -m tools.render mannequins A.json [B.json ...] [--ghost A.obj ...] --out PNG [--view SIDE]
         [--ghost-shift X Y Z] [--side-too]
     python -m tools.render poses A.json --out PNG [--view THREE_QUARTER] [--pose NAME ...] [--walk-frame K]
+    python -m tools.render objs A.obj [B.obj ...] --out PNG [--side K ...]
 """
 
 import argparse
@@ -191,6 +192,23 @@ def poses(path, out, names=POSE_NAMES, view="FRONT", walk_frame=6):
     return render(out, slots, resolution=(max(800, 420 * len(slots)), 1000), view=view, spacing=0.25)
 
 
+def objs(files, out, sides=(), color=(0.87, 0.72, 0.62, 1.0)):
+    """OBJ files ElliMann wrote (a skin's, ``--skin``) side by side, read by Blender's own OBJ importer in its
+    default axes (Y up, -Z forward: the convention every ElliMann OBJ follows), shaded as the file says; the files
+    at the 0-based indices ``sides`` also seen from the side."""
+    bpy.ops.wm.read_homefile(use_empty=True)
+    slots = []
+    for path in files:
+        before = set(bpy.data.objects)
+        bpy.ops.wm.obj_import(filepath=str(path))
+        imported = [o for o in bpy.data.objects if o not in before]
+        for obj in imported:
+            obj.color = color
+        slots.append(Slot(solid=imported))
+    slots += [Slot(solid=slots[k].solid, turn=90.0) for k in sides]
+    return render(out, slots, resolution=(max(800, 300 * len(slots)), 750), spacing=0.25)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m tools.render", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -214,11 +232,19 @@ def main(argv=None):
     posing.add_argument("--view", default="FRONT", choices=sorted(VIEWS))
     posing.add_argument("--pose", action="append", choices=POSE_NAMES, help="which poses (default: all five)")
     posing.add_argument("--walk-frame", type=int, default=6, help="the frame of the walk cycle shown (default 6)")
+    meshes = sub.add_parser("objs", help="OBJ files ElliMann wrote (Y up), side by side")
+    meshes.add_argument("files", nargs="+", type=Path)
+    meshes.add_argument("--out", required=True, type=Path)
+    meshes.add_argument(
+        "--side", action="append", type=int, default=[], help="also the K-th file (0-based) from the side"
+    )
     args = parser.parse_args(argv)
     ellimann_addon.register()  # the mannequin collections need ElliMann's properties
     try:
         if args.command == "poses":
             poses(args.file, args.out, args.pose or POSE_NAMES, args.view, args.walk_frame)
+        elif args.command == "objs":
+            objs(args.files, args.out, args.side)
         else:
             mannequins(args.files, args.ghost, args.out, args.view, args.ghost_shift, args.side_too)
     finally:

@@ -13,6 +13,7 @@ import sys
 
 import numpy as np
 
+from ..core.constants import MEASUREMENTS
 from ..core.errors import ElliMannError
 from ..core.files import incomplete
 from ..core.formats.npz_bundle import BatchFileWriter
@@ -24,7 +25,7 @@ from ..core.synthesis.batch import by_reference_set, chunks, synthesize_chunk
 from ..core.synthesis.misses import missed_text, request_misses
 from ..core.synthesis.refine import EXACT_TOLERANCE
 from ..core.synthesis.synthesize import IDW_EXTRA_NOTE
-from . import arguments, distributed, output, reporting, writing
+from . import arguments, distributed, output, reporting, skinning, writing
 from .batch_csv import MeasurementsCsv
 from .output import PROG, UsageError
 
@@ -76,6 +77,7 @@ def add_parser(commands):
     )
     arguments.add_synthesis_options(batch)
     arguments.add_pose_option(batch)
+    skinning.add_skin_options(batch)
     batch.set_defaults(run=run, blender=needs_blender)
 
 
@@ -111,6 +113,7 @@ def run(args):
     pose_file = arguments.check_pose_argument(args, formats)
     shard, shards = parse_shard(args.shard)
     options = arguments.synthesis_options(args).checked()  # once, before anything is written
+    args.skin_settings = skinning.skin_settings(args)
     sets = {"": arguments.references(args)}  # the command's set, read once, and each other set a row names
 
     def reference_of(chosen):
@@ -121,12 +124,31 @@ def run(args):
     table = MeasurementsCsv(args.csv, shard, shards)  # the header checked and the rows counted
     if not table.count:
         raise UsageError(f"{args.csv} has a header but no rows")
+    check_skin_batch(args, formats, table, sets[""])
     cluster = distributed.connect(args.dask) if args.dask else None  # before anything is written
     try:
         return _run(args, formats, shard, shards, table, reference_of, options, cluster, pose_file)
     finally:
         if cluster is not None:
             cluster.close()
+
+
+def check_skin_batch(args, formats, table, reference):
+    """Refuse, before anything is written, what --skin cannot do in this batch: the batch file (it holds pieces),
+    Dask (skins are made in this process), exact mode with extra measurement columns, a voxel the command's
+    reference set refuses, posing a set without joints."""
+    settings = args.skin_settings
+    if settings is None:
+        return
+    if NPZ in formats:
+        raise UsageError("--skin with --format npz: the batch file holds the pieces only; write json, obj or mjcf")
+    if args.dask:
+        raise UsageError("--skin with --dask: skins are made one row at a time in this process; drop --dask")
+    extra = [key for key in EXTRA_MEASUREMENTS if key in table.columns]
+    skinning.check_skin_request(settings, args.mode, extra, f"columns of {args.csv}")
+    if args.pose is not None:
+        skinning.require_joints_for_skin(reference.mannequins[0], f"the {reference.name} set's")
+    skinning.check_skins_fit(settings, reference.mannequins)
 
 
 def _run(args, formats, shard, shards, table, reference_of, options, cluster, pose_file):
@@ -194,9 +216,12 @@ def _run(args, formats, shard, shards, table, reference_of, options, cluster, po
         output.say(f"{PROG} batch: error: {failed} row(s) failed; see {report.path}")
         return 1
     if missed:
+        tolerance = f"{EXACT_TOLERANCE * 100:g}%"
+        if args.skin_settings is not None:
+            tolerance = f"{skinning.mesh_tolerance_cm() * 10:g} mm on the skin"
         output.say(
-            f"{PROG} batch: warning: exact mode missed the request of {missed} row(s) by more than "
-            f"{EXACT_TOLERANCE * 100:g}%; see {report.path}"
+            f"{PROG} batch: warning: exact mode missed the request of {missed} row(s) by more than {tolerance}; "
+            f"see {report.path}"
         )
         return output.MISSED
     return 0
@@ -278,31 +303,64 @@ def _row(args, formats, result, i, row, bundles=None, pose_file=None):
         measured.update(
             (key, float(value)) for key, value in zip(EXTRA_MEASUREMENTS, result.extra_measured[i]) if key in extra
         )
-    missed = request_misses(measured, values, extra, args.mode)
-    if missed:
-        notes.append(missed_text(missed))
-        output.say(f"{PROG} batch: line {line}: warning: {missed_text(missed)}")
-    status = "missed" if missed else "ok"
     bundle = bundles.path_of(row.reference) if bundles is not None else None
     listed = paths + ([bundle] if bundle is not None else [])
-    references = row.reference.name
-    if args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths) and paths:
-        report = reporting.report_row(
-            line, name, status, "; ".join(notes + ["kept (--resume)"]), values, measured, listed, references, extra
-        )
-        report["kept"] = True
-    else:
+    kept = bool(paths) and args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths)
+    skinned = None
+    if not kept:
         try:
-            if paths:
-                frames = arguments.pose_frames(args, mannequin, pose_file, notes)
-                writing.write(mannequin, paths, as_dict(result.measured[i]), args.cushions, frames, args.fps)
+            skinned = _write_row(
+                args, paths, mannequin, measured, dict(zip(MEASUREMENTS, values)), extra, pose_file, notes
+            )
         except (ElliMannError, OSError, RuntimeError) as error:
             output.say(f"{PROG} batch: line {line}: failed: {output.one_line(error)}")
             return reporting.report_row(line, name, "error", output.one_line(error), values, extra=extra)
-        report = reporting.report_row(line, name, status, "; ".join(notes), values, measured, listed, references, extra)
+    if skinned is not None:
+        missed = skinned.misses(dict(zip(MEASUREMENTS, values)))
+        text = skinning.missed_text(missed, skinned.rounds) if missed else ""
+    elif args.skin_settings is not None:  # kept with --skin: what its skin and pieces measure is in its files
+        missed, text, measured = [], "", None
+    else:
+        missed = request_misses(measured, values, extra, args.mode)
+        text = missed_text(missed) if missed else ""
+    if missed:
+        notes.append(text)
+        output.say(f"{PROG} batch: line {line}: warning: {text}")
+    report = reporting.report_row(
+        line,
+        name,
+        "missed" if missed else "ok",
+        "; ".join(notes + (["kept (--resume)"] if kept else [])),
+        values,
+        measured,
+        listed,
+        row.reference.name,
+        extra,
+        skin_settings=skinned.skin.settings if skinned else None,
+        skin_measured=skinned.measured if skinned else None,
+    )
+    report["kept"] = kept
     if bundles is not None:
         bundles.mark(row.reference, result, i, name)
     return report
+
+
+def _write_row(args, paths, mannequin, measured, request, extra, pose_file, notes):
+    """Write one row's files; with --skin, its skin made first (its pieces refined for it in exact mode, their m_T
+    put in ``measured``) and dropped once written. Returns the ``skinning.Skinned``, or None."""
+    skinned = None
+    if args.skin_settings is not None:
+        if args.pose is not None:  # before the skin is made (a row of another reference set)
+            skinning.require_joints_for_skin(mannequin, f"the {mannequin.reference_set} set's")
+        skinned = skinning.make_skin(mannequin, args.skin_settings, args.mode, request, extra)
+        mannequin = skinned.mannequin
+        measured.update(skinned.pieces)
+    if paths:
+        frames = arguments.pose_frames(args, mannequin, pose_file, notes)
+        skin = skinned.skin if skinned else None
+        five = {key: measured[key] for key in MEASUREMENTS}
+        writing.write(mannequin, paths, five, args.cushions, frames, args.fps, skin=skin)
+    return skinned
 
 
 class Bundles:

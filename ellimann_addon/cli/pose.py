@@ -4,7 +4,7 @@ import sys
 
 from ..core.errors import MannequinError
 from ..core.formats.table import FORMATS, format_of
-from . import arguments, output, writing
+from . import arguments, output, skinning, writing
 from .output import PROG, UsageError
 
 
@@ -29,6 +29,7 @@ def add_parser(commands):
     )
     arguments.add_verbose(pose)
     arguments.add_pose_option(pose)
+    skinning.add_skin_options(pose, rebuilt=True)
     pose.set_defaults(run=run, blender=needs_blender)
 
 
@@ -50,8 +51,24 @@ def run(args):
         mannequin = Mannequin.load(args.input)
     except MannequinError as error:
         raise UsageError(f"{args.input}: {error}") from None
+    settings = skinning.skin_settings(args, mannequin.skin)
+    if settings is not None:
+        skinning.require_joints_for_skin(mannequin, args.input)
     frames = arguments.pose_frames(args, mannequin, pose_file)
-    writing.write(mannequin, [args.output], None, args.cushions, frames, args.fps)
+    skin = None
+    if settings is not None:  # made again from the pieces, as the file records (the same pieces: the same skin)
+        skinning.check_skins_fit(settings, [mannequin])
+        recorded = mannequin.skin and skinning.SkinSettings.from_dict(mannequin.skin)
+        if recorded and recorded != settings:
+            output.say(
+                f"{PROG} pose: {args.input} records its skin at {skinning.describe(recorded)}; made at "
+                f"{skinning.describe(settings)} as asked (another voxel or blend measures a little differently)"
+            )
+        from ..core.skin.surface import build_skin
+
+        skin = build_skin(mannequin, settings)
+    writing.write(mannequin, [args.output], None, args.cushions, frames, args.fps, skin=skin)
     count = f" ({len(frames)} frames)" if len(frames) > 1 else ""
-    output.say(f"wrote {args.output}: '{mannequin.name}' in pose {args.pose}{count}", file=sys.stdout)
+    made = f", with its {skinning.describe(settings)}" if skin is not None else ""
+    output.say(f"wrote {args.output}: '{mannequin.name}' in pose {args.pose}{count}{made}", file=sys.stdout)
     return 0

@@ -1,6 +1,7 @@
 """The report CSV of ``batch`` and ``demo``: its columns (requested, measured and error of each of the five and of
-the extra measurements a row asked for), one row per mannequin (cells safe for spreadsheets and terminals), and
-the batch's report written row by row as a batch streams."""
+the extra measurements a row asked for; with ``--skin``, how its skin was made and what the skin measures beside),
+one row per mannequin (cells safe for spreadsheets and terminals), and the batch's report written row by row as a
+batch streams."""
 
 import contextlib
 import csv
@@ -21,15 +22,38 @@ REPORT_COLUMNS = (
     + [f"{k}_measured" for k in ALL_MEASUREMENTS]
     + [f"{k}_error_pct" for k in ALL_MEASUREMENTS]
     + ["files", "references"]
+    + ["skin_voxel_mm", "skin_blend"]
+    + [f"{k}_skin" for k in ALL_MEASUREMENTS]
+    + [f"{k}_skin_error_pct" for k in ALL_MEASUREMENTS]
 )
 
+# the result columns, empty until a row has them
+EMPTY_RESULTS = {
+    column: ""
+    for column in REPORT_COLUMNS[REPORT_COLUMNS.index("He_measured") :]
+    if column not in ("files", "references")
+}
 
-def report_row(line, name, status, message, requested=None, measured=None, paths=(), references="", extra=None):
+
+def report_row(
+    line,
+    name,
+    status,
+    message,
+    requested=None,
+    measured=None,
+    paths=(),
+    references="",
+    extra=None,
+    skin_settings=None,
+    skin_measured=None,
+):
     """One report row. ``requested``: the five (cm, MEASUREMENTS order) and ``extra`` the extra measurements asked
-    ({key: cm}); ``measured`` ({key: cm}, or the five's 5 values): what the mannequin measures, the five and those
-    extra ones. A measurement not asked for has empty cells. Text from the CSV or messages is made safe for
-    spreadsheets and terminals (:func:`cell`); ``references``: the reference set the row was synthesized from (its
-    name)."""
+    ({key: cm}); ``measured`` ({key: cm}, or the five's 5 values): what the mannequin (its pieces) measures, the
+    five and those extra ones; with a skin, ``skin_settings`` (how it was made) and ``skin_measured`` ({key: cm},
+    what the skin measures on its mesh). A measurement not asked for has empty cells. Text from the CSV or messages
+    is made safe for spreadsheets and terminals (:func:`cell`); ``references``: the reference set the row was
+    synthesized from (its name)."""
     row = {
         "line": line,
         "name": cell(name),
@@ -44,12 +68,16 @@ def report_row(line, name, status, message, requested=None, measured=None, paths
         measured = dict(zip(MEASUREMENTS, measured))
     for key in ALL_MEASUREMENTS:
         row[key] = f"{asked[key]:g}" if key in asked else ""
-        row[f"{key}_measured"] = row[f"{key}_error_pct"] = ""
-    both = [key for key in asked if measured is not None and measured.get(key) is not None]
-    if both:
-        got = [measured[key] for key in both]
+    row.update(EMPTY_RESULTS)
+    for suffix, errors, values in (("measured", "error_pct", measured), ("skin", "skin_error_pct", skin_measured)):
+        both = [key for key in asked if values is not None and values.get(key) is not None]
+        if not both:
+            continue
+        got = [values[key] for key in both]
         for key, value, error in zip(both, got, relative_error(got, [asked[key] for key in both])):
-            row[f"{key}_measured"], row[f"{key}_error_pct"] = f"{value:.4f}", f"{error:.4f}"
+            row[f"{key}_{suffix}"], row[f"{key}_{errors}"] = f"{value:.4f}", f"{error:.4f}"
+    if skin_settings is not None:
+        row["skin_voxel_mm"], row["skin_blend"] = f"{skin_settings.voxel_mm:g}", f"{skin_settings.blend:g}"
     return row
 
 

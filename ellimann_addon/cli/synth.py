@@ -1,6 +1,7 @@
 """``ellimann synth``: one mannequin from five measurements (and any of the extra ones), or from a body mesh's
 own measurements (``--from body.obj``), written as .json/.xml (no Blender) or .blend/.glb/.obj (Blender)."""
 
+import json
 import sys
 
 from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS, RANGES
@@ -8,7 +9,7 @@ from ..core.errors import ElliMannError
 from ..core.formats.table import FORMATS
 from ..core.measure.extra import EXTRA_ABSURD_LIMITS, EXTRA_LABELS, EXTRA_MEASUREMENTS
 from ..core.synthesis.request import relative_error
-from . import arguments, output, writing
+from . import arguments, output, skinning, writing
 from .output import PROG, UsageError
 
 
@@ -54,8 +55,15 @@ def add_parser(commands):
         help="output file: .blend, .glb, .obj, .json (ElliMann's mannequin JSON) or .xml (MJCF, for MuJoCo)",
     )
     synth.add_argument("--name", help="mannequin name (default: 'ElliMann He-Sh-Br-Wa-Hi')")
+    synth.add_argument(
+        "--json",
+        action="store_true",
+        help="print the result as one JSON object on stdout (what was asked, what the pieces measure and, with "
+        "--skin, what the skin measures) instead of the line",
+    )
     arguments.add_synthesis_options(synth)
     arguments.add_pose_option(synth)
+    skinning.add_skin_options(synth)
     synth.set_defaults(run=run, blender=needs_blender)
 
 
@@ -85,7 +93,7 @@ def _wanted(args):
             output.say(f"{PROG} synth: warning: {args.from_mesh}: {problem}")
         output.say(
             f"{args.from_mesh}: measured " + ", ".join(f"{key} {value:.2f}" for key, value in found.items()),
-            file=sys.stdout,
+            file=sys.stderr if args.json else sys.stdout,  # --json: stdout holds the JSON alone
         )
     given = {key: getattr(args, key) for key in MEASUREMENTS + EXTRA_MEASUREMENTS if getattr(args, key) is not None}
     wanted = {**found, **given}
@@ -99,12 +107,29 @@ def _wanted(args):
     )
 
 
+def _skin_request(args, settings, extra):
+    """The extra measurements to meet: with --skin in exact mode, those a --from body gave that the skin cannot meet
+    yet are left to the reference set (said in a line); one given as an option is refused before any work."""
+    if settings is not None and args.mode == "exact" and args.from_mesh:
+        found = [key for key in extra if getattr(args, key) is None and key not in skinning.SKIN_EXACT]
+        if found:
+            output.say(
+                f"{PROG} synth: warning: --skin in exact mode meets {', '.join(skinning.SKIN_EXACT)} on the skin; "
+                f"{args.from_mesh}'s {', '.join(found)} are left to the reference set"
+            )
+            extra = {key: value for key, value in extra.items() if key not in found}
+    skinning.check_skin_request(settings, args.mode, extra)
+    return extra
+
+
 def run(args):
     from ..core.synthesis.synthesize import synthesize_extra
 
     kind = writing.output_kind(args.output)
     pose_file = arguments.check_pose_argument(args, [kind])
+    settings = skinning.skin_settings(args)
     five, extra = _wanted(args)
+    extra = _skin_request(args, settings, extra)
     reference = arguments.references(args)
     try:  # the request is checked here, once, before any work (its warnings come back with the result)
         options = arguments.synthesis_options(args, args.name)
@@ -114,6 +139,15 @@ def run(args):
     mannequin, measured = result.mannequin, result.measured
     for warning in result.warnings:
         output.say(f"{PROG} synth: warning: {warning}")
+    skinned = None
+    if settings is not None:  # everything that can refuse the skin is checked before it is made
+        if args.pose is not None:
+            skinning.require_joints_for_skin(mannequin, f"synthesized from the {reference.name} set")
+            arguments.pose_frames(args, mannequin, pose_file, notes=[])
+        skinning.check_skins_fit(settings, [mannequin])
+        skinned = skinning.make_skin(mannequin, settings, args.mode, five, extra)
+        mannequin = skinned.mannequin
+        measured = {**measured, **skinned.pieces}
     frames = arguments.pose_frames(args, mannequin, pose_file)
     writing.write(
         mannequin,
@@ -122,14 +156,75 @@ def run(args):
         args.cushions and kind != "json",
         frames,
         args.fps,
+        skin=skinned.skin if skinned else None,
     )
-    achieved = [measured[key] for key in MEASUREMENTS]
-    error = relative_error(achieved, [five[key] for key in MEASUREMENTS]).max()
+    missed = skinned.misses(five) if skinned else []
+    if missed:
+        output.say(f"{PROG} synth: warning: {skinning.missed_text(missed, skinned.rounds)}")
+    if args.json:
+        print(json.dumps(_result(args, mannequin, five, extra, measured, skinned, missed)))
+    else:
+        output.say(_line(args, mannequin, five, extra, measured, skinned), file=sys.stdout)
+    return output.MISSED if (missed if skinned else result.missed) else 0
+
+
+def _line(args, mannequin, five, extra, measured, skinned):
+    """ "wrote OUT: 'NAME' (exact), m_T ... cm, max error ...%"; with a skin, the skin's measurements first and
+    the pieces' m_T beside them."""
     posed = f" in pose {args.pose}" if args.pose else ""
-    extra_line = "; " + ", ".join(f"{key} {measured[key]:.2f}" for key in EXTRA_MEASUREMENTS) + " cm" if extra else ""
-    output.say(
-        f"wrote {args.output}: '{mannequin.name}'{posed} ({args.mode}), m_T {output.format_me(achieved)} cm, "
-        f"max error {error:.3f}%{extra_line}",
-        file=sys.stdout,
+    asked = [five[key] for key in MEASUREMENTS]
+    if skinned is None:
+        achieved = [measured[key] for key in MEASUREMENTS]
+        error = relative_error(achieved, asked).max()
+        extra_line = ""
+        if extra:
+            extra_line = "; " + ", ".join(f"{key} {measured[key]:.2f}" for key in EXTRA_MEASUREMENTS) + " cm"
+        return (
+            f"wrote {args.output}: '{mannequin.name}'{posed} ({args.mode}), m_T {output.format_me(achieved)} cm, "
+            f"max error {error:.3f}%{extra_line}"
+        )
+    on_skin = [skinned.measured[key] for key in MEASUREMENTS]
+    error = relative_error(on_skin, asked).max()
+    extra_line = "; " + ", ".join(f"{key} {skinned.measured[key]:.2f}" for key in extra) + " cm" if extra else ""
+    rounds = f"; {skinned.rounds} round(s) of exact mode on the skin" if skinned.exact else ""
+    return (
+        f"wrote {args.output}: '{mannequin.name}'{posed} ({args.mode}, {skinning.describe(skinned.skin.settings)}), "
+        f"skin {output.format_me(on_skin)} cm, max error {error:.3f}%{extra_line}; pieces' m_T "
+        f"{output.format_me(skinned.pieces)} cm{rounds}"
     )
-    return output.MISSED if result.missed else 0
+
+
+def _result(args, mannequin, five, extra, measured, skinned, missed):
+    """The --json object: what was asked, what the pieces measure (m_T, and the extra measurements asked) and, with
+    a skin, what the skin measures on its mesh."""
+    asked = {**five, **extra}
+
+    def errors(values):
+        keys = [key for key in asked if key in values]
+        return dict(zip(keys, (float(e) for e in relative_error([values[k] for k in keys], [asked[k] for k in keys]))))
+
+    pieces = {key: measured[key] for key in list(MEASUREMENTS) + [k for k in EXTRA_MEASUREMENTS if k in extra]}
+    out = {
+        "output": args.output,
+        "name": mannequin.name,
+        "mode": args.mode,
+        "pose": args.pose,
+        "requested": asked,
+        "measured": pieces,
+        "error_pct": errors(pieces),
+        "skin": None,
+    }
+    if skinned is not None:
+        skin = skinned.skin
+        out["skin"] = {
+            **skin.settings.to_dict(),
+            "measured": skinned.measured,
+            "error_pct": errors(skinned.measured),
+            "exact": skinned.exact,
+            "rounds": skinned.rounds,
+            "converged": (skinned.converged and not missed) if skinned.exact else None,
+            "vertices": len(skin.vertices),
+            "faces": len(skin.faces),
+            "volume_l": skin.volume * 1000.0,
+        }
+    return json.loads(json.dumps(out), parse_constant=lambda constant: None)  # NaN (not taken): null

@@ -60,25 +60,27 @@ def extension(kind):
     return FORMATS[kind].extension
 
 
-def write(mannequin, paths, measured, cushions, frames=None, fps=None):
+def write(mannequin, paths, measured, cushions, frames=None, fps=None, skin=None):
     """Write every path (format from the extension); Blender is loaded only for .blend and .glb. ``frames``: the
-    pose (a list of core.pose.kinematics.Pose) to write the mannequin in, if any.
+    pose (a list of core.pose.kinematics.Pose) to write the mannequin in, if any; ``skin``: its skin
+    (``core.skin.surface.Skin``, ``--skin``), written with it (``core.formats.core_writers``; .blend and .glb:
+    ``blender.services``).
 
     A path that cannot be written raises UsageError naming it (not the temporary file behind it).
     """
     if frames is not None:
-        return write_posed(mannequin, paths, cushions, frames, fps, measured)
+        return write_posed(mannequin, paths, cushions, frames, fps, measured, skin)
     for path in paths:
         if core_format(path):
             with writing(path):
-                write_core_file(mannequin, path, cushions)
+                write_core_file(mannequin, path, cushions, skin)
     blender = [p for p in paths if core_format(p) is None]
     if blender:
         ensure_registered(f"writing {blender[0]}")
         from ..blender.services.files import write_mannequin
 
         try:
-            write_mannequin(mannequin, blender, measured, cushions)
+            write_mannequin(mannequin, blender, measured, cushions, skin=skin)
         except OSError as error:  # atomic_output names the file that failed
             if error.filename is None:
                 raise
@@ -86,15 +88,15 @@ def write(mannequin, paths, measured, cushions, frames=None, fps=None):
     return paths
 
 
-def write_posed(mannequin, paths, cushions, frames, fps, measured=None):
-    """:func:`write` of a posed mannequin: .json, .xml and .obj by the core (core.formats.posed_files), .blend and
-    .glb by the Blender rig (``blender.services.posing.write_posed``)."""
+def write_posed(mannequin, paths, cushions, frames, fps, measured=None, skin=None):
+    """:func:`write` of a posed mannequin (and its ``skin``): .json, .xml and .obj by the core
+    (core.formats.posed_files), .blend and .glb by the Blender rig (``blender.services.posing.write_posed``)."""
     from ..core.formats.posed_files import write_posed as write_core_posed
 
     blender = [p for p in paths if format_of(p).needs_blender_for(True)]
     for path in [p for p in paths if p not in blender]:
         with writing(path):
-            write_core_posed(mannequin, frames, path, cushions, fps)
+            write_core_posed(mannequin, frames, path, cushions, fps, skin)
     if blender:
         ensure_registered(f"writing {blender[0]}")
         try:
@@ -104,7 +106,7 @@ def write_posed(mannequin, paths, cushions, frames, fps, measured=None):
                 f"writing a posed {blender[0]} needs ElliMann's Blender rig, which this build lacks; "
                 "write .json, .xml or .obj"
             ) from None
-        write_blender_posed(mannequin, frames, blender, cushions, fps, measured)
+        write_blender_posed(mannequin, frames, blender, cushions, fps, measured, skin=skin)
     return paths
 
 

@@ -646,11 +646,11 @@ def test_a_batch_row_blender_fails_to_write_is_reported_and_the_batch_goes_on(
 def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_path, capsys, references, monkeypatch):
     real, calls = writing.write, []
 
-    def interrupted_on_the_second_row(*args):
+    def interrupted_on_the_second_row(*args, **keywords):
         calls.append(args)
         if len(calls) == 2:
             raise KeyboardInterrupt
-        return real(*args)
+        return real(*args, **keywords)
 
     monkeypatch.setattr(writing, "write", interrupted_on_the_second_row)
     source = write_csv(tmp_path / "in.csv", GOOD_ROWS + [(160, 40, "abc", 90, 100, "bad")])
@@ -677,12 +677,12 @@ import os, signal, sys, tempfile
 from ellimann_addon.cli import writing, main
 from ellimann_addon.core.files import temp_prefix
 real, calls = writing.write, []
-def killed_on_the_third_row(mannequin, paths, *args):
+def killed_on_the_third_row(mannequin, paths, *args, **keywords):
     calls.append(paths)
     if len(calls) == 3:  # killed while writing: a temporary is on disk
         tempfile.mkstemp(prefix=temp_prefix(), suffix=".tmp", dir=os.path.dirname(paths[0]))
         os.kill(os.getpid(), signal.SIGKILL)
-    return real(mannequin, paths, *args)
+    return real(mannequin, paths, *args, **keywords)
 writing.write = killed_on_the_third_row
 from ellimann_addon.blender.services import teardown
 teardown.exit_with(main({argv!r}))

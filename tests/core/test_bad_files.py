@@ -395,6 +395,46 @@ def test_garbage_bytes_never_raise_anything_else(tmp_path, content):
         Mannequin.load(path)
 
 
+# ------------------------------------------------------------------------------------------------ the skin section
+
+SKIN_RECORD = {"version": 1, "voxel_mm": 5.0, "blend": 0.6, "method": "how it was made"}
+WITH_SKIN = {**GOOD, "skin": SKIN_RECORD}
+
+
+@pytest.mark.parametrize(
+    "skin, words",
+    [
+        ([], ["skin: must be an object (version, voxel_mm, blend, method) or absent, got a list"]),
+        ({**SKIN_RECORD, "version": 2}, ["skin.version: is 2; this ElliMann reads skin version 1"]),
+        ({**SKIN_RECORD, "version": True}, ["skin.version"]),
+        ({k: v for k, v in SKIN_RECORD.items() if k != "version"}, ["skin.version: is None"]),
+        ({**SKIN_RECORD, "voxel_mm": "5"}, ["skin.voxel_mm: must be a number from 1 to 40, got '5'"]),
+        ({**SKIN_RECORD, "voxel_mm": 0.5}, ["skin.voxel_mm: is 0.5; accepted range 1 to 40"]),
+        ({**SKIN_RECORD, "voxel_mm": float("nan")}, ["skin.voxel_mm: must be a number"]),
+        ({**SKIN_RECORD, "blend": -1}, ["skin.blend: is -1; accepted range 0 to 3"]),
+        ({**SKIN_RECORD, "blend": None}, ["skin.blend: must be a number from 0 to 3"]),
+        ({**SKIN_RECORD, "method": 3}, ["skin.method: must be a string"]),
+        ({**SKIN_RECORD, "colour": "pink"}, ["skin.'colour': is not a field of the skin section"]),
+    ],
+)
+def test_a_bad_skin_section_names_its_field(skin, words):
+    refused({**GOOD, "skin": skin}, *words)
+
+
+def test_a_skin_section_round_trips_and_is_checked_in_python_too():
+    mannequin = Mannequin.from_dict(WITH_SKIN)
+    assert mannequin.skin == SKIN_RECORD and Mannequin.from_dict(mannequin.to_dict()).skin == SKIN_RECORD
+    assert "skin" not in TOY.to_dict()  # no skin made: no section
+    problems = mannequin.copy(skin={**SKIN_RECORD, "blend": 9}).problems()
+    assert [(p.field, p.message) for p in problems] == [("skin.blend", "is 9; accepted range 0 to 3")]
+
+
+@settings(max_examples=100, deadline=None)
+@given(path=st.sampled_from([("skin", key) for key in SKIN_RECORD] + [("skin",)]), value=st.deferred(lambda: JSON))
+def test_garbage_in_the_skin_section_never_raises_anything_else(path, value):
+    _loads_or_refuses(_replace(WITH_SKIN, path, value))
+
+
 # ------------------------------------------------------------------------------------------------ cloth size
 
 

@@ -1,6 +1,7 @@
-"""The command line needs numpy only: synth to .json/.xml, batch to json/mjcf, measure of a .json and every --help
-run with the bpy module blocked (a meta-path finder refusing it), and never import ``ellimann_addon.blender``;
-what needs Blender (.blend/.glb/.obj, drape, demo) is refused in one line that says so."""
+"""The command line needs numpy only: synth to .json/.xml, batch to json/mjcf, measure of a .json, --skin to
+.obj/.json/.xml and every --help run with the bpy module blocked (a meta-path finder refusing it), and never
+import ``ellimann_addon.blender``; what needs Blender (.blend/.glb, drape, demo) is refused in one line that says
+so."""
 
 import ast
 import json
@@ -139,6 +140,23 @@ def test_obj_rest_and_posed_are_written_without_blender_standing_in_y_up_axes(tm
         extent = np.ptp(points, axis=0)
         assert extent[1] == pytest.approx(1.65, abs=0.01) and extent[1] > 1.5 * extent[2], out  # upright along Y
         assert abs(points[:, 1].min()) < 0.01, out  # feet on the floor y = 0
+
+
+def test_the_skin_is_made_and_written_to_core_formats_without_blender(tmp_path):
+    """--skin on synth (.obj, .json, .xml), pose (rebuilt from the .json's record) and batch: numpy alone."""
+    skin = ["--skin", "--skin-level", "preview", "--mode", "idw"]
+    for out in ("w.obj", "w.json", "w.xml"):
+        code, stdout, stderr = without_blender("synth", *REQUEST, *skin, "-o", str(tmp_path / out))
+        assert code == 0 and "(idw, skin 10 mm), skin He " in stdout, stderr
+    code, stdout, stderr = without_blender(
+        "pose", str(tmp_path / "w.json"), "--pose", "sit", "--skin", "-o", str(tmp_path / "s.obj")
+    )
+    assert code == 0 and stdout.endswith("with its skin 10 mm\n"), stderr
+    source = tmp_path / "in.csv"
+    source.write_text("He,Sh,Br,Wa,Hi,name\n160,40,95,80,105,a\n", encoding="utf-8")
+    code, _, stderr = without_blender("batch", str(source), "-o", str(tmp_path / "out"), "--format", "obj,mjcf", *skin)
+    assert code == 0, stderr
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["a.obj", "a.xml", "report.csv"]
 
 
 @pytest.mark.parametrize(

@@ -188,12 +188,14 @@ def read_glb_json(path):
 # ------------------------------------------------------------------------------------------------ mannequin files
 
 
-def write_mannequin(mannequin, paths, measured=None, cushions=False):
+def write_mannequin(mannequin, paths, measured=None, cushions=False, skin=None):
     """Write one mannequin to every .blend and .glb in ``paths`` (format from the extension), all
     from one empty scene. Returns the paths. (.obj, .json and MJCF need no Blender: ``core.formats.core_writers``;
     a posed mannequin: ``services.posing``.)
 
-    ``cushions``: the files show the cushions instead of the ellipsoids they replace. A path of another
+    ``cushions``: the files show the cushions instead of the ellipsoids they replace. ``skin``: the mannequin's
+    skin (``core.skin.surface.Skin``, ``--skin``), made by the command line from these pieces, to be written beside
+    them (what the files hold of it: issue 26's Blender side; not written yet). A path of another
     kind raises ElliMannError before anything is written; an OSError names the file that failed
     (``filename``, as given in ``paths``).
     """

@@ -16,11 +16,13 @@ from .rig import apply_motion, apply_pose, build_rig, check_rig
 from .scene import add_mannequin, empty_scene
 
 
-def write_posed(mannequin, frames, paths, cushions=False, fps=WALK_FPS, measured=None):
+def write_posed(mannequin, frames, paths, cushions=False, fps=WALK_FPS, measured=None, skin=None):
     """Write ``mannequin`` (at rest, with joints) posed by ``frames`` (core Poses, already within the limits:
     one for a still pose, several for a motion at ``fps``: the walk loops, a clip named after its file plays
     once) to every .blend and .glb in ``paths``;
-    ``measured``: its rest m_T ({key: cm}) for the .glb's extras, if the caller holds it.
+    ``measured``: its rest m_T ({key: cm}) for the .glb's extras, if the caller holds it; ``skin``: its skin
+    (``core.skin.surface.Skin``, ``--skin``) made from these pieces at rest, to be bound to the rig (issue 26's
+    Blender side; not written yet).
 
     Raises ElliMannError before anything is written for a path of another kind, no frames, or a mannequin
     that cannot be rigged (no joints, a part without a bone). Returns the paths.

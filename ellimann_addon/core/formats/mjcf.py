@@ -12,6 +12,9 @@ Names: bodies and geoms carry the part names verbatim (``"7.a Thigh.L"``); a cus
 ``xml.etree`` escapes what XML needs, so no sanitising is done; part names are already validated
 by the topology (unique, ``number.letter label[.L|.R]``).
 
+With a skin (``--skin``) the file also holds it, drawn and never colliding, bound to the world
+(``core.formats.mjcf_skin``).
+
 Measurements go into ``<custom>``: ``numeric`` fields ``target_He`` ... (the requested
 measurements, when the mannequin has them) and ``measured_He`` ... (m_T of the ellipsoids), in cm,
 plus ``text`` fields ``ellimann_name`` and ``ellimann_role``; a comment at the top repeats them.
@@ -27,6 +30,7 @@ from ..files import atomic_write_text
 from ..geometry.cushion import mannequin_cushions
 from ..geometry.mesh import check_subdivision_level
 from ..geometry.quaternion import rotation_to_quaternion
+from .mjcf_skin import add_skin, skin_comment
 
 # Contact and integration defaults for a static mannequin that objects fall onto. MuJoCo's own
 # defaults (2 ms steps, 20 ms contact time constant) let a 1 cm ball dropped 0.5 m onto an arm sink
@@ -47,11 +51,14 @@ def format_numbers(values, digits=9):
     return " ".join(f"{float(v):.{digits}g}" for v in np.ravel(values))
 
 
-def mannequin_to_mjcf(mannequin, cushions=False, subdivisions=MJCF_CUSHION_LEVEL, floor=True, timestep=TIMESTEP):
+def mannequin_to_mjcf(
+    mannequin, cushions=False, subdivisions=MJCF_CUSHION_LEVEL, floor=True, timestep=TIMESTEP, skin=None
+):
     """MJCF text for ``mannequin`` (validated first: MannequinError names every problem).
 
     ``cushions`` replaces each cushion pair by one convex mesh geom built at ``subdivisions``
-    (icosphere level of the support directions, 1..6); ``floor`` adds a plane at z = 0.
+    (icosphere level of the support directions, 1..6); ``floor`` adds a plane at z = 0; ``skin`` (its
+    ``core.skin.surface.Skin``) is drawn over the pieces.
     """
     mannequin.check()
     subdivisions = check_subdivision_level("subdivisions", subdivisions, CUSHION_LEVELS)
@@ -61,7 +68,7 @@ def mannequin_to_mjcf(mannequin, cushions=False, subdivisions=MJCF_CUSHION_LEVEL
     measured = mannequin.measure()
 
     root = ET.Element("mujoco", model=mannequin.name or "ElliMann mannequin")
-    root.append(ET.Comment(summary_comment(mannequin, measured, cushions)))
+    root.append(ET.Comment(summary_comment(mannequin, measured, cushions, skin)))
     ET.SubElement(root, "compiler", angle="radian", autolimits="true")
     # Elliptic friction cones: with MuJoCo's default pyramidal cones, objects resting on the sloped
     # top of an ellipsoid creep and eventually roll off; elliptic cones hold them.
@@ -145,19 +152,25 @@ def mannequin_to_mjcf(mannequin, cushions=False, subdivisions=MJCF_CUSHION_LEVEL
             quat=format_numbers(quats[hull.first]),
         )
         ET.SubElement(body, "geom", name=hull.name, type="mesh", mesh=hull.name, material="ellimann_cushion")
+    if skin is not None:
+        add_skin(root, skin)
 
     ET.indent(root, space="  ")
     return ET.tostring(root, encoding="unicode") + "\n"
 
 
-def write_mjcf(mannequin, path, cushions=False, subdivisions=MJCF_CUSHION_LEVEL, floor=True, timestep=TIMESTEP):
+def write_mjcf(
+    mannequin, path, cushions=False, subdivisions=MJCF_CUSHION_LEVEL, floor=True, timestep=TIMESTEP, skin=None
+):
     """Write :func:`mannequin_to_mjcf` to ``path`` atomically (nothing is written if it fails)."""
-    text = mannequin_to_mjcf(mannequin, cushions=cushions, subdivisions=subdivisions, floor=floor, timestep=timestep)
+    text = mannequin_to_mjcf(
+        mannequin, cushions=cushions, subdivisions=subdivisions, floor=floor, timestep=timestep, skin=skin
+    )
     atomic_write_text(path, text)
     return path
 
 
-def summary_comment(mannequin, measured, cushions):
+def summary_comment(mannequin, measured, cushions, skin=None):
     def row(values):
         return "  ".join(f"{k} {values[k]:.2f}" for k in MEASUREMENTS if k in values)
 
@@ -170,5 +183,7 @@ def summary_comment(mannequin, measured, cushions):
     ]
     if mannequin.measurements:
         lines.append(f" target (cm):       {row(mannequin.measurements)}")
+    if skin is not None:
+        lines.append(skin_comment(skin).rstrip("\n"))
     # "--" may not appear inside an XML comment (a mannequin name could hold it).
     return "\n".join(lines).replace("--", "- -") + "\n"

@@ -14,7 +14,8 @@ asymmetric ranges of a hip or a shoulder. Masses come from the geoms' volumes at
 that the pieces' overlaps count once (:func:`overlap_share`). The mannequin's pieces collide with the floor and
 with anything added, not with each other (they overlap at rest). Poses become keyframes (``<key name="t_pose"
 qpos=...>``; a motion gives one key per frame, ``walk 0``, ``walk 1``, ...); the model itself is in the rest
-pose.
+pose. With a skin (``--skin``) the file holds it bound to the 24 bodies, which move it as ``Skin.posed`` does
+(``core.formats.mjcf_skin``).
 """
 
 import xml.etree.ElementTree as ET
@@ -31,6 +32,7 @@ from ..mannequin.skeleton import CHILDREN, HINGES, JOINT_NAMES, ROOT, joint_fram
 from ..pose.kinematics import Pose, forward_kinematics, require_joints, rotation_angles
 from ..pose.posed_pieces import PosingRig, union_volume
 from .mjcf import CUSHION_RGBA, FRICTION, SIDE_RGBA, SOLREF, TIMESTEP, format_numbers, summary_comment
+from .mjcf_skin import add_skin
 
 BODY_DENSITY = 985.0  # kg/m^3, a human body's mean density
 JOINT_DAMPING = 2.0  # N m s/rad: keeps a falling, limp body from flailing
@@ -54,9 +56,10 @@ def articulated_mjcf(
     floor=True,
     timestep=TIMESTEP,
     density=BODY_DENSITY,
+    skin=None,
 ):
     """MJCF text of ``mannequin`` (with joints) as an articulated body, ``poses`` (core.pose.kinematics.Pose) as
-    keyframes."""
+    keyframes, ``skin`` (its ``core.skin.surface.Skin``) bound to the bodies."""
     mannequin.check()
     joints = require_joints(mannequin)
     if isinstance(density, bool) or not isinstance(density, (int, float)) or not 100.0 <= density <= 3000.0:
@@ -68,7 +71,7 @@ def articulated_mjcf(
     root = ET.Element("mujoco", model=mannequin.name or "ElliMann mannequin")
     root.append(
         ET.Comment(
-            summary_comment(mannequin, mannequin.measure(), cushions).replace(
+            summary_comment(mannequin, mannequin.measure(), cushions, skin).replace(
                 "Static: bodies have no joints.", "Articulated: SMPL's 24 bones, hinges with anatomical ranges."
             )
         )
@@ -185,6 +188,8 @@ def articulated_mjcf(
             add_body(child, body)
 
     add_body(ROOT, world)
+    if skin is not None:
+        add_skin(root, skin, JOINT_NAMES, joints)
     if poses:
         keys = ET.SubElement(root, "keyframe")
         for pose, qpos in zip(poses, poses_qpos(poses, joints)):
@@ -230,7 +235,7 @@ def poses_qpos(poses, joints):
     return np.concatenate([posed[:, ROOT], rotation_to_quaternion(world[:, ROOT]), angles[:, joint, axis]], axis=1)
 
 
-def write_articulated_mjcf(mannequin, path, poses=(), cushions=False):
+def write_articulated_mjcf(mannequin, path, poses=(), cushions=False, skin=None):
     """Write :func:`articulated_mjcf` atomically."""
-    atomic_write_text(path, articulated_mjcf(mannequin, poses, cushions))
+    atomic_write_text(path, articulated_mjcf(mannequin, poses, cushions, skin=skin))
     return path

@@ -7,6 +7,9 @@
 - ``.obj``: the posed pieces (``core.formats.obj``, Y up as every OBJ ElliMann writes); a still pose only (OBJ
   holds no animation).
 
+With a skin (``--skin``): the .json records how it was made (its ``skin`` section), the .xml binds it to the
+bodies, the .obj holds the posed skin alone.
+
 :func:`read_pose` reads a pose file: such a ``.json`` (its ``pose`` section) or a bare ``Pose.to_dict``.
 """
 
@@ -15,8 +18,9 @@ import json
 from ..errors import ElliMannError
 from ..files import atomic_write_text
 from ..pose.kinematics import Pose
+from .core_writers import with_skin_record
 from .mjcf_articulated import write_articulated_mjcf
-from .obj import write_obj
+from .obj import write_obj, write_skin_obj
 from .table import FORMATS, format_of
 
 POSE_SECTION_VERSION = 1
@@ -56,9 +60,10 @@ def read_pose(path):
     return [Pose.from_dict(frame) for frame in section["frames"]]
 
 
-def write_posed(mannequin, frames, path, cushions=False, fps=None):
+def write_posed(mannequin, frames, path, cushions=False, fps=None, skin=None):
     """Write ``mannequin`` in ``frames`` (a list of Pose; the walk cycle's frames, or one pose) to a .json, .xml
-    or .obj, atomically. ElliMannError (nothing written) for another format or an animation in a .obj."""
+    or .obj, atomically, with its ``skin`` if given. ElliMannError (nothing written) for another format or an
+    animation in a .obj."""
     kind = format_of(path)
     if kind is None or kind.posed_writer != "core":
         names = ", ".join(f".{f.extension}" for f in FORMATS.values() if f.posed_writer == "core")
@@ -68,12 +73,15 @@ def write_posed(mannequin, frames, path, cushions=False, fps=None):
             f"pose: a .{kind.extension} file holds no animation; write the {len(frames)} frames "
             f"of '{frames[0].name.rsplit(' ', 1)[0]}' to .json or .xml (keyframes), or pose a still pose"
         )
+    mannequin = with_skin_record(mannequin, skin)
     if kind.name == "json":
         data = mannequin.to_dict()
         data["pose"] = pose_section(frames, fps)
         atomic_write_text(path, json.dumps(data, indent=1) + "\n")
     elif kind.name == "mjcf":
-        write_articulated_mjcf(mannequin, path, frames, cushions)
+        write_articulated_mjcf(mannequin, path, frames, cushions, skin)
+    elif skin is not None:
+        write_skin_obj(skin, path, frames[0])
     else:
         write_obj(mannequin, path, frames[0], cushions)
     return path

@@ -19,6 +19,7 @@ from .field_checks import json_type as _json_type
 from .field_checks import measurement_problems, section_fraction_problems
 from .field_checks import short as _short
 from .joints import joint_problems, joints_from_dict, joints_to_dict
+from .skin_record import skin_record_from_dict, skin_record_problems
 from .topology import Topology
 from .traces import traces_from_dict, traces_to_dict
 
@@ -35,6 +36,8 @@ class Mannequin:
     ``reference_set`` and ``section_fractions``: the reference set the mannequin belongs to (synthesized from,
     or part of) and the section heights m_T measures it at (fractions of He); the female set's by default.
     ``joints``: None or the (24, 3) rest joint centres in SMPL order (core.mannequin.skeleton, core.mannequin.joints).
+    ``skin``: None or how its skin was made (the file's ``skin`` section, core.mannequin.skin_record), so that it can
+    be made again.
     """
 
     topology: Topology
@@ -48,6 +51,7 @@ class Mannequin:
     reference_set: str = FEMALE_SET
     section_fractions: dict = field(default=None)
     joints: np.ndarray = None
+    skin: dict = None
 
     def __post_init__(self):
         # a copy (mannequins never share one); anything but a dict is left for problems() to name
@@ -74,6 +78,7 @@ class Mannequin:
             reference_set=self.reference_set,
             section_fractions=self.section_fractions,
             joints=None if self.joints is None else self.joints.copy(),
+            skin=dict(self.skin) if isinstance(self.skin, dict) else self.skin,
         )
         values.update(changes)
         return Mannequin(**values)
@@ -139,6 +144,7 @@ class Mannequin:
         if not isinstance(self.reference_set, str) or not self.reference_set:
             out.append(Problem("", "reference_set", f"must be a non-empty name, got {_short(self.reference_set)}"))
         out += section_fraction_problems(self.section_fractions)
+        out += [] if self.skin is None else skin_record_problems(self.skin)
         return out + joint_problems(self)
 
     def check(self):
@@ -171,6 +177,7 @@ class Mannequin:
     def to_dict(self):
         traces = {"traces": traces_to_dict(self.traces)} if self.traces else {}
         joints = {} if self.joints is None else {"joints": joints_to_dict(self.joints)}
+        skin = {} if self.skin is None else {"skin": dict(self.skin)}
         return {
             "format": FORMAT,
             "version": FORMAT_VERSION,
@@ -190,6 +197,7 @@ class Mannequin:
             ],
             **traces,
             **joints,
+            **skin,
         }
 
     @classmethod
@@ -294,6 +302,7 @@ class Mannequin:
             measurements=measurements,
             traces=traces_from_dict(data.get("traces"), topology.names),
             joints=joints_from_dict(data.get("joints")),
+            skin=skin_record_from_dict(data.get("skin")),
             **landmarks,
         )
         return mannequin.check() if check else mannequin

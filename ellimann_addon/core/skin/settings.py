@@ -9,16 +9,14 @@ import numpy as np
 
 from ..errors import ElliMannError
 from ..geometry.ellipsoid import bounds
+from ..mannequin.skin_record import BLEND_RANGE, SKIN_VERSION, VOXEL_RANGE_MM
 from ..option_table import Choice, Option
 
 LEVELS = {"preview": 10.0, "final": 5.0}  # voxel, mm
-VOXEL_RANGE_MM = (1.0, 40.0)
-BLEND_RANGE = (0.0, 3.0)
 DEFAULT_BLEND = 0.6  # times the thinner piece's smallest semi-axis (core.skin.field.blend_widths)
 BYTES_PER_NODE = 40  # the field's grid: its values, the marks and the meshing's temporaries (measured, 5 mm)
 MAX_BYTES = 4 * 1024**3  # a skin that would need more is refused before any work
 THIN = 1.5  # a piece must be this many voxels thick (twice its smallest semi-axis) or it may vanish or tear
-SKIN_VERSION = 1  # of the ``skin`` section a mannequin file records
 
 SKIN = {
     "skin_level": Option(

@@ -71,12 +71,9 @@ def build_skin(mannequin, settings=None):
     line, before any work where it can be told) for a voxel too fine for memory or too coarse for its thinnest
     piece, or a body whose outer surface falls apart."""
     settings = settings or SkinSettings()
+    check_skin(mannequin, settings)
     pairs = blend_pairs(mannequin.topology)
     widths = blend_widths(mannequin.semi_axes, pairs, settings.blend)
-    try:
-        check_skin_size(mannequin, settings, FADE * max(widths, default=0.0) + 2.0 * settings.voxel)
-    except ElliMannError as error:
-        raise SkinError(str(error)) from None
     arrays = (mannequin.rotation, mannequin.center, mannequin.semi_axes)
     values, grid, nearest = sample_field(*arrays, pairs, widths, settings.voxel)
     vertices, faces, inner = marching_cubes(values, grid.origin, grid.spacing)
@@ -84,6 +81,18 @@ def build_skin(mannequin, settings=None):
     owner = nearest[inner]
     pieces, weights = piece_weights(vertices, owner, *arrays, pairs, widths)
     return Skin(mannequin, vertices, faces, pieces, weights, settings)
+
+
+def check_skin(mannequin, settings=None):
+    """Refuse, before any work, a skin of ``mannequin`` at ``settings`` that :func:`build_skin` would refuse before
+    its work: SkinError naming a voxel too fine for memory (and the finest that fits) or pieces too thin for it.
+    Returns the estimated bytes (cheap: what the command line checks before a batch starts)."""
+    settings = settings or SkinSettings()
+    widths = blend_widths(mannequin.semi_axes, blend_pairs(mannequin.topology), settings.blend)
+    try:
+        return check_skin_size(mannequin, settings, FADE * max(widths, default=0.0) + 2.0 * settings.voxel)
+    except ElliMannError as error:
+        raise SkinError(str(error)) from None
 
 
 def outer_surface(vertices, faces, inner, nearest, names):
