@@ -275,13 +275,15 @@ def smooth_creases(dense, vertices, faces):
     edge length): the stretch is shared by the faces there."""
     edges = directed_edges(faces)
     edges = edges[edges[:, 0] < edges[:, 1]]  # a closed 2-manifold: each edge once
-    jump = np.abs(dense[edges[:, 0]] - dense[edges[:, 1]]).sum(axis=1) > CREASE_JUMP
-    if not jump.any():
+    top = np.argmax(dense, axis=1)
+    changing = edges[top[edges[:, 0]] != top[edges[:, 1]]]  # a jump changes the largest bone: only those are tested
+    jump = changing[np.abs(dense[changing[:, 0]] - dense[changing[:, 1]]).sum(axis=1) > CREASE_JUMP]
+    if len(jump) == 0:
         return dense
     length = np.linalg.norm(vertices[edges[:, 0]] - vertices[edges[:, 1]], axis=1).mean()
     steps = max(1, int(np.ceil(CREASE_WIDTH / length)))
     band = np.zeros(len(vertices), dtype=bool)
-    band[edges[jump].ravel()] = True
+    band[jump.ravel()] = True
     for _ in range(steps):  # the band: every vertex within ``steps`` edges of a crease
         band[edges[band[edges].any(axis=1)].ravel()] = True
     rows = np.flatnonzero(band)
@@ -294,10 +296,11 @@ def smooth_creases(dense, vertices, faces):
     neighbours = target[order]
     count = np.diff(np.append(starts, len(order)))[:, None]
     smoothed = dense.copy()
-    local = smoothed[rows]
+    used = np.flatnonzero(dense[rows].any(axis=0))  # the bones the band holds
+    local = dense[rows[:, None], used]
     for _ in range(steps * steps):  # a diffusion's reach grows as the square root of its steps
         local = np.add.reduceat(local[neighbours], starts, axis=0) / count
-    smoothed[rows] = local
+    smoothed[rows[:, None], used] = local
     return smoothed
 
 
