@@ -30,6 +30,7 @@ ADD_ARMATURE = "ellimann.add_armature"
 APPLY_POSE = "ellimann.apply_pose"
 REST_POSE = "ellimann.rest_pose"
 IMPORT_BVH = "ellimann.import_bvh"
+BUILD_SKIN = "ellimann.build_skin"
 
 PANEL_MAIN = "ELLIMANN_PT_main"
 PANEL_TRACE = "ELLIMANN_PT_trace"
@@ -41,6 +42,7 @@ PANEL_SYNTHESIZE = "ELLIMANN_PT_synthesize"
 PANEL_DRAPE = "ELLIMANN_PT_drape"
 PANEL_POSE = "ELLIMANN_PT_pose"
 PANEL_REFERENCES = "ELLIMANN_PT_references"
+PANEL_SKIN = "ELLIMANN_PT_skin"
 
 # Sub-panels of PANEL_MAIN sort by bl_order. Room is left after Measure for the Synthesize (60),
 # Pose (65) and Drape (70) panels that other parts of the add-on add.
@@ -50,6 +52,7 @@ PANEL_ORDER = {
     PANEL_PART: 20,
     PANEL_CLEAN: 30,
     PANEL_CUSHIONS: 40,
+    PANEL_SKIN: 45,
     PANEL_MEASURE: 50,
     PANEL_REFERENCES: 55,
 }

@@ -23,12 +23,13 @@ from .features import (
     part,
     pose,
     references,
+    skin,
     synthesize,
     trace,
 )
 
 # One package per user task, in the sidebar's order.
-FEATURES = (trace, part, clean, cushions, measure, references, synthesize, pose, drape, export)
+FEATURES = (trace, part, clean, cushions, skin, measure, references, synthesize, pose, drape, export)
 
 # Property groups first (pointers need them), the main panel before its sub-panels.
 CLASSES = props.classes + main_panel.classes + tuple(c for feature in FEATURES for c in feature.classes) + menus.classes

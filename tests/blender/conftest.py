@@ -37,12 +37,15 @@ def toy_collection(toy):
 
 @pytest.fixture(autouse=True)
 def no_settle_timer_left():
-    """Live updates leave the settle timer registered; it must not fire in a later test."""
+    """Live updates leave the settle timers (the cushions', the skin's) registered; they must not fire in a later
+    test."""
     yield
+    from ellimann_addon.blender.features.skin import live as skin_live
     from ellimann_addon.blender.features.synthesize import live
 
-    if bpy.app.timers.is_registered(live._settle_timer):
-        bpy.app.timers.unregister(live._settle_timer)
+    for timer in (live._settle_timer, skin_live._settle_timer):
+        if bpy.app.timers.is_registered(timer):
+            bpy.app.timers.unregister(timer)
 
 
 _exit_status = {}

@@ -4,6 +4,7 @@ import bpy
 
 import ellimann_addon
 from ellimann_addon.blender import registry
+from ellimann_addon.blender.features.skin import live as skin_live
 from ellimann_addon.blender.features.synthesize import live
 
 
@@ -33,15 +34,19 @@ def leftovers():
         if getattr(handler, "__module__", "").startswith(ellimann_addon.__name__)
     ]
     found += ["bpy.app.timers: settle"] if bpy.app.timers.is_registered(live._settle_timer) else []
+    found += ["bpy.app.timers: skin settle"] if bpy.app.timers.is_registered(skin_live._settle_timer) else []
+    found += [f"live follower: {f.__name__}" for f in live._followers]
     return found
 
 
 def test_disable_leaves_nothing_and_enable_works_again():
     # property groups, operators, panels, menus (the Synthesize, Reference Set and Pose features' among them)
-    assert len(all_classes()) == 2 + 14 + 6 + 1 + 2 + 6 + 6 + 6 + 2  # + Measure Body Mesh, Synthesize from Mesh
+    # + Measure Body Mesh, Synthesize from Mesh; Build Skin and its panel
+    assert len(all_classes()) == 2 + 14 + 6 + 1 + 2 + 6 + 6 + 6 + 2 + 2
     assert len(all_classes()) == len(set(all_classes()))
     assert not [c.__name__ for c in all_classes() if not c.is_registered]
-    live._settle_later(bpy.context.scene)  # a live update's timer, still waiting
+    live._settle_later(bpy.context.scene)  # a live update's timers, still waiting
+    skin_live._settle_later(bpy.context.scene)
     assert {
         "Object.ellimann",
         "Scene.ellimann_drape",
@@ -49,6 +54,8 @@ def test_disable_leaves_nothing_and_enable_works_again():
         "VIEW3D_MT_add entry",
         "TOPBAR_MT_file_export entry",
         "bpy.app.timers: settle",
+        "bpy.app.timers: skin settle",
+        "live follower: follow",
         "bpy.app.handlers.undo_post: settle_restored",
         "bpy.app.handlers.redo_post: settle_restored",
         "bpy.app.handlers.load_post: settle_restored",

@@ -150,3 +150,18 @@ def test_apply_pose_and_rest():
     after = undo_redo(bpy.ops.ellimann.apply_pose, pose="walk")
     assert len(after["actions"]) == 1
     undo_redo(bpy.ops.ellimann.rest_pose)
+
+
+def test_build_skin_and_build_it_again_in_place():
+    from ellimann_addon.blender.services.rig import build_rig
+    from ellimann_addon.core.synthesis.shipped import named_reference_set
+
+    average = named_reference_set("female").mannequins[4]
+    collection = mannequin_to_collection(average)
+    build_rig(collection, average)
+    bpy.context.view_layer.objects.active = parts(collection)["1.a Cranium"]
+    after = undo_redo(bpy.ops.ellimann.build_skin, level="PREVIEW")
+    assert any(name.endswith("Skin") for name in after["objects"])
+    parts(bpy.data.collections[average.name])["5.a Thigh.L"].location.x += 0.01  # undo made new data
+    rebuilt = undo_redo(bpy.ops.ellimann.build_skin, level="PREVIEW")  # the same object, a new surface
+    assert set(rebuilt["objects"]) == set(after["objects"]) and rebuilt["meshes"] != after["meshes"]

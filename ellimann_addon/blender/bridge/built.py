@@ -1,4 +1,4 @@
-"""Things ElliMann builds from a mannequin (cushion meshes, section curves) and may rebuild.
+"""Things ElliMann builds from a mannequin (cushion meshes, section curves, the skin) and may rebuild.
 
 They live in child collections of the mannequin, tagged with the ID property ``ellimann_built``,
 and each object is tagged with ``Object.ellimann.kind``. Rebuilding removes only objects that carry
@@ -13,7 +13,7 @@ from .convert import SIDE_COLORS, mesh_from_arrays, new_collection
 BUILT_KEY = "ellimann_built"
 SOURCE_KEY = "ellimann_source"  # on a cushion: its ellipsoids' matrices relative to it, when it was built
 STALE_TOLERANCE = 1e-5
-CHILD_NAMES = {"CUSHION": "Cushions", "SECTION": "Sections"}
+CHILD_NAMES = {"CUSHION": "Cushions", "SECTION": "Sections", "SKIN": "Skin"}
 SECTION_BEVEL = 0.003  # m: curves need a bevel to show in renders
 SECTION_COLOR = (0.1, 0.35, 0.9, 1.0)
 
@@ -62,7 +62,7 @@ def built_collection(mannequin, kind):
     return collection
 
 
-def _tag(obj, kind, part_name, side="C", partner="", region="", girth=False):
+def tag_built(obj, kind, part_name, side="C", partner="", region="", girth=False):
     props = obj.ellimann
     props.is_part = True
     props.kind = kind
@@ -85,7 +85,7 @@ def new_cushion_object(name, first, second, local_vertices, faces, frame, collec
     mesh = mesh_from_arrays(name, local_vertices, faces)
     obj = bpy.data.objects.new(name, mesh)
     a, b = first.ellimann, second.ellimann
-    _tag(obj, "CUSHION", a.part_name, a.side, b.part_name, a.region, a.girth or b.girth)
+    tag_built(obj, "CUSHION", a.part_name, a.side, b.part_name, a.region, a.girth or b.girth)
     obj.matrix_world = frame
     obj[SOURCE_KEY] = _relative(frame, first, second).tolist()
     obj.color = SIDE_COLORS[a.side]
@@ -114,7 +114,7 @@ def new_section_object(name, key, z, points, collection):
     spline.points.foreach_set("co", co.astype(np.float32).ravel())
     spline.use_cyclic_u = True
     obj = bpy.data.objects.new(name, curve)
-    _tag(obj, "SECTION", key)
+    tag_built(obj, "SECTION", key)
     obj.color = SECTION_COLOR
     collection.objects.link(obj)
     return obj

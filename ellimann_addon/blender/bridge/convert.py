@@ -45,9 +45,13 @@ def unit_sphere_mesh():
 
 def mesh_from_arrays(name, vertices, faces):
     """A new triangle mesh from numpy arrays (V, 3) and (F, 3), written with foreach_set."""
+    return fill_mesh(bpy.data.meshes.new(name), vertices, faces)
+
+
+def fill_mesh(mesh, vertices, faces):
+    """Give an empty mesh (new, or after ``clear_geometry``) the triangles of numpy arrays (V, 3) and (F, 3)."""
     vertices = np.ascontiguousarray(vertices, dtype=np.float32).reshape(-1, 3)
     faces = np.ascontiguousarray(faces, dtype=np.int32).reshape(-1, 3)
-    mesh = bpy.data.meshes.new(name)
     mesh.vertices.add(len(vertices))
     mesh.vertices.foreach_set("co", vertices.ravel())
     mesh.loops.add(faces.size)

@@ -1,7 +1,7 @@
 """ElliMann's data on Blender objects and collections (PropertyGroups), registered as pointers.
 
 ``Object.ellimann`` marks an object as a mannequin part (an ellipsoid, or something ElliMann built
-from parts: a cushion or a section curve) and carries the topology fields. ``Collection.ellimann``
+from parts: a cushion, a section curve or the skin) and carries the topology fields. ``Collection.ellimann``
 marks a collection as a mannequin and keeps its role and measurements.
 """
 
@@ -25,6 +25,7 @@ KIND_ITEMS = (
     ("ELLIPSOID", "Ellipsoid", "A mannequin part: unit-sphere mesh scaled by its semi-axes"),
     ("CUSHION", "Cushion", "Convex hull of a cushion pair, built by ElliMann"),
     ("SECTION", "Section", "A measurement section hull drawn by ElliMann"),
+    ("SKIN", "Skin", "The smooth skin over the pieces, built by ElliMann (Build Skin)"),
 )
 MEASUREMENT_ITEMS = tuple((key, key, MEASUREMENT_LABELS[key]) for key in MEASUREMENTS)
 
@@ -39,8 +40,8 @@ class ELLIMANN_PG_part(bpy.types.PropertyGroup):
         name="Kind",
         items=KIND_ITEMS,
         default="ELLIPSOID",
-        description="What this object is: an ellipsoid of the mannequin, or a cushion hull or "
-        "section curve ElliMann built from the ellipsoids (rebuilt on demand)",
+        description="What this object is: an ellipsoid of the mannequin, or a cushion hull, "
+        "section curve or skin ElliMann built from the ellipsoids (rebuilt on demand)",
     )
     part_name: StringProperty(
         name="Part Name",

@@ -25,6 +25,7 @@ class ELLIMANN_MT_object(bpy.types.Menu):
         layout.operator(ids.REGISTER_MANNEQUIN)
         layout.separator()
         layout.operator(ids.BUILD_CUSHIONS)
+        layout.operator(ids.BUILD_SKIN)
         layout.operator(ids.MEASURE_MANNEQUIN)
         layout.operator(ids.MEASURE_BODY)
         layout.operator(ids.BUILD_REFERENCE_SET)

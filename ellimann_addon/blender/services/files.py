@@ -34,6 +34,10 @@ A mannequin with an armature (``services.rig``) is a skinned glTF: one joint nod
 every piece a skinned mesh weighted fully to its bone (the exporter writes each piece's vertices at rest
 in the armature's space, so such a node carries no transform of its own; ``extras.ellimann`` still
 gives its rest frame), the armature in its current pose, and its action (the walk) as an animation.
+
+With a skin (``services.skin``), the skin is one more skinned mesh (``extras.ellimann``: kind SKIN and how it was
+made), weighted smoothly to the bones (up to four per vertex); the pieces stay beside it, inside it, as colliders.
+In a .blend the pieces are hidden with a Collision modifier each.
 """
 
 import json
@@ -50,8 +54,11 @@ from ...core.formats.table import BLENDER_FORMATS, extension_of
 from ..bridge.built import built_objects, is_stale
 from ..bridge.convert import collection_to_mannequin, objects_recursive
 from ..bridge.selection import part_lookup
+from ..bridge.skin import is_stale_skin, skin_object, skin_settings_of
 from .chatter import blender_output
+from .rig import build_rig
 from .scene import add_mannequin, empty_scene
+from .skin import add_skin, pieces_as_colliders
 
 # ------------------------------------------------------------------------------------------------ glTF
 
@@ -73,6 +80,9 @@ def part_extras(obj):
         "depends": [m for m in MEASUREMENTS if m in props.depends],
         "partner": props.partner,
     }
+    if props.kind == "SKIN":
+        settings = skin_settings_of(obj)
+        return {"kind": "SKIN", "skin": settings.to_dict() if settings is not None else None}
     if props.kind == "ELLIPSOID":
         matrix = np.array(obj.matrix_world)
         semi = np.linalg.norm(matrix[:3, :3], axis=0)
@@ -122,8 +132,14 @@ def export_gltf(collection, path, mannequin=None, measured=None):
         mannequin = collection_to_mannequin(collection)
         parts = part_lookup(collection)
         stale = [c.name for c in built_objects(collection, "CUSHION") if is_stale(c, parts)]
+        skin = skin_object(collection)
+        if skin is not None and is_stale_skin(skin, mannequin):
+            raise ElliMannError(
+                f"the skin of '{collection.name}' is out of date (its pieces moved since it was built): "
+                "Build Skin first"
+            )
     else:
-        stale = []  # its cushions were built from the mannequin a moment ago
+        stale = []  # its cushions and skin were built from the mannequin a moment ago
     if stale:
         more = f" and {len(stale) - 1} more" if len(stale) > 1 else ""
         raise ElliMannError(
@@ -194,8 +210,7 @@ def write_mannequin(mannequin, paths, measured=None, cushions=False, skin=None):
     a posed mannequin: ``services.posing``.)
 
     ``cushions``: the files show the cushions instead of the ellipsoids they replace. ``skin``: the mannequin's
-    skin (``core.skin.surface.Skin``, ``--skin``), made by the command line from these pieces, to be written beside
-    them (what the files hold of it: issue 26's Blender side; not written yet). A path of another
+    core Skin (``core.skin.surface``), written beside the pieces (:func:`write_with_skin`). A path of another
     kind raises ElliMannError before anything is written; an OSError names the file that failed
     (``filename``, as given in ``paths``).
     """
@@ -203,9 +218,23 @@ def write_mannequin(mannequin, paths, measured=None, cushions=False, skin=None):
     if paths:
         empty_scene()
         collection = add_mannequin(mannequin, measured, cushions)
-        for path in paths:
-            write_blender_file(path, collection, mannequin, measured)
+        if skin is not None and mannequin.joints is not None:
+            build_rig(collection, mannequin)  # the skin is bound to the bones: posable in Blender
+        write_with_skin(paths, collection, mannequin, measured, skin)
     return paths
+
+
+def write_with_skin(paths, collection, mannequin, measured=None, skin=None):
+    """Write the scene holding ``collection`` to each path; with ``skin`` (a core Skin of ``mannequin``), the skin
+    object is added first (bound to the armature if there is one), the .glb files are written with the pieces as
+    they are (nodes inside the skin), then the pieces are hidden as colliders for the .blend files."""
+    if skin is not None:
+        add_skin(collection, skin)
+        paths = sorted(paths, key=lambda path: extension_of(path) != "glb")
+    for path in paths:
+        if skin is not None and extension_of(path) == "blend":
+            pieces_as_colliders(collection, hidden=True)
+        write_blender_file(path, collection, mannequin, measured)
 
 
 def checked_paths(paths):

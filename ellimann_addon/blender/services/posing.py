@@ -4,14 +4,15 @@
 (``cli.writing.write_posed``; .json, MJCF and .obj come from ``core.formats.posed_files``): from an empty scene,
 the rest mannequin, its armature (``services.rig``), one pose or a motion as an action on the timeline (the walk,
 looping; a clip, playing once), then each file through ``services.files`` (atomically). A .blend opens posed (or
-playing the motion); a .glb is a skinned glTF in that pose with the motion as an animation.
+playing the motion); a .glb is a skinned glTF in that pose with the motion as an animation. With a skin, the skin
+is bound to the armature too and the pieces stay beside it as colliders.
 """
 
 import bpy
 
 from ...core.errors import ElliMannError
 from ...core.pose.standard import MOTIONS, WALK_FPS
-from .files import checked_paths, write_blender_file
+from .files import checked_paths, write_with_skin
 from .rig import apply_motion, apply_pose, build_rig, check_rig
 from .scene import add_mannequin, empty_scene
 
@@ -20,9 +21,8 @@ def write_posed(mannequin, frames, paths, cushions=False, fps=WALK_FPS, measured
     """Write ``mannequin`` (at rest, with joints) posed by ``frames`` (core Poses, already within the limits:
     one for a still pose, several for a motion at ``fps``: the walk loops, a clip named after its file plays
     once) to every .blend and .glb in ``paths``;
-    ``measured``: its rest m_T ({key: cm}) for the .glb's extras, if the caller holds it; ``skin``: its skin
-    (``core.skin.surface.Skin``, ``--skin``) made from these pieces at rest, to be bound to the rig (issue 26's
-    Blender side; not written yet).
+    ``measured``: its rest m_T ({key: cm}) for the .glb's extras, if the caller holds it; ``skin``: its core Skin
+    at rest, bound to the armature beside the pieces (``services.files.write_with_skin``).
 
     Raises ElliMannError before anything is written for a path of another kind, no frames, or a mannequin
     that cannot be rigged (no joints, a part without a bone). Returns the paths.
@@ -47,6 +47,5 @@ def write_posed(mannequin, frames, paths, cushions=False, fps=WALK_FPS, measured
         scene.frame_start, scene.frame_end = 1, len(frames)
         scene.frame_set(1)
     bpy.context.view_layer.update()
-    for path in paths:
-        write_blender_file(path, collection, mannequin, measured)
+    write_with_skin(paths, collection, mannequin, measured, skin)
     return paths

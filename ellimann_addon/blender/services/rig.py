@@ -6,8 +6,8 @@ bound rigidly by an Armature modifier and one vertex group weighted 1.0 to its b
 one unit-sphere mesh per bone, since vertex group names live on the mesh), not parented to a bone:
 the glTF exporter writes that as a skin, a cloth collider built the same way follows the deformed
 mesh, and the objects' own matrices stay the rest pose, so m_T read from the scene is always the rest
-pose's. A cushion joining pieces on two bones gets both bones' groups with per-vertex weights.
-Rotation limits are Limit Rotation constraints in each bone's local space (exactly the core's ranges:
+pose's. A cushion joining pieces on two bones gets both bones' groups with per-vertex weights; a skin
+(``services.skin``) comes with its own smooth weights and is only bound. Rotation limits are Limit Rotation constraints in each bone's local space (exactly the core's ranges:
 ``core.pose.bones.bone_limit``).
 
 Everything is computed before the scene changes; building raises ElliMannError without touching it.
@@ -44,6 +44,7 @@ CONSTRAINT_NAME = "ElliMann Limits"
 UNIT_SPHERE_BONE_KEY = "ellimann_unit_sphere_bone"  # on a per-bone copy of the unit sphere: the bone's name
 HULL_LEVEL_KEY = "ellimann_hull_level"  # on a cushion's halves: the icosphere level of the hull they were cut from
 SOURCE_ATTRIBUTES = ("ellimann_hull_first", "ellimann_hull_second", "ellimann_hull_share")  # where each vertex is
+WEIGHT_STEPS = 1024  # a vertex group weight's resolution
 
 
 # ------------------------------------------------------------------------------------------------ lookups
@@ -96,6 +97,8 @@ def build_rig(collection, mannequin):
     for obj in objects:
         bind_rigid(obj, rig, bone_of[obj.ellimann.part_name])
     bind_cushions(collection, mannequin, rig)
+    for skin in built_objects(collection, "SKIN"):  # its bone groups are its own (services.skin): only bound
+        bind_armature(skin, rig)
     return rig
 
 
@@ -114,20 +117,20 @@ def bind_piece(obj, rig, bone_name):
     """Bind any mesh object rigidly to one bone of ``rig`` (its mesh made its own first if it is shared)."""
     if obj.data.users > 1:
         obj.data = obj.data.copy()
-    _set_weights(obj, {bone_name: np.ones(len(obj.data.vertices))})
-    _armature_modifier(obj, rig)
+    set_bone_weights(obj, {bone_name: np.ones(len(obj.data.vertices))})
+    bind_armature(obj, rig)
 
 
 def bind_weights(obj, rig, weights):
     """Bind a mesh object to ``rig`` with per-vertex weights {bone name: (V,)} (its own mesh, not shared)."""
-    _set_weights(obj, weights)
-    _armature_modifier(obj, rig)
+    set_bone_weights(obj, weights)
+    bind_armature(obj, rig)
 
 
 def bind_across(obj, rig, point, toward, first_bone, second_bone):
     """Bind a convex mesh object to two bones, cut at the plane through ``point`` normal to ``toward``."""
     _split_at_joint(obj, point, toward, first_bone, second_bone)
-    _armature_modifier(obj, rig)
+    bind_armature(obj, rig)
 
 
 def _armature_object(name, layout, collection):
@@ -192,22 +195,26 @@ def bind_rigid(obj, rig, bone_name):
         if bone_name not in obj.vertex_groups:
             obj.vertex_groups.new(name=bone_name).add(range(len(obj.data.vertices)), 1.0, "REPLACE")
     else:
-        _set_weights(obj, {bone_name: np.ones(len(obj.data.vertices))})
-    _armature_modifier(obj, rig)
+        set_bone_weights(obj, {bone_name: np.ones(len(obj.data.vertices))})
+    bind_armature(obj, rig)
 
 
-def _set_weights(obj, weights):
-    """Replace the object's bone groups (those named after joints) by ``weights``; other groups (a cloth's pins)
-    stay."""
+def set_bone_weights(obj, weights):
+    """Replace the object's bone groups (those named after joints) by ``weights`` {bone name: (V,)}; other groups
+    (a cloth's pins) stay. Weights are kept to 1/WEIGHT_STEPS (vertex groups are filled one value at a time: a
+    skin's smooth weights would take a call per vertex); the Armature modifier and glTF normalise each vertex's."""
     for group in [g for g in obj.vertex_groups if g.name in JOINT_INDEX]:
         obj.vertex_groups.remove(group)
     for bone_name, values in weights.items():
+        values = np.round(np.asarray(values, dtype=float) * WEIGHT_STEPS) / WEIGHT_STEPS
         group = obj.vertex_groups.new(name=bone_name)
         for value in np.unique(values[values > 0]):
             group.add([int(i) for i in np.flatnonzero(values == value)], float(value), "REPLACE")
 
 
-def _armature_modifier(obj, rig):
+def bind_armature(obj, rig):
+    """An Armature modifier on ``rig`` (first in the stack) for an object whose bone groups are set, parented to the
+    rig with its world matrix kept."""
     modifier = obj.modifiers.get(MODIFIER_NAME) or obj.modifiers.new(MODIFIER_NAME, "ARMATURE")
     modifier.object = rig
     modifier.use_vertex_groups, modifier.use_bone_envelopes = True, False
@@ -240,7 +247,7 @@ def bind_cushions(collection, mannequin, rig=None):
         second_bone = JOINT_NAMES[bones[topology.index[second]]]
         joint = crossing.get((first, second), crossing.get((second, first)))
         if joint is None:
-            _set_weights(cushion, {first_bone: np.ones(len(cushion.data.vertices))})
+            set_bone_weights(cushion, {first_bone: np.ones(len(cushion.data.vertices))})
         else:
             if cushion.data.get(HULL_LEVEL_KEY) is not None:  # cut before (a rig built again): the whole hull first
                 _whole_hull(cushion, mannequin, (topology.index[first], topology.index[second]))
@@ -251,7 +258,7 @@ def bind_cushions(collection, mannequin, rig=None):
                 first_bone,
                 second_bone,
             )
-        _armature_modifier(cushion, rig)
+        bind_armature(cushion, rig)
 
 
 def _split_at_joint(cushion, point, toward, first_bone, second_bone):
@@ -282,7 +289,7 @@ def _split_at_joint(cushion, point, toward, first_bone, second_bone):
     if old.users == 0:
         bpy.data.meshes.remove(old)
     mesh.name = cushion.name
-    _set_weights(cushion, weights)
+    set_bone_weights(cushion, weights)
 
 
 def _whole_hull(cushion, mannequin, pair):
@@ -324,7 +331,7 @@ def remove_rig(collection):
             obj.modifiers.remove(modifier)
         if obj.ellimann.kind == "ELLIPSOID" and obj.data.get(UNIT_SPHERE_BONE_KEY):
             obj.data = shared
-        elif obj.type == "MESH":
+        elif obj.type == "MESH" and obj.ellimann.kind != "SKIN":  # a skin's weights are its own, kept
             for group in [g for g in obj.vertex_groups if g.name in JOINT_INDEX]:
                 obj.vertex_groups.remove(group)
         obj.parent = None

@@ -7,5 +7,6 @@ the measurements (floor 5: everything below).
 - surface: the Skin (mesh, weights, how it was made), building it, following the pieces, measuring it
 - exact: exact mode on the skin: the pieces refined until their skin measures the request
 - measure: the skin measured by m_T's definitions, on the surface itself and on its mesh
-- weights: the pieces and bones each vertex follows
+- weights: the pieces each vertex follows, and following them
+- skinning: bone weights for linear-blend skinning: smooth across the joints, keeping the volume as the legs bend
 """

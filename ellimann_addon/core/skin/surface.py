@@ -9,6 +9,7 @@ is refused, naming the pieces of the loose part.
 """
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -19,7 +20,8 @@ from ..pose.kinematics import bone_matrices, require_joints
 from .contour import marching_cubes
 from .field import FADE, blend_pairs, blend_widths, sample_field
 from .settings import SkinSettings, check_skin_size
-from .weights import bone_weights, follow_pieces, piece_motions, piece_weights
+from .skinning import skinning_weights
+from .weights import follow_pieces, piece_motions, piece_weights
 
 
 class SkinError(ElliMannError):
@@ -39,8 +41,14 @@ class Skin:
     settings: SkinSettings
 
     def bones(self):
-        """(bones (V, 4), weights (V, 4)): linear-blend skinning weights on the SMPL joints."""
-        return bone_weights(self.mannequin.topology, self.pieces, self.weights)
+        """(bones (V, 4), weights (V, 4)): linear-blend skinning weights on the SMPL joints, smooth across every
+        joint and keeping the volume where the legs bend (``core.skin.skinning``; made once, on first use).
+        ElliMannError without joints."""
+        return self._bones
+
+    @cached_property
+    def _bones(self):
+        return skinning_weights(self.vertices, self.faces, self.pieces, self.weights, self.mannequin)
 
     def following(self, moved):
         """This skin moved with its pieces to ``moved`` (the same topology, e.g. the next step of a slider),

@@ -1,4 +1,4 @@
-"""Which pieces each skin vertex follows, and so which bones: weights that blend smoothly where neighbours meet.
+"""Which pieces each skin vertex follows: weights that blend smoothly where neighbours meet.
 
 A vertex belongs to its nearest piece (its *owner*) and, where the owner's neighbours in the body (the pairs that
 blend, ``core.skin.field.blend_pairs``) come near, to them too: a neighbour i weighs (1 - t)^2 with
@@ -6,15 +6,14 @@ t = (d_i - d_nearest) / w, w that pair's blend width, so the weights change over
 surface blends, and never reach a piece that does not touch the owner (an arm beside the torso). The four
 largest weights are kept, normalised.
 
-The pieces' weights move the skin in two ways: live, each vertex follows its pieces' affine motion from one
-mannequin to the next (:func:`follow_pieces`: the slider's preview, no new surface); posed, the same weights
-summed per bone are linear-blend skinning weights (:func:`bone_weights`), which glTF and Blender's Armature
-modifier apply alike.
+Live, each vertex follows its pieces' affine motion from one mannequin to the next (:func:`follow_pieces`: the
+slider's preview, no new surface). Posed, the skin follows the bones by linear-blend skinning with weights made
+from the joints (``core.skin.skinning``), which the piece weights only place in the skeleton: pieces do not end at
+joints. :func:`follow_pieces` applies those too (glTF and Blender's Armature modifier apply them alike).
 """
 
 import numpy as np
 
-from ..mannequin.skeleton import JOINT_COUNT, part_bones
 from .field import piece_distance
 
 INFLUENCES = 4  # pieces (and bones) per vertex: what glTF's JOINTS_0 / WEIGHTS_0 hold
@@ -48,17 +47,6 @@ def piece_weights(vertices, owner, rotation, center, semi_axes, pairs, widths):
     pieces = np.take_along_axis(candidates, keep, axis=1)
     weights = np.take_along_axis(scores, keep, axis=1)
     return pieces, weights / weights.sum(axis=1, keepdims=True)
-
-
-def bone_weights(topology, pieces, weights):
-    """(bones (V, 4) int, weights (V, 4)): the pieces' weights summed per bone (SMPL joint index), largest
-    first (unused slots: bone 0 with weight 0)."""
-    bone = part_bones(topology)[pieces]
-    dense = np.zeros((len(pieces), JOINT_COUNT))
-    np.add.at(dense, (np.arange(len(pieces))[:, None], bone), weights)
-    keep = np.argsort(-dense, axis=1, kind="stable")[:, :INFLUENCES]
-    kept = np.take_along_axis(dense, keep, axis=1)
-    return np.where(kept > 0.0, keep, 0), kept / kept.sum(axis=1, keepdims=True)
 
 
 def piece_motions(rest, moved):

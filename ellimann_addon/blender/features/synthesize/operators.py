@@ -11,6 +11,9 @@ from ... import ids
 from ...bridge.convert import ellipsoid_objects
 from ...services.rig import build_rig, check_rig
 from ...services.scene import add_mannequin
+from ...services.skin import add_skin, make_skin
+from ..skin import live as skin_live
+from ..skin.operator import settings_of
 from .request import extra_of, request_of, synthesize_request
 
 
@@ -32,8 +35,11 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
             five = {key: measured[key] for key in MEASUREMENTS}
             if mannequin.joints is not None:
                 check_rig(mannequin)  # before the scene changes
+            skin = make_skin(mannequin, settings_of(props.skin_level)) if props.skin else None
             collection = add_mannequin(mannequin, five, cushions=props.output == "CUSHIONS")
             rig = build_rig(collection, mannequin) if mannequin.joints is not None else None
+            if skin is not None:
+                skin_live.remember(add_skin(collection, skin), skin)
         except ElliMannError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
@@ -46,7 +52,8 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
         self.report(
             {"INFO"},
             f"Synthesized '{collection.name}' ({len(ellipsoid_objects(collection))} ellipsoids, "
-            f"{props.mode.lower()}{', with an armature' if rig else ''}): m_T {values} cm, "
+            f"{props.mode.lower()}{', with an armature' if rig else ''}{', with a skin' if props.skin else ''}): "
+            f"m_T {values} cm, "
             f"max error {worst:.2f}%",
         )
         return {"FINISHED"}

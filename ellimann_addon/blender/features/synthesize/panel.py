@@ -52,6 +52,11 @@ class ELLIMANN_PT_synthesize(SubPanel, bpy.types.Panel):
 
         layout.row().prop(props, "mode", expand=True)
         layout.row().prop(props, "output", expand=True)
+        row = layout.row()
+        row.prop(props, "skin")
+        level = row.row()
+        level.active = props.skin
+        level.prop(props, "skin_level", text="")
         options = layout.column(align=True)
         options.prop(props, "normalize")
         options.prop(props, "metric")

@@ -7,6 +7,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, PointerProperty
 from ....core.constants import ABSURD_LIMITS, MEASUREMENT_LABELS, RANGES, REFERENCE_MEASUREMENTS
 from ....core.measure.extra import EXTRA_ABSURD_LIMITS, EXTRA_DEFAULTS, EXTRA_LABELS, EXTRA_MEASUREMENTS
 from ....core.synthesis.options import SYNTHESIS
+from ..skin.operator import level_property
 from .live import on_request_change
 from .request import REFERENCE_SET_ITEMS
 
@@ -73,6 +74,14 @@ class ELLIMANN_PG_synthesis(bpy.types.PropertyGroup):
             ),
         ),
     )
+    skin: BoolProperty(
+        name="Skin",
+        default=False,
+        update=on_request_change,
+        description="Give the mannequin a smooth skin over its pieces, bound to its armature. Live, the skin follows "
+        "the pieces at each step and is made again at the preview level once the fields are still",
+    )
+    skin_level: level_property()
     normalize: _option("normalize")
     metric: _option("metric")
     power: _option("power")

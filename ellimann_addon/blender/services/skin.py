@@ -1,0 +1,69 @@
+"""A mannequin's skin in the scene: made by the core (``core.skin``), written into the mannequin's built Skin
+collection (one object, rebuilt in place: ``bridge.skin``), weighted to the SMPL bones (one vertex group per bone,
+``Skin.bones()``) and bound to the mannequin's armature by an Armature modifier when it has one.
+
+With a skin, the pieces stay beside it as colliders: in a .blend they are hidden (viewport and render) and each gets a
+Collision modifier (hidden, not disabled: Blender evaluates them, so cloth collides with them); a .glb keeps them as
+nodes (the skin covers them).
+
+Everything the core computes (the surface, the bone weights) comes before the scene changes: a SkinError leaves the
+file as it was.
+"""
+
+import bpy
+import numpy as np
+
+from ...core.mannequin.skeleton import JOINT_COUNT, JOINT_NAMES
+from ...core.skin.surface import build_skin
+from ..bridge.convert import objects_recursive, rig_object
+from ..bridge.skin import write_skin_object
+from .rig import bind_armature, set_bone_weights
+
+COLLIDER_NAME = "ElliMann Collider"
+
+
+def make_skin(mannequin, settings, progress=None):
+    """The core Skin of ``mannequin`` at ``settings``, with its bone weights made when it has joints (the slow parts,
+    before any scene change). ``progress(fraction, message)``: called as the parts finish. SkinError (one line)."""
+    report = progress or (lambda fraction, message: None)
+    report(0.0, f"making the skin ({settings.voxel_mm:g} mm voxels)")
+    skin = build_skin(mannequin, settings)
+    if mannequin.joints is not None:
+        report(0.7, "weighting it to the bones")
+        skin.bones()
+    report(0.9, "writing it")
+    return skin
+
+
+def add_skin(collection, skin):
+    """Write ``skin`` (a core Skin of the mannequin ``collection`` holds) as the collection's skin object (rebuilt in
+    place if there is one), its bone groups set when the mannequin has joints and bound to its armature if it has
+    one. Returns the object."""
+    obj = write_skin_object(collection, skin)
+    if skin.mannequin.joints is not None:
+        bones, weights = skin.bones()
+        dense = np.zeros((len(bones), JOINT_COUNT))
+        np.add.at(dense, (np.arange(len(bones))[:, None], bones), weights)
+        set_bone_weights(obj, {JOINT_NAMES[b]: dense[:, b] for b in np.flatnonzero(dense.max(axis=0) > 0.0)})
+        rig = rig_object(collection)
+        if rig is not None:
+            bind_armature(obj, rig)
+    return obj
+
+
+def pieces_as_colliders(collection, hidden):
+    """With a skin the pieces stay as colliders: ``hidden`` (for a .blend) hides every piece in the view layer and in
+    renders and gives it a Collision modifier after its armature; False (for a .glb) leaves them as
+    ``scene.add_mannequin`` made them. The skin itself is left alone."""
+    if not hidden:
+        return
+    view_layer = bpy.context.view_layer
+    view_layer.update()  # new objects get their view-layer bases (hide_set needs them)
+    for obj in objects_recursive(collection):
+        if not obj.ellimann.is_part or obj.ellimann.kind not in ("ELLIPSOID", "CUSHION") or obj.type != "MESH":
+            continue
+        obj.hide_render = True
+        if view_layer.objects.get(obj.name) == obj:
+            obj.hide_set(True, view_layer=view_layer)
+        if obj.modifiers.get(COLLIDER_NAME) is None:
+            obj.modifiers.new(COLLIDER_NAME, "COLLISION")

@@ -1,0 +1,125 @@
+"""Dev tool (not shipped): the skin's pictures for docs/skin.md, Workbench renders of skins made at the final level.
+
+    .venv/bin/python -m tools.skin_pictures [--only NAME ...] [--voxel MM] [--out DIR]
+
+- ``skin_reference_lineup.png``, ``skin_reference_lineup_male.png``: the five Reference Mannequins of each shipped
+  set with their skins, front;
+- ``skin_table_2_5.png``: the ten Table 2.5 mannequins (the paper's test requests), synthesized and skinned;
+- ``skin_twin_held_out.png``: the neutral reference body (held out of the shipped set of five) beside its skinned
+  twin (synthesized from everything it measures, stood in the body), front and side;
+- ``skin_poses.png``: the Average RM's skin in every standard pose and three walk frames (front for the arms' poses,
+  side for sit and the walk), posed by linear-blend skinning with its bone weights (``core.skin.skinning``).
+"""
+
+import argparse
+from pathlib import Path
+
+import bpy
+
+import ellimann_addon
+from ellimann_addon.blender.bridge.convert import mesh_from_arrays
+from ellimann_addon.blender.bridge.skin import SKIN_COLOR
+from ellimann_addon.core.constants import TABLE_2_5
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.geometry.volume import IOU_MARGIN, BodyVolume
+from ellimann_addon.core.measure.body import measure_body_mesh
+from ellimann_addon.core.measure.extra import split_measurements
+from ellimann_addon.core.pose.motion import clamped_motion
+from ellimann_addon.core.pose.standard import STILL_POSES
+from ellimann_addon.core.skin.settings import SkinSettings
+from ellimann_addon.core.skin.surface import build_skin
+from ellimann_addon.core.synthesis.shipped import named_reference_set
+from ellimann_addon.core.synthesis.synthesize import synthesize, synthesize_extra
+from tools.build_reference import DEFAULT_REFMODELS
+from tools.overlap import standing_in
+from tools.render import Slot, render
+
+IMAGES = Path(__file__).resolve().parent.parent / "docs" / "images"
+BODY_COLOR = (0.62, 0.64, 0.7, 1.0)
+WALK_FRAMES = (0, 6, 12)
+PICTURES = ("lineup", "lineup_male", "table_2_5", "twin", "poses")
+
+
+def skin_object(name, vertices, faces, color=SKIN_COLOR):
+    mesh = mesh_from_arrays(name, vertices, faces)
+    mesh.shade_smooth()
+    obj = bpy.data.objects.new(name, mesh)
+    obj.color = color
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
+def skin_of(mannequin, settings):
+    skin = build_skin(mannequin, settings)
+    return skin_object(mannequin.name or "Skin", skin.vertices, skin.faces)
+
+
+def lineup(set_name, settings, out):
+    reference = named_reference_set(set_name)
+    slots = [Slot(solid=[skin_of(m, settings)]) for m in reference.mannequins]
+    return render(out, slots, resolution=(2400, 1000))
+
+
+def table_2_5(settings, out):
+    reference = named_reference_set("female")
+    slots = []
+    for request in TABLE_2_5:
+        mannequin = synthesize(reference, request)[0]
+        slots.append(Slot(solid=[skin_of(mannequin, settings)]))
+    return render(out, slots, resolution=(4000, 900))
+
+
+def twin(settings, out):
+    body = read_obj(DEFAULT_REFMODELS / "reference_female.obj", up="z")
+    five, extra = split_measurements(measure_body_mesh(body.vertices, body.faces).values)
+    grid = BodyVolume(body.vertices, body.faces).grid(0.005, margin=IOU_MARGIN)
+    mannequin = standing_in(grid, synthesize_extra(named_reference_set("female"), five, extra)[0])
+    body_object = skin_object("Reference body", body.vertices, body.faces, BODY_COLOR)
+    skinned = skin_of(mannequin.copy(name="Twin"), settings)
+    slots = [Slot(solid=[body_object]), Slot(solid=[skinned]), Slot(solid=[body_object], turn=90.0)]
+    slots.append(Slot(solid=[skinned], turn=90.0))
+    return render(out, slots, resolution=(2000, 1000))
+
+
+def poses(settings, out):
+    mannequin = named_reference_set("female").mannequins[4]
+    skin = build_skin(mannequin, settings)
+    shown = [(name, clamped_motion(name, mannequin.joints)[0][0]) for name in STILL_POSES]
+    walk = clamped_motion("walk", mannequin.joints)[0]
+    shown += [(f"walk {k}", walk[k]) for k in WALK_FRAMES]
+    slots = []
+    for name, pose in shown:
+        pose = pose.copy(translation=pose.translation * [0.0, 0.0, 1.0])  # in place: the slots stay apart
+        obj = skin_object(name, skin.posed(pose), skin.faces)
+        slots.append(Slot(solid=[obj], turn=0.0 if name in ("a_pose", "t_pose", "attention") else 90.0))
+    return render(out, slots, resolution=(3200, 1000))
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m tools.skin_pictures", description=__doc__.splitlines()[0])
+    parser.add_argument("--only", nargs="+", choices=PICTURES, default=list(PICTURES))
+    parser.add_argument("--voxel", type=float, default=None, help="the skin's voxel in mm (default: the final level)")
+    parser.add_argument("--out", type=Path, default=IMAGES)
+    args = parser.parse_args(argv)
+    settings = SkinSettings.at_level("final", args.voxel)
+    ellimann_addon.register()
+    try:
+        jobs = {
+            "lineup": lambda: lineup("female", settings, args.out / "skin_reference_lineup.png"),
+            "lineup_male": lambda: lineup("male", settings, args.out / "skin_reference_lineup_male.png"),
+            "table_2_5": lambda: table_2_5(settings, args.out / "skin_table_2_5.png"),
+            "twin": lambda: twin(settings, args.out / "skin_twin_held_out.png"),
+            "poses": lambda: poses(settings, args.out / "skin_poses.png"),
+        }
+        for name in args.only:
+            bpy.ops.wm.read_homefile(use_empty=True)
+            print(f"wrote {jobs[name]()}")
+    finally:
+        ellimann_addon.unregister()
+    return 0
+
+
+if __name__ == "__main__":
+    from ellimann_addon.blender.services import teardown
+
+    teardown.exit_with(main())
