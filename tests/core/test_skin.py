@@ -165,7 +165,10 @@ def test_a_reference_mannequin_s_skin_is_one_closed_oriented_sphere_holding_ever
     # every piece inside: points on each piece's surface are inside the skin or within the meshing's error of it
     points = np.concatenate([sample_surface(r, c, s, 200) for r, c, s in zip(m.rotation, m.center, m.semi_axes)])
     nearest = np.concatenate(
-        [np.min(np.linalg.norm(chunk[:, None] - vertices[None], axis=2), axis=1) for chunk in np.array_split(points, 40)]
+        [
+            np.min(np.linalg.norm(chunk[:, None] - vertices[None], axis=2), axis=1)
+            for chunk in np.array_split(points, 40)
+        ]
     )
     inside = _inside(points, vertices, faces)
     assert np.all(inside | (nearest < 0.012))

@@ -7,8 +7,8 @@ one unit-sphere mesh per bone, since vertex group names live on the mesh), not p
 the glTF exporter writes that as a skin, a cloth collider built the same way follows the deformed
 mesh, and the objects' own matrices stay the rest pose, so m_T read from the scene is always the rest
 pose's. A cushion joining pieces on two bones gets both bones' groups with per-vertex weights; a skin
-(``services.skin``) comes with its own smooth weights and is only bound. Rotation limits are Limit Rotation constraints in each bone's local space (exactly the core's ranges:
-``core.pose.bones.bone_limit``).
+(``services.skin``) comes with its own smooth weights and is only bound. Rotation limits are Limit Rotation
+constraints in each bone's local space (exactly the core's ranges: ``core.pose.bones.bone_limit``).
 
 Everything is computed before the scene changes; building raises ElliMannError without touching it.
 """
