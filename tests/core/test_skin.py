@@ -16,7 +16,7 @@ from ellimann_addon.core.geometry.mesh import euler_characteristic, is_closed_ma
 from ellimann_addon.core.measure.body import measure_body_mesh
 from ellimann_addon.core.skin.contour import marching_cubes
 from ellimann_addon.core.skin.exact import MESH_TOLERANCE_CM, exact_skin
-from ellimann_addon.core.skin.field import PieceField, blend_pairs, field_grid, sample_field
+from ellimann_addon.core.skin.field import PieceField, blend_pairs, blend_widths, sample_field
 from ellimann_addon.core.skin.measure import field_measurements, mesh_measurements
 from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import SkinError, build_skin, outer_surface
@@ -137,20 +137,15 @@ def test_the_neighbours_of_a_body_are_its_joints_and_cushions_never_left_with_ri
 def test_the_narrow_band_gives_the_whole_grid_s_mesh(female):
     m, _, _ = synthesize(female, TABLE_2_5[3])
     pairs = blend_pairs(m.topology)
-    from ellimann_addon.core.skin.field import blend_widths
-
     widths = blend_widths(m.semi_axes, pairs, SkinSettings().blend)
-    values, grid, _ = sample_field(m.rotation, m.center, m.semi_axes, pairs, widths, 0.01)
+    # 16 mm voxels: the narrowing is the same at any voxel, and the whole grid's field costs 4x less than at 10 mm
+    values, grid, _ = sample_field(m.rotation, m.center, m.semi_axes, pairs, widths, 0.016)
     whole, _ = PieceField(m.rotation, m.center, m.semi_axes, pairs, widths).field(
         grid, np.ones(grid.shape, dtype=bool), 1.0
     )
     narrow = marching_cubes(values, grid.origin, grid.spacing)
     dense = marching_cubes(whole, grid.origin, grid.spacing)
     assert np.array_equal(narrow[0], dense[0]) and np.array_equal(narrow[1], dense[1])
-    assert (
-        field_grid(m.rotation, m.center, m.semi_axes, 0.01, 0.0).shape
-        == field_grid(m.rotation, m.center, m.semi_axes, 0.01, 0.0).shape
-    )
 
 
 @pytest.mark.slow
@@ -164,33 +159,45 @@ def test_a_reference_mannequin_s_skin_is_one_closed_oriented_sphere_holding_ever
     assert len(self_intersections(vertices, faces)) == 0
     # every piece inside: points on each piece's surface are inside the skin or within the meshing's error of it
     points = np.concatenate([sample_surface(r, c, s, 200) for r, c, s in zip(m.rotation, m.center, m.semi_axes)])
-    nearest = np.concatenate(
-        [
-            np.min(np.linalg.norm(chunk[:, None] - vertices[None], axis=2), axis=1)
-            for chunk in np.array_split(points, 40)
-        ]
-    )
     inside = _inside(points, vertices, faces)
-    assert np.all(inside | (nearest < 0.012))
+    nearest = _nearest_vertex_distance(points[~inside], vertices, 0.012)
+    assert np.all(nearest < 0.012)
     assert np.allclose(skin.weights.sum(axis=1), 1.0) and skin.pieces.shape == (len(vertices), 4)
 
 
 def _inside(points, vertices, faces):
-    """Ray parity along +x through a closed mesh (fine for the test's sampled points)."""
+    """Ray parity along +x through a closed mesh (fine for the test's sampled points): points taken in height
+    order, a hundred at a time, against the triangles whose height span reaches theirs."""
     tri = vertices[faces]
+    low, high = tri[:, :, 2].min(axis=1), tri[:, :, 2].max(axis=1)
+    order = np.argsort(points[:, 2])
     inside = np.zeros(len(points), dtype=bool)
-    for start in range(0, len(points), 500):
-        p = points[start : start + 500]
+    for rows in np.array_split(order, max(1, len(points) // 100)):
+        p = points[rows]
+        near = tri[(high >= p[:, 2].min()) & (low <= p[:, 2].max())]
         y, z = p[:, None, 1], p[:, None, 2]
-        a, b, c = tri[None, :, 0], tri[None, :, 1], tri[None, :, 2]
+        a, b, c = near[None, :, 0], near[None, :, 1], near[None, :, 2]
         d = (b[..., 1] - a[..., 1]) * (c[..., 2] - a[..., 2]) - (c[..., 1] - a[..., 1]) * (b[..., 2] - a[..., 2])
         u = ((b[..., 1] - y) * (c[..., 2] - z) - (c[..., 1] - y) * (b[..., 2] - z)) / np.where(d == 0, 1, d)
         v = ((c[..., 1] - y) * (a[..., 2] - z) - (a[..., 1] - y) * (c[..., 2] - z)) / np.where(d == 0, 1, d)
         w = 1 - u - v
         hit = (d != 0) & (u >= 0) & (v >= 0) & (w >= 0)
         x = u * a[..., 0] + v * b[..., 0] + w * c[..., 0]
-        inside[start : start + 500] = (np.sum(hit & (x > p[:, None, 0]), axis=1) % 2) == 1
+        inside[rows] = (np.sum(hit & (x > p[:, None, 0]), axis=1) % 2) == 1
     return inside
+
+
+def _nearest_vertex_distance(points, vertices, reach):
+    """Each point's distance to the nearest vertex, looked for within ``reach`` of its height (``reach`` where
+    none is that near)."""
+    order = np.argsort(points[:, 2])
+    distance = np.full(len(points), reach)
+    for rows in np.array_split(order, max(1, len(points) // 100)):
+        p = points[rows]
+        near = vertices[(vertices[:, 2] >= p[:, 2].min() - reach) & (vertices[:, 2] <= p[:, 2].max() + reach)]
+        if len(near):
+            distance[rows] = np.minimum(reach, np.linalg.norm(p[:, None] - near[None], axis=2).min(axis=1))
+    return distance
 
 
 def test_following_the_same_pieces_leaves_the_skin_where_it_is_and_a_move_moves_it_rigidly(female):
