@@ -15,6 +15,7 @@ BENCHES = (
     "bench_exact_population",
     "bench_male",
     "bench_pose",
+    "bench_skin",
     "bench_skin_posing",
     "bench_drape",
     "bench_walk_drape",
