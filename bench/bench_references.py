@@ -50,7 +50,7 @@ def run():
         return
     base = Mannequin.load(REFERENCE_FOLDER / "base_mannequin.json")
     started = time.perf_counter()
-    bodies = [read_obj(p) for p in paths]
+    bodies = [read_obj(p, up="z") for p in paths]  # the refmodels are in ElliMann's axes (Z up)
     read = time.perf_counter() - started
 
     watch = Stopwatch()
