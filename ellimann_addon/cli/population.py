@@ -84,7 +84,15 @@ def run(args):
         return 0
     return batch.run(
         argparse.Namespace(
-            **{**vars(args), "csv": args.output, "output": args.synthesize, "shard": None, "resume": False}
+            # no skin: the batch file population writes holds the pieces only
+            **{
+                **vars(args),
+                "csv": args.output,
+                "output": args.synthesize,
+                "shard": None,
+                "resume": False,
+                "skin": False,
+            }
         )
     )
 
