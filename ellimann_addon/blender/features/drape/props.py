@@ -15,6 +15,8 @@ BODY_POSE_ITEMS = (
 
 # Items, defaults and descriptions: core.drape.settings.DRAPE (the command line's too).
 GARMENT_ITEMS = tuple((c.value, c.label, c.description) for c in DRAPE["garment"].choices)  # keys as they are
+COLLIDER_ITEMS = tuple((c.value, c.label, c.description) for c in DRAPE["collider"].choices)
+SKIN_LEVEL_ITEMS = tuple((c.value, c.label, c.description) for c in DRAPE["skin_level"].choices)
 DEFAULTS = DrapeSettings()
 
 
@@ -57,6 +59,18 @@ class ELLIMANN_PG_drape(bpy.types.PropertyGroup):
         unit="LENGTH",
         description=DRAPE["edge"].description,
     )
+    collider: EnumProperty(
+        name=DRAPE["collider"].label,
+        items=COLLIDER_ITEMS,
+        default=DRAPE["collider"].default,
+        description=DRAPE["collider"].description,
+    )
+    skin_level: EnumProperty(
+        name=DRAPE["skin_level"].label,
+        items=SKIN_LEVEL_ITEMS,
+        default=DRAPE["skin_level"].default,
+        description=DRAPE["skin_level"].description,
+    )
     cushions: BoolProperty(
         name=DRAPE["cushions"].label, default=DEFAULTS.cushions, description=DRAPE["cushions"].description
     )
@@ -73,6 +87,8 @@ class ELLIMANN_PG_drape(bpy.types.PropertyGroup):
 
     def settings(self):
         return DrapeSettings(
+            collider=self.collider,
+            skin_level=self.skin_level,
             frames=self.frames,
             edge=self.edge,
             cushions=self.cushions,
