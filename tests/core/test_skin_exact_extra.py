@@ -1,14 +1,15 @@
-"""Exact mode on the skin with the six extra measurements (core.skin.exact): on a grid of requests (reference
-bodies' own measurements with and without their six extra ones, on both sets, and the set's own extra ones 6 %
-up or down) the skin's mesh measures every one asked within 1 mm by the body-mesh measurer's definitions, the
-five too; the skin's arms are the vertices of its arm pieces, so the measurer takes an arm that touches the torso
-as an arm; a request no body can meet is refused in one line before any work."""
+"""Exact mode on the skin with the six extra measurements (core.skin.exact): on bench/bench_skin_exact.py's grid
+of requests (reference bodies' own measurements with and without their six extra ones, on both sets, and the
+set's own extra ones 6 % up or down) the skin's mesh measures every one asked within 1 mm by the body-mesh
+measurer's definitions, the five too; the skin's arms are the vertices of its arm pieces, so the measurer takes
+an arm that touches the torso as an arm; a request no body can meet is refused in one line before any work."""
 
 import numpy as np
 import pytest
 
+from bench.bench_skin_exact import GRID, grid_request
 from ellimann_addon.core.constants import MEASUREMENTS, TABLE_2_5
-from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS, mannequin_extra_measurements
+from ellimann_addon.core.measure.extra import mannequin_extra_measurements
 from ellimann_addon.core.skin import exact
 from ellimann_addon.core.skin.exact import MESH_TOLERANCE_CM, exact_skin
 from ellimann_addon.core.skin.measure import body_measurements, mesh_measurements, skin_arms
@@ -17,37 +18,13 @@ from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.synthesis.extra_refine import ExtraRequestError
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize
-from tools.bodies import body_requests, load_labels
-from tools.reference_sets import BUILD_SETS, TRACING_FOLDER
 
 PREVIEW = SkinSettings.at_level("preview")
-# The grid: (set, body or Table 2.5 row, extra measurements: "none", "own" (the body's, as the mesh measurer
-# takes them) or a ratio to what the set gives at those five).
-GRID = (
-    ("female", "small_slim", "none"),
-    ("female", "small_slim", "own"),
-    ("female", "tall_chubby", "none"),
-    ("female", "tall_chubby", "own"),
-    ("female", 4, 1.06),
-    ("female", 9, 0.94),
-    ("male", "tall_slim", "own"),
-)
 
 
 @pytest.fixture(scope="module")
 def sets():
     return {name: named_reference_set(name) for name in ("female", "male")}
-
-
-def grid_request(sets, set_name, body, extra):
-    """(reference set, five {cm}, extra {cm}) of a GRID row."""
-    reference = sets[set_name]
-    if isinstance(body, int):
-        five = dict(zip(MEASUREMENTS, TABLE_2_5[body]))
-        own = mannequin_extra_measurements(synthesize(reference, TABLE_2_5[body])[0])
-        return reference, five, {key: extra * own[key] for key in EXTRA_MEASUREMENTS}
-    five, six = body_requests(BUILD_SETS[set_name], load_labels(TRACING_FOLDER), [body])[body]
-    return reference, five, (six if extra == "own" else {})
 
 
 def test_the_skin_s_arms_are_its_arm_pieces_and_the_measurer_takes_them_so(sets):
@@ -75,7 +52,8 @@ def test_the_skin_s_arms_are_its_arm_pieces_and_the_measurer_takes_them_so(sets)
 @pytest.mark.slow
 @pytest.mark.parametrize("set_name, body, extra", GRID, ids=[f"{s}-{b}-{e}" for s, b, e in GRID])
 def test_exact_mode_on_the_skin_meets_the_five_and_the_six_asked_on_its_mesh(sets, set_name, body, extra):
-    reference, five, six = grid_request(sets, set_name, body, extra)
+    reference = sets[set_name]
+    five, six = grid_request(reference, set_name, body, extra)
     mannequin = synthesize(reference, list(five.values()))[0]
     result = exact_skin(mannequin, PREVIEW, five, six)
     assert result.converged and result.misses() == []
