@@ -29,14 +29,14 @@ from ..measure.tailor import as_dict
 from ..synthesis.extra_refine import ExtraRequestError, extra_request_problems, meet_extra
 from ..synthesis.refine import refine
 from .measure import body_measurements, field_measurements, mesh_measurements
-from .surface import SkinError, build_skin
+from .surface import build_skin
 
 SKIN_TOLERANCE_CM = 0.03  # the loop's aim on the surface: 0.3 mm (the promise on the mesh is 1 mm)
 MESH_TOLERANCE_CM = 0.1  # what the skin's mesh must measure within
 EXTRA_AIM_CM = 0.05  # the loop's aim on the mesh with extra measurements: half the promise, a margin for the last
 MAX_ROUNDS = 8
 EXTRA_MAX_ROUNDS = 10
-SLOPE_RANGE = (0.5, 2.5)  # the skin's response to its pieces' target, per measurement, as the secant may find it
+SLOPE_RANGE = (0.3, 8.0)  # the skin's response to its pieces' target, per measurement, as the secant may find it
 SECANT_MIN_STEP_CM = 0.01  # a target moved less than this tells no slope (the mesh's own noise is near it)
 MAX_STEP = 0.15  # no target moves by more than this share of the request in one round
 
@@ -115,43 +115,64 @@ def _exact_five(mannequin, settings, request, max_rounds):
 
 def _exact_with_extra(mannequin, settings, request, extra, max_rounds):
     """exact_skin with extra measurements: every round the pieces meet offset targets of the five and the extra
-    ones (meet_extra), their skin is meshed and measured on the mesh, and each target moves by its error over the
-    skin's response to it (a secant per measurement: the skin's neck, say, grows faster than its pieces'); the
-    round nearest the request is kept. A skin that cannot be made after the first round ends the loop there."""
+    ones (meet_extra, from the last round's pieces: small steps deform them smoothly, where starting over let
+    meet_extra's own rounds end elsewhere and the skin's upper arm jumped by millimetres), their skin is meshed and
+    measured on the mesh, and each target moves by its error over the skin's response to it (a secant per
+    measurement: the skin's neck, say, grows faster than its pieces'). A round further from the request than the
+    best one (or whose skin cannot be made or measured) is undone: the next goes half as far from the best. The
+    best is kept."""
     keys = list(request) + list(extra)
     count = len(MEASUREMENTS)
     wanted = np.array([request[key] for key in MEASUREMENTS] + [extra[key] for key in extra])
-    targets, slope, previous, best = wanted.copy(), np.ones(len(keys)), None, None
+    targets, slope, best = wanted.copy(), np.ones(len(keys)), None
+    start = mannequin
     for rounds in range(max_rounds + 1):
         five, more = dict(zip(MEASUREMENTS, targets[:count])), dict(zip(extra, targets[count:]))
-        pieces, _, _ = meet_extra(mannequin.copy(measurements=five), more)
+        pieces, _, _ = meet_extra(start.copy(measurements=five), more)
         try:
             skin = build_skin(pieces, settings)
-        except SkinError:
+            on_mesh = _skin_all(skin, list(extra))
+        except ElliMannError:  # a skin that cannot be made (SkinError) or measured: undone, unless the first round's
             if best is None:
                 raise
-            break
-        on_mesh = _skin_all(skin, list(extra))
-        measured = np.array([on_mesh[key] for key in keys])
-        error = wanted - measured
-        worst = float(np.abs(error).max())
-        if best is None or worst < best[0]:
-            best = (worst, pieces, skin, on_mesh, rounds)
-        if worst <= EXTRA_AIM_CM:
-            break
-        if previous is not None:
-            moved = targets - previous[0]
+            skin = None
+        if skin is not None:
+            measured = np.array([on_mesh[key] for key in keys])
+            worst = float(np.abs(wanted - measured).max())
+        if best is not None and (skin is None or worst >= best.worst):  # undone: back towards the best round
+            targets, start = best.targets + 0.5 * (targets - best.targets), best.pieces
+            continue
+        if best is not None:
+            moved = targets - best.targets
             with np.errstate(divide="ignore", invalid="ignore"):
-                secant = (measured - previous[1]) / moved
+                secant = (measured - best.measured) / moved
             known = np.abs(moved) > SECANT_MIN_STEP_CM
             slope[known] = np.clip(secant[known], *SLOPE_RANGE)
-        previous = (targets.copy(), measured)
-        step = np.clip(error / slope, -MAX_STEP * wanted, MAX_STEP * wanted)
-        targets = targets + step
-    worst, pieces, skin, on_mesh, rounds = best
-    pieces_measured = {**pieces.measure(), **mannequin_extra_measurements(pieces)}
+        best = _Round(worst, targets, measured, pieces, skin, on_mesh, rounds)
+        if worst <= EXTRA_AIM_CM:
+            break
+        targets = targets + np.clip((wanted - measured) / slope, -MAX_STEP * wanted, MAX_STEP * wanted)
+        start = pieces
+    pieces_measured = {**best.pieces.measure(), **mannequin_extra_measurements(best.pieces)}
     pieces_measured = {key: float(pieces_measured[key]) for key in keys}
-    return ExactSkin(pieces, skin, {**request, **extra}, on_mesh, pieces_measured, rounds, worst <= MESH_TOLERANCE_CM)
+    converged = best.worst <= MESH_TOLERANCE_CM
+    return ExactSkin(
+        best.pieces, best.skin, {**request, **extra}, best.on_mesh, pieces_measured, best.rounds, converged
+    )
+
+
+@dataclass
+class _Round:
+    """A round of the loop with extra measurements: its largest error (cm), targets, what the skin measured (both
+    in the loop's order), the pieces, their skin and its measurements {key: cm}, the round's number."""
+
+    worst: float
+    targets: np.ndarray
+    measured: np.ndarray
+    pieces: object
+    skin: object
+    on_mesh: dict
+    rounds: int
 
 
 def _skin_all(skin, extra_keys):
