@@ -14,10 +14,18 @@ BODY_POSE_ITEMS = (
 )
 
 # Items, defaults and descriptions: core.drape.settings.DRAPE (the command line's too).
-GARMENT_ITEMS = tuple((c.value, c.label, c.description) for c in DRAPE["garment"].choices)  # keys as they are
-COLLIDER_ITEMS = tuple((c.value, c.label, c.description) for c in DRAPE["collider"].choices)
-SKIN_LEVEL_ITEMS = tuple((c.value, c.label, c.description) for c in DRAPE["skin_level"].choices)
 DEFAULTS = DrapeSettings()
+
+
+def _choice(name):
+    """An EnumProperty of DRAPE's option ``name``: its choices' values (the keys as they are) are the items."""
+    option = DRAPE[name]
+    return EnumProperty(
+        name=option.label,
+        items=tuple((c.value, c.label, c.description) for c in option.choices),
+        default=option.default,
+        description=option.description,
+    )
 
 
 def _subdivisions(name):
@@ -34,12 +42,7 @@ def _subdivisions(name):
 class ELLIMANN_PG_drape(bpy.types.PropertyGroup):
     """Drape settings of a scene."""
 
-    garment: EnumProperty(
-        name=DRAPE["garment"].label,
-        items=GARMENT_ITEMS,
-        default=DRAPE["garment"].default,
-        description=DRAPE["garment"].description,
-    )
+    garment: _choice("garment")
     frames: IntProperty(
         name=DRAPE["frames"].label,
         default=DEFAULTS.frames,
@@ -59,18 +62,8 @@ class ELLIMANN_PG_drape(bpy.types.PropertyGroup):
         unit="LENGTH",
         description=DRAPE["edge"].description,
     )
-    collider: EnumProperty(
-        name=DRAPE["collider"].label,
-        items=COLLIDER_ITEMS,
-        default=DRAPE["collider"].default,
-        description=DRAPE["collider"].description,
-    )
-    skin_level: EnumProperty(
-        name=DRAPE["skin_level"].label,
-        items=SKIN_LEVEL_ITEMS,
-        default=DRAPE["skin_level"].default,
-        description=DRAPE["skin_level"].description,
-    )
+    collider: _choice("collider")
+    skin_level: _choice("skin_level")
     cushions: BoolProperty(
         name=DRAPE["cushions"].label, default=DEFAULTS.cushions, description=DRAPE["cushions"].description
     )
