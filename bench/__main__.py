@@ -23,6 +23,7 @@ BENCHES = (
     "bench_scan",
     "bench_scan_held_out",
     "bench_extra",
+    "bench_skin_exact",
     "bench_bvh",
     "bench_batch",
 )

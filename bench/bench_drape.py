@@ -6,17 +6,18 @@ that dense body are the two collision bodies. One garment per kind is built from
 m_T and moved clear of both bodies, then draped with the same cloth settings on:
   (a) the mannequin's convex pieces as collision meshes (cushions + the ellipsoids not in one, or
       ellipsoids only), at several icosphere levels;
-  (b) the dense body (26,692 triangles): the baseline.
+  (b) the mannequin's skin (core.skin) as one collision mesh, at the preview (10 mm) and final (5 mm) levels;
+  (c) the dense body (26,692 triangles): the baseline.
 Per run: seconds per simulated frame (the mean step of frame_set, best of REPEAT runs, by the wall
 clock, with this process's CPU time beside it: Blender runs parts of the cloth step on two threads,
 so CPU time can exceed wall time; the cloth alone, with no collider, gives the floor), collider
 triangles, and the final garment against the DENSE body surface (signed distances, vertices
-inside) for both, so the comparison is fair; (a) also against its own exact pieces. "Equal fit"
-for the resolution sweep (both garments, cushion and ellipsoid colliders each against the finest of
-their own kind): median and 95th-percentile gap to the dense body within FIT_TOLERANCE (p95: twice
+inside) for all, so the comparison is fair; (a) also against its own exact pieces, (b) against its own
+mesh. "Equal fit" for the resolution sweep (both garments, cushion, ellipsoid and skin colliders each
+against the finest of their own kind): median and 95th-percentile gap to the dense body within FIT_TOLERANCE (p95: twice
 that) of the finest colliders', vertices inside it within PENETRATING_TOLERANCE of the garment of
-theirs, and no vertex more than FIT_TOLERANCE inside the exact pieces (a coarse collider lets the
-cloth into them).
+theirs, and no vertex more than FIT_TOLERANCE inside its own exact collider (a coarse collider lets the
+cloth into it).
 """
 
 import os
@@ -27,7 +28,7 @@ import time
 import numpy as np
 
 from ellimann_addon.core.drape import garments
-from ellimann_addon.core.drape.colliders import collision_pieces, triangle_count
+from ellimann_addon.core.drape.colliders import collision_pieces, skin_collider, skin_distance, triangle_count
 from ellimann_addon.core.drape.fit_metrics import BodyPieces, fit_statistics, mesh_distance
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.mannequin.model import Mannequin
@@ -57,7 +58,11 @@ SWEEP = (
 HEADLINE = "cushions L2/L2"
 
 
-def run(frames=FRAMES, repeat=REPEAT, sweep=SWEEP, kinds=("tube_dress", "t_shirt")):
+SKINS = ("preview", "final")  # the skin as the collider, at these levels (core.drape.colliders.skin_collider)
+SKIN_SAMPLE = 4  # the skin's vertices measured against the dense body: every 4th (25,800 at preview take ~20 s)
+
+
+def run(frames=FRAMES, repeat=REPEAT, sweep=SWEEP, kinds=("tube_dress", "t_shirt"), skins=SKINS):
     source = REFERENCE_FOLDER / f"{BODY}.json"
     body_path = REFMODELS / f"{BODY}.obj"
     if not source.is_file() or not body_path.is_file():
@@ -68,18 +73,33 @@ def run(frames=FRAMES, repeat=REPEAT, sweep=SWEEP, kinds=("tube_dress", "t_shirt
 
     ellimann_addon.register()
     try:
-        body = read_obj(body_path)
+        body = read_obj(body_path, up="z")
         compare(
-            Mannequin.load(source), body.vertices, body.faces, frames=frames, repeat=repeat, sweep=sweep, kinds=kinds
+            Mannequin.load(source),
+            body.vertices,
+            body.faces,
+            frames=frames,
+            repeat=repeat,
+            sweep=sweep,
+            kinds=kinds,
+            skins=skins,
         )
     finally:
         ellimann_addon.unregister()
 
 
 def compare(
-    mannequin, body_vertices, body_faces, frames=FRAMES, repeat=REPEAT, sweep=SWEEP, kinds=("tube_dress", "t_shirt")
+    mannequin,
+    body_vertices,
+    body_faces,
+    frames=FRAMES,
+    repeat=REPEAT,
+    sweep=SWEEP,
+    kinds=("tube_dress", "t_shirt"),
+    skins=SKINS,
 ):
-    """Drape each garment of ``kinds`` on every collider of ``sweep`` and on the dense body; print the table."""
+    """Drape each garment of ``kinds`` on every collider of ``sweep``, on the skin at each level of ``skins`` and on
+    the dense body; print the table."""
     import bpy
 
     from ellimann_addon.blender.services import drape
@@ -102,7 +122,25 @@ def compare(
         f"mannequin surface vs dense body: median {np.median(gap) * 1e3:.1f} mm, {np.mean(gap < 0) * 100:.0f}% of "
         "it inside the body (the pieces are fitted mostly inside the skin)"
     )
+    built = {}
+    for level in skins:
+        start = time.perf_counter()
+        built[level] = skin_collider(mannequin, level)
+        skin, seconds = built[level][0], time.perf_counter() - start
+        gap = dense(skin.vertices[::SKIN_SAMPLE])
+        print(
+            f"skin ({level}, {len(skin.faces):,} triangles, made in {seconds:.1f} s) vs dense body (every "
+            f"{SKIN_SAMPLE}th vertex): median {np.median(gap) * 1e3:.1f} mm, {np.mean(gap < 0) * 100:.0f}% of it "
+            "inside the body"
+        )
     print(f"cloth: settings {drape.DrapeSettings(frames=frames, edge=EDGE)}")
+    colliders = [("dense body", [drape.mesh_piece(f"{BODY}.obj", body_vertices, body_faces)], None)]
+    for label, cushions, sphere, cushion in sweep:
+        pieces = collision_pieces(mannequin, cushions, sphere, cushion)
+        colliders.append((label, pieces, lambda p, c=cushions: own[c].signed_distance(p, drape.FIT_CUTOFF)[0]))
+    for level, (skin, piece) in built.items():
+        colliders.append((f"skin {level}", [piece], lambda p, s=skin: mesh_distance(p, s.vertices, s.faces)[0]))
+    skin_field = skin_distance(next(iter(built.values()))[0]) if built else None  # one field at any voxel
 
     def simulate(garment, pieces):
         settings = drape.DrapeSettings(frames=frames, edge=EDGE)
@@ -112,22 +150,23 @@ def compare(
             wall, cpu = drape.bake(bpy.context.scene, obj, frames)
         return float(np.mean(wall)), float(np.mean(cpu)), drape.evaluated_vertices(obj)
 
-    body_piece = [drape.mesh_piece(f"{BODY}.obj", body_vertices, body_faces)]
+    def every_body(points):
+        nearest = np.minimum(exact.signed_distance(points, 0.05)[0], dense(points))
+        return nearest if skin_field is None else np.minimum(nearest, skin_field(points))
+
     for kind in kinds:
         garment = garments.make_garment(mannequin, kind, edge=EDGE)
         start = time.perf_counter()
-        garment = garments.clear_of(garment, lambda p: np.minimum(exact.signed_distance(p, 0.05)[0], dense(p)))
+        garment = garments.clear_of(garment, every_body)
         print(
             f"\n== {garment.name}: {len(garment.vertices)} vertices, {len(garment.faces)} triangles, "
             f"{len(garment.seams)} seams, {len(garment.pins)} pins; {garment.pattern['cleared']} vertices moved "
-            f"clear of both bodies ({time.perf_counter() - start:.1f} s)"
+            f"clear of every body ({time.perf_counter() - start:.1f} s)"
         )
         rows = {}
-        runs = [("dense body", None, 0, 0), *sweep]
         # The cloth alone (no collider: it falls freely) is the floor under every collider's cost.
         free = min(simulate(garment, [])[0] for _ in range(repeat))
-        for label, cushions, sphere, cushion in runs:
-            pieces = body_piece if cushions is None else collision_pieces(mannequin, cushions, sphere, cushion)
+        for label, pieces, own_distance in colliders:
             results = [simulate(garment, pieces) for _ in range(repeat)]
             vertices = results[0][2]
             row = {
@@ -136,9 +175,7 @@ def compare(
                 "triangles": triangle_count(pieces),
                 "vertices": vertices,
                 "dense": fit_statistics(dense(vertices)),
-                "own": None
-                if cushions is None
-                else fit_statistics(own[cushions].signed_distance(vertices, drape.FIT_CUTOFF)[0]),
+                "own": None if own_distance is None else fit_statistics(own_distance(vertices)),
             }
             if len(garment.seams):
                 gaps = np.linalg.norm(vertices[garment.seams[:, 0]] - vertices[garment.seams[:, 1]], axis=1)
@@ -169,7 +206,7 @@ def report(rows, garment, free):
     )
     print(
         f"{'collider':<16}{'triangles':>10}{'s/frame':>15}{'speed-up':>9} | vs dense body: {'median':>6}{'p05':>6}"
-        f"{'p95':>6}{'inside':>7}{'deepest':>8} | vs own pieces: {'inside':>6}{'deepest':>8}"
+        f"{'p95':>6}{'inside':>7}{'deepest':>8} | vs own collider: {'inside':>6}{'deepest':>8}"
         + (" | seams median/max" if len(garment.seams) else "")
     )
     for label, row in rows.items():
@@ -189,7 +226,7 @@ def report(rows, garment, free):
         f"same garment, {headline} vs dense body, per vertex: median {np.median(shift) * 1e3:.1f} mm, "
         f"95th percentile {np.percentile(shift, 95) * 1e3:.1f} mm apart"
     )
-    for kind in ("cushions", "ellipsoids"):
+    for kind in ("cushions", "ellipsoids", "skin"):
         print(best_at_equal_fit({label: row for label, row in rows.items() if label.startswith(kind)}, kind))
 
 
@@ -210,7 +247,7 @@ def best_at_equal_fit(sweep, kind):
     criteria = (
         f"median within {FIT_TOLERANCE * 1e3:g} mm, p95 within {2 * FIT_TOLERANCE * 1e3:g} mm and vertices "
         f"inside the dense body within {PENETRATING_TOLERANCE:.0%} of the garment of {finest_label}'s, none "
-        f"over {FIT_TOLERANCE * 1e3:g} mm inside the exact pieces"
+        f"over {FIT_TOLERANCE * 1e3:g} mm inside its own exact collider"
     )
     if not equal:
         return f"{kind}: no resolution fits as {finest_label} does ({criteria})"

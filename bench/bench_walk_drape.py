@@ -1,8 +1,10 @@
-"""A tube dress on a walking body: the convex mannequin against the dense body mesh skinned to the same motion.
+"""A tube dress on a walking body: the convex mannequin and its skin against the dense body mesh skinned to the
+same motion.
 
 The Average Reference Mannequin walks (``core.pose.standard`` walk, after ``services.drape_motion.SETTLE_FRAMES``
 frames turning from rest into its first frame) with the dress draped on (a) its convex pieces (cushions
-and the ellipsoids not in one, the drape's default resolution), each bound rigidly to its bone, and (b)
+and the ellipsoids not in one, the drape's default resolution), each bound rigidly to its bone, (b) its skin
+at the drape's default level (one mesh, bound by the skin's own bone weights), and (c)
 the dense body it stands for (``../shared/refmodels/average.obj``, 26,692 triangles), every vertex
 weighted fully to the SMPL bone of its body-model bone (``reference_female_regions.json``'s per-vertex
 skinning bone, mapped up MakeHuman's skeleton to the first bone the MakeHuman name map knows). Both run
@@ -20,7 +22,7 @@ import time
 import numpy as np
 
 from ellimann_addon.core.drape import garments
-from ellimann_addon.core.drape.colliders import collision_pieces, triangle_count
+from ellimann_addon.core.drape.colliders import collision_pieces, skin_collider, skin_distance, triangle_count
 from ellimann_addon.core.drape.fit_metrics import BodyPieces, fit_statistics, mesh_distance
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.mannequin.model import Mannequin
@@ -48,7 +50,7 @@ def run(frames=FRAMES):
     ellimann_addon.register()
     try:
         mannequin = Mannequin.load(source)
-        body = read_obj(paths[0])  # the refmodels' bodies are in ElliMann's axes (Z up)
+        body = read_obj(paths[0], up="z")  # the refmodels' bodies are in ElliMann's axes (Z up)
         vertices, faces = body.vertices, body.faces
         compare(mannequin, vertices, faces, dense_bones(paths[1], paths[2]), frames)
     finally:
@@ -84,9 +86,14 @@ def compare(mannequin, body_vertices, body_faces, bones, frames):
     motion = body_motion(walk, frames, True)
     settings = drape.DrapeSettings(frames=frames, edge=EDGE)
     exact = BodyPieces(mannequin, cushions=True, subdivisions=4)
+    skin, skin_piece = skin_collider(mannequin, settings.skin_level)
+    to_skin = skin_distance(skin)
     garment = garments.make_garment(mannequin, "tube_dress", edge=EDGE)
     garment = garments.clear_of(
-        garment, lambda p: np.minimum(exact.signed_distance(p, 0.05)[0], mesh_distance(p, body_vertices, body_faces)[0])
+        garment,
+        lambda p: np.minimum.reduce(
+            [exact.signed_distance(p, 0.05)[0], to_skin(p), mesh_distance(p, body_vertices, body_faces)[0]]
+        ),
     )
     print(
         f"mannequin: {mannequin.name}; dense body {BODY}.obj, {len(body_vertices):,} vertices, "
@@ -97,7 +104,7 @@ def compare(mannequin, body_vertices, body_faces, bones, frames):
         f"{garment.name} {len(garment.vertices)} vertices, cloth edge {EDGE * 100:g} cm"
     )
 
-    def simulate(pieces, dense):
+    def simulate(pieces, dense, skin=None):
         with blender_output():
             empty_scene()
             collection, obj, colliders = drape.setup(garment, pieces, settings, "bench")
@@ -113,7 +120,7 @@ def compare(mannequin, body_vertices, body_faces, bones, frames):
                     "bench motion",
                 )
             else:
-                animate_drape(collection, colliders, obj, mannequin, walk, True, frames)
+                animate_drape(collection, colliders, obj, mannequin, walk, True, frames, skin)
             wall, _ = drape.bake(bpy.context.scene, obj, frames)
             cloth = drape.evaluated_vertices(obj)
             body = drape.evaluated_vertices(colliders[0]) if dense else None
@@ -122,15 +129,17 @@ def compare(mannequin, body_vertices, body_faces, bones, frames):
     start = time.perf_counter()
     pieces = collision_pieces(mannequin, True, settings.sphere_subdivisions, settings.cushion_subdivisions)
     convex_seconds, convex_cloth, _ = simulate(pieces, dense=False)
+    skin_seconds, skin_cloth, _ = simulate([skin_piece], dense=False, skin=skin)
     dense_piece = [drape.mesh_piece(f"{BODY}.obj", body_vertices, body_faces)]
     dense_seconds, dense_cloth, posed_body = simulate(dense_piece, dense=True)
-    print(f"(both drapes and their set-up: {time.perf_counter() - start:.0f} s)")
+    print(f"(the three drapes and their set-up: {time.perf_counter() - start:.0f} s)")
     print(
         f"{'collider':<18}{'triangles':>10}{'s/frame':>9} | vs the dense body at the last frame, mm: "
         f"{'median':>6}{'p95':>6}{'inside':>7}{'deepest':>8}"
     )
     for label, triangles, seconds, cloth in (
         ("convex pieces", triangle_count(pieces), convex_seconds, convex_cloth),
+        (f"skin ({settings.skin_level})", len(skin.faces), skin_seconds, skin_cloth),
         ("dense body", len(body_faces), dense_seconds, dense_cloth),
     ):
         fit = fit_statistics(mesh_distance(cloth, posed_body, body_faces)[0])
@@ -138,11 +147,13 @@ def compare(mannequin, body_vertices, body_faces, bones, frames):
             f"{label:<18}{triangles:>10,}{seconds:>9.3f} | {'':40}{fit['median'] * 1e3:>6.1f}"
             f"{fit['p95'] * 1e3:>6.1f}{fit['penetrating']:>7}{fit['max_depth'] * 1e3:>8.1f}"
         )
-    apart = np.linalg.norm(convex_cloth - dense_cloth, axis=1)
-    print(
-        f"speed-up of the convex pieces: {dense_seconds / convex_seconds:.2f}x; the two dresses per vertex: median "
-        f"{np.median(apart) * 1e3:.1f} mm, 95th percentile {np.percentile(apart, 95) * 1e3:.1f} mm apart"
-    )
+    for label, seconds, cloth in (("convex pieces", convex_seconds, convex_cloth), ("skin", skin_seconds, skin_cloth)):
+        apart = np.linalg.norm(cloth - dense_cloth, axis=1)
+        print(
+            f"{label}: {dense_seconds / seconds:.2f}x the dense body's speed; its dress and the dense body's per "
+            f"vertex: median {np.median(apart) * 1e3:.1f} mm, 95th percentile {np.percentile(apart, 95) * 1e3:.1f} mm "
+            "apart"
+        )
 
 
 def _pins(garment_object, mannequin):

@@ -12,8 +12,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ellimann_addon.core.constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
+from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.geometry.mesh import convex_hull_2d, plane_section_points, polygon_perimeter
 from ellimann_addon.core.mannequin.joints import joints_from_makehuman
+from ellimann_addon.core.measure.body import measure_body_mesh
+from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
 
 REFERENCE_BODY = "reference_female"
 RM_BODIES = ("small_slim", "tall_slim", "small_chubby", "tall_chubby", "average")
@@ -62,3 +65,17 @@ def body_measurements(body, labels, fractions=SECTION_FRACTIONS):
         points = plane_section_points(vertices, torso_faces, floor + fractions[key] * height)
         out[key] = polygon_perimeter(convex_hull_2d(points)) * CM_PER_M
     return {key: float(out[key]) for key in MEASUREMENTS}
+
+
+def body_requests(build_set, labels, names=None):
+    """{body: (five {He..Hi: cm}, six {extra measurement: cm})} of a set's bodies (``names``, default all six;
+    ``labels``: load_labels of the neutral body's folder, the topology every body shares): the five as the README
+    measures them (body_measurements, at the set's section heights), the six extra ones as the body-mesh measurer
+    takes them (core.measure.body): what a twin of each body is asked."""
+    out = {}
+    for name in names or (build_set.reference_body, *RM_BODIES):
+        body = read_obj(build_set.refmodels / f"{name}.obj", up="z")
+        five = body_measurements(body, labels, build_set.fractions)
+        measured = measure_body_mesh(body.vertices, body.faces, build_set.fractions).values
+        out[name] = (five, {key: measured[key] for key in EXTRA_MEASUREMENTS if key in measured})
+    return out

@@ -1,10 +1,12 @@
 """Dev tool (not shipped): the README's draping picture, made as bench/bench_drape.py drapes.
 
-Each garment, built from the Average Reference Mannequin's m_T and moved clear of both bodies, is
+Each garment, built from the Average Reference Mannequin's m_T and moved clear of every body, is
 draped (Blender cloth, cushion colliders at the default resolution) on the mannequin and, beside
-it, on the dense body it stands for (``../shared/refmodels/average.obj``). Front view, Workbench.
+it, on the dense body it stands for (``../shared/refmodels/average.obj``) or, with ``--versus skin``,
+on the mannequin's skin (the drape's skin collider at its default level). Front view, Workbench.
 
     .venv/bin/python -m tools.drape_picture [--out docs/images/drape_average.png] [--frames 60]
+    .venv/bin/python -m tools.drape_picture --versus skin --out docs/images/drape_skin.png
 """
 
 import argparse
@@ -16,7 +18,7 @@ import numpy as np
 
 from bench.bench_drape import BODY, EDGE, REFMODELS
 from ellimann_addon.core.drape import garments
-from ellimann_addon.core.drape.colliders import collision_pieces
+from ellimann_addon.core.drape.colliders import collision_pieces, skin_collider, skin_distance
 from ellimann_addon.core.drape.fit_metrics import BodyPieces, mesh_distance
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.geometry.ellipsoid import bounds
@@ -32,6 +34,7 @@ def main(argv=None):
     parser.add_argument("--out", default="docs/images/drape_average.png")
     parser.add_argument("--frames", type=int, default=60)
     parser.add_argument("--width", type=int, default=2000)
+    parser.add_argument("--versus", choices=("dense", "skin"), default="dense", help="beside the mannequin's drape")
     args = parser.parse_args(argv)
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="ellimann-tools-"))
     import bpy
@@ -50,9 +53,15 @@ def main(argv=None):
     settings = drape.DrapeSettings(frames=args.frames, edge=EDGE)
     low, high = np.full(3, np.inf), np.full(3, -np.inf)
     exact = BodyPieces(mannequin, cushions=True, subdivisions=4)
+    skin = skin_collider(mannequin, settings.skin_level)[0] if args.versus == "skin" else None
+    to_skin = skin_distance(skin) if skin is not None else None
 
     def both_bodies(points):
-        return np.minimum(exact.signed_distance(points)[0], mesh_distance(points, body_vertices, body_faces)[0])
+        if to_skin is not None:
+            other = to_skin(points)
+        else:
+            other = mesh_distance(points, body_vertices, body_faces)[0]
+        return np.minimum(exact.signed_distance(points)[0], other)
 
     slot = 0
     for kind in ("t_shirt", "tube_dress"):
@@ -60,7 +69,14 @@ def main(argv=None):
         for on_body in (False, True):
             offset = np.array([slot * SPACING, 0.0, 0.0])
             moved = replace(garment, vertices=garment.vertices + offset)
-            if on_body:
+            if on_body and args.versus == "skin":
+                name = f"skin ({settings.skin_level})"
+                obj = bpy.data.objects.new(name, mesh_from_arrays(name, skin.vertices + offset, skin.faces))
+                obj.color = BODY_COLOR
+                scene.collection.objects.link(obj)
+                pieces = [drape.mesh_piece(name, skin.vertices + offset, skin.faces)]
+                label = f"{garment.name} on the skin"
+            elif on_body:
                 obj = bpy.data.objects.new(
                     f"{BODY}.obj", mesh_from_arrays(f"{BODY}.obj", body_vertices + offset, body_faces)
                 )

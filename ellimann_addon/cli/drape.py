@@ -14,6 +14,7 @@ from ..core.geometry.ellipsoid import bounds
 from ..core.pose.kinematics import require_joints
 from ..core.pose.motion import clamped_motion
 from ..core.pose.standard import POSE_NAMES
+from ..core.skin.settings import LEVELS
 from . import arguments, output, writing
 from .measure import load_blend_mannequin, load_json_mannequin
 from .output import PROG, UsageError
@@ -25,7 +26,7 @@ def add_parser(commands):
         "drape",
         help="drape a garment on a mannequin with Blender's cloth simulation",
         description="Build a garment sized from the mannequin's m_T, drape it with "
-        "Blender cloth (the mannequin's convex pieces as colliders), bake the "
+        "Blender cloth (the mannequin's convex pieces or its skin as the collider), bake the "
         "frames and save the scene as a .blend; prints the fit (garment-to-"
         "body distances, vertices inside the body). Defaults are the Drape "
         "panel's (DrapeSettings).",
@@ -34,6 +35,9 @@ def add_parser(commands):
     garment = DRAPE["garment"]
     drape.add_argument("--garment", choices=garment.values, default=garment.default, help=garment_help())
     drape.add_argument("--frames", type=int, help=DRAPE["frames"].help.format(default=defaults.frames))
+    for name in ("collider", "skin_level"):
+        option = DRAPE[name]
+        drape.add_argument(f"--{name.replace('_', '-')}", choices=option.values, help=option.help)
     drape.add_argument(
         "--cushions",
         action=argparse.BooleanOptionalAction,
@@ -90,7 +94,7 @@ def run(args):
         motion, loop = motion_of(args, mannequin)
         empty_scene()
         shown = add_mannequin(mannequin, cushions=settings.cushions and bool(mannequin.topology.cushion_pairs))
-        if motion:  # the drape's colliders are the moving body; the standing one would hide it
+        if motion or settings.collider == "skin":  # the drape's colliders are the body; the pieces would hide it
             shown.hide_render = shown.hide_viewport = True
     else:
         mannequin = load_blend_mannequin(args.mannequin, args.collection)
@@ -102,9 +106,13 @@ def run(args):
             f"{size / 1e9:.1f} GB; it is slow (a larger --edge is faster)"
         )
     moving = f" ({args.pose})" if motion else ""
+    if settings.collider == "skin":
+        collider = f"its skin ({settings.skin_level}, {LEVELS[settings.skin_level]:g} mm voxels)"
+    else:
+        collider = "cushions" if settings.cushions else "ellipsoids"
     output.say(
         f"{PROG} drape: {args.garment} on '{mannequin.name}'{moving}, {settings.frames} frames, cloth edge "
-        f"{settings.edge * CM_PER_M:g} cm, colliding with {'cushions' if settings.cushions else 'ellipsoids'}"
+        f"{settings.edge * CM_PER_M:g} cm, colliding with {collider}"
     )
     progress = output.Progress(
         settings.frames,
@@ -150,9 +158,13 @@ def settings_of(args):
     low, high = (bound * CM_PER_M for bound in EDGE_RANGE)
     if args.edge is not None and not low <= args.edge <= high:  # in the flag's unit, not DrapeSettings' metres
         raise UsageError(f"--edge: the cloth's edge length must be from {low:g} to {high:g} cm, got {args.edge:g} cm")
+    if args.skin_level is not None and args.collider != "skin":
+        raise UsageError("--skin-level sets the skin collider's level: give it with --collider skin")
     given = {
         "frames": args.frames,
         "edge": None if args.edge is None else args.edge / CM_PER_M,
         "cushions": args.cushions,
+        "collider": args.collider,
+        "skin_level": args.skin_level,
     }
     return dataclasses.replace(DrapeSettings(), **{k: v for k, v in given.items() if v is not None}).checked()

@@ -12,7 +12,7 @@ only (tests/core/test_layering.py):
 - mannequin (3): the model, its topology, fields' checks, traces, skeleton, joints, cleaning
 - synthesis (4): request, options, IDW, refinement, reference sets, batches, populations
 - pose (4): poses, standard poses, posed pieces, motion, retargeting, bones
-- drape (4): garments, patterns, colliders, fit metrics, drape settings
 - fitting (5): fitting ellipsoids and mannequins to bodies, building a reference set, reading body meshes
 - formats (5): the format table and the files the core writes (JSON, MJCF, posed files, the .npz bundle)
+- drape (6): garments, patterns, colliders (the pieces or the skin), fit metrics, drape settings
 """

@@ -22,9 +22,11 @@ def test_drape_bench_prints_its_table_and_the_resolution_verdict(capsys):
         repeat=1,
         sweep=sweep,
         kinds=("tube_dress",),
+        skins=("preview",),
     )
     out = capsys.readouterr().out
     rows = [line[:16].strip() for line in out.splitlines() if " | " in line and "triangles" not in line]
-    assert rows == ["dense body", "cushions L1/L1", "cushions L2/L2", "ellipsoids L1"]
+    assert rows == ["dense body", "cushions L1/L1", "cushions L2/L2", "ellipsoids L1", "skin preview"]
     assert "cushions" in out and ("best speed at equal fit" in out or "no resolution fits" in out)
     assert "ellipsoids: fewer than two resolutions, no comparison" in out
+    assert "skin: fewer than two resolutions, no comparison" in out

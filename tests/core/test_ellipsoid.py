@@ -211,3 +211,30 @@ def test_repair_leaves_a_valid_frame_alone_and_refuses_a_flat_one():
     flat[:3, 1] = flat[:3, 0]
     with pytest.raises(FrameError, match="zero along some axis"):
         el.repair_matrix_world(flat)
+
+
+def test_linear_image_of_an_ellipsoid_is_its_mapped_set_with_its_axes_named_as_before():
+    """A stretch along a unit axis a (A = I + (f - 1) a a^T) of a sphere is a spheroid of semi-axes (r, r, f r)
+    with its long axis along a; touching ellipsoids stay touching (the contact point maps onto both images); the
+    identity keeps every axis, and a small map keeps each axis its name (the one nearest before)."""
+    axis = np.array([0.3, -0.4, 0.866])
+    axis /= np.linalg.norm(axis)
+    stretch = np.eye(3) + 0.5 * np.outer(axis, axis)  # f = 1.5
+    rotation, semi = el.linear_image(np.eye(3), np.full(3, 0.2), stretch)
+    assert is_rotation(rotation) and sorted(semi) == pytest.approx([0.2, 0.2, 0.3], abs=1e-12)
+    assert abs(rotation[:, np.argmax(semi)] @ axis) == pytest.approx(1.0, abs=1e-12)
+    # two ellipsoids touching at a point: the images touch at its image
+    r0, r1 = rotation_from_vector((0.3, 0.2, -0.1)), rotation_from_vector((-0.5, 0.1, 0.7))
+    semi0, semi1 = np.array([0.1, 0.05, 0.2]), np.array([0.08, 0.12, 0.04])
+    normal = np.array([0.2, 0.9, -0.3]) / np.linalg.norm([0.2, 0.9, -0.3])
+    contact = el.support_point(r0, np.zeros(3), semi0, normal)
+    center1 = contact - (el.support_point(r1, np.zeros(3), semi1, -normal))  # its support point at -n is there
+    for rotation_k, center_k, semi_k in ((r0, np.zeros(3), semi0), (r1, center1, semi1)):
+        new_rotation, new_semi = el.linear_image(rotation_k, semi_k, stretch)
+        surface = np.vstack([contact, el.sample_surface(rotation_k, center_k, semi_k, 200)])
+        local = (surface - center_k) @ stretch.T @ new_rotation / new_semi  # mapped, in the image's frame
+        assert np.allclose(np.linalg.norm(local, axis=1), 1.0, atol=1e-9)  # on the image's surface
+    same = el.linear_image(r0, semi0, np.eye(3))
+    assert np.allclose(same[0], r0, atol=1e-12) and np.allclose(same[1], semi0, atol=1e-12)
+    nudged = el.linear_image(r0, semi0, np.eye(3) + 0.05 * np.outer(axis, axis))
+    assert np.all(np.einsum("ij,ij->j", nudged[0], r0) > 0.99)  # each axis near its old self

@@ -153,6 +153,32 @@ def test_mesh_distance_on_a_cube_matches_the_box_sdf():
     assert np.allclose(fm.mesh_distance(corners, v, f)[0], box_distance(corners), atol=1e-12)
 
 
+def test_mesh_distance_through_face_groups_is_the_nearest_of_every_triangle():
+    """The grouped search (bounding spheres of groups, then of triangles) finds what trying every triangle
+    finds, near a fine mesh (a torus: a surface with a hole, points inside it, near it and far from it) and
+    with chunks of a few pairs (each point alone)."""
+    u, w = np.meshgrid(np.linspace(0, 2 * np.pi, 60, endpoint=False), np.linspace(0, 2 * np.pi, 24, endpoint=False))
+    v = np.stack([(0.3 + 0.1 * np.cos(w)) * np.cos(u), (0.3 + 0.1 * np.cos(w)) * np.sin(u), 0.1 * np.sin(w)], -1)
+    v = v.reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(60), np.arange(24))
+    a, b, c, d = (jj % 24 * 60 + ii % 60 for ii, jj in ((i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)))
+    f = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+    p = np.random.default_rng(3).normal(size=(300, 3)) * np.array([0.3, 0.3, 0.1])
+    p = np.concatenate([p, [[0.0, 0.0, 0.0], [2.0, 1.0, -1.0]]])  # the hole's centre, far off
+    t = v[f]
+    every = np.linalg.norm(
+        fm.closest_points_on_triangles(p[:, None], t[None, :, 0], t[None, :, 1], t[None, :, 2]) - p[:, None], axis=-1
+    ).min(axis=1)
+    ring = np.hypot(np.hypot(p[:, 0], p[:, 1]) - 0.3, p[:, 2]) - 0.1  # the smooth torus' signed distance
+    for budget in (200_000, 1):
+        d, face = fm.mesh_distance(p, v, f, pairs_per_chunk=budget)
+        assert np.allclose(np.abs(d), every, atol=1e-12)
+        assert np.array_equal(np.sign(d), np.sign(ring))  # no point lies within the facets' sag of the surface
+        assert np.allclose(
+            np.linalg.norm(fm.closest_points_on_triangles(p, *np.moveaxis(t[face], 1, 0)) - p, axis=1), every
+        )
+
+
 def test_mesh_distance_refuses_open_meshes_for_signs():
     v, f = unit_cube()
     with pytest.raises(ElliMannError, match="closed"):

@@ -137,10 +137,10 @@ FLOORS = {
     "mannequin": 3,
     "synthesis": 4,
     "pose": 4,
-    "drape": 4,
     "fitting": 5,
     "skin": 5,
     "formats": 6,
+    "drape": 6,
 }
 
 

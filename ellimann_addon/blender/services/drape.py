@@ -6,7 +6,9 @@
   ``seams`` become loose edges pulled together by sewing springs;
 - a child collection "Colliders": one object per convex piece (:mod:`core.drape.colliders`: cushions
   and the ellipsoids not in a cushion, or every ellipsoid) with a Collision modifier, hidden in
-  the viewport and in renders. The cloth collides with that collection only.
+  the viewport and in renders; or, with the skin as the collider (``DrapeSettings.collider``), one object,
+  the mannequin's skin (``core.drape.colliders.skin_collider``), shown: it is the body the cloth lies on.
+  The cloth collides with that collection only.
 It then steps the frames one by one (``scene.frame_set``, timing each step) and turns the memory
 cache into a bake (``ptcache.bake_from_cache``), so a saved .blend replays the drape and opens on
 its last frame. The simulated frames are the cloth's point cache range (1..frames), which Blender
@@ -27,13 +29,19 @@ from mathutils import Matrix
 
 from ...core.constants import CLEARING_CUSHION_LEVEL, FIT_CUSHION_LEVEL
 from ...core.drape import garments
-from ...core.drape.colliders import CollisionPiece, collision_pieces, triangle_count
-from ...core.drape.fit_metrics import BodyPieces, fit_statistics
+from ...core.drape.colliders import (
+    CollisionPiece,
+    collision_pieces,
+    skin_collider,
+    skin_distance,
+    triangle_count,
+)
+from ...core.drape.fit_metrics import BodyPieces, fit_statistics, mesh_distance
 from ...core.drape.settings import FRAME_RANGE, MAX_CLOTH_VERTICES, DrapeSettings  # noqa: F401  (DrapeSettings: public here)
 from ...core.errors import ElliMannError
 from ...core.pose.kinematics import pose_mannequin
 from ..bridge.convert import mesh_from_arrays, new_collection
-from .drape_motion import PIECE_KEY, animate_drape
+from .drape_motion import BODY_COLOR, PIECE_KEY, animate_drape
 from .rig import check_rig
 
 DRAPE_KEY = "ellimann_drape"  # ID property on a drape collection: the garment's name
@@ -63,8 +71,9 @@ class DrapeResult:
     seconds: np.ndarray  # wall-clock seconds per simulated frame
     cpu_seconds: np.ndarray  # CPU seconds of this process per simulated frame
     vertices: np.ndarray  # final garment vertices, world (V, 3)
-    fit: dict = field(default_factory=dict)  # fit_statistics against the exact pieces
+    fit: dict = field(default_factory=dict)  # fit_statistics against the exact pieces (or the skin's mesh)
     body: object = None  # the core mannequin as the cloth last saw it (posed at the last frame of a motion)
+    skin: object = None  # the core Skin the cloth collided with (collider "skin"), at rest
 
     @property
     def frames(self):
@@ -86,9 +95,10 @@ class DrapeResult:
 
     def summary(self):
         fit = self.fit
+        collider = "skin" if self.skin is not None else "collider"
         text = (
             f"{self.frames} frames, {self.seconds_per_frame:.3f} s/frame, "
-            f"{self.collider_triangles} collider triangles; {fit['penetrating']} of {fit['count']} "
+            f"{self.collider_triangles} {collider} triangles; {fit['penetrating']} of {fit['count']} "
             f"vertices inside the body (deepest {fit['max_depth'] * 1e3:.1f} mm), median gap "
             f"{fit['median'] * 1e3:.1f} mm"
         )
@@ -294,15 +304,18 @@ def drape(
     from rest into them and the cloth follows (``services.drape_motion``); the mannequin needs joints. The
     fit is then measured against the body in the last frame's pose.
 
-    A garment named by its key is built from the mannequin's m_T and moved clear of the pieces
+    ``settings.collider``: "pieces" (the convex pieces) or "skin" (the mannequin's skin at ``settings.skin_level``,
+    one mesh; on a moving body it follows the bones by the skin's own weights).
+
+    A garment named by its key is built from the mannequin's m_T and moved clear of the collider
     (:func:`garments.clear_of`); a Garment given as such is used as it is.
 
     Returns a :class:`DrapeResult` whose ``fit`` compares the final garment with the exact pieces
-    (ellipsoids in closed form, cushions at a fine resolution): negative distances are inside;
-    distances beyond FIT_CUTOFF (20 cm, a garment hanging far off the body) are lower bounds.
-    Raises ElliMannError (MannequinError naming the parts, or a cloth of more than ``settings.max_vertices``
-    vertices: :func:`check_cloth_size`) before anything is built. ``progress(frame)``
-    is called as each frame is simulated (see :func:`bake`). Should anything fail once building has
+    (ellipsoids in closed form, cushions at a fine resolution; distances beyond FIT_CUTOFF, 20 cm, a
+    garment hanging far off the body, are lower bounds) or with the skin's mesh: negative distances are
+    inside (:func:`fit_distance`). Raises ElliMannError (MannequinError naming the parts, a SkinError, or a
+    cloth of more than ``settings.max_vertices`` vertices: :func:`check_cloth_size`) before anything is built.
+    ``progress(frame)`` is called as each frame is simulated (see :func:`bake`). Should anything fail once building has
     begun (simulating, or measuring the fit), everything the drape made is removed, the scene goes
     back to its frame and the error goes on; a RuntimeError of Blender's becomes an ElliMannError
     saying what Blender reported.
@@ -314,37 +327,58 @@ def drape(
         check_rig(mannequin)
     check_cloth_size(mannequin, garment, settings)
     cushions = settings.cushions and bool(mannequin.topology.cushion_pairs)
-    if isinstance(garment, str):
-        garment = garments.make_garment(mannequin, garment, edge=settings.edge)
+    skin = None
+    if settings.collider == "skin":
+        skin, piece = skin_collider(mannequin, settings.skin_level)
+        pieces, clearing = [piece], skin_distance(skin)
+    else:
+        pieces = collision_pieces(mannequin, cushions, settings.sphere_subdivisions, settings.cushion_subdivisions)
         # The builders wrap the ellipsoids, a few mm off; a cushion also fills the hollow between its two.
-        clearing = BodyPieces(mannequin, cushions, CLEARING_CUSHION_LEVEL)
-        garment = garments.clear_of(garment, lambda points: clearing.signed_distance(points, CLEARING_CUTOFF)[0])
-    pieces = collision_pieces(mannequin, cushions, settings.sphere_subdivisions, settings.cushion_subdivisions)
-    exact = None if motion else BodyPieces(mannequin, cushions, FIT_CUSHION_LEVEL)
+        clearing_pieces = BodyPieces(mannequin, cushions, CLEARING_CUSHION_LEVEL)
+        clearing = lambda points: clearing_pieces.signed_distance(points, CLEARING_CUTOFF)[0]  # noqa: E731
+    if isinstance(garment, str):
+        garment = garments.clear_of(garments.make_garment(mannequin, garment, edge=settings.edge), clearing)
     name = name or f"Drape {garment.name} on {mannequin.name}"
     frame = scene.frame_current
     stage = "building"
     try:
         with removed_on_failure():
             collection, obj, colliders = setup(garment, pieces, settings, name, scene.collection)
-            body = mannequin
+            body, last = mannequin, None
             if motion:
-                last = animate_drape(collection, colliders, obj, mannequin, motion, loop, settings.frames)
+                last = animate_drape(collection, colliders, obj, mannequin, motion, loop, settings.frames, skin)
                 body = pose_mannequin(mannequin, last)
-                exact = BodyPieces(body, cushions, FIT_CUSHION_LEVEL)
+            elif skin is not None:
+                show_body(colliders)
             stage = "simulating"
             collection[DRAPE_KEY] = garment.name
             wall, cpu = bake(scene, obj, settings.frames, progress)
             vertices = evaluated_vertices(obj)
-            distance, _ = exact.signed_distance(vertices, FIT_CUTOFF)
-            fit = fit_statistics(distance)
+            fit = fit_statistics(fit_distance(vertices, body, cushions, skin, last))
     except Exception as error:
         if stage == "simulating":
             scene.frame_set(frame)
         if isinstance(error, RuntimeError):
             raise ElliMannError(f"Blender failed while {stage} the drape: {error}") from error
         raise
-    return DrapeResult(collection, obj, garment, pieces, wall, cpu, vertices, fit, body)
+    return DrapeResult(collection, obj, garment, pieces, wall, cpu, vertices, fit, body, skin)
+
+
+def fit_distance(points, body, cushions, skin=None, pose=None):
+    """Signed distances (P,) of ``points`` to the body the cloth collided with at the end: the exact pieces of
+    ``body`` (cushions at a fine resolution; beyond FIT_CUTOFF a lower bound), or the skin's mesh (posed in
+    ``pose``, a core Pose, by its own bone weights as the drape's armature moved it; exact)."""
+    if skin is None:
+        return BodyPieces(body, cushions, FIT_CUSHION_LEVEL).signed_distance(points, FIT_CUTOFF)[0]
+    vertices = skin.vertices if pose is None else skin.posed(pose)
+    return mesh_distance(points, vertices, skin.faces)[0]
+
+
+def show_body(colliders):
+    """Show collider objects as the body (solid, in renders too): the skin the cloth lies on."""
+    for obj in colliders:
+        obj.display_type, obj.hide_render, obj.color = "SOLID", False, BODY_COLOR
+        obj.hide_set(False)
 
 
 def mesh_piece(name, vertices, faces):

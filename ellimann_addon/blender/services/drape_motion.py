@@ -6,13 +6,16 @@ The armature lives in the drape's collection (hidden), so the mannequin and its 
 they are; the colliders, which are the moving body, are shown (solid, in renders too). Each collider is
 bound rigidly to its piece's bone (a cushion across a joint cut there into two halves, as ``services.rig``
 does for the mannequin), by an Armature modifier before its Collision modifier, which therefore sees the
-moving mesh. The garment gets an Armature modifier before its Cloth modifier:
+moving mesh; the skin collider (``core.drape.colliders.skin_collider``) is bound by the skin's own bone weights
+(``Skin.bones``: linear-blend skinning, as ``Skin.posed`` computes it). The garment gets an Armature modifier
+before its Cloth modifier:
 Blender's cloth pulls pinned vertices to that deformed mesh, so the pins (a dress's straps) go where the
 torso goes; the other vertices are the simulation's.
 """
 
 import numpy as np
 
+from ...core.drape.colliders import SKIN_COLLIDER
 from ...core.geometry.cushion import cushion_name
 from ...core.mannequin.skeleton import JOINT_INDEX, JOINT_NAMES, cross_joint_pairs
 from ...core.pose.motion import arms_out, drape_motion, loop_drift
@@ -31,9 +34,10 @@ def settle_frames(frames):
     return min(SETTLE_FRAMES, frames // 3)
 
 
-def animate_drape(collection, colliders, garment_object, mannequin, poses, loop, frames):
-    """Bind a drape's colliders and garment to a new hidden armature playing ``poses`` (from rest, see the
-    module docstring) over frames 1..``frames``; returns the last frame's pose."""
+def animate_drape(collection, colliders, garment_object, mannequin, poses, loop, frames, skin=None):
+    """Bind a drape's colliders (``skin``: the core Skin of the skin collider, if it is one) and garment to a new
+    hidden armature playing ``poses`` (from rest, see the module docstring) over frames 1..``frames``; returns the
+    last frame's pose."""
     joints, bones = check_rig(mannequin)
     rig = bare_armature(f"{collection.name} Body", joints, collection)
     rig.hide_render = True
@@ -45,7 +49,9 @@ def animate_drape(collection, colliders, garment_object, mannequin, poses, loop,
         obj.display_type, obj.hide_render, obj.color = "SOLID", False, BODY_COLOR
         obj.hide_set(False)
         piece = obj.get(PIECE_KEY, "")
-        if piece in crossing:
+        if piece == SKIN_COLLIDER and skin is not None:
+            bind_weights(obj, rig, skin_bone_weights(skin))
+        elif piece in crossing:
             i, j, joint = crossing[piece]
             bind_across(
                 obj,
@@ -67,6 +73,15 @@ def animate_drape(collection, colliders, garment_object, mannequin, poses, loop,
         f"{collection.name} motion",
     )
     return motion[-1]
+
+
+def skin_bone_weights(skin):
+    """{joint name: (V,) weight} of a core Skin's linear-blend weights (Skin.bones), for an Armature modifier."""
+    bones, weights = skin.bones()
+    return {
+        JOINT_NAMES[joint]: np.where(bones == joint, weights, 0.0).sum(axis=1)
+        for joint in np.unique(bones[weights > 0.0])
+    }
 
 
 def body_motion(poses, frames, loop):

@@ -1,13 +1,14 @@
 """Drape settings: :class:`DrapeSettings` (lengths in metres), what Blender's ``drape`` takes, and ``DRAPE``, the
 one table of their defaults, labels and descriptions (the command line's and ``Scene.ellimann_drape``'s)."""
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..constants import COLLIDER_LEVELS
 from ..errors import ElliMannError
 from ..option_table import Choice, Option
+from ..skin.settings import SKIN
 from .colliders import check_subdivisions
 from .garments import EDGE_RANGE, GARMENTS
 
@@ -39,6 +40,25 @@ DRAPE = {
         "Edge length of the garment's mesh (smaller: finer folds, slower)",
         "edge length of the cloth mesh in cm (default {default_cm:g}; smaller is finer and slower)",
         limits=EDGE_RANGE,
+    ),
+    "collider": Option(
+        "Collider",
+        "pieces",
+        "What the cloth collides with: the convex pieces (fastest) or the smooth skin over them (one closed mesh, "
+        "no seams for the cloth to catch on)",
+        "what the cloth collides with: pieces (the convex pieces, default) or skin (the smooth skin over them, at "
+        "--skin-level)",
+        choices=(
+            Choice("pieces", "Pieces", "The convex pieces: cushions and ellipsoids, or every ellipsoid"),
+            Choice("skin", "Skin", "The smooth skin over the pieces, at the skin level"),
+        ),
+    ),
+    "skin_level": replace(
+        SKIN["skin_level"],
+        default="preview",
+        description="How fine the skin collider is: Preview (10 mm voxels, fits as Final does in the drape "
+        "benchmark and collides faster) or Final (5 mm)",
+        help="the skin collider's level: preview (10 mm voxels, default) or final (5 mm)",
     ),
     "cushions": Option(
         "Cushions",
@@ -76,12 +96,17 @@ def garment_help():
 class DrapeSettings:
     """Simulation options (defaults: ``DRAPE``). Lengths in metres.
 
+    ``collider``: "pieces" (the convex pieces, ``cushions`` and the subdivision levels say how) or "skin" (the
+    mannequin's skin at ``skin_level``, one mesh: ``core.drape.colliders.skin_collider``);
+
     ``distance``: the cloth's collision distance (it keeps this far from the colliders);
     ``sewing_force``: the sewing springs' force limit (0 would be unbounded, which explodes while
     seams are far apart); ``quality``: solver steps per frame; ``collision_quality``: collision
     passes per step.
     """
 
+    collider: str = DRAPE["collider"].default
+    skin_level: str = DRAPE["skin_level"].default
     frames: int = DRAPE["frames"].default
     edge: float = DRAPE["edge"].default
     cushions: bool = DRAPE["cushions"].default
@@ -94,6 +119,10 @@ class DrapeSettings:
     max_vertices: int = MAX_CLOTH_VERTICES  # a larger cloth is refused (see blender/services/drape.py's cloth_size)
 
     def checked(self):
+        for name in ("collider", "skin_level"):
+            accepted = DRAPE[name].values
+            if getattr(self, name) not in accepted:
+                raise ElliMannError(f"{name}: must be one of {', '.join(accepted)}, got {getattr(self, name)!r}")
         if (
             isinstance(self.frames, bool)
             or not isinstance(self.frames, (int, np.integer))

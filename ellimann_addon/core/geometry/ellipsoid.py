@@ -22,6 +22,16 @@ def shape_matrix(rotation, semi_axes):
     return scaled @ np.swapaxes(rotation, -1, -2)
 
 
+def linear_image(rotation, semi_axes, matrix):
+    """The ellipsoid mapped by a linear map A (3, 3), invertible, about its centre (move the centre by A
+    yourself): (rotation, semi_axes) of {A x : x in E}, shape A M A^T, its axes labelled as the original's
+    nearest (relabel_to_reference), so that a map near the identity keeps each axis its name. Stacks (..., 3, 3)."""
+    values, vectors = np.linalg.eigh(matrix @ shape_matrix(rotation, semi_axes) @ np.swapaxes(matrix, -1, -2))
+    vectors[..., :, 2] *= np.sign(np.linalg.det(vectors))[..., None]  # proper: an orthonormal det is +-1
+    new_rotation, new_semi_axes, _ = relabel_to_reference(vectors, np.sqrt(values), rotation)
+    return new_rotation, new_semi_axes
+
+
 def support_and_point(rotation, center, semi_axes, directions):
     """Support function h(n) = c.n + sqrt(n^T M n) and support point c + M n / sqrt(n^T M n), the
     boundary point where the plane with outward normal n touches the ellipsoid.

@@ -78,18 +78,22 @@ class BodyVolume:
         """A regular grid around the body with its inside mask (see :class:`Grid`)."""
         lo = self.vertices.min(axis=0) - margin + np.asarray(_OFFSET) * spacing
         shape = np.ceil((self.vertices.max(axis=0) + margin - lo) / spacing).astype(int)
-        xs, ys = (lo[k] + spacing * np.arange(shape[k]) for k in (0, 1))
+        return Grid(lo, spacing, self.cells_inside(lo, spacing, shape))
+
+    def cells_inside(self, origin, spacing, shape):
+        """(nx, ny, nz) bool: which cells of a grid (cell (0, 0, 0) centred at ``origin``, ``spacing`` apart) have
+        their centre inside the surface. ValueError if a vertical ray crosses it an odd number of times."""
+        xs, ys = (origin[k] + spacing * np.arange(shape[k]) for k in (0, 1))
         xy = np.stack(np.meshgrid(xs, ys, indexing="ij"), axis=-1).reshape(-1, 2)
         line, z = self.crossings(xy)
         # a cell is inside when an odd number of crossings lies below it
-        first_above = np.clip(np.ceil((z - lo[2]) / spacing).astype(int), 0, shape[2])
+        first_above = np.clip(np.ceil((z - origin[2]) / spacing).astype(int), 0, shape[2])
         steps = np.zeros((len(xy), shape[2] + 1), dtype=np.int32)
         np.add.at(steps, (line, first_above), 1)
         odd_columns = int(np.count_nonzero(steps.sum(axis=1) % 2))
         if odd_columns:
             raise ValueError(f"{odd_columns} vertical rays cross the body an odd number of times: not a closed mesh")
-        inside = (np.cumsum(steps[:, :-1], axis=1) % 2 == 1).reshape(shape)
-        return Grid(lo, spacing, inside)
+        return (np.cumsum(steps[:, :-1], axis=1) % 2 == 1).reshape(tuple(shape))
 
 
 @dataclass
@@ -228,4 +232,12 @@ def voxel_iou(mannequin, vertices=None, faces=None, cushions=True, spacing=IOU_S
     if grid is None:
         grid = BodyVolume(vertices, faces).grid(spacing, margin=IOU_MARGIN)
     occupied = occupancy(grid, mannequin, cushions, cushion_hulls(mannequin) if cushions else None)
+    return np.count_nonzero(occupied & grid.inside) / max(np.count_nonzero(occupied | grid.inside), 1)
+
+
+def mesh_voxel_iou(vertices, faces, grid):
+    """Volumetric IoU, as :func:`voxel_iou`, of a closed, outward-wound triangle mesh (a skin, in the body's frame)
+    and the body of ``grid`` (``BodyVolume(...).grid(spacing, margin=IOU_MARGIN)``), on the grid's voxels; the
+    mesh's voxels beyond the grid are not counted (the margin holds anything near the body)."""
+    occupied = BodyVolume(vertices, faces).cells_inside(grid.origin, grid.spacing, grid.inside.shape)
     return np.count_nonzero(occupied & grid.inside) / max(np.count_nonzero(occupied | grid.inside), 1)

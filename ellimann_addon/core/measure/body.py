@@ -130,9 +130,10 @@ class StandingBody:
             return np.nonzero((self.face_low < z) & (self.face_high >= z))[0]
         return rows[(self.face_low[rows] < z) & (self.face_high[rows] >= z)]
 
-    def section(self, z):
-        """section_segments of the whole mesh at height z (the triangle indices into ``faces``)."""
-        crossed = self.crossed(z)
+    def section(self, z, rows=None):
+        """section_segments of the mesh (of the triangles ``rows``, default all) at height z (the triangle indices
+        into ``faces``)."""
+        crossed = self.crossed(z, rows)
         segments, rows = section_segments(self.vertices, self.faces[crossed], z)
         return segments, crossed[rows]
 
@@ -151,9 +152,6 @@ class StandingBody:
             side = "L" if part[:, :, 0].mean() > self.mid_x else "R"
             arms[side] = np.concatenate([arms[side], part]) if side in arms else part
         return segments[body], arms, rows[body]
-
-    def body_section(self, z):
-        return self.parted_section(z)[0]
 
     def find_arms(self):
         """(armpit height per side or None, arm vertex mask per side). The armpit is the first height above the
@@ -274,10 +272,13 @@ def check_mesh(vertices, faces, up=None, unit=None):
     return None
 
 
-def measure_body_mesh(vertices, faces, fractions=None, neck_tilt=None):
+def measure_body_mesh(vertices, faces, fractions=None, neck_tilt=None, arms=None):
     """Measure an upright A-pose body mesh (metres, Z up, facing -Y): a BodyMeasurement. ``neck_tilt``: the
     neck's forward tilt (radians) when it is known (a mannequin's own mesh or skin: its own tilt); by default
-    the tilt a tape drawn tight settles at (core.measure.neck)."""
+    the tilt a tape drawn tight settles at (core.measure.neck). ``arms``: {"L", "R": (V,) bool} the arms' vertices
+    when they are known (a skin knows them from the pieces it follows): every section then leaves them out,
+    wherever the armpit is; by default they are found by geometry (StandingBody.find_arms) and a girth above the
+    armpit is not taken."""
     vertices, faces = np.asarray(vertices, float).reshape(-1, 3), np.asarray(faces, np.int64).reshape(-1, 3)
     result = BodyMeasurement()
     fatal = check_mesh(vertices, faces)
@@ -293,15 +294,20 @@ def measure_body_mesh(vertices, faces, fractions=None, neck_tilt=None):
     values["Sh"] = float(np.ptp(segments[:, :, 0])) if len(segments) else 0.0
     result.sections["Sh"] = _at_height(convex_hull_2d(segments.reshape(-1, 2)) if len(segments) else [], z_sh)
 
-    armpit, arm_vertex = body.find_arms()
+    if arms is None:
+        armpit, arm_vertex = body.find_arms()
+    else:
+        arm_vertex = {side: np.asarray(arms[side], bool) for side in SIDES}
+        armpit = {side: np.inf for side in SIDES}  # the arms' own faces are left out of every section instead
     arms_found = all(armpit[side] is not None and arm_vertex[side].any() for side in SIDES)
     if not arms_found:
         result.problems.append(
-            "the arms are against the torso (no gap beside the waist section): Br, Wa, Hi, "
-            "thigh, upper_arm and arm_length cannot be taken"
+            ("the arms are against the torso (no gap beside the waist section)" if arms is None else "no arm given")
+            + ": Br, Wa, Hi, thigh, upper_arm and arm_length cannot be taken"
         )
     arm_faces = {side: arm_vertex[side][faces].all(axis=1) for side in SIDES}
     leg_rows = np.nonzero(~(arm_vertex["L"] | arm_vertex["R"])[faces].any(axis=1))[0]
+    body_rows = None if arms is None else np.nonzero(~(arm_faces["L"] | arm_faces["R"]))[0]
     lowest_armpit = min((z for z in armpit.values() if z is not None), default=np.inf)
     for key in GIRTHS:
         z = body.at(body.fractions[key])
@@ -313,7 +319,7 @@ def measure_body_mesh(vertices, faces, fractions=None, neck_tilt=None):
                 f"({lowest_armpit - body.bottom:.3f} m): arms too close to the torso; not taken"
             )
             continue
-        segments = body.body_section(z)
+        segments = body.parted_section(z)[0] if arms is None else body.section(z, body_rows)[0]
         values[key], hull = hull_girth(segments.reshape(-1, 2))
         result.sections[key] = _at_height(hull, z)
 

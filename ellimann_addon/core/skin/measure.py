@@ -13,6 +13,8 @@ import numpy as np
 from ..constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
 from ..geometry.ellipsoid import bounds
 from ..geometry.mesh import convex_hull_2d, polygon_perimeter, section_segments
+from ..measure.body import measure_body_mesh
+from ..measure.extra import SIDES, MannequinLandmarks
 from .field import FADE, Grid, PieceField, blend_pairs, blend_widths
 
 SECTION_COARSE = 0.004  # m between the samples of a section plane whose grid edges bracket the surface
@@ -39,6 +41,22 @@ def mesh_measurements(skin, fractions=None):
         kept = segments[girth_vertex[faces[rows]].any(axis=1)].reshape(-1, 2)
         out[key] = polygon_perimeter(convex_hull_2d(kept)) if len(kept) >= 3 else 0.0
     return {key: float(out[key]) * CM_PER_M for key in MEASUREMENTS}
+
+
+def skin_arms(skin):
+    """{"L", "R": (V,) bool}: the skin's vertices that follow an arm's or a hand's piece first (the pieces the
+    extra measurements take as the arms)."""
+    marks = MannequinLandmarks(skin.mannequin)
+    first = skin.pieces[:, 0]
+    return {side: (marks.arm & (marks.side == side))[first] for side in SIDES}
+
+
+def body_measurements(skin, fractions=None):
+    """The skin's mesh measured by the body-mesh measurer (core.measure.body: the extra measurements' definitions
+    on any mesh) with its arms known (:func:`skin_arms`), not searched for by geometry: an arm that touches the
+    torso is still an arm. A BodyMeasurement."""
+    fractions = fractions or skin.mannequin.section_fractions
+    return measure_body_mesh(skin.vertices, skin.faces, fractions, arms=skin_arms(skin))
 
 
 class SkinField:

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..constants import MEASUREMENTS
 from ..errors import ElliMannError
-from ..geometry.ellipsoid import axis_extent
+from ..geometry.ellipsoid import axis_extent, linear_image
 from ..mannequin.joints import anchor_indices, follow_pieces
 from ..measure.extra import (
     CALF_BAND,
@@ -196,10 +196,12 @@ def _apply(key, factor, mannequin, rotation, center, semi, stretch, spread):
                 )
                 center[arm], semi[arm] = arm_center @ frame + origin, arm_semi
                 stretch[arm], spread[arm] = arm_stretch, arm_spread
-            else:
-                center[arm] = start + factor * (center[arm] - start)
-                along = np.einsum("nik,i->nk", rotation[arm], axis) ** 2
-                semi[arm] *= factor**along
+            else:  # the arm stretched along itself about the shoulder point: an affine map, so pieces that touch
+                # keep touching (scaling each piece's own axes by their share along the arm opened the fingers off
+                # the hand by 2 mm at 5 % longer)
+                along = np.eye(3) + (factor - 1.0) * np.outer(axis, axis)
+                center[arm] = start + (center[arm] - start) @ along
+                rotation[arm], semi[arm] = linear_image(rotation[arm], semi[arm], along)
 
 
 def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXTRA_MAX_ROUNDS):

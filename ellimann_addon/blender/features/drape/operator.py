@@ -1,4 +1,4 @@
-"""Drape: a garment sized from the active mannequin, simulated with Blender cloth on its convex pieces."""
+"""Drape: a garment sized from the active mannequin, simulated with Blender cloth on its convex pieces or its skin."""
 
 import contextlib
 
@@ -35,7 +35,7 @@ def progress_bar(window_manager, total):
 
 
 class ELLIMANN_OT_drape_garment(MannequinOperator, bpy.types.Operator):
-    """Drape a garment sized from the active mannequin's measurements, with its convex pieces as cloth colliders"""
+    """Drape a garment sized from the active mannequin's measurements, on its convex pieces or its skin"""
 
     bl_idname = ids.DRAPE_GARMENT
     bl_label = "Drape Garment"

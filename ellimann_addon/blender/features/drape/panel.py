@@ -1,4 +1,4 @@
-"""The Drape sub-panel of the ElliMann sidebar tab: garment, cloth and collider settings, Drape."""
+"""The Drape sub-panel of the ElliMann sidebar tab: garment, cloth and collider (the pieces or the skin), Drape."""
 
 import bpy
 
@@ -25,12 +25,16 @@ class ELLIMANN_PT_drape(SubPanel, bpy.types.Panel):
         column.prop(props, "pose")
         column.prop(props, "frames")
         column.prop(props, "edge")
+        layout.row().prop(props, "collider", expand=True)
         column = layout.column(align=True)
-        column.prop(props, "cushions")
-        column.prop(props, "sphere_subdivisions")
-        row = column.row()
-        row.enabled = props.cushions
-        row.prop(props, "cushion_subdivisions")
+        if props.collider == "skin":
+            column.prop(props, "skin_level")
+        else:
+            column.prop(props, "cushions")
+            column.prop(props, "sphere_subdivisions")
+            row = column.row()
+            row.enabled = props.cushions
+            row.prop(props, "cushion_subdivisions")
         layout.operator(ids.DRAPE_GARMENT, icon="MOD_CLOTH")
         if props.status:
             box = layout.box()

@@ -14,8 +14,18 @@ BODY_POSE_ITEMS = (
 )
 
 # Items, defaults and descriptions: core.drape.settings.DRAPE (the command line's too).
-GARMENT_ITEMS = tuple((c.value, c.label, c.description) for c in DRAPE["garment"].choices)  # keys as they are
 DEFAULTS = DrapeSettings()
+
+
+def _choice(name):
+    """An EnumProperty of DRAPE's option ``name``: its choices' values (the keys as they are) are the items."""
+    option = DRAPE[name]
+    return EnumProperty(
+        name=option.label,
+        items=tuple((c.value, c.label, c.description) for c in option.choices),
+        default=option.default,
+        description=option.description,
+    )
 
 
 def _subdivisions(name):
@@ -32,12 +42,7 @@ def _subdivisions(name):
 class ELLIMANN_PG_drape(bpy.types.PropertyGroup):
     """Drape settings of a scene."""
 
-    garment: EnumProperty(
-        name=DRAPE["garment"].label,
-        items=GARMENT_ITEMS,
-        default=DRAPE["garment"].default,
-        description=DRAPE["garment"].description,
-    )
+    garment: _choice("garment")
     frames: IntProperty(
         name=DRAPE["frames"].label,
         default=DEFAULTS.frames,
@@ -57,6 +62,8 @@ class ELLIMANN_PG_drape(bpy.types.PropertyGroup):
         unit="LENGTH",
         description=DRAPE["edge"].description,
     )
+    collider: _choice("collider")
+    skin_level: _choice("skin_level")
     cushions: BoolProperty(
         name=DRAPE["cushions"].label, default=DEFAULTS.cushions, description=DRAPE["cushions"].description
     )
@@ -73,6 +80,8 @@ class ELLIMANN_PG_drape(bpy.types.PropertyGroup):
 
     def settings(self):
         return DrapeSettings(
+            collider=self.collider,
+            skin_level=self.skin_level,
             frames=self.frames,
             edge=self.edge,
             cushions=self.cushions,
