@@ -44,6 +44,7 @@ class Lane:
     pins: tuple  # the bpy wheel and the numpy Blender bundles
     suites: tuple  # which of SUITES run here
     venv_name: str = ""  # default .venv-bpy<blender>
+    quick: tuple = ()  # suites whose tests marked slow this lane leaves to another lane (tests/conftest.py)
 
     @property
     def venv(self):
@@ -52,15 +53,18 @@ class Lane:
 
 # Oldest LTS (the manifest's minimum), newest LTS, the last Python 3.11 release, the newest release.
 # numpy: Blender 4.2-5.0 bundle numpy 1.26; bpy 5.1+ wheels require numpy>=2.2,<3, of which pip takes
-# the newest. The core runs once per numpy major: on 5.0 (numpy 1) and on 5.3 (numpy 2). The tools
-# suite (the reference build, twice: some 4 minutes) runs once, on numpy 2: the shipped data are built
-# on the working venv's numpy 1, so it also shows the build does not depend on numpy's major.
+# the newest. The core runs once per numpy major: on 5.0 (numpy 1) and on 5.3 (numpy 2); its tests marked
+# slow (half its time: the skin's exact grid, the falling balls, the golden-section grids) run once, on 5.0,
+# since 5.3 also carries the tools suite (the reference build, twice: some 4 minutes), which runs once, on
+# numpy 2: the shipped data are built on the working venv's numpy 1, so it also shows the build does not
+# depend on numpy's major. The Blender suite's slow tests run on the oldest and the newest Blender.
 LANES = (
     Lane("4.2", "3.11", ("bpy==4.2.23", "numpy==1.26.4"), ("blender",)),
-    Lane("4.5", "3.11", ("bpy==4.5.15", "numpy==1.26.4"), ("blender",)),
-    Lane("5.0", "3.11", ("bpy==5.0.1", "numpy==1.26.4"), ("core", "blender"), ".venv"),  # the working venv
-    Lane("5.3", "3.13", ("bpy==5.3.0", "numpy==2.5.5"), ("core", "tools", "blender")),
+    Lane("4.5", "3.11", ("bpy==4.5.15", "numpy==1.26.4"), ("blender",), quick=("blender",)),
+    Lane("5.0", "3.11", ("bpy==5.0.1", "numpy==1.26.4"), ("core", "blender"), ".venv", quick=("blender",)),
+    Lane("5.3", "3.13", ("bpy==5.3.0", "numpy==2.5.5"), ("core", "tools", "blender"), quick=("core",)),
 )
+QUICK_VARIABLE = "ELLIMANN_QUICK_SUITES"  # read by tests/conftest.py
 
 
 def find_python(version):
@@ -138,9 +142,8 @@ def run_lane(lane, extra_args, threads=None):
         command = [str(python), "-m", "pytest", "-p", "no:cacheprovider", f"--junitxml={xml_path}", *paths, *extra_args]
         log.write("$ " + " ".join(command) + "\n")
         log.flush()
-        code = subprocess.run(
-            command, cwd=REPO, stdout=log, stderr=subprocess.STDOUT, env=_lane_env(threads)
-        ).returncode
+        env = {**_lane_env(threads), QUICK_VARIABLE: ",".join(lane.quick)}
+        code = subprocess.run(command, cwd=REPO, stdout=log, stderr=subprocess.STDOUT, env=env).returncode
         counts = _counts(xml_path)
         if counts is not None and code != 0 and counts[1] == 0:
             # pytest said nothing failed but did not exit cleanly (a crash at exit, no test collected…)
@@ -220,7 +223,8 @@ def main(argv=None):
     lanes = [lane for lane in LANES if not chosen or lane.blender in chosen]
     if args.list:
         for lane in lanes:
-            pins, suites = " ".join(lane.pins), ", ".join(lane.suites)
+            pins = " ".join(lane.pins)
+            suites = ", ".join(f"{s} (not slow)" if s in lane.quick else s for s in lane.suites)
             print(f"Blender {lane.blender}: Python {lane.python}, {pins}; suites {suites}")
         return 0
     if any("blender" in lane.suites for lane in lanes) and not ensure_gltf_validator():

@@ -1,7 +1,10 @@
 """The test matrix covers what the manifest promises, and the shipped .blend files open on all of it."""
 
+import os
 import pathlib
 import re
+import subprocess
+import sys
 import tomllib
 
 import pytest
@@ -39,6 +42,29 @@ def test_core_runs_on_each_numpy_major_tools_once_and_blender_on_every_lane():
     assert set(majors) == {"1", "2"}
     assert all({"core", "blender"} <= suites for suites in majors.values())
     assert sum("tools" in lane.suites for lane in matrix.LANES) == 1
+
+
+def test_every_suite_s_slow_tests_run_on_some_lane_and_the_blender_ones_on_the_oldest_and_newest():
+    for suite in matrix.SUITES:
+        assert any(suite in lane.suites and suite not in lane.quick for lane in matrix.LANES), suite
+    for lane in matrix.LANES:
+        assert set(lane.quick) <= set(lane.suites)
+    assert "blender" not in matrix.LANES[0].quick and "blender" not in matrix.LANES[-1].quick
+
+
+def test_a_quick_suite_leaves_out_its_slow_tests_only(tmp_path):
+    tests = pathlib.Path(__file__).resolve().parents[1]
+    command = [sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "--collect-only", "-q"]
+    paths = [str(tests / "core" / "test_skin.py"), str(tests / "tools" / "test_matrix.py")]
+
+    def collected(quick, *options):
+        env = {**os.environ, matrix.QUICK_VARIABLE: quick}
+        out = subprocess.run([*command, *options, *paths], capture_output=True, text=True, env=env, cwd=tests.parent)
+        return {line for line in out.stdout.splitlines() if "::" in line}
+
+    everything, quick, slow = collected(""), collected("core"), collected("", "-m", "slow")
+    slow_core = {item for item in slow if item.startswith("tests/core")}
+    assert slow_core and everything - quick == slow_core  # the tools suite's slow tests stay
 
 
 def blend_header_version(path):
