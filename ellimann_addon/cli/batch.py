@@ -144,8 +144,6 @@ def check_skin_batch(args, formats, table, reference):
         raise UsageError("--skin with --format npz: the batch file holds the pieces only; write json, obj or mjcf")
     if args.dask:
         raise UsageError("--skin with --dask: skins are made one row at a time in this process; drop --dask")
-    extra = [key for key in EXTRA_MEASUREMENTS if key in table.columns]
-    skinning.check_skin_request(settings, args.mode, extra, f"columns of {args.csv}")
     if args.pose is not None:
         skinning.require_joints_for_skin(reference.mannequins[0], f"the {reference.name} set's")
     skinning.check_skins_fit(settings, reference.mannequins)
@@ -316,7 +314,7 @@ def _row(args, formats, result, i, row, bundles=None, pose_file=None):
             output.say(f"{PROG} batch: line {line}: failed: {output.one_line(error)}")
             return reporting.report_row(line, name, "error", output.one_line(error), values, extra=extra)
     if skinned is not None:
-        missed = skinned.misses(dict(zip(MEASUREMENTS, values)))
+        missed = skinned.misses({**dict(zip(MEASUREMENTS, values)), **extra})
         text = skinning.missed_text(missed, skinned.rounds) if missed else ""
     elif args.skin_settings is not None:  # kept with --skin: what its skin and pieces measure is in its files
         missed, text, measured = [], "", None

@@ -16,7 +16,6 @@ from ..core.skin.settings import LEVELS, SKIN, SkinSettings
 from .arguments import number
 from .output import UsageError, one_line
 
-SKIN_EXACT = MEASUREMENTS  # what exact mode meets on the skin so far (core.skin.exact): the five
 METAVARS = {"skin_voxel": "MM", "skin_blend": "TIMES"}
 
 
@@ -89,17 +88,6 @@ def describe(settings):
     return f"skin {settings.voxel_mm:g} mm{blend}"
 
 
-def check_skin_request(settings, mode, extra, source="asked"):
-    """Refuse, before any work, what the skin cannot do yet: exact mode meeting extra measurements on the skin
-    (``extra``: those asked, by ``source``)."""
-    beyond = [key for key in extra if key not in SKIN_EXACT]
-    if settings is not None and mode == "exact" and beyond:
-        raise UsageError(
-            f"--skin in exact mode meets {', '.join(SKIN_EXACT)} on the skin, not yet {', '.join(beyond)} ({source}): "
-            "use --mode idw for the skin over the pieces as they are, measured"
-        )
-
-
 def check_skins_fit(settings, mannequins):
     """Refuse, before any work, a voxel too fine for memory or too coarse for a piece of any of ``mannequins`` (a
     synthesized one, a file's, or a reference set's for a batch): the core's line, naming --skin-voxel."""
@@ -130,27 +118,28 @@ class Skinned:
     converged: bool = True
 
     def misses(self, request):
-        """[(key, skin cm, requested cm)] of the five further than 1 mm on the skin's mesh (exact mode only)."""
+        """[(key, skin cm, requested cm)] of the measurements asked (the five and any extra ones) further than 1 mm
+        on the skin's mesh (exact mode only)."""
         if not self.exact:
             return []
         return [
-            (key, self.measured[key], request[key])
-            for key in SKIN_EXACT
-            if abs(self.measured[key] - request[key]) > mesh_tolerance_cm()
+            (key, self.measured[key], wanted)
+            for key, wanted in request.items()
+            if abs(self.measured[key] - wanted) > mesh_tolerance_cm()
         ]
 
 
 def make_skin(mannequin, settings, mode, request, extra=None):
     """The Skinned of ``mannequin`` at ``settings``: in exact ``mode`` its pieces refined until the skin measures
-    ``request`` ({He..Hi: cm}), else the skin of the pieces as they are. ``extra``: the extra measurements asked
-    ({key: cm}), measured on the skin by the body-mesh measurer (IDW: exact mode refuses them first,
-    :func:`check_skin_request`). SkinError (one line) if the skin cannot be made."""
+    ``request`` ({He..Hi: cm}) and ``extra`` (the extra measurements asked, {key: cm}), else the skin of the pieces
+    as they are, the extra ones measured on it by the body-mesh measurer. SkinError (one line) if the skin cannot be
+    made."""
     from ..core.skin.exact import exact_skin
     from ..core.skin.measure import mesh_measurements
     from ..core.skin.surface import build_skin
 
     if mode == "exact":
-        result = exact_skin(mannequin, settings, {key: request[key] for key in MEASUREMENTS})
+        result = exact_skin(mannequin, settings, {key: request[key] for key in MEASUREMENTS}, dict(extra or {}) or None)
         skinned = Skinned(
             result.mannequin,
             result.skin,
@@ -163,9 +152,9 @@ def make_skin(mannequin, settings, mode, request, extra=None):
     else:
         skin = build_skin(mannequin, settings)
         skinned = Skinned(mannequin, skin, mesh_measurements(skin), dict(mannequin.measure()), False)
-    if extra:
-        values = skinned.skin.measure().values
-        skinned.measured.update({key: values.get(key, math.nan) for key in EXTRA_MEASUREMENTS if key in extra})
+        if extra:
+            values = skin.measure().values
+            skinned.measured.update({key: values.get(key, math.nan) for key in EXTRA_MEASUREMENTS if key in extra})
     return skinned
 
 

@@ -107,21 +107,6 @@ def _wanted(args):
     )
 
 
-def _skin_request(args, settings, extra):
-    """The extra measurements to meet: with --skin in exact mode, those a --from body gave that the skin cannot meet
-    yet are left to the reference set (said in a line); one given as an option is refused before any work."""
-    if settings is not None and args.mode == "exact" and args.from_mesh:
-        found = [key for key in extra if getattr(args, key) is None and key not in skinning.SKIN_EXACT]
-        if found:
-            output.say(
-                f"{PROG} synth: warning: --skin in exact mode meets {', '.join(skinning.SKIN_EXACT)} on the skin; "
-                f"{args.from_mesh}'s {', '.join(found)} are left to the reference set"
-            )
-            extra = {key: value for key, value in extra.items() if key not in found}
-    skinning.check_skin_request(settings, args.mode, extra)
-    return extra
-
-
 def run(args):
     from ..core.synthesis.synthesize import synthesize_extra
 
@@ -129,7 +114,6 @@ def run(args):
     pose_file = arguments.check_pose_argument(args, [kind])
     settings = skinning.skin_settings(args)
     five, extra = _wanted(args)
-    extra = _skin_request(args, settings, extra)
     reference = arguments.references(args)
     try:  # the request is checked here, once, before any work (its warnings come back with the result)
         options = arguments.synthesis_options(args, args.name)
@@ -158,7 +142,7 @@ def run(args):
         args.fps,
         skin=skinned.skin if skinned else None,
     )
-    missed = skinned.misses(five) if skinned else []
+    missed = skinned.misses({**five, **extra}) if skinned else []
     if missed:
         output.say(f"{PROG} synth: warning: {skinning.missed_text(missed, skinned.rounds)}")
     if args.json:

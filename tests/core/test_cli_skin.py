@@ -103,10 +103,8 @@ BAD = [
     (["synth", *REQUEST, "--skin", "--skin-blend", "5", "-o", "{tmp}/x.obj"], ["--skin-blend: must be", "0 to 3"]),
     (["synth", *REQUEST, "--skin", "--skin-voxel", "1", "-o", "{tmp}/x.obj"], ["--skin-voxel: 1 mm", "GB", "fits"]),
     (["synth", *REQUEST, "--skin", "--skin-voxel", "20", "-o", "{tmp}/x.obj"], ["Fingers", "too thin for 20 mm"]),
-    (["synth", *REQUEST, "--skin", "--neck", "33", "-o", "{tmp}/x.obj"], ["exact mode meets He, Sh", "not yet neck"]),
     (["batch", "{tmp}/in.csv", "-o", "{tmp}/out", "--skin", "--format", "json,npz"], ["--format npz", "pieces only"]),
     (["batch", "{tmp}/in.csv", "-o", "{tmp}/out", "--skin", "--dask", "local:1"], ["--skin with --dask"]),
-    (["batch", "{tmp}/neck.csv", "-o", "{tmp}/out", "--skin"], ["not yet neck", "MEASUREMENTS.csv"]),
     (["batch", "{tmp}/in.csv", "-o", "{tmp}/out", "--skin", "--skin-voxel", "30"], ["Hand.L", "too thin"]),
     (["batch", "{tmp}/in.csv", "-o", "{tmp}/out", "--skin-blend", "1"], ["--skin-blend is a setting"]),
     (["pose", "{tmp}/nojoints.json", "--pose", "sit", "--skin", "-o", "{tmp}/x.obj"], ["has no joints", "skin"]),
@@ -119,7 +117,6 @@ BAD = [
 def inputs(tmp_path_factory):
     folder = tmp_path_factory.mktemp("inputs")
     (folder / "in.csv").write_text("He,Sh,Br,Wa,Hi,name\n160,40,95,80,105,a\n", encoding="utf-8")
-    (folder / "neck.csv").write_text("He,Sh,Br,Wa,Hi,name,neck\n160,40,95,80,105,a,\n", encoding="utf-8")
     assert quiet_main(["synth", *REQUEST, "-o", str(folder / "rest.json")])[0] == 0
     data = json.loads((folder / "rest.json").read_text())
     (folder / "nojoints.json").write_text(json.dumps({k: v for k, v in data.items() if k != "joints"}))
@@ -129,26 +126,40 @@ def inputs(tmp_path_factory):
 
 @pytest.mark.parametrize("argv, words", BAD)
 def test_bad_skin_input_is_refused_in_one_line_before_any_work(tmp_path, inputs, capsys, argv, words):
-    for name in ("in.csv", "neck.csv", "rest.json", "nojoints.json", "badskin.json"):
+    for name in ("in.csv", "rest.json", "nojoints.json", "badskin.json"):
         (tmp_path / name).write_bytes((inputs / name).read_bytes())
     before = sorted(p.name for p in tmp_path.iterdir())
     code, stdout, stderr = run([a.format(tmp=tmp_path) for a in argv], capsys)
-    words = [w.replace("MEASUREMENTS.csv", f"{tmp_path}/neck.csv") for w in words]
     assert_one_line_error(code, stderr, *words)
     assert stdout == "" and sorted(p.name for p in tmp_path.iterdir()) == before  # nothing written, no folder made
 
 
-def test_a_body_s_extra_measurements_are_left_to_the_reference_set_in_exact_mode_on_the_skin(idw, tmp_path, capsys):
-    """synth --from BODY --skin in exact mode: the body's extra measurements (which the skin cannot meet yet) are
-    dropped with a line, not refused; the voxel refused next shows the request got that far, nothing written."""
+def test_a_body_s_extra_measurements_are_kept_in_exact_mode_on_the_skin(idw, tmp_path, capsys):
+    """synth --from BODY --skin in exact mode keeps the body's extra measurements (the skin meets them too): no
+    line about them; the voxel refused next shows the request got that far, nothing written."""
     body = idw.folder / "w.obj"
     code, stdout, stderr = run(
         ["synth", "--from", str(body), "--skin", "--skin-voxel", "20", "-o", str(tmp_path / "x.obj")], capsys
     )
-    warning, error = stderr.strip().splitlines()
-    assert code == 1 and "w.obj's neck, upper_arm, thigh, calf, crotch_height, arm_length are left" in warning
-    assert error.startswith("ellimann synth: error: --skin-voxel: ") and "too thin for 20 mm" in error
+    (error,) = stderr.strip().splitlines()
+    assert code == 1 and error.startswith("ellimann synth: error: --skin-voxel: ") and "too thin for 20 mm" in error
     assert not list(tmp_path.iterdir())
+
+
+def test_exact_mode_meets_an_extra_measurement_on_the_skin(tmp_path, capsys):
+    """--neck with --skin in exact mode: the skin's mesh measures the five and the neck asked within 1 mm (the
+    pieces' neck left below it: the blend adds the rest), reported in --json and in no warning."""
+    out = tmp_path / "n.obj"
+    code, stdout, stderr = run(
+        ["synth", *REQUEST, "--neck", "27", "--skin", "--skin-level", "preview", "--json", "-o", str(out)], capsys
+    )
+    assert code == 0, stderr
+    result = json.loads(stdout)
+    asked = {**dict(zip(MEASUREMENTS, map(float, REQUEST[1::2]))), "neck": 27.0}
+    for key, wanted in asked.items():
+        assert abs(result["skin"]["measured"][key] - wanted) <= MESH_TOLERANCE_CM, key
+    assert result["skin"]["exact"] and result["skin"]["converged"]
+    assert result["measured"]["neck"] < 27.0 - MESH_TOLERANCE_CM
 
 
 # ------------------------------------------------------------------------------------------------ files

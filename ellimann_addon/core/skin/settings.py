@@ -89,7 +89,7 @@ class SkinSettings:
 
 METHOD = (
     "signed-distance bound of each ellipsoid; neighbours in the body blended by the polynomial smooth minimum "
-    "(width: blend times the thinner piece's smallest semi-axis, at most 8 cm), the blends joined by a 4-norm; "
+    "(width: blend times the thinner piece's smallest semi-axis, at most 4 cm), the blends joined by a 4-norm; "
     "marching cubes with a watertight table"
 )
 
