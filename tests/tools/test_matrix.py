@@ -138,3 +138,10 @@ def test_lanes_side_by_side_share_the_cores_blas_threads_unless_set(monkeypatch)
     monkeypatch.setenv("OPENBLAS_NUM_THREADS", "4")  # the user's own choice stays
     assert matrix._lane_env(1)["OPENBLAS_NUM_THREADS"] == "4"
     assert "OMP_NUM_THREADS" not in matrix._lane_env()
+
+
+def test_no_two_test_files_share_a_name():
+    """A lane runs tests/core and tests/blender in one pytest, which imports test files by their base name."""
+    tests = pathlib.Path(__file__).resolve().parents[1]
+    names = [path.name for path in tests.rglob("test_*.py")]
+    assert sorted({name for name in names if names.count(name) > 1}) == []
