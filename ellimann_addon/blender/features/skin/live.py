@@ -12,20 +12,17 @@ the stamp may name none: the skin is then left until the fields settle again.
 import sys
 import uuid
 
-import bpy
-
 from ....core.errors import ElliMannError
 from ....core.skin.settings import SkinSettings
 from ...bridge.convert import collection_to_mannequin
 from ...bridge.skin import is_stale_skin, skin_object, write_skin_vertices
 from ...services.skin import add_skin, make_skin
-from ..synthesize.live import LIVE_SETTLE_SECONDS, add_follower, remove_follower
+from ..synthesize.live import Debounced, add_follower, remove_follower
 
 STAMP_KEY = "ellimann_skin_stamp"  # on a skin object: which core Skin it holds (_made)
 KEPT = 8  # core Skins kept in memory (each a few MB at the preview level)
 LIVE_LEVEL = "preview"
 _made = {}  # stamp -> the core Skin a skin object was made from
-_settling = {"scenes": set()}
 
 
 def remember(obj, skin):
@@ -59,24 +56,6 @@ def follow(scene, target, mannequin, seconds_left):
     _settle_later(scene)
 
 
-def _settle_later(scene):
-    if bpy.app.timers.is_registered(_settle_timer):
-        bpy.app.timers.unregister(_settle_timer)
-    else:
-        _settling["scenes"].clear()
-    _settling["scenes"].add(scene.name)
-    bpy.app.timers.register(_settle_timer, first_interval=LIVE_SETTLE_SECONDS)
-
-
-def _settle_timer():
-    names, _settling["scenes"] = _settling["scenes"], set()
-    for name in sorted(names):
-        scene = bpy.data.scenes.get(name)
-        if scene is not None:
-            settle_skin(scene)
-    return None
-
-
 def settle_skin(scene):
     """Make the live target's skin again from its pieces at the preview level, unless it holds them already.
     Returns the skin object, or None (nothing to do, or it could not be made: the panel's status says why)."""
@@ -100,13 +79,15 @@ def settle_skin(scene):
     return obj
 
 
+_settling = Debounced(settle_skin)  # the scenes whose live targets' skins wait to be made again
+_settle_later, _settle_timer = _settling.later, _settling.timer
+
+
 def register_hooks():
     add_follower(follow)
 
 
 def unregister_hooks():
     remove_follower(follow)
-    if bpy.app.timers.is_registered(_settle_timer):
-        bpy.app.timers.unregister(_settle_timer)
-    _settling["scenes"].clear()
+    _settling.cancel()
     _made.clear()

@@ -42,7 +42,6 @@ LIVE_NAME_KEY = "ellimann_live_name"  # on a live target: the name live updates 
 LIVE_STEP_BUDGET = 0.050  # s: a live step with what follows its pieces (pieces_moved), e.g. a preview skin
 _followers = []  # called by every live step after its pieces moved (add_follower)
 _held = {"depth": 0, "changed": False}  # live updates held back while a preset sets its fields
-_settling = {"scenes": set()}  # names of the scenes whose live targets wait for exact cushions
 
 
 def on_request_change(self, context):
@@ -161,23 +160,37 @@ def move_cushions(mannequin, cushions):
     return True
 
 
-def _settle_later(scene):
-    """(Re)start the timer that rebuilds the cushions once the fields are still (restarted by every update)."""
-    if bpy.app.timers.is_registered(_settle_timer):
-        bpy.app.timers.unregister(_settle_timer)
-    else:  # a file load removes the timer: forget what it was to do in the old file
-        _settling["scenes"].clear()
-    _settling["scenes"].add(scene.name)
-    bpy.app.timers.register(_settle_timer, first_interval=LIVE_SETTLE_SECONDS)
+class Debounced:
+    """``action(scene)`` once for each scene asked, LIVE_SETTLE_SECONDS after the last ask (every ask restarts the
+    wait): what a live update leaves to do once the fields are still. ``timer`` is the function Blender's timer runs
+    (kept as one object, so that it can be looked up and unregistered)."""
 
+    def __init__(self, action):
+        self.action, self.scenes = action, set()
 
-def _settle_timer():
-    names, _settling["scenes"] = _settling["scenes"], set()
-    for name in sorted(names):
-        scene = bpy.data.scenes.get(name)
-        if scene is not None:
-            settle_live(scene)
-    return None  # once
+        def timer():
+            names, self.scenes = self.scenes, set()
+            for name in sorted(names):
+                scene = bpy.data.scenes.get(name)
+                if scene is not None:
+                    self.action(scene)
+            return None  # once
+
+        self.timer = timer
+
+    def later(self, scene):
+        """(Re)start the wait for ``scene``."""
+        if bpy.app.timers.is_registered(self.timer):
+            bpy.app.timers.unregister(self.timer)
+        else:  # a file load removes the timer: forget what it was to do in the old file
+            self.scenes.clear()
+        self.scenes.add(scene.name)
+        bpy.app.timers.register(self.timer, first_interval=LIVE_SETTLE_SECONDS)
+
+    def cancel(self):
+        if bpy.app.timers.is_registered(self.timer):
+            bpy.app.timers.unregister(self.timer)
+        self.scenes.clear()
 
 
 @bpy.app.handlers.persistent
@@ -222,6 +235,10 @@ def settle_live(scene):
         print(f"ElliMann: cushions of '{target.name}' not rebuilt: {message}", file=sys.stderr)
         return 0
     return len(built_objects(target, "CUSHION"))
+
+
+_settling = Debounced(settle_live)  # the scenes whose live targets wait for exact cushions
+_settle_later, _settle_timer = _settling.later, _settling.timer
 
 
 def _has_stale(target, cushions):
@@ -270,6 +287,4 @@ def unregister_hooks():
         handlers = getattr(bpy.app.handlers, name)
         if settle_restored in handlers:
             handlers.remove(settle_restored)
-    if bpy.app.timers.is_registered(_settle_timer):
-        bpy.app.timers.unregister(_settle_timer)
-    _settling["scenes"].clear()
+    _settling.cancel()
