@@ -16,13 +16,15 @@ from ellimann_addon.core.mannequin.skeleton import JOINT_INDEX, JOINT_NAMES, bon
 from ellimann_addon.core.pose.kinematics import Pose, axis_angle, clamp_pose, forward_kinematics
 from ellimann_addon.core.pose.standard import WALK_FPS, standard_motion, standard_pose
 from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
+from ellimann_addon.core.synthesis.shipped import FEMALE_FINE_SET, FEMALE_SET, SHIPPED_SETS
 
 TOLERANCE = 2e-5  # m: Blender evaluates in single precision
 
 
-@pytest.fixture(scope="module")
-def average():
-    mannequin = Mannequin.load(REFERENCE_FOLDER / "average.json")
+@pytest.fixture(scope="module", params=[FEMALE_SET, FEMALE_FINE_SET])
+def average(request):
+    """The Average RM of the paper's 40 and of the fine topology (every part on a bone: the rig takes both)."""
+    mannequin = Mannequin.load(SHIPPED_SETS[request.param] / "average.json")
     assert mannequin.joints is not None
     return mannequin
 

@@ -15,14 +15,15 @@ from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.mannequin.skeleton import JOINT_NAMES, bone_name
 from ellimann_addon.core.pose.motion import clamped_motion
 from ellimann_addon.core.pose.standard import standard_motion
-from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
+from ellimann_addon.core.synthesis.shipped import FEMALE_FINE_SET, FEMALE_SET, SHIPPED_SETS
 
 Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # glTF (x, y, z) -> Blender
 
 
-@pytest.fixture(scope="module")
-def average():
-    return Mannequin.load(REFERENCE_FOLDER / "average.json")
+@pytest.fixture(scope="module", params=[FEMALE_SET, FEMALE_FINE_SET])
+def average(request):
+    """The Average RM of the paper's 40 and of the fine topology: posed files of either."""
+    return Mannequin.load(SHIPPED_SETS[request.param] / "average.json")
 
 
 def write_mannequin(mannequin, paths, cushions=False, pose="a_pose"):

@@ -10,7 +10,9 @@ import pytest
 from devkit.cli_runs import assert_one_line_error, run
 from ellimann_addon.core.formats.posed_files import read_pose
 from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.skeleton import cross_joint_pairs
 from ellimann_addon.core.pose.standard import standard_pose, walk
+from ellimann_addon.core.synthesis.shipped import FEMALE_FINE_SET, FEMALE_SET, named_reference_set
 
 REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]
 
@@ -44,28 +46,37 @@ def test_synth_with_a_pose_writes_the_pose_of_the_synthesized_mannequin(tmp_path
     assert np.allclose(frame.rotations, standard_pose("sit", Mannequin.load(rest).joints).rotations, atol=1e-12)
 
 
-def test_batch_with_a_pose_writes_each_row_posed(tmp_path, capsys):
+@pytest.mark.parametrize("references", [FEMALE_SET, FEMALE_FINE_SET])
+def test_batch_with_a_pose_writes_each_row_posed(tmp_path, capsys, references):
     source = tmp_path / "in.csv"
     source.write_text("He,Sh,Br,Wa,Hi,name\n160,40,95,80,105,a\n170,42,100,85,110,b\n", encoding="utf-8")
-    code, _, _ = run(
-        ["batch", str(source), "-o", str(tmp_path / "out"), "--format", "json,mjcf,obj", "--pose", "t_pose"], capsys
-    )
+    out = tmp_path / "out"
+    options = ["--format", "json,mjcf,obj", "--pose", "t_pose", "--references", references]
+    code, _, _ = run(["batch", str(source), "-o", str(out), *options], capsys)
     assert code == 0
+    parts = len(named_reference_set(references).topology)
     for name in "ab":
-        assert read_pose(tmp_path / "out" / f"{name}.json")[0].name == "t_pose"
-        text = (tmp_path / "out" / f"{name}.xml").read_text()
+        assert (
+            read_pose(out / f"{name}.json")[0].name == "t_pose" and len(Mannequin.load(out / f"{name}.json")) == parts
+        )
+        text = (out / f"{name}.xml").read_text()
         assert '<key name="t_pose"' in text and "<freejoint" in text
-        obj = (tmp_path / "out" / f"{name}.obj").read_text()
-        assert obj.count("\no ") == 40  # every ellipsoid, as no --cushions
+        obj = (out / f"{name}.obj").read_text()
+        assert obj.count("\no ") == parts  # every ellipsoid, as no --cushions
 
 
-def test_posed_obj_with_cushions_has_the_split_halves(tmp_path, rest, capsys):
+@pytest.mark.parametrize("references", [FEMALE_SET, FEMALE_FINE_SET])
+def test_posed_obj_with_cushions_has_the_split_halves(tmp_path, capsys, references):
+    rest = tmp_path / "rest.json"
+    assert run(["synth", *REQUEST, "--references", references, "-o", str(rest)], capsys)[0] == 0
     out = tmp_path / "t.obj"
     code, _, _ = run(["pose", str(rest), "--pose", "t_pose", "--cushions", "-o", str(out)], capsys)
     assert code == 0
     names = [line[2:] for line in out.read_text().splitlines() if line.startswith("o ")]
     assert "3.a Upper Arm.L + 3.b Forearm.L (3.b Forearm.L)" in names and "5.a Thigh.L + 5.b Knee.L" in names
-    assert "3.a Upper Arm.L" not in names and len(names) == 40 - 30 + 15 + 8
+    topology = Mannequin.load(rest).topology
+    pairs, split = len(topology.cushion_pairs), len(cross_joint_pairs(topology))
+    assert "3.a Upper Arm.L" not in names and len(names) == len(topology) - 2 * pairs + pairs + split
 
 
 def _no_joints(tmp_path, rest):
