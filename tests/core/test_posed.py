@@ -85,6 +85,7 @@ def _cushion_volumes(rig, pose, first):
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("average", [FEMALE_SET], indirect=True)  # the fine topology's cushions across joints: the 40's
 @pytest.mark.parametrize("pose_name", ["t_pose", "attention", "sit", "walk"])
 def test_posed_cushions_across_joints_keep_their_rest_volume(average, rig, pose_name):
     joints = average.joints
