@@ -18,6 +18,7 @@ BENCHES = (
     "bench_scan",
     "bench_scan_held_out",
     "bench_extra",
+    "bench_fine",
 )
 
 
