@@ -99,7 +99,6 @@ def test_the_manifest_names_the_fine_set_and_its_topology(fine):
     assert f"{len(fine.topology)} parts" in manifest["provenance"]["topology"]
 
 
-@pytest.mark.slow
 def test_exact_mode_meets_the_243_grid_on_the_fine_sets(fine):
     grid = np.array(list(itertools.product(*[quartile_points(k, fine.ranges) for k in MEASUREMENTS])))
     result = synthesize_batch(fine, grid, mode="exact")
