@@ -458,13 +458,7 @@ def measurements_doc(base, rms, report):
         "| RM | | He | Sh | Br | Wa | Hi | max rel. error |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    for name, rm in rms.items():
-        target = REFERENCE_MEASUREMENTS[name]
-        measured = rm.measure()
-        errors = relative_errors(measured, target)
-        worst = max(abs(e) for e in errors.values())
-        lines.append(f"| {DISPLAY_NAMES[name]} | target | " + _row(target) + " | |")
-        lines.append("| | m_T | " + _row(measured) + f" | {worst:.4%} |")
+    lines += target_rows(rms, REFERENCE_MEASUREMENTS)
     lines += [
         "",
         "## How far each body and fit were from the table",
@@ -477,13 +471,7 @@ def measurements_doc(base, rms, report):
         "| RM | | He | Sh | Br | Wa | Hi |",
         "|---|---|---|---|---|---|---|",
     ]
-    for name in rms:
-        body = report["body_measurements"][name]
-        fitted = report["fitted_measurements"][name]
-        factors = report["factors"][name]
-        lines.append(f"| {DISPLAY_NAMES[name]} | body | " + _row(body) + " |")
-        lines.append("| | fit | " + _row(fitted) + " |")
-        lines.append("| | factor | " + _row(factors, 4) + " |")
+    lines += fit_rows(rms, report)
     body = report["body_measurements"][REFERENCE_BODY]
     measured = base.measure()
     lines += [
@@ -511,6 +499,27 @@ def measurements_doc(base, rms, report):
     for name, value in sorted(report["agreement"].items(), key=lambda item: item[1]):
         lines.append(f"| {name} | {value:.4f} |")
     return "\n".join(lines) + "\n"
+
+
+def target_rows(rms, targets):
+    """Markdown rows of the targets-vs-m_T table: each RM's targets, its m_T and its largest relative error."""
+    lines = []
+    for name, rm in rms.items():
+        measured, target = rm.measure(), targets[name]
+        worst = max(abs(e) for e in relative_errors(measured, target).values())
+        lines.append(f"| {DISPLAY_NAMES[name]} | target | " + _row(target) + " | |")
+        lines.append("| | m_T | " + _row(measured) + f" | {worst:.4%} |")
+    return lines
+
+
+def fit_rows(rms, report):
+    """Markdown rows of the bodies-and-fits table: each RM's body, its fit before the refinement, the factors."""
+    lines = []
+    for name in rms:
+        lines.append(f"| {DISPLAY_NAMES[name]} | body | " + _row(report["body_measurements"][name]) + " |")
+        lines.append("| | fit | " + _row(report["fitted_measurements"][name]) + " |")
+        lines.append("| | factor | " + _row(report["factors"][name], 4) + " |")
+    return lines
 
 
 def fill_doc(fill, links=coverage.CHAINS):
