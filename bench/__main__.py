@@ -26,6 +26,7 @@ BENCHES = (
     "bench_skin_exact",
     "bench_bvh",
     "bench_batch",
+    "bench_fine",
 )
 
 

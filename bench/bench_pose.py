@@ -51,7 +51,7 @@ def run():
         cycle, _ = median_ms(lambda r=rig: [r.pose(f) for f in frames], count=5)
         verdict = "under" if posing < TARGET_MS else "OVER"
         print(
-            f"pose 40 pieces + {len(rig.meshes)} cushion meshes (level {level}, {vertices:,} vertices): "
+            f"pose {len(mannequin)} pieces + {len(rig.meshes)} cushion meshes (level {level}, {vertices:,} vertices): "
             f"{posing:6.2f} ms median, {posing_max:.2f} max ({verdict} the {TARGET_MS:g} ms target; "
             f"{posing / live:.2f}x the live synthesis step); rig built once in {built:.0f} ms; "
             f"the 24-frame walk cycle {cycle:.0f} ms"

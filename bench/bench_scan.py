@@ -35,15 +35,17 @@ def overlap(mannequin, body):
     return voxel_iou(standing_in(grid, mannequin), grid=grid, cushions=False)
 
 
-def twin_overlaps(reference, body, found):
-    """(IoU of the twin from the five, IoU of the twin from all of ``found``, the extra measurements missed)."""
+def twin_overlaps(reference, body, found, with_twin=False):
+    """(IoU of the twin from the five, IoU of the twin from all of ``found``, the extra measurements missed; with
+    ``with_twin``, also the twin from the five)."""
     five, extra = split_measurements(found)
-    iou, missed = [], []
+    iou, missed, twins = [], [], []
     for given in ({}, extra):
         result = synthesize_extra(reference, five, given)
         missed += [miss.key for miss in result.missed]
         iou.append(overlap(result.mannequin, body))
-    return iou[0], iou[1], missed
+        twins.append(result.mannequin)
+    return (iou[0], iou[1], missed, twins[0]) if with_twin else (iou[0], iou[1], missed)
 
 
 def run():

@@ -125,11 +125,7 @@ def report_doc(base, rms, report):
         "| RM | | He | Sh | Br | Wa | Hi | max rel. error |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    for name, rm in rms.items():
-        measured, target = rm.measure(), MALE.targets[name]
-        worst = max(abs(e) for e in relative_errors(measured, target).values())
-        lines.append(f"| {br.DISPLAY_NAMES[name]} | target | " + br._row(target) + " | |")
-        lines.append("| | m_T | " + br._row(measured) + f" | {worst:.4%} |")
+    lines += br.target_rows(rms, MALE.targets)
     lines += [
         "",
         "## How far each body and fit were from the targets",
@@ -140,10 +136,7 @@ def report_doc(base, rms, report):
         "| RM | | He | Sh | Br | Wa | Hi |",
         "|---|---|---|---|---|---|---|",
     ]
-    for name in rms:
-        lines.append(f"| {br.DISPLAY_NAMES[name]} | body | " + br._row(report["body_measurements"][name]) + " |")
-        lines.append("| | fit | " + br._row(report["fitted_measurements"][name]) + " |")
-        lines.append("| | factor | " + br._row(report["factors"][name], 4) + " |")
+    lines += br.fit_rows(rms, report)
     body, measured = report["body_measurements"][MALE.reference_body], base.measure()
     lines += [
         "",

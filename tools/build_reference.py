@@ -75,19 +75,20 @@ DISPLAY_NAMES = {**{stem: display_name(stem) for stem in RM_BODIES}, BASE_FILE: 
 FILL_SPACING = FitConstants().fill_spacing
 
 
-def trace_reference(reference_body, labels):
-    """{part name: PartTrace}: the vertices of every part on the reference body (tools/reference_topology.py)
-    and its fit settings; the cavity walls (open mouth and eye sockets, bodies.hidden_vertices) are looked
-    for in the head only: elsewhere every vertex is skin. Also returns the cavity mask (bool per vertex)."""
+def trace_reference(reference_body, labels, specs=rt.SPECS):
+    """{part name: PartTrace}: the vertices of every part of ``specs`` (default: the shipped 40,
+    tools/reference_topology.py) on the reference body and its fit settings; the cavity walls (open mouth and eye
+    sockets, bodies.hidden_vertices) are looked for in the head only: elsewhere every vertex is skin. Also returns
+    the cavity mask (bool per vertex)."""
     vertices = reference_body.vertices
     height = vertices[:, 2].max() - vertices[:, 2].min()
     hidden = np.zeros(len(vertices), dtype=bool)
-    if any(spec.cavities for spec in rt.SPECS):
+    if any(spec.cavities for spec in specs):
         head = np.nonzero(labels.region == "head")[0]
         normals = vertex_normals(vertices, reference_body.faces)
         hidden[head] = hidden_vertices(vertices, reference_body.faces, normals, head)
     traces = {}
-    for spec, side in rt.expanded():
+    for spec, side in rt.expanded(specs):
         name = rt.part_name(spec, side)
         idx = rt.select_vertices(spec.select, side, vertices, labels, height)
         if len(idx) < 8:
@@ -99,12 +100,13 @@ def trace_reference(reference_body, labels):
     return traces, hidden
 
 
-def trace_base(reference_body, traces, constants=None, joints=None):
+def trace_base(reference_body, traces, constants=None, joints=None, topology=None):
     """The Base Mannequin fitted over the reference body: symmetric, registered, each part's trace
     recording the axis its frame took from the points, ``joints`` (the body's, or None) moved with it.
-    ``constants``: the fit's (core.fitting.mannequin_fit.FitConstants; default the female set's section heights).
+    ``constants``: the fit's (core.fitting.mannequin_fit.FitConstants; default the female set's section heights);
+    ``topology``: its parts (default: the shipped 40 of tools/reference_topology.py).
     Returns (base, body -> base translation)."""
-    topology = rt.topology()
+    topology = topology or rt.topology()
     base, kept = fit_mannequin(
         reference_body, topology, traces, constants=constants, name=DISPLAY_NAMES[BASE_FILE], role="base"
     )
@@ -337,7 +339,6 @@ def generated_docs(base, rms, report):
 
 
 def topology_doc(base):
-    crossed = sections_crossed(base)
     lines = [
         "# ElliMann's reference topology",
         "",
@@ -350,6 +351,15 @@ def topology_doc(base):
         "mirror images, central parts are symmetric about x = 0. The `Trapezius` pair is the registration "
         "landmark of `core/mannequin/clean.py`.",
         "",
+    ]
+    return "\n".join(lines + topology_tables(base, rt.SPECS)) + "\n"
+
+
+def topology_tables(base, specs):
+    """Markdown lines: what the columns mean, every part of ``base`` (traced by ``specs``) and the parts each
+    section cuts."""
+    crossed = sections_crossed(base)
+    lines = [
         "- **girth**: takes part in the breast, waist and hip sections of m_T (arms and hands do not; the "
         "shoulder width is measured over every part).",
         "- **depends**: the measurements the part is interpolated on in synthesis (segmented IDW): head and "
@@ -378,9 +388,9 @@ def topology_doc(base):
         "| part | side | cushion partner | region | girth | depends | traced from | fit |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    specs = dict((rt.part_name(spec, side), spec) for spec, side in rt.expanded())
+    by_name = dict((rt.part_name(spec, side), spec) for spec, side in rt.expanded(specs))
     for part in base.topology:
-        spec = specs[part.name]
+        spec = by_name[part.name]
         lines.append(
             f"| {part.name} | {part.side} | {part.partner or '-'} | {part.region} | "
             f"{'yes' if part.girth else 'no'} | {', '.join(part.depends)} | {_describe(spec)} | "
@@ -395,7 +405,7 @@ def topology_doc(base):
     ]
     for key, names in crossed.items():
         lines.append(f"| {key} | {SECTION_FRACTIONS[key]} | {', '.join(names)} |")
-    return "\n".join(lines) + "\n"
+    return lines
 
 
 def _describe(spec):
@@ -448,13 +458,7 @@ def measurements_doc(base, rms, report):
         "| RM | | He | Sh | Br | Wa | Hi | max rel. error |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    for name, rm in rms.items():
-        target = REFERENCE_MEASUREMENTS[name]
-        measured = rm.measure()
-        errors = relative_errors(measured, target)
-        worst = max(abs(e) for e in errors.values())
-        lines.append(f"| {DISPLAY_NAMES[name]} | target | " + _row(target) + " | |")
-        lines.append("| | m_T | " + _row(measured) + f" | {worst:.4%} |")
+    lines += target_rows(rms, REFERENCE_MEASUREMENTS)
     lines += [
         "",
         "## How far each body and fit were from the table",
@@ -467,13 +471,7 @@ def measurements_doc(base, rms, report):
         "| RM | | He | Sh | Br | Wa | Hi |",
         "|---|---|---|---|---|---|---|",
     ]
-    for name in rms:
-        body = report["body_measurements"][name]
-        fitted = report["fitted_measurements"][name]
-        factors = report["factors"][name]
-        lines.append(f"| {DISPLAY_NAMES[name]} | body | " + _row(body) + " |")
-        lines.append("| | fit | " + _row(fitted) + " |")
-        lines.append("| | factor | " + _row(factors, 4) + " |")
+    lines += fit_rows(rms, report)
     body = report["body_measurements"][REFERENCE_BODY]
     measured = base.measure()
     lines += [
@@ -503,8 +501,29 @@ def measurements_doc(base, rms, report):
     return "\n".join(lines) + "\n"
 
 
-def fill_doc(fill):
-    """Markdown lines: how each mannequin fills its body (tools/coverage.py)."""
+def target_rows(rms, targets):
+    """Markdown rows of the targets-vs-m_T table: each RM's targets, its m_T and its largest relative error."""
+    lines = []
+    for name, rm in rms.items():
+        measured, target = rm.measure(), targets[name]
+        worst = max(abs(e) for e in relative_errors(measured, target).values())
+        lines.append(f"| {DISPLAY_NAMES[name]} | target | " + _row(target) + " | |")
+        lines.append("| | m_T | " + _row(measured) + f" | {worst:.4%} |")
+    return lines
+
+
+def fit_rows(rms, report):
+    """Markdown rows of the bodies-and-fits table: each RM's body, its fit before the refinement, the factors."""
+    lines = []
+    for name in rms:
+        lines.append(f"| {DISPLAY_NAMES[name]} | body | " + _row(report["body_measurements"][name]) + " |")
+        lines.append("| | fit | " + _row(report["fitted_measurements"][name]) + " |")
+        lines.append("| | factor | " + _row(report["factors"][name], 4) + " |")
+    return lines
+
+
+def fill_doc(fill, links=coverage.CHAINS):
+    """Markdown lines: how each mannequin fills its body (tools/coverage.py), the gaps along the chains ``links``."""
     spacing = coverage.GRID_SPACING * 1e3
     lines = [
         "## How much of its body each mannequin fills",
@@ -530,13 +549,13 @@ def fill_doc(fill):
             f"({e['deepest']}) | {c['coverage']:.1%} | {c['excess']:.1%} | {c['depth'] * 1e3:.1f} "
             f"({c['deepest']}) |"
         )
-    chains = list(coverage.CHAINS)
+    chains = list(links)
     lines += [
         "",
         "Largest gap (mm) between consecutive links of each chain (0: every link touches the next), "
         "ellipsoids / cushions. The chains, link by link (left side; the first link of a limb is where it "
         "hangs from the trunk): "
-        + "; ".join(f"*{chain}*: " + " → ".join("/".join(link) for link in coverage.CHAINS[chain]) for chain in chains)
+        + "; ".join(f"*{chain}*: " + " → ".join("/".join(link) for link in links[chain]) for chain in chains)
         + ".",
         "",
         "| mannequin | " + " | ".join(chains) + " |",

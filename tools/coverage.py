@@ -156,25 +156,25 @@ def _gap_between(mannequin, first, second, cushions):
     return min(separation(mannequin, list(pa), list(pb)) for pa in a for pb in b)
 
 
-def chain_gaps(mannequin, cushions=False):
-    """{chain: [gap (m) between each two consecutive links]} over CHAINS."""
+def chain_gaps(mannequin, cushions=False, chains=CHAINS):
+    """{chain: [gap (m) between each two consecutive links]} over ``chains`` (default: CHAINS, the 40's)."""
     return {
         name: [
             _gap_between(mannequin, first, second, cushions)
             for first, second in zip(links, links[1:])
             if first and second
         ]
-        for name, links in ((name, _links(mannequin, chain)) for name, chain in CHAINS.items())
+        for name, links in ((name, _links(mannequin, chain)) for name, chain in chains.items())
     }
 
 
-def report(mannequin, body_vertices, body_faces, cavity=None, spacing=GRID_SPACING):
+def report(mannequin, body_vertices, body_faces, cavity=None, spacing=GRID_SPACING, chains=CHAINS):
     """All metrics for one mannequin over its body (same coordinates), ellipsoids and cushions:
     {"ellipsoids" | "cushions": {"coverage", "excess", "depth", "deepest" (the piece that reaches
-    deepest), "gaps": {chain: [m]}}}. ``cavity``: see
-    :func:`_outside_depth`."""
+    deepest), "gaps": {chain: [m]}}}. ``cavity``: see :func:`_outside_depth`; ``chains``: see
+    :func:`chain_gaps`."""
     body = BodyVolume(body_vertices, body_faces)
     out = fill_metrics(body, body.grid(spacing), mannequin, cavity)
-    out["ellipsoids"]["gaps"] = chain_gaps(mannequin)
-    out["cushions"]["gaps"] = chain_gaps(mannequin, True)
+    out["ellipsoids"]["gaps"] = chain_gaps(mannequin, chains=chains)
+    out["cushions"]["gaps"] = chain_gaps(mannequin, True, chains)
     return out

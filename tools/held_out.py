@@ -32,22 +32,31 @@ from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 
 from .bodies import REFERENCE_BODY, body_measurements, load_labels
 from .build_reference import DEFAULT_REFMODELS, REFERENCE_RM
+from .reference_sets import TRACING_FOLDER
 
 SIZES = (3, 4, 5)
 
 
-def six_rms(refmodels, workers):
-    """({stem: RM} of the six bodies, {stem: targets}, {stem: body -> RM shift}, {stem: BodyMesh})."""
+def six_rms(refmodels, workers, build_set=None):
+    """({stem: RM} of the six bodies, {stem: targets}, {stem: body -> RM shift}, {stem: BodyMesh}).
+
+    ``build_set`` (tools/reference_sets.py, default the female set of the 40): whose base, bodies (its six, from
+    ``refmodels``), targets and section heights."""
     from ellimann_addon.core.fitting.reference_build import build_reference_set
 
-    bodies = {
-        name: read_obj(pathlib.Path(refmodels) / f"{name}.obj", up="z")
-        for name in (REFERENCE_BODY, *REFERENCE_MEASUREMENTS)
-    }
-    targets = {name: dict(row) for name, row in REFERENCE_MEASUREMENTS.items()}
+    if build_set is None:
+        reference_body, rm_targets, fractions, folder = REFERENCE_BODY, REFERENCE_MEASUREMENTS, None, REFERENCE_FOLDER
+    else:
+        reference_body, rm_targets = build_set.reference_body, build_set.targets
+        fractions, folder = build_set.fractions, build_set.out
+    bodies = {name: read_obj(pathlib.Path(refmodels) / f"{name}.obj", up="z") for name in (reference_body, *rm_targets)}
+    targets = {name: dict(row) for name, row in rm_targets.items()}
     # the reference body's targets: its own measurements (measured as refmodels/README.md says)
-    targets[REFERENCE_BODY] = body_measurements(bodies[REFERENCE_BODY], load_labels(refmodels))
-    base = Mannequin.load(REFERENCE_FOLDER / "base_mannequin.json")
+    if fractions is None:
+        targets[reference_body] = body_measurements(bodies[reference_body], load_labels(refmodels))
+    else:  # the labels of the traced body: every body shares its vertex order
+        targets[reference_body] = body_measurements(bodies[reference_body], load_labels(TRACING_FOLDER), fractions)
+    base = Mannequin.load(folder / "base_mannequin.json")
     built = build_reference_set(
         base,
         list(bodies.values()),

@@ -8,7 +8,7 @@ male body as on a female one.
 """
 
 import pathlib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 from ellimann_addon.core.fitting.reference_build import read_targets
@@ -61,4 +61,21 @@ MALE = BuildSet(
     "reference_lineup_male.png",
 )
 
-BUILD_SETS = {s.name: s for s in (FEMALE, MALE)}
+# The same bodies, targets and heights on the fine topology (tools/reference_topology_fine.py, tools/build_fine.py).
+FEMALE_FINE = replace(
+    FEMALE,
+    name="female-fine",
+    out=FEMALE.out / "female-fine",
+    docs_name="reference_mannequins_fine.md",
+    lineup_name="reference_lineup_fine.png",
+)
+MALE_FINE = replace(
+    MALE,
+    name="male-fine",
+    out=FEMALE.out / "male-fine",
+    docs_name="reference_mannequins_male_fine.md",
+    lineup_name="reference_lineup_male_fine.png",
+)
+
+BUILD_SETS = {s.name: s for s in (FEMALE, MALE, FEMALE_FINE, MALE_FINE)}
+FINE_SETS = {FEMALE.name: FEMALE_FINE, MALE.name: MALE_FINE}  # each set's fine twin

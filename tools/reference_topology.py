@@ -343,9 +343,9 @@ def fit_settings(spec, kept=None):
     )
 
 
-def _partners():
+def _partners(specs):
     by_key = {}
-    for spec in SPECS:
+    for spec in specs:
         by_key.setdefault((spec.number, spec.side), []).append(spec)
     return by_key
 
@@ -355,21 +355,23 @@ def part_name(spec, side):
     return f"{spec.number}.{spec.letter} {spec.label}{suffix}"
 
 
-def expanded():
-    """[(spec, side)] for every part: central parts once, left parts followed by their right twins."""
+def expanded(specs=SPECS):
+    """[(spec, side)] for every part of ``specs`` (default: the shipped 40): central parts once, left parts followed
+    by their right twins."""
     out = []
-    for spec in SPECS:
+    for spec in specs:
         out.append((spec, spec.side))
         if spec.side == "L":
             out.append((spec, "R"))
     return out
 
 
-def topology():
-    """The topology as the core's Topology (cushion partners: same number and side, letters a/b)."""
-    groups = _partners()
+def topology(specs=SPECS):
+    """The topology of ``specs`` (default: the shipped 40) as the core's Topology (cushion partners: same number
+    and side, letters a/b)."""
+    groups = _partners(specs)
     parts = []
-    for spec, side in expanded():
+    for spec, side in expanded(specs):
         mates = [s for s in groups[(spec.number, spec.side)] if s is not spec]
         if len(mates) > 1:
             raise ValueError(f"part number {spec.number} has more than two ellipsoids")

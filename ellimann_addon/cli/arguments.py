@@ -66,7 +66,7 @@ def add_mesh_axes(parser, what, default_up=None):
     parser.add_argument("--unit", choices=tuple(UNITS), default="m", help=f"{what}: the file's length unit (default m)")
 
 
-def add_references(parser, what, shipped="female (the default) or male"):
+def add_references(parser, what, shipped="female (the default), male, female-fine or male-fine"):
     parser.add_argument(
         "--references",
         metavar="NAME_OR_DIR",

@@ -48,7 +48,7 @@ def add_parser(commands):
         measure,
         "measure at the section heights of this reference set instead of those the "
         "mannequin records (its own set's; female for files that record none)",
-        shipped="female or male",
+        shipped="female, male, female-fine or male-fine (of the mannequin's own topology)",
     )
     arguments.add_verbose(measure)
     measure.set_defaults(run=run, blender=needs_blender)
@@ -88,6 +88,7 @@ def run(args):
         )
     if args.references:
         reference = arguments.references(args)
+        reference.check_topology(mannequin, path)
         mannequin = mannequin.copy(reference_set=reference.name, section_fractions=reference.section_fractions)
     values = dict(mannequin.measure())
     values.update(mannequin_extra_measurements(mannequin))

@@ -41,6 +41,10 @@ def test_zip_passes_blenders_validator_and_ships_only_the_add_on(built_zip):
     assert "ellimann_addon/blender/features/trace/operators.py" in names
     assert "ellimann_addon/core/measure/tailor.py" in names
     assert "ellimann_addon/core/synthesis/populations/ansur2_female.json" in names
+    for folder in ("", "male/", "female-fine/", "male-fine/"):  # every shipped set, without its .blend twins
+        assert (
+            f"reference_blends/{folder}average.json" in names and f"reference_blends/{folder}average.blend" not in names
+        )
     shipped_tops = {name.split("/")[0] for name in names}
     assert shipped_tops <= {
         "blender_manifest.toml",

@@ -1,5 +1,5 @@
-"""The .blend twins in reference_blends/ (the female set) and reference_blends/male/ hold the same mannequins as
-the JSON files, measured at the same section heights."""
+"""The .blend twins in reference_blends/ (the female set), reference_blends/male/ and the fine sets' folders hold the
+same mannequins as the JSON files, measured at the same section heights."""
 
 import pathlib
 
@@ -14,7 +14,11 @@ FOLDER = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"
 STEMS = ("base_mannequin", "small_slim", "tall_slim", "small_chubby", "tall_chubby", "average")
 
 
-@pytest.mark.parametrize("folder", [FOLDER, FOLDER / "male"], ids=["female", "male"])
+@pytest.mark.parametrize(
+    "folder",
+    [FOLDER, FOLDER / "male", FOLDER / "female-fine", FOLDER / "male-fine"],
+    ids=["female", "male", "female-fine", "male-fine"],
+)
 @pytest.mark.parametrize("stem", STEMS)
 def test_blend_and_json_agree(stem, folder):
     json_twin = Mannequin.load(folder / f"{stem}.json")

@@ -379,7 +379,13 @@ def test_shipped_presets_hold_the_reference_and_table_2_5_measurements_and_choos
     assert {p.stem for p in shipped_presets()} == set(expected)
     for path in shipped_presets():
         values, chosen = expected[path.stem]
-        for before, after in (("FOLDER", "FOLDER" if chosen == "FEMALE" else chosen), ("MALE", chosen)):
+        fine = f"{chosen}_FINE"  # from a set of the fine topology: its twin of the preset's sex
+        for before, after in (
+            ("FOLDER", "FOLDER" if chosen == "FEMALE" else chosen),
+            ("MALE", chosen),
+            ("FEMALE_FINE", fine),
+            ("MALE_FINE", fine),
+        ):
             props.reference_set = before
             bpy.ops.script.execute_preset(filepath=str(path), menu_idname="ELLIMANN_MT_measurement_presets")
             assert [getattr(props, m.lower()) for m in MEASUREMENTS] == pytest.approx(values)

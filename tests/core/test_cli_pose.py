@@ -10,7 +10,9 @@ import pytest
 from devkit.cli_runs import assert_one_line_error, run
 from ellimann_addon.core.formats.posed_files import read_pose
 from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.skeleton import cross_joint_pairs
 from ellimann_addon.core.pose.standard import standard_pose, walk
+from ellimann_addon.core.synthesis.shipped import FEMALE_FINE_SET, FEMALE_SET
 
 REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]
 
@@ -59,13 +61,18 @@ def test_batch_with_a_pose_writes_each_row_posed(tmp_path, capsys):
         assert obj.count("\no ") == 40  # every ellipsoid, as no --cushions
 
 
-def test_posed_obj_with_cushions_has_the_split_halves(tmp_path, rest, capsys):
+@pytest.mark.parametrize("references", [FEMALE_SET, FEMALE_FINE_SET])
+def test_posed_obj_with_cushions_has_the_split_halves(tmp_path, capsys, references):
+    rest = tmp_path / "rest.json"
+    assert run(["synth", *REQUEST, "--references", references, "-o", str(rest)], capsys)[0] == 0
     out = tmp_path / "t.obj"
     code, _, _ = run(["pose", str(rest), "--pose", "t_pose", "--cushions", "-o", str(out)], capsys)
     assert code == 0
     names = [line[2:] for line in out.read_text().splitlines() if line.startswith("o ")]
     assert "3.a Upper Arm.L + 3.b Forearm.L (3.b Forearm.L)" in names and "5.a Thigh.L + 5.b Knee.L" in names
-    assert "3.a Upper Arm.L" not in names and len(names) == 40 - 30 + 15 + 8
+    topology = Mannequin.load(rest).topology
+    pairs, split = len(topology.cushion_pairs), len(cross_joint_pairs(topology))
+    assert "3.a Upper Arm.L" not in names and len(names) == len(topology) - 2 * pairs + pairs + split
 
 
 def _no_joints(tmp_path, rest):

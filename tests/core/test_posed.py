@@ -18,16 +18,18 @@ from ellimann_addon.core.pose.posed_pieces import (
     split_cushion_names,
     union_volume,
 )
-from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
+from ellimann_addon.core.synthesis.shipped import FEMALE_FINE_SET, FEMALE_SET, SHIPPED_SETS
 
 LEVEL = 3  # cushion resolution of these checks
 SAMPLES = 100_000  # Monte Carlo samples per volume (standard error about 0.4% of a cushion)
 TOLERANCE = 0.03  # the posed union keeps the rest volume within 3%
 
 
-@pytest.fixture(scope="module")
-def average():
-    return Mannequin.load(REFERENCE_FOLDER / "average.json")
+@pytest.fixture(scope="module", params=[FEMALE_SET, FEMALE_FINE_SET])
+def average(request):
+    """The Average RM of the paper's 40 and of the fine topology: posing takes any topology whose parts ride on
+    bones."""
+    return Mannequin.load(SHIPPED_SETS[request.param] / "average.json")
 
 
 @pytest.fixture(scope="module")
@@ -123,6 +125,7 @@ def _cushion_volumes(rig, pose, first):
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("average", [FEMALE_SET], indirect=True)  # the fine topology's cushions across joints: the 40's
 @pytest.mark.parametrize("pose_name", ["t_pose", "attention", "sit", "walk"])
 def test_posed_cushions_across_joints_keep_their_rest_volume(average, rig, pose_name):
     joints = average.joints

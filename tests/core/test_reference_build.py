@@ -150,6 +150,7 @@ def _files(inputs, tmp_path, targets_text=None):
         ("missing row", ["no row for body 'c'"]),
         ("not a number", ["Hi='wide' is not a number"]),
         ("old base", ["no recorded selection"]),
+        ("part added", ["has no recorded selection", "Fit Ellipsoid"]),
     ],
 )
 def test_the_command_refuses_in_one_line_and_writes_nothing(inputs, tmp_path, capsys, case, words):
@@ -159,7 +160,11 @@ def test_the_command_refuses_in_one_line_and_writes_nothing(inputs, tmp_path, ca
         text = "name,He,Sh,Br,Wa,Hi\na,150,32,86,64,84\nb,170,31,85,64,85\n"
     elif case == "not a number":
         text = "name,He,Sh,Br,Wa,Hi\na,150,32,86,64,84\nb,170,31,85,64,85\nc,160,43,117,104,wide\n"
-    args = _files((base.copy(traces=None) if case == "old base" else base, bodies, targets), tmp_path, text)
+    if case == "old base":
+        base = base.copy(traces=None)
+    elif case == "part added":  # a finer base: a part added to a traced one and never fitted
+        base = base.copy(traces={name: trace for name, trace in list(base.traces.items())[1:]})
+    args = _files((base, bodies, targets), tmp_path, text)
     if case == "two bodies":
         args = args[:-1]
     out = tmp_path / "set"

@@ -293,6 +293,18 @@ def update_collection_geometry(collection, mannequin):
     """Move the collection's ellipsoids to ``mannequin``'s geometry (same parts), e.g. for live updates."""
     by_name = {o.ellimann.part_name: o for o in ellipsoid_objects(collection)}
     missing = [name for name in mannequin.topology.names if name not in by_name]
+    extra = [name for name in by_name if name not in mannequin.topology.index]
+    if extra or len(missing) > len(mannequin.topology) // 2:  # another topology: the 40 and the fine one
+        raise MannequinError(
+            [
+                Problem(
+                    "",
+                    "collection",
+                    f"'{collection.name}' has {len(by_name)} ellipsoids, the mannequin {len(mannequin.topology)}: "
+                    "a mannequin of another topology cannot be moved onto it; synthesize a new one",
+                )
+            ]
+        )
     if missing:
         raise MannequinError([Problem(n, "collection", f"has no object in '{collection.name}'") for n in missing])
     write_frames(

@@ -200,6 +200,12 @@ def validate_inputs(base, bodies, targets):
         )
     traces = base.traces or {}
     missing = [name for name in _traced_parts(base.topology) if name not in traces]
+    if missing and traces:  # some recorded: parts added to a traced base (a finer topology) and never fitted
+        raise ReferenceBuildError(
+            f"base '{base.name}': '{missing[0]}' has no recorded selection ({len(missing)} of its "
+            f"{len(_traced_parts(base.topology))} left and central parts have none): in Blender select its vertices on "
+            "the body mesh in Edit Mode and run Fit Ellipsoid (Trace panel), then save the base"
+        )
     if missing:
         raise ReferenceBuildError(
             f"base '{base.name}': {len(missing)} of its {len(_traced_parts(base.topology))} left and central parts "

@@ -66,8 +66,9 @@ class ReferenceSet:
                 raise ReferenceSetError(source, "geometry", str(MannequinError(problems)))
             mismatch = first.topology.mismatch(mannequin.topology)
             if mismatch:
-                more = f" (and {len(mismatch) - 1} more)" if len(mismatch) > 1 else ""
-                raise ReferenceSetError(source, "topology", f"differs from {sources[0]}: {mismatch[0]}{more}")
+                raise ReferenceSetError(
+                    source, "topology", topology_mismatch(mismatch, len(mannequin), len(first), sources[0])
+                )
             mannequin = mannequin.reordered(first.topology) if mannequin.topology != first.topology else mannequin
             ordered.append(mannequin)
             measurements.append(_reference_measurements(mannequin, source))
@@ -128,6 +129,15 @@ class ReferenceSet:
 
     def __len__(self):
         return len(self.mannequins)
+
+    def check_topology(self, mannequin, source):
+        """Raise ReferenceSetError (one line naming ``source``) if ``mannequin`` is not of the set's topology: a
+        mannequin of the 40 measured or updated with the fine set's landmarks, or the other way round."""
+        mismatch = self.topology.mismatch(mannequin.topology)
+        if mismatch:
+            raise ReferenceSetError(
+                source, "topology", topology_mismatch(mismatch, len(mannequin), len(self.topology), f"set {self.name}")
+            )
 
     def size_scales(self, measurements, normalize):
         """Horizontal and vertical scale (..., s) of each interpolated part at ``measurements`` (..., 5) cm.
@@ -196,6 +206,19 @@ class ReferenceSet:
                 self.mirror_label_mismatch.append(self.topology.names[self._right[p]])
             chosen[p] = max(patterns, key=patterns.count) if patterns else (-1.0, 1.0, 1.0)
         return chosen
+
+
+def topology_mismatch(mismatch, mine, theirs, other):
+    """The line that says why a mannequin of ``mine`` parts does not go with ``other``'s of ``theirs``: its first
+    ``mismatch`` (Topology.mismatch) or, for two topologies of different sizes (the paper's 40 and the fine one),
+    that one set holds one topology."""
+    if mine != theirs:
+        return (
+            f"has {mine} parts and {other} {theirs} ('{mismatch[0].ellipsoid}' is in only one): a reference set holds "
+            "mannequins of one topology (the 40 of female and male, or the fine one of female-fine and male-fine)"
+        )
+    more = f" (and {len(mismatch) - 1} more)" if len(mismatch) > 1 else ""
+    return f"differs from {other}: {mismatch[0]}{more}"
 
 
 def _reference_measurements(mannequin, source):

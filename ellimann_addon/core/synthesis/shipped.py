@@ -1,6 +1,7 @@
 """The reference sets that ship, by name: ``female`` (reference_blends/, the default) and ``male``
-(reference_blends/male/). A name or a folder is what ``--references``, a batch CSV's ``references`` column
-and the Synthesize panel choose."""
+(reference_blends/male/), the paper's 40 ellipsoids, and the same bodies on the fine topology (docs/topology_fine.md),
+``female-fine`` and ``male-fine`` (reference_blends/female-fine/, reference_blends/male-fine/). A name or a folder is
+what ``--references``, a batch CSV's ``references`` column and the Synthesize panel choose."""
 
 import pathlib
 
@@ -9,7 +10,14 @@ from ..errors import ReferenceSetError
 from .reference_set import REFERENCE_FOLDER, cached_reference_set
 
 MALE_SET = "male"
-SHIPPED_SETS = {FEMALE_SET: REFERENCE_FOLDER, MALE_SET: REFERENCE_FOLDER / MALE_SET}
+FEMALE_FINE_SET = "female-fine"
+MALE_FINE_SET = "male-fine"
+SHIPPED_SETS = {
+    FEMALE_SET: REFERENCE_FOLDER,
+    MALE_SET: REFERENCE_FOLDER / MALE_SET,
+    FEMALE_FINE_SET: REFERENCE_FOLDER / FEMALE_FINE_SET,
+    MALE_FINE_SET: REFERENCE_FOLDER / MALE_FINE_SET,
+}
 
 
 def reference_folder(name_or_dir=None):

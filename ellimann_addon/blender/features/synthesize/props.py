@@ -103,7 +103,7 @@ class ELLIMANN_PG_synthesis(bpy.types.PropertyGroup):
         default="FEMALE",
         update=on_request_change,
         description="The Reference Mannequins to synthesize from: the shipped female or "
-        "male set, or a folder of your own",
+        "male set (the paper's 40 pieces, or the fine topology's), or a folder of your own",
     )
     references: StringProperty(
         name="References",

@@ -8,16 +8,26 @@ from ....core.errors import ReferenceSetError
 from ....core.measure.extra import EXTRA_MEASUREMENTS
 from ....core.synthesis.options import SynthesisOptions
 from ....core.synthesis.reference_set import cached_reference_set
-from ....core.synthesis.shipped import MALE_SET, SHIPPED_SETS
+from ....core.synthesis.shipped import FEMALE_FINE_SET, MALE_FINE_SET, MALE_SET, SHIPPED_SETS
 from ....core.synthesis.synthesize import synthesize_extra
 
 FIELDS = {key: key.lower() for key in MEASUREMENTS}  # He -> props.he
 REFERENCE_SET_ITEMS = (
     ("FEMALE", "Female", "The shipped female Reference Mannequins (the paper's Table 2.3)"),
     ("MALE", "Male", "The shipped male Reference Mannequins"),
+    (
+        "FEMALE_FINE",
+        "Female, fine",
+        "The female bodies on the fine topology: more pieces, filling more of each body (docs/topology_fine.md)",
+    ),
+    (
+        "MALE_FINE",
+        "Male, fine",
+        "The male bodies on the fine topology: more pieces, filling more of each body (docs/topology_fine.md)",
+    ),
     ("FOLDER", "Folder", "Reference Mannequins of your own, in a folder"),
 )
-_SHIPPED = {"FEMALE": FEMALE_SET, "MALE": MALE_SET}
+_SHIPPED = {"FEMALE": FEMALE_SET, "MALE": MALE_SET, "FEMALE_FINE": FEMALE_FINE_SET, "MALE_FINE": MALE_FINE_SET}
 
 
 def request_of(props):

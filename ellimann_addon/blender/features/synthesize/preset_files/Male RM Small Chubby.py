@@ -7,4 +7,4 @@ props.sh = 55.0
 props.br = 122.0
 props.wa = 116.0
 props.hi = 114.0
-props.reference_set = "MALE"
+props.reference_set = "MALE_FINE" if props.reference_set in ("FEMALE_FINE", "MALE_FINE") else "MALE"

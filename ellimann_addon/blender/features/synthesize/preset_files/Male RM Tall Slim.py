@@ -7,4 +7,4 @@ props.sh = 46.0
 props.br = 90.0
 props.wa = 74.0
 props.hi = 90.0
-props.reference_set = "MALE"
+props.reference_set = "MALE_FINE" if props.reference_set in ("FEMALE_FINE", "MALE_FINE") else "MALE"

@@ -7,5 +7,5 @@ props.sh = 35.75
 props.br = 101.25
 props.wa = 82.75
 props.hi = 117.5
-if props.reference_set == "MALE":  # a female body: from the male set back to the female one
-    props.reference_set = "FEMALE"
+if props.reference_set in ("MALE", "MALE_FINE"):  # a female body: from a male set to the female one of its topology
+    props.reference_set = "FEMALE_FINE" if props.reference_set == "MALE_FINE" else "FEMALE"

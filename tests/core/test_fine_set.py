@@ -1,0 +1,136 @@
+"""The shipped sets on the fine topology (reference_blends/female-fine/, reference_blends/male-fine/): the 40's rules
+hold on every part (mirror twins, right-handed frames, one bone each, girth sections cut only the parts that follow
+their measurement), the RMs meet the same targets as their 40-part twins at the same heights, exact mode meets the
+243 grid, and mannequins of the two topologies are never mixed: a set holding both, a mannequin measured with the
+other topology's set and a live target of the other topology are refused in one line, nothing written."""
+
+import itertools
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+from devkit.cli_runs import assert_one_line_error, run
+from ellimann_addon.core.constants import GIRTHS, MEASUREMENTS, quartile_points
+from ellimann_addon.core.errors import ReferenceSetError
+from ellimann_addon.core.fitting.reference_build import cleanliness_problems
+from ellimann_addon.core.geometry.ellipsoid import section_at_height
+from ellimann_addon.core.geometry.frames import is_rotation
+from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.skeleton import PARENTS, bone_names, cross_joint_pairs, part_bones
+from ellimann_addon.core.measure.tailor import section_heights
+from ellimann_addon.core.synthesis.reference_set import load_reference_set
+from ellimann_addon.core.synthesis.shipped import (
+    FEMALE_FINE_SET,
+    FEMALE_SET,
+    MALE_FINE_SET,
+    MALE_SET,
+    SHIPPED_SETS,
+    named_reference_set,
+)
+from ellimann_addon.core.synthesis.synthesize import EXACT_TOLERANCE, synthesize_batch
+
+TWINS = {FEMALE_FINE_SET: FEMALE_SET, MALE_FINE_SET: MALE_SET}
+
+
+@pytest.fixture(scope="module", params=sorted(TWINS))
+def fine(request):
+    return named_reference_set(request.param)
+
+
+def test_the_fine_topology_holds_the_40_and_more(fine):
+    coarse = named_reference_set(TWINS[fine.name]).topology
+    assert len(fine.topology) > len(coarse)
+    for part in coarse:
+        assert fine.topology.parts[fine.topology.index[part.name]] == part  # the same side, region, flags, partner
+    assert not fine.topology.problems()  # names, sides, mirror twins, partners
+    girths = fine.topology.dependency_mask[:, [MEASUREMENTS.index(key) for key in GIRTHS]]
+    assert girths.sum(axis=1).max() == 1  # no part follows two girths: their factors would be tied (exact mode)
+
+
+def test_every_part_rides_on_one_bone_and_cushions_are_on_one_bone_or_across_a_joint(fine):
+    topology = fine.topology
+    bones = part_bones(topology)
+    assert len(bones) == len(topology)
+    for i, j in topology.cushion_pairs:
+        a, b = bones[i], bones[j]
+        assert a == b or PARENTS[b] == a or PARENTS[a] == b, (topology.names[i], topology.names[j])
+    assert all(joint >= 0 for _, _, joint in cross_joint_pairs(topology))
+    named = bone_names(topology)
+    for name, bone in named.items():  # a part and its mirror twin ride on mirrored bones
+        if name.endswith(".L"):
+            assert named[name[:-2] + ".R"] == (f"R{bone[1:]}" if bone.startswith("L_") else bone), name
+
+
+def test_the_rms_are_clean_right_handed_and_meet_their_40_twins_targets(fine):
+    coarse = named_reference_set(TWINS[fine.name])
+    assert fine.names == coarse.names and fine.section_fractions == coarse.section_fractions
+    assert np.array_equal(fine.measurements, coarse.measurements) and fine.ranges == coarse.ranges
+    for name, mannequin in zip(fine.names, fine.mannequins):
+        assert mannequin.reference_set == fine.name and mannequin.joints is not None
+        assert np.all(is_rotation(mannequin.rotation, 1e-9)) and not cleanliness_problems(mannequin)
+        measured = mannequin.measure()
+        for k, key in enumerate(MEASUREMENTS):
+            assert abs(measured[key] / fine.measurements[fine.names.index(name), k] - 1.0) < EXACT_TOLERANCE
+    base = Mannequin.load(SHIPPED_SETS[fine.name] / "base_mannequin.json")
+    assert base.role == "base" and base.reference_set == fine.name and base.topology == fine.topology
+    assert set(base.traces) == set(base.topology.names)  # every part's selection recorded
+
+
+def test_each_girth_section_cuts_only_parts_that_follow_its_measurement(fine):
+    """The 40's rule on every part: a girth part keeps clear of the sections of measurements it does not depend
+    on, so synthesis' segmented IDW and exact mode's factors act on the parts each measurement is taken on."""
+    girth, depends = fine.topology.girth_mask, fine.topology.dependency_mask
+    for mannequin in fine.mannequins:
+        _, _, heights = section_heights(
+            mannequin.rotation, mannequin.center, mannequin.semi_axes, mannequin.section_fractions
+        )
+        for key in GIRTHS:
+            _, _, hit = section_at_height(mannequin.rotation, mannequin.center, mannequin.semi_axes, heights[key])
+            cut = hit & girth
+            follows = depends[:, MEASUREMENTS.index(key)]
+            assert np.all(follows[cut]), (mannequin.name, key, np.array(fine.topology.names)[cut & ~follows])
+
+
+def test_the_manifest_names_the_fine_set_and_its_topology(fine):
+    manifest = json.loads((SHIPPED_SETS[fine.name] / "reference_set.json").read_text(encoding="utf-8"))
+    assert manifest["name"] == fine.name and manifest["sex"] == named_reference_set(TWINS[fine.name]).manifest.sex
+    assert f"{len(fine.topology)} parts" in manifest["provenance"]["topology"]
+
+
+def test_exact_mode_meets_the_243_grid_on_the_fine_sets(fine):
+    grid = np.array(list(itertools.product(*[quartile_points(k, fine.ranges) for k in MEASUREMENTS])))
+    result = synthesize_batch(fine, grid, mode="exact")
+    assert result.converged.all()
+    assert result.relative_error().max() <= 100.0 * EXACT_TOLERANCE
+
+
+def _mixed_folder(tmp_path):
+    """The female set's folder with one RM replaced by its fine twin."""
+    folder = tmp_path / "mixed"
+    shutil.copytree(SHIPPED_SETS[FEMALE_SET], folder, ignore=shutil.ignore_patterns("*.blend"))
+    shutil.copy(SHIPPED_SETS[FEMALE_FINE_SET] / "tall_slim.json", folder / "tall_slim.json")
+    return folder
+
+
+def test_a_set_mixing_topologies_is_refused_in_one_line(tmp_path, capsys):
+    folder = _mixed_folder(tmp_path)
+    with pytest.raises(ReferenceSetError, match="one topology") as info:
+        load_reference_set(folder)
+    assert "tall_slim.json" in str(info.value) and "\n" not in str(info.value)
+    out = tmp_path / "m.json"
+    request = ["--he", "160", "--sh", "40", "--br", "100", "--wa", "80", "--hi", "100"]
+    code, _, err = run(["synth", *request, "--references", str(folder), "-o", str(out)], capsys)
+    assert_one_line_error(code, err, "tall_slim.json", "one topology")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("mannequin_set, references", [(FEMALE_SET, FEMALE_FINE_SET), (MALE_FINE_SET, MALE_SET)])
+def test_a_mannequin_measured_with_the_other_topologys_set_is_refused(mannequin_set, references, capsys):
+    path = SHIPPED_SETS[mannequin_set] / "average.json"
+    code, out, err = run(["measure", str(path), "--references", references], capsys)
+    assert_one_line_error(code, err, "average.json", "parts", "one topology")
+    assert not out
+    code, out, _ = run(["measure", str(SHIPPED_SETS[references] / "average.json"), "--references", references], capsys)
+    assert code == 0 and "He" in out
