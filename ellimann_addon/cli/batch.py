@@ -135,8 +135,8 @@ def run(args):
 
 def check_skin_batch(args, formats, table, reference):
     """Refuse, before anything is written, what --skin cannot do in this batch: the batch file (it holds pieces),
-    Dask (skins are made in this process), exact mode with extra measurement columns, a voxel the command's
-    reference set refuses, posing a set without joints."""
+    Dask (skins are made in this process), a voxel the command's reference set refuses, posing a set without
+    joints."""
     settings = args.skin_settings
     if settings is None:
         return
@@ -304,6 +304,7 @@ def _row(args, formats, result, i, row, bundles=None, pose_file=None):
     bundle = bundles.path_of(row.reference) if bundles is not None else None
     listed = paths + ([bundle] if bundle is not None else [])
     kept = bool(paths) and args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths)
+    kept = kept and (args.skin_settings is None or skinning.files_hold_skin(paths, args.skin_settings))
     skinned = None
     if not kept:
         try:

@@ -6,6 +6,7 @@ IDW the skin of the pieces as they are; the skin's measurements (on its mesh) re
 A skin is made per mannequin and dropped once its files are written: a batch's memory stays flat. The skin's core is
 imported only when a skin is asked: a command without --skin starts as fast as before."""
 
+import json
 import math
 from dataclasses import dataclass
 
@@ -135,7 +136,7 @@ def make_skin(mannequin, settings, mode, request, extra=None):
     as they are, the extra ones measured on it by the body-mesh measurer. SkinError (one line) if the skin cannot be
     made."""
     from ..core.skin.exact import exact_skin
-    from ..core.skin.measure import mesh_measurements
+    from ..core.skin.measure import body_measurements, mesh_measurements
     from ..core.skin.surface import build_skin
 
     if mode == "exact":
@@ -153,7 +154,7 @@ def make_skin(mannequin, settings, mode, request, extra=None):
         skin = build_skin(mannequin, settings)
         skinned = Skinned(mannequin, skin, mesh_measurements(skin), dict(mannequin.measure()), False)
         if extra:
-            values = skin.measure().values
+            values = body_measurements(skin).values
             skinned.measured.update({key: values.get(key, math.nan) for key in EXTRA_MEASUREMENTS if key in extra})
     return skinned
 
@@ -183,3 +184,33 @@ def mesh_tolerance_cm():
     from ..core.skin.exact import MESH_TOLERANCE_CM
 
     return MESH_TOLERANCE_CM
+
+
+def files_hold_skin(paths, settings):
+    """Whether a batch row's files (``--resume``) hold a skin made at ``settings``: its .json's ``skin`` section or its
+    .obj's first line says so. A row written without a skin or with another voxel or blend, or whose formats (.xml,
+    .blend, .glb) cannot tell, is written again."""
+    told = False
+    for path in paths:
+        if path.endswith(".json"):
+            try:
+                with open(path, encoding="utf-8") as stream:
+                    record = json.load(stream).get("skin")
+            except (OSError, ValueError, AttributeError):
+                return False
+            if not isinstance(record, dict) or (record.get("voxel_mm"), record.get("blend")) != (
+                settings.voxel_mm,
+                settings.blend,
+            ):
+                return False
+            told = True
+        elif path.endswith(".obj"):
+            try:
+                with open(path, encoding="utf-8") as stream:
+                    first = stream.readline()
+            except (OSError, UnicodeDecodeError):
+                return False
+            if f": {settings.voxel_mm:g} mm voxels, blend {settings.blend:g};" not in first:
+                return False
+            told = True
+    return told

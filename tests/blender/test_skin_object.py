@@ -21,6 +21,8 @@ from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.geometry.mesh import is_closed_manifold
 from ellimann_addon.core.mannequin.skeleton import JOINT_NAMES
 from ellimann_addon.core.pose.motion import clamped_motion
+from ellimann_addon.core.skin.exact import MESH_TOLERANCE_CM
+from ellimann_addon.core.skin.measure import mesh_measurements
 from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.synthesis.shipped import named_reference_set
@@ -168,7 +170,8 @@ def test_a_glb_with_a_skin_is_a_valid_skinned_gltf_with_the_walk(average, previe
     weights = gltf_skin.accessor(doc, binary, primitive["attributes"]["WEIGHTS_0"])
     assert np.allclose(weights.sum(axis=1), 1.0, atol=1e-3) and (weights[:, 1] > 0.0).any()  # blended, not rigid
     # the pieces are there too, inside the skin (colliders for an engine)
-    kinds = [n["extras"]["ellimann"]["kind"] for n in doc["nodes"] if "ellimann" in n.get("extras", {})]
+    # (the armature's node carries the mannequin's extras, without a kind)
+    kinds = [n["extras"]["ellimann"].get("kind") for n in doc["nodes"] if "ellimann" in n.get("extras", {})]
     assert kinds.count("SKIN") == 1 and "CUSHION" in kinds and "ELLIPSOID" in kinds
 
 
@@ -231,6 +234,19 @@ def test_synthesize_with_skin_and_live_the_skin_follows_the_pieces_then_is_made_
     assert skin_object(target) == obj and not is_stale_skin(obj, collection_to_mannequin(target))
     assert skin_live.remembered(obj) is not made and len(built_objects(target, "SKIN")) == 1
     props.live = False
+
+
+def test_synthesize_with_skin_in_exact_mode_makes_the_skin_measure_the_request(props):
+    """The skin the user sees meets the five (the pieces under it measure less: the blend adds the rest), and the
+    report says what the skin measures."""
+    assert bpy.ops.ellimann.synthesize_mannequin() == {"FINISHED"}
+    skin = skin_live.remembered(skin_object(props.target))
+    asked = dict(zip(MEASUREMENTS, (159.0, 43.0, 117.0, 104.0, 117.0)))
+    on_mesh = mesh_measurements(skin)
+    assert all(abs(on_mesh[key] - wanted) <= MESH_TOLERANCE_CM for key, wanted in asked.items()), on_mesh
+    pieces = collection_to_mannequin(props.target).measure()
+    assert pieces["Hi"] < asked["Hi"] - MESH_TOLERANCE_CM
+    assert np.allclose(skin.mannequin.center, collection_to_mannequin(props.target).center, atol=1e-6)
 
 
 def test_ticking_skin_with_live_on_makes_one_when_the_fields_settle(props):

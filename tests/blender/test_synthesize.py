@@ -445,3 +445,16 @@ def test_the_panel_is_a_sub_panel_registered_with_the_add_on():
 def test_recorder_catches_a_misspelt_property(props):
     with pytest.raises(AttributeError):
         Recorder().prop(props, "height")
+
+
+def test_the_reference_set_choice_keeps_the_numbers_files_store(props):
+    """A .blend stores an enum's number: Folder stayed 2 when the fine sets came (a file saved with Folder must not
+    reopen with another set)."""
+    items = props.bl_rna.properties["reference_set"].enum_items
+    assert {item.identifier: item.value for item in items} == {
+        "FEMALE": 0,
+        "MALE": 1,
+        "FOLDER": 2,
+        "FEMALE_FINE": 3,
+        "MALE_FINE": 4,
+    }

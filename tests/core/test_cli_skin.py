@@ -280,6 +280,18 @@ def test_batch_reports_each_row_s_skin_beside_its_pieces_and_resume_keeps_the_fi
     assert code == 0 and "(2 already complete, kept)" in stdout, stderr
     kept = list(csv.DictReader((tmp_path / "out" / "report.csv").open(encoding="utf-8")))
     assert [r["message"] for r in kept] == ["kept (--resume)"] * 2 and kept[0]["He_skin"] == ""
+    # resumed with another skin, or with none before: each row is written again, never kept without its skin
+    coarser = [*argv[: argv.index("--skin-level")], "--skin-voxel", "12", "--mode", "idw", "--resume"]
+    code, stdout, stderr = run(coarser, capsys)
+    assert code == 0 and "(2 already complete" not in stdout, stderr
+    assert Mannequin.load(tmp_path / "out" / "a.json").skin == SkinSettings(12.0).to_dict()
+    plain = tmp_path / "plain"
+    assert run(["batch", str(source), "-o", str(plain), "--format", "obj,json", "--mode", "idw"], capsys)[0] == 0
+    code, stdout, stderr = run(
+        ["batch", str(source), "-o", str(plain), "--format", "obj,json", *PREVIEW, "--resume"], capsys
+    )
+    assert code == 0 and "(2 already complete" not in stdout, stderr
+    assert "mm voxels" in (plain / "a.obj").read_text(encoding="utf-8").splitlines()[0]
 
 
 @pytest.mark.slow

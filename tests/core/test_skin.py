@@ -10,6 +10,7 @@ import pytest
 
 from devkit.mesh_checks import self_intersections, vertex_manifold
 from ellimann_addon.core.constants import MEASUREMENTS, TABLE_2_5
+from ellimann_addon.core.drape.fit_metrics import mesh_distance
 from ellimann_addon.core.errors import ElliMannError
 from ellimann_addon.core.geometry.ellipsoid import sample_surface
 from ellimann_addon.core.geometry.mesh import euler_characteristic, is_closed_manifold, section_segments, volume
@@ -22,6 +23,8 @@ from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import SkinError, build_skin, outer_surface
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize
+
+MESHING_ERROR_M = 0.0065  # how far a piece may poke out of its 10 mm skin (the fingers' mitten: 4.7-5.9 mm measured)
 
 
 @pytest.fixture(scope="module")
@@ -148,8 +151,7 @@ def test_the_narrow_band_gives_the_whole_grid_s_mesh(female):
     assert np.array_equal(narrow[0], dense[0]) and np.array_equal(narrow[1], dense[1])
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("index", range(5))
+@pytest.mark.parametrize("index", range(5))  # not slow (about 5 s each): on numpy 1 and 2 alike
 def test_a_reference_mannequin_s_skin_is_one_closed_oriented_sphere_holding_every_piece(female, index):
     m = female.mannequins[index]
     skin = build_skin(m, SkinSettings(10.0))
@@ -157,47 +159,11 @@ def test_a_reference_mannequin_s_skin_is_one_closed_oriented_sphere_holding_ever
     assert is_closed_manifold(faces) and vertex_manifold(faces, len(vertices))
     assert euler_characteristic(vertices, faces) == 2 and skin.volume > 0.0
     assert len(self_intersections(vertices, faces)) == 0
-    # every piece inside: points on each piece's surface are inside the skin or within the meshing's error of it
-    points = np.concatenate([sample_surface(r, c, s, 200) for r, c, s in zip(m.rotation, m.center, m.semi_axes)])
-    inside = _inside(points, vertices, faces)
-    nearest = _nearest_vertex_distance(points[~inside], vertices, 0.012)
-    assert np.all(nearest < 0.012)
+    # every piece inside: points on each piece's surface inside the skin or outside by at most the meshing's error
+    # (exact signed distance; at 10 mm the fingers' mitten, 1 cm thin, pokes out by up to 6 mm)
+    points = np.concatenate([sample_surface(r, c, s, 100) for r, c, s in zip(m.rotation, m.center, m.semi_axes)])
+    assert mesh_distance(points, vertices, faces)[0].max() <= MESHING_ERROR_M
     assert np.allclose(skin.weights.sum(axis=1), 1.0) and skin.pieces.shape == (len(vertices), 4)
-
-
-def _inside(points, vertices, faces):
-    """Ray parity along +x through a closed mesh (fine for the test's sampled points): points taken in height
-    order, a hundred at a time, against the triangles whose height span reaches theirs."""
-    tri = vertices[faces]
-    low, high = tri[:, :, 2].min(axis=1), tri[:, :, 2].max(axis=1)
-    order = np.argsort(points[:, 2])
-    inside = np.zeros(len(points), dtype=bool)
-    for rows in np.array_split(order, max(1, len(points) // 100)):
-        p = points[rows]
-        near = tri[(high >= p[:, 2].min()) & (low <= p[:, 2].max())]
-        y, z = p[:, None, 1], p[:, None, 2]
-        a, b, c = near[None, :, 0], near[None, :, 1], near[None, :, 2]
-        d = (b[..., 1] - a[..., 1]) * (c[..., 2] - a[..., 2]) - (c[..., 1] - a[..., 1]) * (b[..., 2] - a[..., 2])
-        u = ((b[..., 1] - y) * (c[..., 2] - z) - (c[..., 1] - y) * (b[..., 2] - z)) / np.where(d == 0, 1, d)
-        v = ((c[..., 1] - y) * (a[..., 2] - z) - (a[..., 1] - y) * (c[..., 2] - z)) / np.where(d == 0, 1, d)
-        w = 1 - u - v
-        hit = (d != 0) & (u >= 0) & (v >= 0) & (w >= 0)
-        x = u * a[..., 0] + v * b[..., 0] + w * c[..., 0]
-        inside[rows] = (np.sum(hit & (x > p[:, None, 0]), axis=1) % 2) == 1
-    return inside
-
-
-def _nearest_vertex_distance(points, vertices, reach):
-    """Each point's distance to the nearest vertex, looked for within ``reach`` of its height (``reach`` where
-    none is that near)."""
-    order = np.argsort(points[:, 2])
-    distance = np.full(len(points), reach)
-    for rows in np.array_split(order, max(1, len(points) // 100)):
-        p = points[rows]
-        near = vertices[(vertices[:, 2] >= p[:, 2].min() - reach) & (vertices[:, 2] <= p[:, 2].max() + reach)]
-        if len(near):
-            distance[rows] = np.minimum(reach, np.linalg.norm(p[:, None] - near[None], axis=2).min(axis=1))
-    return distance
 
 
 def test_following_the_same_pieces_leaves_the_skin_where_it_is_and_a_move_moves_it_rigidly(female):
@@ -239,6 +205,14 @@ def test_a_voxel_too_fine_for_memory_or_too_coarse_for_a_piece_is_refused_before
         build_skin(m, SkinSettings(1.0))
     with pytest.raises(SkinError, match=r"Fingers.* too thin for 20 mm voxels.* mm or finer keeps every piece"):
         build_skin(m, SkinSettings(20.0))
-    for bad in (float("nan"), -5.0, 0.2, 100.0):
+    for bad in (float("nan"), -5.0, 0.2, 100.0, True):
         with pytest.raises(ElliMannError, match="skin_voxel: must be a number from 1 to 40"):
             SkinSettings(bad)
+
+
+def test_a_topology_off_the_skeleton_blends_by_partners_and_regions(toy):
+    """A reference set of one's own may label its parts as it likes: no bone, yet a skin (no bone clause)."""
+    names = toy.topology.names
+    pairs = {(names[i], names[j]) for i, j in blend_pairs(toy.topology)}
+    assert pairs and all(not (a.endswith(".L") and b.endswith(".R")) for a, b in pairs)
+    assert any({"2.a Chest", "2.b Belly"} == {a, b} for a, b in pairs)

@@ -5,12 +5,13 @@ import numpy as np
 import pytest
 
 from devkit.mesh_checks import self_intersections, vertex_manifold
+from ellimann_addon.core.drape.fit_metrics import mesh_distance
 from ellimann_addon.core.geometry.ellipsoid import sample_surface
 from ellimann_addon.core.geometry.mesh import euler_characteristic, is_closed_manifold, volume
 from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.synthesis.shipped import FEMALE_FINE_SET, MALE_FINE_SET, named_reference_set
-from tests.core.test_skin import _inside, _nearest_vertex_distance
+from tests.core.test_skin import MESHING_ERROR_M
 from tests.core.test_skinning import VOLUME_TOLERANCE, every_frame, posed
 
 
@@ -27,8 +28,7 @@ def test_the_fine_skin_is_one_closed_oriented_sphere_holding_every_piece(skin):
     assert euler_characteristic(vertices, faces) == 2 and skin.volume > 0.0
     assert len(self_intersections(vertices, faces)) == 0
     points = np.concatenate([sample_surface(r, c, s, 100) for r, c, s in zip(m.rotation, m.center, m.semi_axes)])
-    inside = _inside(points, vertices, faces)
-    assert np.all(_nearest_vertex_distance(points[~inside], vertices, 0.012) < 0.012)
+    assert mesh_distance(points, vertices, faces)[0].max() <= MESHING_ERROR_M
     assert skin.pieces.max() < 78 and np.allclose(skin.weights.sum(axis=1), 1.0)
 
 

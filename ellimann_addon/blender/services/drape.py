@@ -41,7 +41,7 @@ from ...core.drape.settings import FRAME_RANGE, MAX_CLOTH_VERTICES, DrapeSetting
 from ...core.errors import ElliMannError
 from ...core.pose.kinematics import pose_mannequin
 from ..bridge.convert import mesh_from_arrays, new_collection
-from .drape_motion import BODY_COLOR, PIECE_KEY, animate_drape
+from .drape_motion import PIECE_KEY, animate_drape, show_body
 from .rig import check_rig
 
 DRAPE_KEY = "ellimann_drape"  # ID property on a drape collection: the garment's name
@@ -372,13 +372,6 @@ def fit_distance(points, body, cushions, skin=None, pose=None):
         return BodyPieces(body, cushions, FIT_CUSHION_LEVEL).signed_distance(points, FIT_CUTOFF)[0]
     vertices = skin.vertices if pose is None else skin.posed(pose)
     return mesh_distance(points, vertices, skin.faces)[0]
-
-
-def show_body(colliders):
-    """Show collider objects as the body (solid, in renders too): the skin the cloth lies on."""
-    for obj in colliders:
-        obj.display_type, obj.hide_render, obj.color = "SOLID", False, BODY_COLOR
-        obj.hide_set(False)
 
 
 def mesh_piece(name, vertices, faces):

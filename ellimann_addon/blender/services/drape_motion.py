@@ -45,9 +45,8 @@ def animate_drape(collection, colliders, garment_object, mannequin, poses, loop,
     names = topology.names
     crossing = {cushion_name(names[i], names[j]): (i, j, joint) for i, j, joint in cross_joint_pairs(topology)}
     pairs = {cushion_name(names[i], names[j]): i for i, j in topology.cushion_pairs}
-    for obj in colliders:  # the moving body is what the drape shows: its colliders, solid
-        obj.display_type, obj.hide_render, obj.color = "SOLID", False, BODY_COLOR
-        obj.hide_set(False)
+    show_body(colliders)  # the moving body is what the drape shows: its colliders, solid
+    for obj in colliders:
         piece = obj.get(PIECE_KEY, "")
         if piece == SKIN_COLLIDER and skin is not None:
             bind_weights(obj, rig, skin_bone_weights(skin))
@@ -98,3 +97,10 @@ def nearest_joint_weights(obj, joints):
     torso = np.array([JOINT_INDEX[name] for name in TORSO_JOINTS])
     nearest = np.argmin(np.linalg.norm(vertices[:, None, :] - joints[torso][None], axis=2), axis=1)
     return {name: (nearest == k).astype(float) for k, name in enumerate(TORSO_JOINTS) if np.any(nearest == k)}
+
+
+def show_body(colliders):
+    """Show collider objects as the body (solid, in renders too): the skin the cloth lies on."""
+    for obj in colliders:
+        obj.display_type, obj.hide_render, obj.color = "SOLID", False, BODY_COLOR
+        obj.hide_set(False)

@@ -14,6 +14,7 @@ import bpy
 import numpy as np
 
 from ...core.mannequin.skeleton import JOINT_COUNT, JOINT_NAMES
+from ...core.skin.exact import exact_skin
 from ...core.skin.surface import build_skin
 from ..bridge.convert import objects_recursive, rig_object
 from ..bridge.skin import write_skin_object
@@ -33,6 +34,20 @@ def make_skin(mannequin, settings, progress=None):
         skin.bones()
     report(0.9, "writing it")
     return skin
+
+
+def make_exact_skin(mannequin, settings, request, extra=None, progress=None):
+    """Exact mode on the skin (``core.skin.exact.exact_skin``): pieces near ``mannequin`` whose skin at ``settings``
+    measures ``request`` ({He..Hi: cm}) and ``extra``, the skin weighted to the bones when it has joints (before any
+    scene change). Returns the ExactSkin; ``progress`` as :func:`make_skin`'s."""
+    report = progress or (lambda fraction, message: None)
+    report(0.0, f"refining the pieces until their skin measures the request ({settings.voxel_mm:g} mm voxels)")
+    result = exact_skin(mannequin, settings, request, extra or None)
+    if result.mannequin.joints is not None:
+        report(0.8, "weighting it to the bones")
+        result.skin.bones()
+    report(0.9, "writing it")
+    return result
 
 
 def add_skin(collection, skin):

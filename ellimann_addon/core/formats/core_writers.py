@@ -47,8 +47,9 @@ def with_skin_record(mannequin, skin):
     if skin is None:
         return mannequin
     made_from = skin.mannequin
-    if made_from is not mannequin and not (
-        np.array_equal(made_from.center, mannequin.center) and np.array_equal(made_from.semi_axes, mannequin.semi_axes)
+    if made_from is not mannequin and not all(
+        np.array_equal(getattr(made_from, field), getattr(mannequin, field))
+        for field in ("rotation", "center", "semi_axes")
     ):
         raise ElliMannError(f"skin: made from other pieces than those of '{mannequin.name}'")
     return mannequin.copy(skin=skin.settings.to_dict())

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.ellipsoid import bounds
-from ..mannequin.skeleton import PARENTS, part_bones
+from ..mannequin.skeleton import PARENTS, bone_problems, part_bones
 
 COARSE = 4  # fine nodes per coarse cell edge (a power of 2)
 LIPSCHITZ = 1.5  # bound on the field's slope used to rule a coarse cell out (the bound's slope is 1 at a surface)
@@ -107,8 +107,10 @@ def blend_pairs(topology):
     """(P, 2) part indices that blend: neighbours in the body. Two parts are neighbours when they are cushion
     partners, or ride on one bone or on a bone and its child, or belong to one region or to two regions that
     touch (REGION_NEIGHBOURS: the shoulder's pieces with the chest's, not the arm's); never a left part with a
-    right one (the thighs, the breasts, the buttocks meet in a crease) nor an arm with the torso beside it."""
-    bones = part_bones(topology)
+    right one (the thighs, the breasts, the buttocks meet in a crease) nor an arm with the torso beside it. A
+    topology whose parts are not all on a bone (a reference set of one's own, with its own labels) blends by
+    partners and regions alone."""
+    bones = None if bone_problems(topology) else part_bones(topology)
     partners = {tuple(sorted(pair)) for pair in topology.cushion_pairs}
     parts = list(topology)
 
@@ -116,7 +118,9 @@ def blend_pairs(topology):
         a, b = parts[i], parts[j]
         if {a.side, b.side} == {"L", "R"}:
             return False
-        joined = bones[i] == bones[j] or PARENTS[bones[i]] == bones[j] or PARENTS[bones[j]] == bones[i]
+        joined = bones is not None and (
+            bones[i] == bones[j] or PARENTS[bones[i]] == bones[j] or PARENTS[bones[j]] == bones[i]
+        )
         return (
             (i, j) in partners or joined or a.region == b.region or frozenset((a.region, b.region)) in REGION_NEIGHBOURS
         )

@@ -14,7 +14,7 @@ from ..constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
 from ..geometry.ellipsoid import bounds
 from ..geometry.mesh import convex_hull_2d, polygon_perimeter, section_segments
 from ..measure.body import measure_body_mesh
-from ..measure.extra import SIDES, MannequinLandmarks
+from ..measure.extra import SIDES, MannequinLandmarks, mannequin_tilt
 from .field import FADE, Grid, PieceField, blend_pairs, blend_widths
 
 SECTION_COARSE = 0.004  # m between the samples of a section plane whose grid edges bracket the surface
@@ -54,9 +54,11 @@ def skin_arms(skin):
 def body_measurements(skin, fractions=None):
     """The skin's mesh measured by the body-mesh measurer (core.measure.body: the extra measurements' definitions
     on any mesh) with its arms known (:func:`skin_arms`), not searched for by geometry: an arm that touches the
-    torso is still an arm. A BodyMeasurement."""
+    torso is still an arm; the neck square to the mannequin's own neck axis (``mannequin_tilt``, as its pieces'
+    neck is taken), not to a tilt searched on the mesh, which jumps between nearby skins. A BodyMeasurement."""
     fractions = fractions or skin.mannequin.section_fractions
-    return measure_body_mesh(skin.vertices, skin.faces, fractions, arms=skin_arms(skin))
+    tilt = mannequin_tilt(skin.mannequin)
+    return measure_body_mesh(skin.vertices, skin.faces, fractions, neck_tilt=tilt, arms=skin_arms(skin))
 
 
 class SkinField:

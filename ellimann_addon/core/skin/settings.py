@@ -58,7 +58,8 @@ class SkinSettings:
             ("skin_voxel", self.voxel_mm, VOXEL_RANGE_MM),
             ("skin_blend", self.blend, BLEND_RANGE),
         ):
-            if not isinstance(value, (int, float)) or not math.isfinite(value) or not low <= value <= high:
+            number = isinstance(value, (int, float)) and not isinstance(value, bool)
+            if not number or not math.isfinite(value) or not low <= value <= high:
                 raise ElliMannError(f"{name}: must be a number from {low:g} to {high:g}, got {value!r}")
 
     @classmethod

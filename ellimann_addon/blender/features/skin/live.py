@@ -66,11 +66,14 @@ def settle_skin(scene):
     try:
         mannequin = collection_to_mannequin(target)
         obj = skin_object(target)
+        if obj is not None and obj.mode != "OBJECT":  # being edited: its mesh is the user's until they leave
+            _settle_later(scene)
+            return None
         if obj is not None and remembered(obj) is not None and not is_stale_skin(obj, mannequin):
             return None
         skin = make_skin(mannequin, SkinSettings.at_level(LIVE_LEVEL))
         obj = add_skin(target, skin)
-    except ElliMannError as error:
+    except (ElliMannError, RuntimeError) as error:
         message = " ".join(str(error).split())
         props.status = f"Skin not made: {message}"
         print(f"ElliMann: the skin of '{target.name}' not made: {message}", file=sys.stderr)

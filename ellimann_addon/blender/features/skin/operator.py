@@ -74,8 +74,8 @@ class ELLIMANN_OT_build_skin(MannequinOperator, bpy.types.Operator):
             settings = settings_of(self.level, self.voxel, self.blend)
             skin = make_skin(mannequin, settings, lambda fraction, _message: window_manager.progress_update(fraction))
             obj = add_skin(collection, skin)  # the core's work is done: from here the scene changes
-        except ElliMannError as error:
-            raise OperatorError(str(error)) from None
+        except (ElliMannError, RuntimeError) as error:
+            raise OperatorError(" ".join(str(error).split())) from None
         finally:
             window_manager.progress_end()
         live.remember(obj, skin)

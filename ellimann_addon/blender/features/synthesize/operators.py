@@ -6,12 +6,13 @@ import bpy
 from ....core.constants import MEASUREMENTS
 from ....core.errors import ElliMannError
 from ....core.measure.tailor import measurement_line
+from ....core.skin.exact import MESH_TOLERANCE_CM
 from ....core.synthesis.synthesize import relative_error
 from ... import ids
 from ...bridge.convert import ellipsoid_objects
 from ...services.rig import build_rig, check_rig
 from ...services.scene import add_mannequin
-from ...services.skin import add_skin, make_skin
+from ...services.skin import add_skin, make_exact_skin, make_skin
 from ..skin import live as skin_live
 from ..skin.operator import settings_of
 from .request import extra_of, request_of, synthesize_request
@@ -35,7 +36,10 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
             five = {key: measured[key] for key in MEASUREMENTS}
             if mannequin.joints is not None:
                 check_rig(mannequin)  # before the scene changes
-            skin = make_skin(mannequin, settings_of(props.skin_level)) if props.skin else None
+            skin, on_skin = None, None
+            if props.skin:
+                mannequin, skin, on_skin = self.skin_of(context, props, mannequin)
+                five = {key: float(value) for key, value in mannequin.measure().items()}
             collection = add_mannequin(mannequin, five, cushions=props.output == "CUSHIONS")
             rig = build_rig(collection, mannequin) if mannequin.joints is not None else None
             if skin is not None:
@@ -43,20 +47,45 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
         except ElliMannError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
+        if on_skin is not None:
+            asked = {**request_of(props), **extra_of(props)}
+            missed = [key for key, wanted in asked.items() if abs(on_skin[key] - wanted) > MESH_TOLERANCE_CM]
+            warnings = list(warnings) + [
+                f"exact mode on the skin missed {key}: skin {on_skin[key]:.2f} cm for {asked[key]:g} cm"
+                for key in missed
+            ]
         props.target = collection
         props.status = "; ".join(warnings)
         for warning in warnings:
             self.report({"WARNING"}, warning)
-        worst = relative_error(five, request_of(props)).max()
-        values = measurement_line(five) + "".join(f", {key} {measured[key]:.2f}" for key in extra_of(props))
+        shown = five if on_skin is None else {key: on_skin[key] for key in MEASUREMENTS}
+        worst = relative_error(shown, request_of(props)).max()
+        extra_values = measured if on_skin is None else on_skin
+        values = measurement_line(shown) + "".join(f", {key} {extra_values[key]:.2f}" for key in extra_of(props))
         self.report(
             {"INFO"},
             f"Synthesized '{collection.name}' ({len(ellipsoid_objects(collection))} ellipsoids, "
             f"{props.mode.lower()}{', with an armature' if rig else ''}{', with a skin' if props.skin else ''}): "
-            f"m_T {values} cm, "
+            f"{'m_T' if on_skin is None else 'on the skin'} {values} cm, "
             f"max error {worst:.2f}%",
         )
         return {"FINISHED"}
+
+    @staticmethod
+    def skin_of(context, props, mannequin):
+        """(pieces, core Skin, what the skin measures or None): in exact mode the pieces refined until their skin
+        measures the request (the five and the extra ones ticked), else the skin over the pieces as they are."""
+        settings = settings_of(props.skin_level)
+        window_manager = context.window_manager
+        window_manager.progress_begin(0.0, 1.0)
+        try:
+            progress = lambda fraction, _message: window_manager.progress_update(fraction)  # noqa: E731
+            if props.mode != "EXACT":
+                return mannequin, make_skin(mannequin, settings, progress), None
+            result = make_exact_skin(mannequin, settings, request_of(props), extra_of(props), progress)
+            return result.mannequin, result.skin, result.skin_measured
+        finally:
+            window_manager.progress_end()
 
 
 classes = (ELLIMANN_OT_synthesize_mannequin,)

@@ -12,20 +12,24 @@ from ....core.synthesis.shipped import FEMALE_FINE_SET, MALE_FINE_SET, MALE_SET,
 from ....core.synthesis.synthesize import synthesize_extra
 
 FIELDS = {key: key.lower() for key in MEASUREMENTS}  # He -> props.he
+# Each item's number is what a .blend stores: fixed, so that a file saved before the fine sets existed (Folder
+# was 2) reopens with the set it chose.
 REFERENCE_SET_ITEMS = (
-    ("FEMALE", "Female", "The shipped female Reference Mannequins (the paper's Table 2.3)"),
-    ("MALE", "Male", "The shipped male Reference Mannequins"),
+    ("FEMALE", "Female", "The shipped female Reference Mannequins (the paper's Table 2.3)", 0),
+    ("MALE", "Male", "The shipped male Reference Mannequins", 1),
     (
         "FEMALE_FINE",
         "Female, fine",
         "The female bodies on the fine topology: more pieces, filling more of each body (docs/topology_fine.md)",
+        3,
     ),
     (
         "MALE_FINE",
         "Male, fine",
         "The male bodies on the fine topology: more pieces, filling more of each body (docs/topology_fine.md)",
+        4,
     ),
-    ("FOLDER", "Folder", "Reference Mannequins of your own, in a folder"),
+    ("FOLDER", "Folder", "Reference Mannequins of your own, in a folder", 2),
 )
 _SHIPPED = {"FEMALE": FEMALE_SET, "MALE": MALE_SET, "FEMALE_FINE": FEMALE_FINE_SET, "MALE_FINE": MALE_FINE_SET}
 
