@@ -74,7 +74,7 @@ def test_on_a_walking_body_the_skin_follows_its_bones_as_skin_posed_does(average
 def test_pieces_whose_skin_falls_apart_cannot_be_a_skin_collider_and_nothing_is_built():
     toy = make_apose_toy()  # its head floats above its chest
     before = state()
-    with pytest.raises(ElliMannError, match="skin: the body falls apart: 1.a Head touch no other piece"):
+    with pytest.raises(ElliMannError, match="skin: the body falls apart: 1.a Head touches no other piece"):
         drape(toy, "tube_dress", DrapeSettings(frames=4, **COARSE))
     assert state() == before
     for bad, field in (({"collider": "mesh"}, "collider"), ({"skin_level": "draft"}, "skin_level")):

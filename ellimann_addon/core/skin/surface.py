@@ -121,7 +121,7 @@ def outer_surface(vertices, faces, inner, nearest, names):
         loose = sorted({names[nearest[inner[v]]] for v in np.flatnonzero(np.isin(label, outer[outer != main]))})
         raise SkinError(
             f"skin: the body falls apart: {', '.join(loose[:4])}{' and more' if len(loose) > 4 else ''} "
-            "touch no other piece (the skin must be one closed surface)"
+            f"{'touches' if len(loose) == 1 else 'touch'} no other piece (the skin must be one closed surface)"
         )
     keep_faces = face_label == outer[0]
     kept = np.flatnonzero(label == outer[0])
