@@ -20,6 +20,7 @@ from ...core.geometry.cushion import cushion_name
 from ...core.mannequin.skeleton import JOINT_INDEX, JOINT_NAMES, cross_joint_pairs
 from ...core.pose.motion import arms_out, drape_motion, loop_drift
 from .rig import bake_action, bare_armature, bind_across, bind_piece, bind_weights, check_rig
+from .skin import skin_bone_weights
 
 PIECE_KEY = "ellimann_piece"  # on a collider: the name of the piece it stands for (a part or a cushion)
 SETTLE_FRAMES = 20  # frames from rest into the first pose (at most a third of the drape): slow enough for the cloth
@@ -72,15 +73,6 @@ def animate_drape(collection, colliders, garment_object, mannequin, poses, loop,
         f"{collection.name} motion",
     )
     return motion[-1]
-
-
-def skin_bone_weights(skin):
-    """{joint name: (V,) weight} of a core Skin's linear-blend weights (Skin.bones), for an Armature modifier."""
-    bones, weights = skin.bones()
-    return {
-        JOINT_NAMES[joint]: np.where(bones == joint, weights, 0.0).sum(axis=1)
-        for joint in np.unique(bones[weights > 0.0])
-    }
 
 
 def body_motion(poses, frames, loop):

@@ -13,7 +13,7 @@ file as it was.
 import bpy
 import numpy as np
 
-from ...core.mannequin.skeleton import JOINT_COUNT, JOINT_NAMES
+from ...core.mannequin.skeleton import JOINT_NAMES
 from ...core.skin.exact import exact_skin
 from ...core.skin.surface import build_skin
 from ..bridge.convert import objects_recursive, rig_object
@@ -56,14 +56,20 @@ def add_skin(collection, skin):
     one. Returns the object."""
     obj = write_skin_object(collection, skin)
     if skin.mannequin.joints is not None:
-        bones, weights = skin.bones()
-        dense = np.zeros((len(bones), JOINT_COUNT))
-        np.add.at(dense, (np.arange(len(bones))[:, None], bones), weights)
-        set_bone_weights(obj, {JOINT_NAMES[b]: dense[:, b] for b in np.flatnonzero(dense.max(axis=0) > 0.0)})
+        set_bone_weights(obj, skin_bone_weights(skin))
         rig = rig_object(collection)
         if rig is not None:
             bind_armature(obj, rig)
     return obj
+
+
+def skin_bone_weights(skin):
+    """{joint name: (V,) weight} of a core Skin's linear-blend weights (Skin.bones), for an Armature modifier."""
+    bones, weights = skin.bones()
+    return {
+        JOINT_NAMES[joint]: np.where(bones == joint, weights, 0.0).sum(axis=1)
+        for joint in np.unique(bones[weights > 0.0])
+    }
 
 
 def pieces_as_colliders(collection, hidden):

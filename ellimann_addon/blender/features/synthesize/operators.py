@@ -6,7 +6,6 @@ import bpy
 from ....core.constants import MEASUREMENTS
 from ....core.errors import ElliMannError
 from ....core.measure.tailor import measurement_line
-from ....core.skin.exact import MESH_TOLERANCE_CM
 from ....core.synthesis.synthesize import relative_error
 from ... import ids
 from ...bridge.convert import ellipsoid_objects
@@ -36,10 +35,11 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
             five = {key: measured[key] for key in MEASUREMENTS}
             if mannequin.joints is not None:
                 check_rig(mannequin)  # before the scene changes
-            skin, on_skin = None, None
+            skin, exact = None, None
             if props.skin:
-                mannequin, skin, on_skin = self.skin_of(context, props, mannequin)
-                five = {key: float(value) for key, value in mannequin.measure().items()}
+                mannequin, skin, exact = self.skin_of(context, props, mannequin)
+            if exact is not None:  # the pieces were refined for the skin: their m_T is the refinement's
+                five = {key: exact.pieces_measured[key] for key in MEASUREMENTS}
             collection = add_mannequin(mannequin, five, cushions=props.output == "CUSHIONS")
             rig = build_rig(collection, mannequin) if mannequin.joints is not None else None
             if skin is not None:
@@ -47,12 +47,11 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
         except ElliMannError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        if on_skin is not None:
-            asked = {**request_of(props), **extra_of(props)}
-            missed = [key for key, wanted in asked.items() if abs(on_skin[key] - wanted) > MESH_TOLERANCE_CM]
+        on_skin = exact.skin_measured if exact is not None else None
+        if exact is not None:
             warnings = list(warnings) + [
-                f"exact mode on the skin missed {key}: skin {on_skin[key]:.2f} cm for {asked[key]:g} cm"
-                for key in missed
+                f"exact mode on the skin missed {key}: skin {got:.2f} cm for {wanted:g} cm"
+                for key, got, wanted in exact.misses()
             ]
         props.target = collection
         props.status = "; ".join(warnings)
@@ -73,8 +72,8 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
 
     @staticmethod
     def skin_of(context, props, mannequin):
-        """(pieces, core Skin, what the skin measures or None): in exact mode the pieces refined until their skin
-        measures the request (the five and the extra ones ticked), else the skin over the pieces as they are."""
+        """(pieces, core Skin, the ExactSkin or None): in exact mode the pieces refined until their skin measures the
+        request (the five and the extra ones ticked), else the skin over the pieces as they are."""
         settings = settings_of(props.skin_level)
         window_manager = context.window_manager
         window_manager.progress_begin(0.0, 1.0)
@@ -83,7 +82,7 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
             if props.mode != "EXACT":
                 return mannequin, make_skin(mannequin, settings, progress), None
             result = make_exact_skin(mannequin, settings, request_of(props), extra_of(props), progress)
-            return result.mannequin, result.skin, result.skin_measured
+            return result.mannequin, result.skin, result
         finally:
             window_manager.progress_end()
 
