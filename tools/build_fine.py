@@ -40,7 +40,7 @@ from . import coverage
 from . import reference_topology as rt
 from .bodies import RM_BODIES, body_measurements, load_labels, load_skeletons
 from .reference_sets import FEMALE, FEMALE_FINE, MALE_FINE, TRACING_FOLDER
-from .reference_topology_fine import EXTRA_SPECS, FINE_CHAINS, FINE_SPECS
+from .reference_topology_fine import EXTRA_SPECS, FINE_CHAINS, FINE_CLEARANCE, FINE_DEPTH, FINE_SPECS
 
 TOPOLOGY_DOC = "topology_fine.md"
 TOPOLOGY_PICTURE = "topology_fine.png"
@@ -147,7 +147,12 @@ def topology_doc(base):
         "over its body: the body's volume outside every piece, each missed cell given the region and skinning bone "
         "of its nearest vertex. It lies in the bands the girth rules leave between the trunk's large ellipsoids "
         "(under the bust, below the waist), at the shoulders and under the arms, the inner thigh, the buttock's fold "
-        "and the groin, the back of the knee, the elbow, the heel and instep, and around the head. The shipped sets "
+        "and the groin, the back of the knee, the elbow, the heel and instep, and around the head; on the five bodies "
+        "of the Reference Mannequins also under the breasts, at the chest's sides, on top of the shoulders, at the "
+        "hip's side and the buttock's top and in front of the knee. The fine parts keep less room from the sections "
+        f"they do not follow ({FINE_CLEARANCE:g} of the height, the 40's {FitConstants().section_clearance:g}) and "
+        "spread further into what the others leave empty; the breast is not centred on the bust section. What each "
+        "change measured, and what was tried and did not pay: `docs/topology_fine_tried.md`. The shipped sets "
         "on it are `female-fine` and `male-fine` (`--references female-fine`); the 40 stay the default and "
         "reproduce the paper's tables. Every rule of the 40 holds: mirror twins, right-handed frames, girth flags "
         "and the sections (a girth part keeps clear of the sections of the measurements it does not depend on), "
@@ -224,7 +229,7 @@ def set_doc(build_set, base, rms, report):
         "| Base Mannequin m_T | " + br._row(measured) + " |",
         "| relative difference | " + " | ".join(f"{measured[k] / body[k] - 1.0:+.1%}" for k in MEASUREMENTS) + " |",
         "",
-        *br.fill_doc(report["fill"], FINE_CHAINS),
+        *br.fill_doc(report["fill"], FINE_CHAINS, FINE_DEPTH, TOPOLOGY_DOC),
         "Smallest cosine between an axis and the same axis in the "
         f"{br.DISPLAY_NAMES[report['reference_rm']]} RM, over the five RMs: "
         f"**{min(report['agreement'].values()):.4f}**.",

@@ -429,8 +429,8 @@ def _describe(spec):
 def _fit_notes(spec):
     defaults = rt.Spec(0, "a", "", "C", "", True, ("He",), rt.Select())
     items = [f"{spec.frame} frame" + (" ({})".format(", ".join(f"{v:g}" for v in spec.axis)) if spec.axis else "")]
-    for attr, unit in (("margin", ""), ("depth", " m"), ("inside", "")):
-        if getattr(spec, attr) != getattr(defaults, attr):
+    for attr, unit in (("margin", ""), ("depth", " m"), ("inside", ""), ("clearance", ""), ("shared", "")):
+        if getattr(spec, attr) is not None and getattr(spec, attr) != getattr(defaults, attr):
             items.append(f"{attr} {getattr(spec, attr):g}{unit}")
     if spec.span:
         items.append("spans its selection")
@@ -522,8 +522,9 @@ def fit_rows(rms, report):
     return lines
 
 
-def fill_doc(fill, links=coverage.CHAINS):
-    """Markdown lines: how each mannequin fills its body (tools/coverage.py), the gaps along the chains ``links``."""
+def fill_doc(fill, links=coverage.CHAINS, depth=rt.Spec.depth, topology_doc="topology.md"):
+    """Markdown lines: how each mannequin fills its body (tools/coverage.py), the gaps along the chains ``links``;
+    ``depth`` (m): how far the topology's parts (``topology_doc``) may reach outside the skin."""
     spacing = coverage.GRID_SPACING * 1e3
     lines = [
         "## How much of its body each mannequin fills",
@@ -533,9 +534,10 @@ def fill_doc(fill, links=coverage.CHAINS):
         "inside the union of the pieces, **excess** the share of the pieces' volume outside the body, "
         "**depth** how far (mm) a piece reaches outside the body surface at most, and which. *Ellipsoids*: "
         "the ellipsoid mannequin; *cushions*: every cushion pair replaced by its hull. The parts may reach "
-        f"{rt.Spec.depth * 1e3:g} mm outside the skin by design (`depth` in `docs/topology.md`); the mitten over "
+        f"{depth * 1e3:g} mm outside the skin by design (`depth` in `docs/{topology_doc}`); the mitten over "
         "the spread fingers reaches further, between them. The points in the mesh's open mouth and eye sockets "
-        "(no eyes or teeth), which the solid head fills, are not counted in the depth. The Reference Mannequins "
+        "(no eyes or teeth), which the solid head fills, are not counted in the depth or the excess. The "
+        "Reference Mannequins "
         "are measured after their adjustment to Table 2.3, which moves and scales parts off their bodies (girth "
         "parts widened or narrowed, the arms carried sideways with the shoulder width).",
         "",

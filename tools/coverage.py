@@ -50,6 +50,10 @@ class BodyVolume(volume.BodyVolume):
         rank = np.arange(len(incident)) - np.repeat(start, valence)
         self._ring[np.repeat(np.arange(len(self.vertices)), valence), rank] = incident
 
+    def nearest_vertex(self, points):
+        """Index of the body vertex nearest each point (P, 3)."""
+        return self._tree.query(np.asarray(points, dtype=float).reshape(-1, 3))[1]
+
     def distance(self, points):
         """Distance (m) from points (P, 3) to the surface: the nearest of the triangles around the
         nearest vertices (an upper bound of the true distance, equal to it on a fair mesh); and the
@@ -77,10 +81,22 @@ def _outside_depth(body, points, cavity=None):
     return float(distance.max()) if len(distance) else 0.0
 
 
+def _hollow(body, grid, mannequin, hulls, cavity):
+    """Bool over the grid: the cells outside the body, inside a piece, whose nearest body vertex is a ``cavity`` wall
+    (the mesh's open mouth and eye sockets, which a solid head fills)."""
+    outside = occupancy(grid, mannequin, True, hulls) & ~grid.inside  # the cushions hold the ellipsoids
+    cells = np.argwhere(outside)
+    nearest = body.nearest_vertex(grid.origin + grid.spacing * cells)
+    hollow = np.zeros_like(outside)
+    hollow[tuple(cells[cavity[nearest]].T)] = True
+    return hollow
+
+
 def fill_metrics(body, grid, mannequin, cavity=None):
-    """{"ellipsoids": ..., "cushions": ...}, each {"coverage", "excess" (shares of volume, core.geometry.volume),
-    "depth" (m, largest outside the body but in its cavities, see :func:`_outside_depth`), "deepest" (the
-    name of the piece that reaches that far)}."""
+    """{"ellipsoids": ..., "cushions": ...}, each {"coverage", "excess" (shares of volume, core.geometry.volume; the
+    mesh's open mouth and eye sockets, ``cavity``, are no excess: a solid head fills them), "depth" (m, largest
+    outside the body but in its cavities, see :func:`_outside_depth`), "deepest" (the name of the piece that reaches
+    that far)}."""
     hulls = volume.cushion_hulls(mannequin)
     samples = sample_surface(mannequin.rotation, mannequin.center, mannequin.semi_axes, _SURFACE_SAMPLES)
     depth = {}  # piece name -> depth, for the ellipsoids and for the cushion pieces
@@ -90,7 +106,7 @@ def fill_metrics(body, grid, mannequin, cavity=None):
         name: _outside_depth(body, hulls[indices][0], cavity) if len(indices) == 2 else depth[name]
         for name, indices in pieces(mannequin, True)
     }
-    out = fill_shares(grid, mannequin, hulls)
+    out = fill_shares(grid, mannequin, hulls, None if cavity is None else _hollow(body, grid, mannequin, hulls, cavity))
     for key, depths in (("ellipsoids", depth), ("cushions", cushion_depth)):
         # mirror twins reach equally deep up to rounding: the first (the left one) within DEPTH_TIE is named
         deepest = next(name for name, d in depths.items() if d >= max(depths.values()) - DEPTH_TIE)

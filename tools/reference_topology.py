@@ -58,6 +58,8 @@ class Spec:
     clear: tuple = ()
     cavities: bool = False  # the walls of the mesh's open eye sockets and mouth are no obstacles: the part
     # may fill them, as a solid head does
+    clearance: float = None  # fraction of the height kept clear of sections it does not follow (None: the fit's)
+    shared: float = None  # what volume other parts cover is worth to it on the second pass (None: the fit's)
 
 
 # The waist's sides are centred on its section (see core.fitting.inscribed.inscribed_ellipsoid's ``level``); the
@@ -340,6 +342,8 @@ def fit_settings(spec, kept=None):
         axis=spec.axis,
         clear=spec.clear,
         kept=kept,
+        clearance=spec.clearance,
+        shared=spec.shared,
     )
 
 

@@ -292,6 +292,78 @@ EXTRA_SPECS = (
         frame="limb",
         margin=0.15,
     ),
+    # the breast's underside and the side of the hip above the hip section, the buttock's top
+    Spec(
+        37,
+        "a",
+        "Under Breast",
+        "L",
+        "chest",
+        True,
+        BUST,
+        Select(regions=("chest",), h=(0.655, 0.715), x=(0.04, 0.17), y=(-1, -0.04)),
+        inward=(0.0, 0.04, 0.0),
+        frame="fixed",
+    ),
+    Spec(
+        38,
+        "a",
+        "Outer Hip",
+        "L",
+        "hips",
+        True,
+        HIPS,
+        Select(bones=("pelvis", "upperleg01"), h=(0.47, 0.58), x=(0.11, 1)),
+        frame="fixed",
+    ),
+    Spec(
+        39,
+        "a",
+        "Upper Gluteus",
+        "L",
+        "hips",
+        True,
+        HIPS,
+        Select(bones=("pelvis", "spine05", "upperleg01"), h=(0.51, 0.61), x=(0.03, 1), y=(0.02, 1)),
+        inward=(0.0, -0.05, 0.0),
+        frame="fixed",
+    ),
+    # the chest's sides between the armpit and the waist, the shoulder's top, the knee's front
+    Spec(
+        40,
+        "a",
+        "Side Ribs",
+        "L",
+        "chest",
+        True,
+        BUST,
+        Select(regions=("chest",), h=(0.66, 0.75), x=(0.08, 1), y=(-0.05, 0.08)),
+        frame="fixed",
+    ),
+    Spec(
+        41,
+        "a",
+        "Shoulder Top",
+        "L",
+        "shoulders",
+        True,
+        SHOULDERS,
+        Select(bones=("clavicle", "shoulder01"), h=(0.80, 0.87), x=(0.06, 0.22)),
+        inward=(0.0, 0.0, -0.03),
+        frame="main",
+    ),
+    Spec(
+        42,
+        "a",
+        "Kneecap",
+        "L",
+        "legs",
+        True,
+        HIPS,
+        Select(bones=("upperleg02", "lowerleg01"), h=(0.25, 0.32), y=(-1, -0.01)),
+        frame="limb",
+        margin=0.15,
+    ),
     # the foot round the 40's Foot ellipsoid
     Spec(36, "a", "Heel", "L", "feet", True, HIPS, Select(bones=("foot",), h=(0, 0.06), y=(-0.03, 1)), frame="fixed"),
     Spec(
@@ -304,32 +376,63 @@ EXTRA_SPECS = (
 # fills inside it: 5 mm gave 93.1 % coverage and 5.4 % excess on the Base Mannequin, 3 mm 90.8 % and 3.0 %.
 FINE_DEPTH = 0.004
 
-FINE_SPECS = tuple(spec if spec.mitten else replace(spec, depth=FINE_DEPTH) for spec in SPECS + EXTRA_SPECS)
+# With more pieces there is less room to leave: each part keeps 0.0125 of the height clear of the sections it does not
+# follow (the 40's keep 0.025) and, placed the second time, values volume another part covers too at 0.05 of the rest
+# (the 40's: 0.25), so it spreads into what is still empty. The breast is not centred on the bust section: the upper
+# breast, the under-breast and the sternum hold the section's outline, and a breast free to sit where the body's is
+# fills more (docs/topology_fine_tried.md has what each change measured).
+FINE_CLEARANCE = 0.0125
+FINE_SHARED = 0.05
+FREE_OF_LEVEL = ("Breast",)
+
+FINE_SPECS = tuple(
+    replace(
+        spec,
+        depth=spec.depth if spec.mitten else FINE_DEPTH,
+        clearance=FINE_CLEARANCE,
+        shared=FINE_SHARED,
+        level=None if spec.label in FREE_OF_LEVEL else spec.level,
+    )
+    for spec in SPECS + EXTRA_SPECS
+)
 
 # tools/coverage.py's chains on the fine topology: the 40's links, each with the new parts that join it.
 FINE_CHAINS = {
     "leg": [
-        ("Pelvis", "Gluteus", "Hip"),
+        ("Pelvis", "Gluteus", "Hip", "Outer Hip", "Upper Gluteus"),
         ("Thigh", "Inner Thigh", "Buttock Fold", "Outer Thigh", "Front Thigh", "Groin"),
-        ("Knee", "Back of Knee"),
+        ("Knee", "Back of Knee", "Kneecap"),
         ("Calf", "Upper Shin"),
         ("Ankle",),
         ("Foot", "Heel", "Instep"),
         ("Toes",),
     ],
-    "arm": [("Deltoid", "Trapezius"), ("Upper Arm",), ("Elbow",), ("Forearm",), ("Hand",), ("Fingers",)],
+    "arm": [
+        ("Deltoid", "Trapezius", "Shoulder Top"),
+        ("Upper Arm",),
+        ("Elbow",),
+        ("Forearm",),
+        ("Hand",),
+        ("Fingers",),
+    ],
     "neck, head": [
         ("Trapezius", "Upper Back", "Thorax", "Upper Chest", "Scapula"),
         ("Neck", "Base of Neck"),
         ("Cranium", "Face", "Jaw", "Occiput", "Forehead"),
     ],
     "trunk, front": [
-        ("Thorax", "Breast", "Sternum", "Upper Breast"),
+        ("Thorax", "Breast", "Sternum", "Upper Breast", "Under Breast"),
         ("Lower Ribs",),
         ("Rectus Abdominalis",),
         ("Lower Belly",),
         ("Pelvis",),
     ],
     "trunk, back": [("Upper Back", "Scapula"), ("Lower Back",), ("Lumbar",), ("Pelvis", "Gluteus", "Sacrum")],
-    "trunk, side": [("Thorax", "Upper Back", "Armpit"), ("Lower Ribs",), ("Oblique",), ("Flank",), ("Hip",)],
+    "trunk, side": [
+        ("Thorax", "Upper Back", "Armpit", "Side Ribs"),
+        ("Lower Ribs",),
+        ("Oblique",),
+        ("Flank",),
+        ("Hip",),
+    ],
 }

@@ -81,6 +81,32 @@ def test_a_trace_for_an_unknown_part_or_a_bad_setting_is_refused():
         Mannequin.from_dict(data)
 
 
+def test_a_parts_own_clearance_and_shared_are_written_only_when_set_and_checked():
+    plain = FitSettings()
+    assert "clearance" not in plain.to_dict() and "shared" not in plain.to_dict()  # older files read the same
+    own = FitSettings(clearance=0.0125, shared=0.05)
+    assert FitSettings.from_dict(own.to_dict(), "1.a Cranium") == own
+    for key, value, accepted in (
+        ("clearance", 0.3, "0 to 0.2"),
+        ("shared", -0.1, "0 to 1"),
+        ("shared", True, "0 to 1"),
+    ):
+        with pytest.raises(MannequinError, match=f"traces.fit.{key}: must be null or a number from {accepted}"):
+            FitSettings.from_dict({key: value}, "1.a Cranium")
+
+
+def test_a_parts_own_clearance_replaces_the_fits_in_its_section_bounds():
+    from ellimann_addon.core.fitting.mannequin_fit import FitConstants, section_bounds
+
+    constants = FitConstants()
+    part = next(p for p in make_toy_mannequin().topology if p.girth and "Wa" not in p.depends and "Br" in p.depends)
+    centre = constants.section_fractions["Wa"] + 0.05  # above the waist it does not follow
+    floor, _ = section_bounds(part, FitSettings(), centre, constants)
+    assert floor == pytest.approx(constants.section_fractions["Wa"] + constants.section_clearance)
+    floor, _ = section_bounds(part, FitSettings(clearance=0.01), centre, constants)
+    assert floor == pytest.approx(constants.section_fractions["Wa"] + 0.01)
+
+
 def _write_set(folder, mannequins, **fields):
     targets = {m.name: dict(m.measurements) for m in mannequins}
     manifest = Manifest(

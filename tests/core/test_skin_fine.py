@@ -1,4 +1,4 @@
-"""The skin on the fine topology (78 pieces): the same promises as on the 40 (tests/core/test_skin.py and
+"""The skin on the fine topology (90 pieces): the same promises as on the 40 (tests/core/test_skin.py and
 test_skinning.py), on the Average Reference Mannequin of each fine set."""
 
 import numpy as np
@@ -18,7 +18,7 @@ from tests.core.test_skinning import VOLUME_TOLERANCE, every_frame, posed
 @pytest.fixture(scope="module", params=[FEMALE_FINE_SET, MALE_FINE_SET])
 def skin(request):
     mannequin = named_reference_set(request.param).mannequins[4]  # Average
-    assert len(mannequin.topology) == 78
+    assert len(mannequin.topology) == 90
     return build_skin(mannequin, SkinSettings(10.0))
 
 
@@ -29,7 +29,7 @@ def test_the_fine_skin_is_one_closed_oriented_sphere_holding_every_piece(skin):
     assert len(self_intersections(vertices, faces)) == 0
     points = np.concatenate([sample_surface(r, c, s, 100) for r, c, s in zip(m.rotation, m.center, m.semi_axes)])
     assert mesh_distance(points, vertices, faces)[0].max() <= MESHING_ERROR_M
-    assert skin.pieces.max() < 78 and np.allclose(skin.weights.sum(axis=1), 1.0)
+    assert skin.pieces.max() < 90 and np.allclose(skin.weights.sum(axis=1), 1.0)
 
 
 def test_the_fine_skin_keeps_its_volume_in_every_standard_pose_and_walk_frame(skin):

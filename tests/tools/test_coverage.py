@@ -65,11 +65,16 @@ def test_a_part_slightly_larger_than_the_body_covers_it_and_reaches_out_by_the_d
     assert half["ellipsoids"]["depth"] < 5e-4
 
 
-def test_cavity_walls_leave_their_points_out_of_the_depth(ball):
+def test_cavity_walls_leave_their_points_out_of_the_depth_and_the_excess(ball):
     body, grid, _ = ball
     grown = mannequin(("1.a Ball", (0, 0, 0), (RADIUS + 0.005,) * 3, ""))
     cavity = np.ones(len(body.vertices), dtype=bool)
-    assert fill_metrics(body, grid, grown, cavity)["ellipsoids"]["depth"] == 0.0
+    fill = fill_metrics(body, grid, grown, cavity)["ellipsoids"]
+    assert fill["depth"] == 0.0 and fill["excess"] == 0.0 and fill["coverage"] > 0.999
+    # the walls of the upper half only: the shell above the equator is no excess, the shell below is
+    upper = body.vertices[:, 2] > 0.0
+    shell = 1.0 - (RADIUS / (RADIUS + 0.005)) ** 3
+    assert fill_metrics(body, grid, grown, upper)["ellipsoids"]["excess"] == pytest.approx(shell / 2, abs=0.01)
 
 
 def test_a_cushion_occupies_its_hull_a_capsule():

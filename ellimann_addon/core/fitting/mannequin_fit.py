@@ -47,15 +47,16 @@ class FitConstants:
 def section_bounds(part, fit, centre, constants):
     """(floor, ceiling) heights (fractions of the body's) a part centred at height ``centre`` may reach:
     clear, by ``section_clearance``, of the girth sections of measurements it does not depend on (if it
-    is a girth part) and of the sections in ``fit.clear``."""
+    is a girth part) and of the sections in ``fit.clear``; the part's own ``fit.clearance`` if it has one."""
     fractions = constants.section_fractions
+    clearance = constants.section_clearance if fit.clearance is None else fit.clearance
     floor, ceiling = -np.inf, np.inf
     keys = [key for key in GIRTHS if key not in part.depends] if part.girth else []
     for key in keys + list(fit.clear):
         if centre > fractions[key]:
-            floor = max(floor, fractions[key] + constants.section_clearance)
+            floor = max(floor, fractions[key] + clearance)
         else:
-            ceiling = min(ceiling, fractions[key] - constants.section_clearance)
+            ceiling = min(ceiling, fractions[key] - clearance)
     return floor, ceiling
 
 
@@ -126,7 +127,8 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
             weight = np.ones(len(inside))
             if round_:
                 others = np.delete(covers, [i, twins[i]], axis=0).max(axis=0)
-                weight = 1.0 + (constants.fill_shared - 1.0) * others
+                shared = constants.fill_shared if fit.shared is None else fit.shared
+                weight = 1.0 + (shared - 1.0) * others
             for key in part.depends:
                 if key in constants.section_fractions and (part.girth or key == "Sh"):
                     near = (

@@ -199,18 +199,20 @@ def occupancy(grid, mannequin, cushions=False, hulls=None):
     return np.cumsum(steps[..., :-1], axis=2) > 0
 
 
-def fill_shares(grid, mannequin, hulls=None):
+def fill_shares(grid, mannequin, hulls=None, hollow=None):
     """{"ellipsoids" | "cushions": {"coverage", "excess"}}: the share of the body's volume (``grid``'s
     inside cells) inside the union of the pieces, and the share of the pieces' volume outside the body.
-    ``hulls``: {piece indices: hull mesh}, to reuse (see :func:`cushion_hulls`)."""
+    ``hulls``: {piece indices: hull mesh}, to reuse (see :func:`cushion_hulls`); ``hollow``: cells outside the mesh
+    that a solid body fills (a mesh's open mouth and eye sockets), bool over the grid: no excess, no coverage due."""
     hulls = cushion_hulls(mannequin) if hulls is None else hulls
+    solid = grid.inside if hollow is None else grid.inside | hollow
     out = {}
     for key, cushions in (("ellipsoids", False), ("cushions", True)):
         occupied = occupancy(grid, mannequin, cushions, hulls)
         covered = np.count_nonzero(occupied & grid.inside)
         out[key] = {
             "coverage": covered / np.count_nonzero(grid.inside),
-            "excess": 1.0 - covered / max(np.count_nonzero(occupied), 1),
+            "excess": 1.0 - np.count_nonzero(occupied & solid) / max(np.count_nonzero(occupied), 1),
         }
     return out
 

@@ -147,6 +147,12 @@ PART_BONES = {
     "Upper Shin": "Knee",
     "Heel": "Ankle",
     "Instep": "Ankle",
+    "Under Breast": "Spine2",
+    "Outer Hip": "Pelvis",
+    "Upper Gluteus": "Pelvis",
+    "Side Ribs": "Spine2",
+    "Shoulder Top": "Collar",
+    "Kneecap": "Hip",
 }
 # The part whose centre a joint follows in synthesis (the same IDW weights and proportional scales) and in the
 # exact mode's deformation (core.mannequin.joints).

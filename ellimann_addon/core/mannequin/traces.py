@@ -33,9 +33,17 @@ class FitSettings:
     axis: tuple = None  # world direction of a limb, when its longest extent is not along it (a short neck)
     clear: tuple = ()  # sections it keeps clear of, besides those of the measurements it does not follow
     kept: int = None  # the column of the base part's frame taken from the points (None: none was)
+    # None: the fit's own (core.fitting.mannequin_fit.FitConstants); a topology may set its own per part
+    clearance: float = None  # fraction of the height kept clear of the sections of measurements it does not follow
+    shared: float = None  # what volume another part covers too is worth to it, after the first pass (0 to 1)
+
+    _DEFAULTED = ("clearance", "shared")  # written only when set: traces made before them read the same
 
     def to_dict(self):
         out = asdict(self)
+        for key in self._DEFAULTED:
+            if out[key] is None:
+                del out[key]
         for key in ("inward", "axis", "clear"):
             out[key] = None if out[key] is None else list(out[key])
         return out
@@ -55,6 +63,9 @@ class FitSettings:
         return cls(**values)
 
 
+_LIMITS = {"clearance": 0.2, "shared": 1.0}
+
+
 def _fit_value(part, key, value):
     def bad(expected):
         return MannequinError([Problem(part, f"traces.fit.{key}", f"must be {expected}, got {value!r:.40}")])
@@ -62,6 +73,12 @@ def _fit_value(part, key, value):
     if key in ("margin", "depth", "inside"):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 10.0:
             raise bad("a number from 0 to 10")
+        return float(value)
+    if key in ("clearance", "shared"):
+        if value is None:
+            return None
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= _LIMITS[key]:
+            raise bad(f"null or a number from 0 to {_LIMITS[key]:g}")
         return float(value)
     if key in ("span", "mitten"):
         if not isinstance(value, bool):
