@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ElliMannError
-from ..geometry.mesh import is_closed_manifold, to_scene_axes
+from ..geometry.mesh import is_closed_manifold, to_scene_axes, unique_rows
 from ..measure.body import UNITS, check_mesh
 
 
@@ -55,7 +55,7 @@ def loop_fingerprint(corners, starts, sizes):
     ends = np.asarray(starts, dtype=np.int64) + sizes - 1
     following[ends] = starts  # a polygon's last corner joins its first
     edges = np.sort(np.stack([corners, corners[following]], axis=1), axis=1) if len(corners) else np.zeros((0, 2))
-    edges = np.unique(edges, axis=0).astype("<i8")
+    edges = unique_rows(edges).astype("<i8")
     return zlib.crc32(edges.tobytes())
 
 
