@@ -151,12 +151,13 @@ def mesh_distance(points, vertices, faces, signed=True, pairs_per_chunk=_PAIRS_P
     """Distance from points (P, 3) to a triangle mesh, exact: (distance (P,), face (P,)).
 
     Two levels of bounding spheres, no tree: the faces are grouped by the cell (about GROUP_FACES faces
-    across) their centroid falls in. For each point every group gets a cheap bound (centre distance -+ radius),
-    then every triangle of the groups whose lower bound does not exceed the smallest upper bound gets its own,
-    and the exact point-triangle distance is computed only for triangles whose lower bound does not exceed
-    that. With ``signed`` the mesh must be closed, 2-manifold and outward-wound: the sign is that of
-    (p - q) . N with q the nearest point and N the angle-weighted pseudo-normal of the feature q lies on (face,
-    edge or vertex), which Baerentzen and Aanaes (2005) show is exact for such meshes; negative inside.
+    across) their centroid falls in. For each point every group gets a cheap bound (centre distance -+ radius);
+    the exact distance to the triangles of the group with the smallest upper bound is a tighter upper bound;
+    then every triangle of the groups whose lower bound does not exceed it gets its own, and the exact
+    point-triangle distance is computed only for triangles whose lower bound does not exceed it. With ``signed``
+    the mesh must be closed, 2-manifold and outward-wound: the sign is that of (p - q) . N with q the nearest
+    point and N the angle-weighted pseudo-normal of the feature q lies on (face, edge or vertex), which
+    Baerentzen and Aanaes (2005) show is exact for such meshes; negative inside.
     """
     points = np.asarray(points, dtype=float).reshape(-1, 3)
     vertices, faces = np.asarray(vertices, dtype=float), np.asarray(faces)
@@ -172,6 +173,13 @@ def mesh_distance(points, vertices, faces, signed=True, pairs_per_chunk=_PAIRS_P
         p = points[start : start + step]
         to_centre = _distances(p, centre)
         upper = (to_centre + reach).min(axis=1)
+        # A tighter bound first: the exact distance to the faces of each point's best group (those faces are a
+        # few dozen; the group bounds alone leave a shell of groups some reach thick around the nearest one).
+        best = np.argmin(to_centre + reach, axis=1)
+        near_rows = np.repeat(np.arange(len(p)), count[best])
+        t = tri[order[_ranges(first[best], count[best])]]
+        d2 = np.sum((closest_points_on_triangles(p[near_rows], t[:, 0], t[:, 1], t[:, 2]) - p[near_rows]) ** 2, axis=-1)
+        upper = np.minimum(upper, np.sqrt(np.minimum.reduceat(d2, np.cumsum(count[best]) - count[best])))
         # 1e-9 slack: the expanded-square distances carry rounding error.
         rows, groups = np.nonzero(to_centre - reach <= upper[:, None] + 1e-9 * (1.0 + upper[:, None]))
         rows, cols = np.repeat(rows, count[groups]), order[_ranges(first[groups], count[groups])]
