@@ -2,19 +2,21 @@
 
     .venv/bin/python -m tools.held_out [--refmodels DIR] [--workers N] [--out FILE.md]
 
-The six female bodies of ../shared/refmodels are built into RMs once, by the product's builder (an RM
-depends only on its own body: fitted, refined and cleaned alone; only its axis labels follow the set's
-reference RM, here the Average). Then, leaving each body out in turn, mannequins are synthesized
-(exact mode, default options) at the held-out body's measurements from every set of 3, 4 and 5 of
-the other bodies, and compared with the held-out body's mesh: volumetric IoU (intersection over
-union of the voxels, 5 mm grid: core.geometry.volume.voxel_iou) of the mannequin's cushions (its convex
-pieces) and of its ellipsoids, the body moved by the registration its own RM got (so both stand in
-the same frame). The held-out body's own RM (traced on it) is the ceiling. With the reference body
-held out, the set of five is the shipped set. Prints a markdown table (and writes it with --out).
+The six female bodies of ../shared/refmodels are built into RMs once, by the product's builder (an RM depends
+only on its own body: fitted, refined and cleaned alone; only its axis labels follow the set's reference RM,
+here the Average), with each body's own joints (skeleton.json) as the shipped RMs have them. Then, leaving
+each body out in turn, mannequins are synthesized (exact mode, default options) at the held-out body's
+measurements from every set of 3, 4 and 5 of the other bodies, and compared with the held-out body's mesh:
+volumetric IoU (intersection over union of the voxels, 5 mm grid: core.geometry.volume.voxel_iou) of the
+mannequin's cushions (its convex pieces) and of its ellipsoids, the body moved by the registration its own RM
+got (so both stand in the same frame). The held-out body's own RM (traced on it) is the ceiling. With the
+reference body held out, the set of five is the shipped set. Prints a markdown table (and writes it with
+--out).
 Takes a few minutes.
 """
 
 import argparse
+import dataclasses
 import itertools
 import pathlib
 import sys
@@ -30,7 +32,7 @@ from ellimann_addon.core.synthesis.manifest import Manifest, targets_range
 from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, ReferenceSet
 from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 
-from .bodies import REFERENCE_BODY, body_measurements, load_labels
+from .bodies import REFERENCE_BODY, body_measurements, load_labels, load_skeletons
 from .build_reference import DEFAULT_REFMODELS, REFERENCE_RM
 from .reference_sets import TRACING_FOLDER
 
@@ -49,7 +51,11 @@ def six_rms(refmodels, workers, build_set=None):
     else:
         reference_body, rm_targets = build_set.reference_body, build_set.targets
         fractions, folder = build_set.fractions, build_set.out
-    bodies = {name: read_obj(pathlib.Path(refmodels) / f"{name}.obj", up="z") for name in (reference_body, *rm_targets)}
+    skeletons = load_skeletons(refmodels)  # each body's own joints, as the shipped sets' RMs have them
+    bodies = {
+        name: dataclasses.replace(read_obj(pathlib.Path(refmodels) / f"{name}.obj", up="z"), joints=skeletons[name])
+        for name in (reference_body, *rm_targets)
+    }
     targets = {name: dict(row) for name, row in rm_targets.items()}
     # the reference body's targets: its own measurements (measured as refmodels/README.md says)
     if fractions is None:

@@ -246,6 +246,41 @@ def _is_ancestor(a, b):
     return False
 
 
+# The limbs: root joint -> (the joint its direction points to, the joints below the root). Proportional
+# synthesis (core.synthesis.idw) scales a limb about its root in the limb's own axes, so that the arms keep the
+# A-pose's angle (55 degrees below horizontal on every reference body) on a tall, narrow body.
+LIMBS = {"Shoulder": ("Wrist", ("Elbow", "Wrist", "Hand")), "Hip": ("Ankle", ("Knee", "Ankle", "Foot"))}
+
+
+def limb_roots(bones):
+    """(len(bones),) int: for each joint index in ``bones``, the root joint of the sided limb its bone is on
+    (the root's own bone included: the upper arm's pieces hang from the shoulder), else -1."""
+    roots = {}
+    for root, (_, below) in LIMBS.items():
+        for side in "LR":
+            for joint in (root, *below):
+                roots[JOINT_INDEX[f"{side}_{joint}"]] = JOINT_INDEX[f"{side}_{root}"]
+    return np.array([roots.get(int(b), -1) for b in bones], dtype=int)
+
+
+def joint_limb_roots():
+    """(24,) int: the root joint of the limb each joint lies below (the elbow's: the shoulder), -1 for the roots
+    themselves and the joints of no limb."""
+    roots = limb_roots(range(JOINT_COUNT))
+    return np.where(roots == np.arange(JOINT_COUNT), -1, roots)
+
+
+def limb_directions(joints):
+    """{root joint index: (3,) unit direction of its limb (root to the end joint of LIMBS), the mean over the
+    mannequins} for ``joints`` (k, 24, 3)."""
+    out = {}
+    for root, (end, _) in LIMBS.items():
+        for side in "LR":
+            r, e = JOINT_INDEX[f"{side}_{root}"], JOINT_INDEX[f"{side}_{end}"]
+            out[r] = _unit(np.mean([_unit(j[e] - j[r]) for j in joints], axis=0))
+    return out
+
+
 # ------------------------------------------------------------------------------------------------ limits
 
 # Euler ranges (degrees) of the left-side and central joints about the joint frame's x, y, z (relative to

@@ -7,7 +7,7 @@ from ..constants import MEASUREMENTS, RANGES
 from ..errors import MannequinError, Problem
 from ..geometry.frames import SAGITTAL_REFLECTION, rotation_mean, symmetrize_central
 from ..mannequin.joints import JOINT_SIDES, anchor_indices, mirror_joints
-from ..mannequin.skeleton import JOINT_ANCHORS, JOINT_COUNT, JOINT_NAMES
+from ..mannequin.skeleton import JOINT_ANCHORS, JOINT_COUNT, JOINT_NAMES, joint_limb_roots
 from .options import DEFAULT_NORMALIZE, DEFAULT_POWER
 
 ZERO_DISTANCE = 1e-9  # closer than this (cm, or range units) is the RM's own point
@@ -59,6 +59,32 @@ def center_scale(horizontal, vertical):
     return np.stack([horizontal, horizontal, vertical], axis=-1)
 
 
+def normalized_points(points, roots, along, horizontal, vertical):
+    """Points (k, m, 3) divided by their scales (k, m): (anchor, lengthwise, crosswise), each (k, m, 3), such that
+    ``scaled_points`` of them at the same scales gives the points back. A limb's point (``along`` (m, 3): its
+    limb's unit direction) is anchored at its limb's root (``roots`` (k, m, 3)), which scales as any centre; its
+    offset from the root scales by the vertical scale along the limb and by the horizontal across it, so that a
+    limb keeps its direction however heights and widths scale. Any other point (``along`` 0, ``roots`` the point
+    itself) is its own anchor, its offsets 0."""
+    offset = points - roots
+    lengthwise = np.einsum("kmi,mi->km", offset, along)[..., None] * along
+    crosswise = offset - lengthwise
+    return (
+        roots / center_scale(horizontal, vertical),
+        lengthwise / vertical[..., None],
+        crosswise / horizontal[..., None],
+    )
+
+
+def scaled_points(anchor, lengthwise, crosswise, horizontal, vertical):
+    """The points of ``normalized_points``' three parts (..., m, 3), at scales (..., m)."""
+    return (
+        anchor * center_scale(horizontal, vertical)
+        + lengthwise * vertical[..., None]
+        + crosswise * horizontal[..., None]
+    )
+
+
 def axis_scale(rotation, horizontal, vertical):
     """(..., 3) scale of each semi-axis: vertical^v * horizontal^(1 - v), v = the axis' share along world z.
 
@@ -91,9 +117,10 @@ def interpolate(reference, requests, metric="raw", power=DEFAULT_POWER, normaliz
         center[:, src] = np.einsum("bsk,ksi->bsi", weights, reference.center[:, src])
         semi_axes[:, src] = np.einsum("bsk,ksi->bsi", weights, reference.semi_axes[:, src])
     else:
-        ref_center, ref_semi = reference.normalized_geometry(normalize)
+        *ref_center, ref_semi = reference.normalized_geometry(normalize)
         horizontal, vertical = reference.size_scales(requests, normalize)  # (B, s)
-        center[:, src] = np.einsum("bsk,ksi->bsi", weights, ref_center) * center_scale(horizontal, vertical)
+        mean = [np.einsum("bsk,ksi->bsi", weights, part) for part in ref_center]
+        center[:, src] = scaled_points(*mean, horizontal, vertical)
         semi_axes[:, src] = np.einsum("bsk,ksi->bsi", weights, ref_semi) * axis_scale(
             rotation[:, src], horizontal, vertical
         )
@@ -134,19 +161,29 @@ def interpolate_joints(reference, requests, metric, power, normalize, weights=No
         weights = idw_weights(reference, requests, metric, power)
     weights = weights[:, slots]  # (B, J, k)
     rm_joints = reference.joints[:, own]  # (k, J, 3)
-    if normalize != "none":
+    if normalize == "none":
+        mean = _fixed_order_sum(weights, rm_joints)
+    else:  # as the pieces: a joint below a limb's root is anchored at the root
+        roots = joint_limb_roots()[own]
+        along = np.array([reference.limb_directions.get(int(r), np.zeros(3)) for r in roots])
         horizontal, vertical = reference.size_scales(reference.measurements, normalize)  # (k, s)
-        rm_joints = rm_joints / center_scale(horizontal[:, slots], vertical[:, slots])
-    # The weighted sum in a fixed order (a row gets the same bits in any batch), over runs of J * 3 numbers.
-    each = np.repeat(np.moveaxis(weights, -1, 0), 3, axis=-1)  # (k, B, J * 3): RM k's weight of each coordinate
-    flat = rm_joints.reshape(len(rm_joints), -1)
-    mean = np.zeros(each.shape[1:])
-    for k in range(len(flat)):
-        mean += each[k] * flat[k]
-    mean = mean.reshape(len(weights), len(own), 3)
-    if normalize != "none":
+        root_points = np.where(roots[:, None] >= 0, reference.joints[:, np.maximum(roots, 0)], rm_joints)
+        parts = normalized_points(rm_joints, root_points, along, horizontal[:, slots], vertical[:, slots])
         horizontal, vertical = reference.size_scales(np.atleast_2d(requests), normalize)
-        mean *= center_scale(horizontal[:, slots], vertical[:, slots])
+        mean = scaled_points(
+            *(_fixed_order_sum(weights, part) for part in parts), horizontal[:, slots], vertical[:, slots]
+        )
     out = np.empty((len(mean), JOINT_COUNT, 3))
     out[:, own] = mean
     return mirror_joints(out, "L")
+
+
+def _fixed_order_sum(weights, values):
+    """(B, J, 3) sum over k of weights (B, J, k) times values (k, J, 3), in a fixed order over runs of J * 3
+    numbers: a row gets the same bits in any batch."""
+    each = np.repeat(np.moveaxis(weights, -1, 0), 3, axis=-1)  # (k, B, J * 3): RM k's weight of each coordinate
+    flat = values.reshape(len(values), -1)
+    total = np.zeros(each.shape[1:])
+    for k in range(len(flat)):
+        total += each[k] * flat[k]
+    return total.reshape(len(weights), values.shape[1], 3)

@@ -13,8 +13,9 @@ from ..errors import MannequinError, ReferenceSetError
 from ..geometry.frames import SAGITTAL_REFLECTION
 from ..mannequin.clean import asymmetry
 from ..mannequin.model import Mannequin
+from ..mannequin.skeleton import bone_problems, limb_directions, limb_roots, part_bones
 from ..measure.tailor import tailor_measurements
-from .idw import ZERO_DISTANCE, axis_scale, center_scale
+from .idw import ZERO_DISTANCE, axis_scale, normalized_points
 from .manifest import MANIFEST_FILE, legacy_manifest, read_manifest
 from .options import is_number
 from .refine import deform_basis, fd_jacobian
@@ -124,6 +125,7 @@ class ReferenceSet:
         widths[:, he] = 0.0
         self._width_exponent = widths / np.maximum(widths.sum(axis=1, keepdims=True), 1.0)
         self._size_origin = self.measurements.mean(axis=0)  # scales are relative to the RMs' mean
+        self._limb_root, self._limb_along = self._limbs()
         self._normalized = {}
         self._jacobian = None
 
@@ -176,14 +178,32 @@ class ReferenceSet:
             self._jacobian = each.mean(axis=0)
         return self._jacobian
 
+    def _limbs(self):
+        """(s,) root joint of the limb each interpolated part hangs from (-1: none, or the RMs have no joints) and
+        (s, 3) that limb's direction (zeros for the others): what proportional IDW scales in the limb's own axes
+        (core.synthesis.idw.normalized_points)."""
+        count = len(self._source)
+        self.limb_directions = {}  # {root joint index: the limb's unit direction, the RMs' mean}
+        if self.joints is None or bone_problems(self.topology):
+            return np.full(count, -1), np.zeros((count, 3))
+        self.limb_directions = limb_directions(self.joints)
+        roots = limb_roots(part_bones(self.topology)[self._source])
+        along = np.array([self.limb_directions[r] if r >= 0 else np.zeros(3) for r in roots])
+        return roots, along
+
     def normalized_geometry(self, normalize):
-        """The RMs' centres and semi-axes (k, s, 3) of the interpolated parts, divided by their own scales."""
+        """The RMs' geometry of the interpolated parts divided by their own scales: the centres' three parts
+        (core.synthesis.idw.normalized_points: a limb's part anchored at its limb's root joint) and the semi-axes,
+        each (k, s, 3)."""
         if normalize not in self._normalized:
             src = self._source
             horizontal, vertical = self.size_scales(self.measurements, normalize)
-            center = self.center[:, src] / center_scale(horizontal, vertical)
+            center = self.center[:, src]
+            limb = self._limb_root >= 0
+            roots = np.where(limb[:, None], self.joints[:, self._limb_root], center) if limb.any() else center
+            parts = normalized_points(center, roots, self._limb_along, horizontal, vertical)
             semi_axes = self.semi_axes[:, src] / axis_scale(self.rotation[:, src], horizontal, vertical)
-            self._normalized[normalize] = (center, semi_axes)
+            self._normalized[normalize] = (*parts, semi_axes)
         return self._normalized[normalize]
 
     def _find_mirror_signs(self):

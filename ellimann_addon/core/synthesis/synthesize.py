@@ -27,6 +27,12 @@ the registration origin, horizontal semi-axes) by the part's own measurement (Br
 for shoulders and arms, ...; parts on He alone keep their widths). Scales are relative to the mean
 of the RMs' measurements; a semi-axis tilted from the vertical takes vertical^v * horizontal^(1-v),
 v its share along z, so rotations are untouched (the same mean rotations as the paper's).
+The limbs are the exception: scaling widths and heights apart in the world's axes would turn them (it leaned
+the female set's arms anywhere from 29.9 to 41.4 degrees from the vertical, the RMs' 35.2-35.3, and narrowed a
+tall, narrow request's stance), so a part on an arm or a leg (``skeleton.LIMBS``) is anchored at its limb's root
+joint (the shoulder, the hip), which scales as any centre, and its offset from that joint scales in the limb's
+own axes: by the height along the limb, by the width across it; so do the limb's joints. The limbs then lean as
+the RMs' do (docs/synthesis.md).
 ``"height"`` scales heights only. At an RM's measurements the scales cancel and the result is the RM;
 the weights are the paper's; what is bounded by the RMs is the proportions, not the geometry itself
 (a request outside L is scaled beyond the RMs).
