@@ -68,7 +68,8 @@ EXTRA_SPECS = (
         "C",
         "neck",
         True,
-        HEAD,
+        SHOULDERS,  # its half-width follows Sh (5.6-13 cm on the female RMs): on He alone, a slim body took
+        # a heavy one's of the same height
         Select(regions=("neck", "chest"), h=(0.83, 0.87), y=(-0.06, 0.04)),
         frame="fixed",
         clear=("Sh",),

@@ -15,7 +15,7 @@ from devkit.cli_runs import assert_one_line_error, run
 from ellimann_addon.core.constants import GIRTHS, MEASUREMENTS, quartile_points
 from ellimann_addon.core.errors import ReferenceSetError
 from ellimann_addon.core.fitting.reference_build import cleanliness_problems
-from ellimann_addon.core.geometry.ellipsoid import section_at_height
+from ellimann_addon.core.geometry.ellipsoid import axis_extent, section_at_height
 from ellimann_addon.core.geometry.frames import is_rotation
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.mannequin.skeleton import PARENTS, bone_names, cross_joint_pairs, part_bones
@@ -91,6 +91,20 @@ def test_each_girth_section_cuts_only_parts_that_follow_its_measurement(fine):
             cut = hit & girth
             follows = depends[:, MEASUREMENTS.index(key)]
             assert np.all(follows[cut]), (mannequin.name, key, np.array(fine.topology.names)[cut & ~follows])
+
+
+@pytest.mark.parametrize("name", SHIPPED_SETS)
+def test_a_part_on_the_height_alone_is_about_as_wide_on_every_rm(name):
+    """IDW weighs a part by the measurements it depends on only: a part on He alone takes the RMs of the request's
+    height whatever its build, so its width must not follow the build. Its half-width (x extent) spans at most 1.5x
+    over the RMs (the heads and necks: at most 1.38x, the fine Jaw); the fine Base of Neck on He alone spanned 2.3x
+    (5.6-13 cm), so a slim request of Tall Chubby's height wore Tall Chubby's, 26 cm across."""
+    reference = named_reference_set(name)
+    on_height = np.nonzero(reference.topology.dependency_mask.sum(axis=1) == 1)[0]
+    assert len(on_height)
+    widths = axis_extent(reference.rotation[:, on_height], reference.semi_axes[:, on_height], 0)
+    spans = widths.max(axis=0) / widths.min(axis=0)
+    assert spans.max() <= 1.5, dict(zip(np.array(reference.topology.names)[on_height], spans.round(2)))
 
 
 def test_the_manifest_names_the_fine_set_and_its_topology(fine):
