@@ -246,9 +246,9 @@ def _is_ancestor(a, b):
     return False
 
 
-# The limbs: root joint -> (the joint its direction points to, the joints below the root). Proportional
-# synthesis (core.synthesis.idw) scales a limb about its root in the limb's own axes, so that the arms keep the
-# A-pose's angle (55 degrees below horizontal on every reference body) on a tall, narrow body.
+# The limbs: root joint -> (the joint its direction points to, the joints below the root). Normalized synthesis
+# (core.synthesis.idw, "height" and "proportional") scales a limb about its root in the limb's own axes, so that
+# the arms keep the A-pose's angle (55 degrees below horizontal on every reference body) on a tall, narrow body.
 LIMBS = {"Shoulder": ("Wrist", ("Elbow", "Wrist", "Hand")), "Hip": ("Ankle", ("Knee", "Ankle", "Foot"))}
 
 

@@ -85,13 +85,16 @@ def scaled_points(anchor, lengthwise, crosswise, horizontal, vertical):
     )
 
 
-def axis_scale(rotation, horizontal, vertical):
-    """(..., 3) scale of each semi-axis: vertical^v * horizontal^(1 - v), v = the axis' share along world z.
+def axis_scale(rotation, horizontal, vertical, along=None):
+    """(..., 3) scale of each semi-axis: vertical^v * horizontal^(1 - v), v = the axis' share along world z, or
+    along its limb's direction where ``along`` (..., 3) is not zero (a limb's pieces lengthen as its bones do).
 
     The rotation is kept; for an upright ellipsoid (one axis along z) this is exactly the ellipsoid
     scaled by diag(horizontal, horizontal, vertical).
     """
     v = rotation[..., 2, :] ** 2
+    if along is not None:
+        v = np.where(np.any(along != 0.0, axis=-1)[..., None], np.einsum("...ji,...j->...i", rotation, along) ** 2, v)
     return vertical[..., None] ** v * horizontal[..., None] ** (1.0 - v)
 
 
@@ -122,7 +125,7 @@ def interpolate(reference, requests, metric="raw", power=DEFAULT_POWER, normaliz
         mean = [np.einsum("bsk,ksi->bsi", weights, part) for part in ref_center]
         center[:, src] = scaled_points(*mean, horizontal, vertical)
         semi_axes[:, src] = np.einsum("bsk,ksi->bsi", weights, ref_semi) * axis_scale(
-            rotation[:, src], horizontal, vertical
+            rotation[:, src], horizontal, vertical, reference._limb_along
         )
     central, left, right = reference._central, reference._left, reference._right
     if len(central):
@@ -136,8 +139,9 @@ def interpolate(reference, requests, metric="raw", power=DEFAULT_POWER, normaliz
 
 def interpolate_joints(reference, requests, metric, power, normalize, weights=None):
     """(B, 24, 3) joints of synthesized mannequins, or None if some Reference Mannequin has none: each left and
-    central joint with its anchor part's IDW weights and proportional scales (as that part's centre), the right
-    joints their mirror images. At an RM's measurements, that RM's joints. ``weights``: the requests'
+    central joint with its anchor part's IDW weights and proportional scales (as that part's centre; a joint below
+    a limb's root anchored at the root and scaled in the limb's axes, as the limb's pieces), the right joints
+    their mirror images. At an RM's measurements, that RM's joints. ``weights``: the requests'
     ``idw.idw_weights`` (same metric and power) when they are at hand, e.g. shared with the pieces'."""
     if reference.joints is None:
         return None
@@ -165,6 +169,7 @@ def interpolate_joints(reference, requests, metric, power, normalize, weights=No
         mean = _fixed_order_sum(weights, rm_joints)
     else:  # as the pieces: a joint below a limb's root is anchored at the root
         roots = joint_limb_roots()[own]
+        roots = np.where(np.isin(roots, list(reference.limb_directions)), roots, -1)  # limbs the pieces have too
         along = np.array([reference.limb_directions.get(int(r), np.zeros(3)) for r in roots])
         horizontal, vertical = reference.size_scales(reference.measurements, normalize)  # (k, s)
         root_points = np.where(roots[:, None] >= 0, reference.joints[:, np.maximum(roots, 0)], rm_joints)

@@ -12,8 +12,9 @@ from ..constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, REFERENCE_MEASUREME
 from ..errors import MannequinError, ReferenceSetError
 from ..geometry.frames import SAGITTAL_REFLECTION
 from ..mannequin.clean import asymmetry
+from ..mannequin.joints import anchor_indices
 from ..mannequin.model import Mannequin
-from ..mannequin.skeleton import bone_problems, limb_directions, limb_roots, part_bones
+from ..mannequin.skeleton import bone_problems, joint_limb_roots, limb_directions, limb_roots, part_bones
 from ..measure.tailor import tailor_measurements
 from .idw import ZERO_DISTANCE, axis_scale, normalized_points
 from .manifest import MANIFEST_FILE, legacy_manifest, read_manifest
@@ -179,15 +180,28 @@ class ReferenceSet:
         return self._jacobian
 
     def _limbs(self):
-        """(s,) root joint of the limb each interpolated part hangs from (-1: none, or the RMs have no joints) and
-        (s, 3) that limb's direction (zeros for the others): what proportional IDW scales in the limb's own axes
-        (core.synthesis.idw.normalized_points)."""
+        """(s,) root joint of the limb each interpolated part hangs from and (s, 3) that limb's direction (-1 and
+        zeros for the others): what normalized IDW scales in the limb's own axes (core.synthesis.idw
+        .normalized_points); ``limb_directions`` {root joint index: unit direction, the RMs' mean}. None of it
+        (every part its own anchor, as before) if the RMs have no joints, or if a limb's pieces or joints do not
+        share its root joint's anchor part's measurements: only then do they meet at the same root."""
         count = len(self._source)
-        self.limb_directions = {}  # {root joint index: the limb's unit direction, the RMs' mean}
+        none = np.full(count, -1), np.zeros((count, 3))
+        self.limb_directions = {}
         if self.joints is None or bone_problems(self.topology):
-            return np.full(count, -1), np.zeros((count, 3))
-        self.limb_directions = limb_directions(self.joints)
+            return none
+        try:
+            anchors = anchor_indices(self.topology)
+        except MannequinError:
+            return none
         roots = limb_roots(part_bones(self.topology)[self._source])
+        mask = self.topology.dependency_mask
+        below = joint_limb_roots()
+        pairs = [(int(part), anchors[root]) for part, root in zip(self._source, roots) if root >= 0]
+        pairs += [(anchors[j], anchors[root]) for j, root in enumerate(below) if root >= 0]
+        if any(not np.array_equal(mask[a], mask[b]) for a, b in pairs):
+            return none
+        self.limb_directions = limb_directions(self.joints)
         along = np.array([self.limb_directions[r] if r >= 0 else np.zeros(3) for r in roots])
         return roots, along
 
@@ -202,7 +216,9 @@ class ReferenceSet:
             limb = self._limb_root >= 0
             roots = np.where(limb[:, None], self.joints[:, self._limb_root], center) if limb.any() else center
             parts = normalized_points(center, roots, self._limb_along, horizontal, vertical)
-            semi_axes = self.semi_axes[:, src] / axis_scale(self.rotation[:, src], horizontal, vertical)
+            semi_axes = self.semi_axes[:, src] / axis_scale(
+                self.rotation[:, src], horizontal, vertical, self._limb_along
+            )
             self._normalized[normalize] = (*parts, semi_axes)
         return self._normalized[normalize]
 

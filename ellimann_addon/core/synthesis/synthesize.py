@@ -31,11 +31,11 @@ The limbs are the exception: scaling widths and heights apart in the world's axe
 the female set's arms anywhere from 29.9 to 41.4 degrees from the vertical, the RMs' 35.2-35.3, and narrowed a
 tall, narrow request's stance), so a part on an arm or a leg (``skeleton.LIMBS``) is anchored at its limb's root
 joint (the shoulder, the hip), which scales as any centre, and its offset from that joint scales in the limb's
-own axes: by the height along the limb, by the width across it; so do the limb's joints. The limbs then lean as
-the RMs' do (docs/synthesis.md).
-``"height"`` scales heights only. At an RM's measurements the scales cancel and the result is the RM;
-the weights are the paper's; what is bounded by the RMs is the proportions, not the geometry itself
-(a request outside L is scaled beyond the RMs).
+own axes: by the height along the limb, by the width across it; so do the limb's joints, and a limb's semi-axis
+takes the height by its share along the limb. The limbs then lean as the RMs' do (docs/synthesis.md).
+``"height"`` scales heights only (and a limb along its length). At an RM's measurements the scales cancel and
+the result is the RM; the weights are the paper's; what is bounded by the RMs is the proportions, not the
+geometry itself (a request outside L is scaled beyond the RMs).
 
 **Exact mode** (beyond the paper): IDW is a weighted mean, so m_T of its result misses the request
 (the paper's by a few percent, Table 2.4; proportional IDW by less). ``refine`` then deforms the
