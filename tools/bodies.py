@@ -5,6 +5,7 @@ All six OBJ files share one topology (same vertex order), so labels and vertex s
 the neutral reference body apply to every body.
 """
 
+import dataclasses
 import json
 import pathlib
 from dataclasses import dataclass
@@ -37,6 +38,16 @@ def load_skeletons(folder):
     """{body: (24, 3) SMPL joints} of the reference bodies, from the body model's own rig (skeleton.json)."""
     data = json.loads((pathlib.Path(folder) / SKELETON_FILE).read_text(encoding="utf-8"))
     return {name: joints_from_makehuman(bones) for name, bones in data["bodies"].items()}
+
+
+def read_bodies(folder, names):
+    """{name: BodyMesh} of the bodies ``names`` of a refmodels folder (Z up), each with its own joints
+    (:func:`load_skeletons`), as the builder gives them to the Reference Mannequins."""
+    skeletons = load_skeletons(folder)
+    return {
+        name: dataclasses.replace(read_obj(pathlib.Path(folder) / f"{name}.obj", up="z"), joints=skeletons[name])
+        for name in names
+    }
 
 
 def load_labels(folder):

@@ -20,7 +20,6 @@ docs/topology_fine.md lists the parts and docs/images/topology_fine.png shows th
 """
 
 import argparse
-import dataclasses
 import pathlib
 import sys
 import time
@@ -38,7 +37,7 @@ from ellimann_addon.core.synthesis.manifest import MANIFEST_FILE, read_manifest
 from . import build_reference as br
 from . import coverage
 from . import reference_topology as rt
-from .bodies import RM_BODIES, body_measurements, load_labels, load_skeletons
+from .bodies import RM_BODIES, body_measurements, load_labels, load_skeletons, read_bodies
 from .reference_sets import FEMALE, FEMALE_FINE, MALE_FINE, TRACING_FOLDER
 from .reference_topology_fine import EXTRA_SPECS, FINE_CHAINS, FINE_CLEARANCE, FINE_DEPTH, FINE_SPECS
 
@@ -87,10 +86,7 @@ def build(build_set, traced=None, log=print, workers=2):
     )
     base = base.copy(reference_set=build_set.name, section_fractions=dict(build_set.fractions))
     log(f"{build_set.name} base mannequin fitted ({len(base)} parts)")
-    bodies = [
-        dataclasses.replace(read_obj(build_set.refmodels / f"{name}.obj", up="z"), joints=skeletons[name])
-        for name in RM_BODIES
-    ]
+    bodies = list(read_bodies(build_set.refmodels, RM_BODIES).values())
     built = build_reference_set(
         base,
         bodies,

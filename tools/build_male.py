@@ -15,7 +15,6 @@
 """
 
 import argparse
-import dataclasses
 import pathlib
 import sys
 import time
@@ -31,7 +30,7 @@ from ellimann_addon.core.mannequin.model import Mannequin
 
 from . import build_reference as br
 from . import coverage
-from .bodies import RM_BODIES, body_measurements, load_labels, load_skeletons
+from .bodies import RM_BODIES, body_measurements, load_labels, load_skeletons, read_bodies
 from .reference_sets import FEMALE, MALE, TRACING_FOLDER
 
 DOCS_NAME = MALE.docs_name
@@ -59,10 +58,7 @@ def build(log=print):
     base, base_shift = br.trace_base(reference_body, traced.traces, constants, joints=skeletons[MALE.reference_body])
     base = base.copy(**LANDMARKS)
     log(f"male base mannequin fitted ({len(base)} parts)")
-    bodies = [
-        dataclasses.replace(read_obj(MALE.refmodels / f"{name}.obj", up="z"), joints=skeletons[name])
-        for name in RM_BODIES
-    ]
+    bodies = list(read_bodies(MALE.refmodels, RM_BODIES).values())
     built_set = build_reference_set(
         base,
         bodies,

@@ -16,7 +16,6 @@ Takes a few minutes.
 """
 
 import argparse
-import dataclasses
 import itertools
 import pathlib
 import sys
@@ -24,7 +23,6 @@ import sys
 import numpy as np
 
 from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS
-from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.fitting.reference_build import display_name
 from ellimann_addon.core.geometry.volume import IOU_MARGIN, IOU_SPACING, BodyVolume, voxel_iou
 from ellimann_addon.core.mannequin.model import Mannequin
@@ -32,7 +30,7 @@ from ellimann_addon.core.synthesis.manifest import Manifest, targets_range
 from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, ReferenceSet
 from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 
-from .bodies import REFERENCE_BODY, body_measurements, load_labels, load_skeletons
+from .bodies import REFERENCE_BODY, body_measurements, load_labels, read_bodies
 from .build_reference import DEFAULT_REFMODELS, REFERENCE_RM
 from .reference_sets import TRACING_FOLDER
 
@@ -51,11 +49,7 @@ def six_rms(refmodels, workers, build_set=None):
     else:
         reference_body, rm_targets = build_set.reference_body, build_set.targets
         fractions, folder = build_set.fractions, build_set.out
-    skeletons = load_skeletons(refmodels)  # each body's own joints, as the shipped sets' RMs have them
-    bodies = {
-        name: dataclasses.replace(read_obj(pathlib.Path(refmodels) / f"{name}.obj", up="z"), joints=skeletons[name])
-        for name in (reference_body, *rm_targets)
-    }
+    bodies = read_bodies(refmodels, (reference_body, *rm_targets))  # with their joints, as the shipped sets' RMs
     targets = {name: dict(row) for name, row in rm_targets.items()}
     # the reference body's targets: its own measurements (measured as refmodels/README.md says)
     if fractions is None:
