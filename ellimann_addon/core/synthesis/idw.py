@@ -7,7 +7,7 @@ from ..constants import MEASUREMENTS, RANGES
 from ..errors import MannequinError, Problem
 from ..geometry.frames import SAGITTAL_REFLECTION, rotation_mean, symmetrize_central
 from ..mannequin.joints import JOINT_SIDES, anchor_indices, mirror_joints
-from ..mannequin.skeleton import JOINT_ANCHORS, JOINT_COUNT, JOINT_NAMES, joint_limb_roots
+from ..mannequin.skeleton import JOINT_ANCHORS, JOINT_COUNT, JOINT_NAMES
 from .options import DEFAULT_NORMALIZE, DEFAULT_POWER
 
 ZERO_DISTANCE = 1e-9  # closer than this (cm, or range units) is the RM's own point
@@ -60,28 +60,30 @@ def center_scale(horizontal, vertical):
 
 
 def normalized_points(points, roots, along, horizontal, vertical):
-    """Points (k, m, 3) divided by their scales (k, m): (anchor, lengthwise, crosswise), each (k, m, 3), such that
-    ``scaled_points`` of them at the same scales gives the points back. A limb's point (``along`` (m, 3): its
-    limb's unit direction) is anchored at its limb's root (``roots`` (k, m, 3)), which scales as any centre; its
-    offset from the root scales by the vertical scale along the limb and by the horizontal across it, so that a
-    limb keeps its direction however heights and widths scale. Any other point (``along`` 0, ``roots`` the point
-    itself) is its own anchor, its offsets 0."""
+    """Points (k, m, 3) divided by their scales (k, m): (k, m, 3, 3), the anchor, lengthwise and crosswise parts
+    (axis -2), such that ``scaled_points`` of them at the same scales gives the points back. A limb's point
+    (``along`` (m, 3): its limb's unit direction) is anchored at its limb's root (``roots`` (k, m, 3)), which
+    scales as any centre; its offset from the root scales by the vertical scale along the limb and by the
+    horizontal across it, so that a limb keeps its direction however heights and widths scale. Any other point
+    (``along`` 0, ``roots`` the point itself) is its own anchor, its offsets 0."""
     offset = points - roots
     lengthwise = np.einsum("kmi,mi->km", offset, along)[..., None] * along
-    crosswise = offset - lengthwise
-    return (
-        roots / center_scale(horizontal, vertical),
-        lengthwise / vertical[..., None],
-        crosswise / horizontal[..., None],
+    return np.stack(
+        [
+            roots / center_scale(horizontal, vertical),
+            lengthwise / vertical[..., None],
+            (offset - lengthwise) / horizontal[..., None],
+        ],
+        axis=-2,
     )
 
 
-def scaled_points(anchor, lengthwise, crosswise, horizontal, vertical):
-    """The points of ``normalized_points``' three parts (..., m, 3), at scales (..., m)."""
+def scaled_points(parts, horizontal, vertical):
+    """The points (..., m, 3) of ``normalized_points``' parts (..., m, 3, 3) at scales (..., m)."""
     return (
-        anchor * center_scale(horizontal, vertical)
-        + lengthwise * vertical[..., None]
-        + crosswise * horizontal[..., None]
+        parts[..., 0, :] * center_scale(horizontal, vertical)
+        + parts[..., 1, :] * vertical[..., None]
+        + parts[..., 2, :] * horizontal[..., None]
     )
 
 
@@ -120,10 +122,9 @@ def interpolate(reference, requests, metric="raw", power=DEFAULT_POWER, normaliz
         center[:, src] = np.einsum("bsk,ksi->bsi", weights, reference.center[:, src])
         semi_axes[:, src] = np.einsum("bsk,ksi->bsi", weights, reference.semi_axes[:, src])
     else:
-        *ref_center, ref_semi = reference.normalized_geometry(normalize)
+        ref_center, ref_semi = reference.normalized_geometry(normalize)
         horizontal, vertical = reference.size_scales(requests, normalize)  # (B, s)
-        mean = [np.einsum("bsk,ksi->bsi", weights, part) for part in ref_center]
-        center[:, src] = scaled_points(*mean, horizontal, vertical)
+        center[:, src] = scaled_points(np.einsum("bsk,ksji->bsji", weights, ref_center), horizontal, vertical)
         semi_axes[:, src] = np.einsum("bsk,ksi->bsi", weights, ref_semi) * axis_scale(
             rotation[:, src], horizontal, vertical, reference._limb_along
         )
@@ -168,27 +169,21 @@ def interpolate_joints(reference, requests, metric, power, normalize, weights=No
     if normalize == "none":
         mean = _fixed_order_sum(weights, rm_joints)
     else:  # as the pieces: a joint below a limb's root is anchored at the root
-        roots = joint_limb_roots()[own]
-        roots = np.where(np.isin(roots, list(reference.limb_directions)), roots, -1)  # limbs the pieces have too
-        along = np.array([reference.limb_directions.get(int(r), np.zeros(3)) for r in roots])
-        horizontal, vertical = reference.size_scales(reference.measurements, normalize)  # (k, s)
-        root_points = np.where(roots[:, None] >= 0, reference.joints[:, np.maximum(roots, 0)], rm_joints)
-        parts = normalized_points(rm_joints, root_points, along, horizontal[:, slots], vertical[:, slots])
         horizontal, vertical = reference.size_scales(np.atleast_2d(requests), normalize)
-        mean = scaled_points(
-            *(_fixed_order_sum(weights, part) for part in parts), horizontal[:, slots], vertical[:, slots]
-        )
+        parts = _fixed_order_sum(weights, reference.normalized_joints(normalize, own, slots))
+        mean = scaled_points(parts, horizontal[:, slots], vertical[:, slots])
     out = np.empty((len(mean), JOINT_COUNT, 3))
     out[:, own] = mean
     return mirror_joints(out, "L")
 
 
 def _fixed_order_sum(weights, values):
-    """(B, J, 3) sum over k of weights (B, J, k) times values (k, J, 3), in a fixed order over runs of J * 3
-    numbers: a row gets the same bits in any batch."""
-    each = np.repeat(np.moveaxis(weights, -1, 0), 3, axis=-1)  # (k, B, J * 3): RM k's weight of each coordinate
+    """(B, J, ...) sum over k of weights (B, J, k) times values (k, J, ...), in a fixed order over runs of the
+    rows' numbers: a row gets the same bits in any batch."""
+    width = int(np.prod(values.shape[2:]))
+    each = np.repeat(np.moveaxis(weights, -1, 0), width, axis=-1)  # (k, B, J * width): RM k's weight of each number
     flat = values.reshape(len(values), -1)
     total = np.zeros(each.shape[1:])
     for k in range(len(flat)):
         total += each[k] * flat[k]
-    return total.reshape(len(weights), values.shape[1], 3)
+    return total.reshape(len(weights), *values.shape[1:])

@@ -207,8 +207,8 @@ class ReferenceSet:
 
     def normalized_geometry(self, normalize):
         """The RMs' geometry of the interpolated parts divided by their own scales: the centres' three parts
-        (core.synthesis.idw.normalized_points: a limb's part anchored at its limb's root joint) and the semi-axes,
-        each (k, s, 3)."""
+        (k, s, 3, 3) (core.synthesis.idw.normalized_points: a limb's part anchored at its limb's root joint) and
+        the semi-axes (k, s, 3)."""
         if normalize not in self._normalized:
             src = self._source
             horizontal, vertical = self.size_scales(self.measurements, normalize)
@@ -219,8 +219,24 @@ class ReferenceSet:
             semi_axes = self.semi_axes[:, src] / axis_scale(
                 self.rotation[:, src], horizontal, vertical, self._limb_along
             )
-            self._normalized[normalize] = (*parts, semi_axes)
+            self._normalized[normalize] = (parts, semi_axes)
         return self._normalized[normalize]
+
+    def normalized_joints(self, normalize, own, slots):
+        """The RMs' joints ``own`` divided by the scales of their anchor parts (``slots``, interpolated parts):
+        (k, J, 3, 3), as ``normalized_geometry``'s centres (a joint below a limb's root anchored at the root)."""
+        key = ("joints", normalize)
+        if key not in self._normalized:
+            roots = joint_limb_roots()[own]
+            roots = np.where(np.isin(roots, list(self.limb_directions)), roots, -1)  # limbs the pieces have too
+            along = np.array([self.limb_directions.get(int(r), np.zeros(3)) for r in roots])
+            horizontal, vertical = self.size_scales(self.measurements, normalize)  # (k, s)
+            joints = self.joints[:, own]
+            root_points = np.where(roots[:, None] >= 0, self.joints[:, np.maximum(roots, 0)], joints)
+            self._normalized[key] = normalized_points(
+                joints, root_points, along, horizontal[:, slots], vertical[:, slots]
+            )
+        return self._normalized[key]
 
     def _find_mirror_signs(self):
         """Per left part, the axis signs that turn its sagittal reflection into the right twin's frame.
