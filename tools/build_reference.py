@@ -429,7 +429,14 @@ def _describe(spec):
 def _fit_notes(spec):
     defaults = rt.Spec(0, "a", "", "C", "", True, ("He",), rt.Select())
     items = [f"{spec.frame} frame" + (" ({})".format(", ".join(f"{v:g}" for v in spec.axis)) if spec.axis else "")]
-    for attr, unit in (("margin", ""), ("depth", " m"), ("inside", ""), ("clearance", ""), ("shared", "")):
+    for attr, unit in (
+        ("margin", ""),
+        ("depth", " m"),
+        ("inside", ""),
+        ("clearance", ""),
+        ("shared", ""),
+        ("wall_spacing", " m"),
+    ):
         if getattr(spec, attr) is not None and getattr(spec, attr) != getattr(defaults, attr):
             items.append(f"{attr} {getattr(spec, attr):g}{unit}")
     if spec.span:

@@ -60,6 +60,7 @@ class Spec:
     # may fill them, as a solid head does
     clearance: float = None  # fraction of the height kept clear of sections it does not follow (None: the fit's)
     shared: float = None  # what volume other parts cover is worth to it on the second pass (None: the fit's)
+    wall_spacing: float = None  # m: keeps clear of points this far apart on the body's triangles (None: vertices)
 
 
 # The waist's sides are centred on its section (see core.fitting.inscribed.inscribed_ellipsoid's ``level``); the
@@ -344,6 +345,7 @@ def fit_settings(spec, kept=None):
         kept=kept,
         clearance=spec.clearance,
         shared=spec.shared,
+        wall_spacing=spec.wall_spacing,
     )
 
 

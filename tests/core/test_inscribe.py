@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 from devkit.toy import rotation_from_vector
-from ellimann_addon.core.fitting.body_mesh import hidden_vertices, vertex_areas, vertex_normals
+from ellimann_addon.core.fitting.body_mesh import hidden_vertices, surface_walls, vertex_areas, vertex_normals
 from ellimann_addon.core.fitting.inscribed import _grow, hull_surface, inscribed_ellipsoid, principal_frame
+from ellimann_addon.core.geometry.ellipsoid import fibonacci_sphere
 from ellimann_addon.core.geometry.frames import is_rotation
 from ellimann_addon.core.geometry.mesh import icosphere
 
@@ -159,6 +160,12 @@ def test_fill_weights_draw_the_part_to_the_volume_that_counts():
         points, weights, points, weights, **fit, fill_weight=(inside[:, 0] > 0.1).astype(float)
     )
     assert abs(even[0]) < 0.02 and right[0] > 0.1
+    # a central part keeps its centre in the middle across world x, whatever draws it aside
+    _, middle, _, _ = inscribed_ellipsoid(
+        points, weights, points, weights, **fit, fill_weight=(inside[:, 0] > 0.1).astype(float), midline=True
+    )
+    box_middle = 0.5 * (points[:, 0].min() + points[:, 0].max())
+    assert middle[0] == pytest.approx(box_middle, abs=1e-12)
 
 
 def test_hull_surface_samples_the_hull_and_its_area():
@@ -169,6 +176,66 @@ def test_hull_surface_samples_the_hull_and_its_area():
     assert areas.sum() == pytest.approx(24.0)
     moved, _ = hull_surface(corners, depth=0.1, spacing=0.2)
     assert np.allclose(np.abs(moved).max(axis=1), 1.1)
+
+
+def _icosahedron(radius=0.1):
+    vertices, faces = icosphere(0)
+    return radius * vertices, faces
+
+
+def _outside_planes(vertices, faces, points):
+    """How far (m) each point lies outside a convex mesh: the largest signed distance to its faces' planes."""
+    a, b, c = (vertices[faces[:, i]] for i in range(3))
+    normal = np.cross(b - a, c - a)
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    return np.max(points @ normal.T - np.einsum("fi,fi->f", normal, a), axis=1)
+
+
+def test_surface_walls_without_a_spacing_are_the_vertices_moved_out():
+    vertices, faces = _icosahedron()
+    areas, normals = vertex_areas(vertices, faces), vertex_normals(vertices, faces)
+    kept = np.arange(1, 12)
+    points, weights = surface_walls(vertices, faces, normals, areas, kept, 0.004)
+    assert np.array_equal(points, vertices[kept] + 0.004 * normals[kept]) and np.array_equal(weights, areas[kept])
+    # a spacing longer than every edge divides nothing: the same bits
+    same = surface_walls(vertices, faces, normals, areas, kept, 0.004, spacing=0.5)
+    assert np.array_equal(same[0], points) and np.array_equal(same[1], weights)
+
+
+def test_surface_walls_cover_every_kept_triangle_and_keep_its_area():
+    vertices, faces = _icosahedron()  # edges 105 mm
+    areas, normals = vertex_areas(vertices, faces), vertex_normals(vertices, faces)
+    kept = np.arange(1, 12)  # vertex 0 is a cavity wall: its five triangles are no walls, as before
+    points, weights = surface_walls(vertices, faces, normals, areas, kept, 0.0, spacing=0.01)
+    assert weights.sum() == pytest.approx(areas[kept].sum(), rel=1e-12)
+    assert np.all(weights > 0.0)
+    assert np.abs(_outside_planes(vertices, faces, points)).max() < 1e-12  # on the surface (inside: <= 0, on: 0)
+    # every point of a kept triangle lies within the spacing of a wall point; of vertex 0's, not
+    rng = np.random.default_rng(3)
+    u, v = rng.uniform(size=(2, 2000))
+    u, v = np.where(u + v > 1.0, 1.0 - u, u), np.where(u + v > 1.0, 1.0 - v, v)
+    for face in faces:
+        a, b, c = vertices[face]
+        samples = a + u[:, None] * (b - a) + v[:, None] * (c - a)
+        nearest = np.linalg.norm(samples[:, None, :] - points[None], axis=2).min(axis=1)
+        assert (nearest.max() <= 0.01) == (0 not in face)
+
+
+def test_wall_points_keep_a_part_from_slipping_out_between_the_vertices():
+    # a sphere fitted in a coarse icosahedron: its 12 vertices alone let it grow to them, 20 mm out of the faces;
+    # with points 5 mm apart on the faces it stays within a sagitta of them
+    vertices, faces = _icosahedron()
+    areas, normals = vertex_areas(vertices, faces), vertex_normals(vertices, faces)
+    surface = fibonacci_sphere(4000)
+    reach = {}
+    for spacing in (None, 0.005):
+        walls, wall_areas = surface_walls(vertices, faces, normals, areas, np.arange(12), 0.0, spacing)
+        rotation, center, semi, _ = inscribed_ellipsoid(
+            vertices, areas, walls, wall_areas, np.eye(3), frame="fixed", inside_fraction=0.0, margin=0.5
+        )
+        reach[spacing] = _outside_planes(vertices, faces, center + (surface * semi) @ rotation.T).max()
+    assert reach[None] > 0.015
+    assert reach[0.005] < 0.001
 
 
 def test_hidden_vertices_are_those_that_cannot_see_out():

@@ -153,6 +153,42 @@ def vertex_normals(vertices, faces):
     return normals / np.linalg.norm(normals, axis=1, keepdims=True)
 
 
+def surface_walls(vertices, faces, normals, areas, kept, depth, spacing=None):
+    """The body's surface moved out by ``depth`` along its ``normals``, as the points a fitted part keeps outside
+    (core.fitting.inscribed.inscribed_ellipsoid's obstacles), with the area each stands for: the ``kept`` vertices
+    (indices, with their ``areas``) and, if ``spacing`` (m) is given, points about that far apart on each triangle of
+    kept vertices with a longer edge, so that a thin part cannot slip out between the vertices of a coarse mesh.
+    A divided triangle's area is spread evenly over its points, corners included: the areas still sum to the
+    kept vertices'. Without ``spacing``, or where no edge is longer, the kept vertices alone."""
+    points, weights = vertices[kept] + depth * normals[kept], areas[kept]
+    if spacing is None:
+        return points, weights
+    position = np.full(len(vertices), -1)
+    position[kept] = np.arange(len(kept))
+    triangles = faces[np.all(position[faces] >= 0, axis=1)]
+    corners = vertices[triangles]  # (t, 3 corners, 3)
+    longest = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max(axis=1)
+    divisions = np.ceil(longest / spacing).astype(int)
+    weights = weights.copy()
+    extra_points, extra_weights = [points], [weights]
+    for k in np.unique(divisions[divisions > 1]):
+        tri = triangles[divisions == k]
+        a, b, c = (vertices[tri[:, i]] for i in range(3))
+        area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+        share = area / ((k + 1) * (k + 2) // 2)  # per point of the triangle's grid
+        i, j = np.meshgrid(np.arange(k + 1), np.arange(k + 1), indexing="ij")
+        grid = (i + j <= k) & ~(((i == 0) | (i == k)) & (j == 0)) & ~((i == 0) & (j == k))  # no corners
+        bary = np.stack([k - i[grid] - j[grid], i[grid], j[grid]], axis=1) / k  # (g, 3)
+        surface = np.einsum("gc,tcx->tgx", bary, vertices[tri])
+        normal = np.einsum("gc,tcx->tgx", bary, normals[tri])
+        normal /= np.linalg.norm(normal, axis=2, keepdims=True)
+        extra_points.append((surface + depth * normal).reshape(-1, 3))
+        extra_weights.append(np.repeat(share, len(bary)))
+        # the corners stand for the triangle's corner points now, not a third of it each
+        np.add.at(weights, position[tri].ravel(), np.repeat(share - area / 3.0, 3))
+    return np.concatenate(extra_points), np.concatenate(extra_weights)
+
+
 def hidden_vertices(vertices, faces, normals, candidates, reach=0.1, cell=0.01):
     """Which ``candidates`` (vertex indices) cannot see out: the ray from the vertex along its normal
     meets the surface again within ``reach`` (m). On a closed body mesh these are the walls of its

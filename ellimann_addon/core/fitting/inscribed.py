@@ -27,6 +27,7 @@ from ..geometry.ellipsoid import to_frame
 from ..geometry.frames import relabel_to_reference
 from ..geometry.mesh import face_normals
 
+MIDLINE_ALIGNED = 0.99  # |cos| between world x and the frame's axis a central part's centre keeps still along
 DEGENERATE = 0.12  # relative gap below which two principal variances do not fix their axes
 GROWTH = 1.15  # largest growth of a semi-axis per round: keeps the ascent from favouring one axis
 ROUNDS = 60  # of the growth towards a maximal ellipsoid, at most
@@ -229,6 +230,7 @@ def inscribed_ellipsoid(
     fill=None,
     fill_weight=None,
     fill_spacing=None,
+    midline=False,
 ):
     """A maximal ellipsoid, in the part's frame, inside the body and the selection's box.
 
@@ -247,7 +249,9 @@ def inscribed_ellipsoid(
     ``fill_spacing`` sampling the body's volume; if given, the centre is chosen for the
     ellipsoid to cover most of them (by :func:`cell_share`) within the box, instead of for the largest ellipsoid: a part
     fills its region rather than settling where the body is thickest. ``fill_weight`` (p,): what
-    covering each point is worth (default 1), e.g. less where other parts already cover it.
+    covering each point is worth (default 1), e.g. less where other parts already cover it. ``midline``: the centre
+    stays in the box's middle across the frame's axis along world x (a central part, which the mannequin makes
+    symmetric about that middle afterwards: fitted off it, it would be moved into a body it was not fitted to).
     Returns (rotation, center, semi_axes, kept axis index).
     """
     rotation, centroid, kept = principal_frame(selected, weights, reference, frame, match)
@@ -292,6 +296,9 @@ def inscribed_ellipsoid(
         free.remove(kept)
     if level is not None and up in free:
         free.remove(up)
+    across = int(np.argmax(np.abs(rotation[0])))
+    if midline and across in free and abs(rotation[0, across]) > MIDLINE_ALIGNED:
+        free.remove(across)
     # Searched: the free coordinates of the centre and, when filling, the shape the growth starts
     # from (log ratios of two semi-axes to the third), which decides the maximal ellipsoid it reaches.
     shaped = [] if fill is None else [k for k in range(3) if k != kept][1:] if span else [1, 2]

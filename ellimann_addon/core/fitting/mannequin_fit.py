@@ -18,7 +18,7 @@ from ..geometry.ellipsoid import to_frame
 from ..geometry.frames import mirror_frame
 from ..geometry.volume import BodyVolume
 from ..mannequin.model import Mannequin
-from .body_mesh import vertex_areas, vertex_normals
+from .body_mesh import surface_walls, vertex_areas, vertex_normals
 from .inscribed import cell_share, hull_surface, inscribed_ellipsoid
 
 
@@ -123,7 +123,9 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
                 walls, wall_areas = hull_surface(body.vertices[idx], fit.depth)
             else:
                 # the surface moved out by depth: the part may reach that far outside the body
-                walls, wall_areas = body.vertices[walls] + fit.depth * normals[walls], areas[walls]
+                walls, wall_areas = surface_walls(
+                    body.vertices, body.faces, normals, areas, walls, fit.depth, fit.wall_spacing
+                )
             weight = np.ones(len(inside))
             if round_:
                 others = np.delete(covers, [i, twins[i]], axis=0).max(axis=0)
@@ -153,6 +155,7 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
                 fill=inside,
                 fill_weight=weight,
                 fill_spacing=spacing,
+                midline=part.side == "C",
             )
             if twins[i] != i:
                 rotation[twins[i]], center[twins[i]] = mirror_frame(rotation[i], center[i])

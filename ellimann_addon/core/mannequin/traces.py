@@ -36,8 +36,11 @@ class FitSettings:
     # None: the fit's own (core.fitting.mannequin_fit.FitConstants); a topology may set its own per part
     clearance: float = None  # fraction of the height kept clear of the sections of measurements it does not follow
     shared: float = None  # what volume another part covers too is worth to it, after the first pass (0 to 1)
+    # m: besides the body's vertices, it keeps clear of points this far apart on the triangles with longer edges
+    # (core.fitting.body_mesh.surface_walls); None: of the vertices only
+    wall_spacing: float = None
 
-    _DEFAULTED = ("clearance", "shared")  # written only when set: traces made before them read the same
+    _DEFAULTED = ("clearance", "shared", "wall_spacing")  # written only when set: traces made before them read the same
 
     def to_dict(self):
         out = asdict(self)
@@ -63,7 +66,7 @@ class FitSettings:
         return cls(**values)
 
 
-_LIMITS = {"clearance": 0.2, "shared": 1.0}
+_LIMITS = {"clearance": (0.0, 0.2), "shared": (0.0, 1.0), "wall_spacing": (0.001, 0.1)}
 
 
 def _fit_value(part, key, value):
@@ -74,11 +77,12 @@ def _fit_value(part, key, value):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= 10.0:
             raise bad("a number from 0 to 10")
         return float(value)
-    if key in ("clearance", "shared"):
+    if key in _LIMITS:
+        low, high = _LIMITS[key]
         if value is None:
             return None
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0.0 <= value <= _LIMITS[key]:
-            raise bad(f"null or a number from 0 to {_LIMITS[key]:g}")
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not low <= value <= high:
+            raise bad(f"null or a number from {low:g} to {high:g}")
         return float(value)
     if key in ("span", "mitten"):
         if not isinstance(value, bool):
