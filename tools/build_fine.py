@@ -39,7 +39,14 @@ from . import coverage
 from . import reference_topology as rt
 from .bodies import RM_BODIES, body_measurements, load_labels, load_skeletons, read_bodies
 from .reference_sets import FEMALE, FEMALE_FINE, MALE_FINE, TRACING_FOLDER
-from .reference_topology_fine import EXTRA_SPECS, FINE_CHAINS, FINE_CLEARANCE, FINE_DEPTH, FINE_SPECS
+from .reference_topology_fine import (
+    EXTRA_SPECS,
+    FINE_CHAINS,
+    FINE_CLEARANCE,
+    FINE_DEPTH,
+    FINE_SPECS,
+    FINE_WALL_SPACING,
+)
 
 TOPOLOGY_DOC = "topology_fine.md"
 TOPOLOGY_PICTURE = "topology_fine.png"
@@ -147,7 +154,10 @@ def topology_doc(base):
         "of the Reference Mannequins also under the breasts, at the chest's sides, on top of the shoulders, at the "
         "hip's side and the buttock's top and in front of the knee. The fine parts keep less room from the sections "
         f"they do not follow ({FINE_CLEARANCE:g} of the height, the 40's {FitConstants().section_clearance:g}) and "
-        "spread further into what the others leave empty; the breast is not centred on the bust section. What each "
+        "spread further into what the others leave empty; the breast is not centred on the bust section. They keep "
+        f"clear of points {FINE_WALL_SPACING * 1000:g} mm apart on the body's triangles, not only of its vertices: "
+        "the heavy bodies' meshes are stretched (triangles up to 95 mm long), and a thin part slipped out between "
+        "the vertices (`wall_spacing`, core.fitting.body_mesh.surface_walls). What each "
         "change measured, and what was tried and did not pay: `docs/topology_fine_tried.md`. The shipped sets "
         "on it are `female-fine` and `male-fine` (`--references female-fine`); the 40 stay the default and "
         "reproduce the paper's tables. Every rule of the 40 holds: mirror twins, right-handed frames, girth flags "
