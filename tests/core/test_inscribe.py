@@ -221,6 +221,17 @@ def test_surface_walls_cover_every_kept_triangle_and_keep_its_area():
         assert (nearest.max() <= 0.01) == (0 not in face)
 
 
+def test_surface_walls_of_a_fold_stay_on_the_surface():
+    # a long triangle whose corners' normals cancel half way (a fold of the mesh): no point of it is lost or NaN
+    vertices = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.0, 0.1, 0.0]])
+    faces = np.array([[0, 1, 2]])
+    normals = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [0.0, 0.0, 1.0]])
+    points, weights = surface_walls(vertices, faces, normals, vertex_areas(vertices, faces), np.arange(3), 0.004, 0.02)
+    assert np.all(np.isfinite(points)) and weights.sum() == pytest.approx(0.005)
+    halfway = np.all(np.isclose(points, [0.05, 0.0, 0.0]), axis=1)
+    assert halfway.sum() == 1  # where the normals cancel the point is not moved
+
+
 def test_wall_points_keep_a_part_from_slipping_out_between_the_vertices():
     # a sphere fitted in a coarse icosahedron: its 12 vertices alone let it grow to them, 20 mm out of the faces;
     # with points 5 mm apart on the faces it stays within a sagitta of them

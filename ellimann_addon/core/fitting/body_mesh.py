@@ -181,7 +181,9 @@ def surface_walls(vertices, faces, normals, areas, kept, depth, spacing=None):
         bary = np.stack([k - i[grid] - j[grid], i[grid], j[grid]], axis=1) / k  # (g, 3)
         surface = np.einsum("gc,tcx->tgx", bary, vertices[tri])
         normal = np.einsum("gc,tcx->tgx", bary, normals[tri])
-        normal /= np.linalg.norm(normal, axis=2, keepdims=True)
+        length = np.linalg.norm(normal, axis=2, keepdims=True)
+        # where the corners' normals cancel (a fold of the mesh) the point stays on the surface
+        normal = np.divide(normal, length, out=np.zeros_like(normal), where=length > 1e-9)
         extra_points.append((surface + depth * normal).reshape(-1, 3))
         extra_weights.append(np.repeat(share, len(bary)))
         # the corners stand for the triangle's corner points now, not a third of it each
