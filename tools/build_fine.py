@@ -156,7 +156,7 @@ def topology_doc(base):
         f"they do not follow ({FINE_CLEARANCE:g} of the height, the 40's {FitConstants().section_clearance:g}) and "
         "spread further into what the others leave empty; the breast is not centred on the bust section. They keep "
         f"clear of points {FINE_WALL_SPACING * 1000:g} mm apart on the body's triangles, not only of its vertices: "
-        "the heavy bodies' meshes are stretched (triangles up to 95 mm long), and a thin part slipped out between "
+        "the heavy bodies' meshes are stretched (triangles up to 97 mm long), and a thin part slipped out between "
         "the vertices (`wall_spacing`, core.fitting.body_mesh.surface_walls). What each "
         "change measured, and what was tried and did not pay: `docs/topology_fine_tried.md`. The shipped sets "
         "on it are `female-fine` and `male-fine` (`--references female-fine`); the 40 stay the default and "
