@@ -97,6 +97,14 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
     def cover(i):
         return cell_share(to_frame(inside, center[i], rotation[i]), semi_axes[i], spacing)
 
+    surfaces = {}  # most parts keep clear of the same surface: sampled once per obstacles, depth and spacing
+
+    def surface(indices, depth, wall_spacing):
+        key = (indices.tobytes(), depth, wall_spacing)
+        if key not in surfaces:
+            surfaces[key] = surface_walls(body.vertices, body.faces, normals, areas, indices, depth, wall_spacing)
+        return surfaces[key]
+
     for round_ in range(constants.fill_passes):
         for i in fitted:
             if cancel is not None and cancel():
@@ -123,12 +131,12 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
                 walls, wall_areas = hull_surface(body.vertices[idx], fit.depth)
             else:
                 # the surface moved out by depth: the part may reach that far outside the body
-                walls, wall_areas = surface_walls(
-                    body.vertices, body.faces, normals, areas, walls, fit.depth, fit.wall_spacing
-                )
+                walls, wall_areas = surface(walls, fit.depth, fit.wall_spacing)
             weight = np.ones(len(inside))
             if round_:
-                others = np.delete(covers, [i, twins[i]], axis=0).max(axis=0)
+                rest = np.ones(n, dtype=bool)
+                rest[[i, twins[i]]] = False
+                others = covers.max(axis=0, where=rest[:, None], initial=0.0)  # shares are >= 0; no copy of covers
                 shared = constants.fill_shared if fit.shared is None else fit.shared
                 weight = 1.0 + (shared - 1.0) * others
             for key in part.depends:
