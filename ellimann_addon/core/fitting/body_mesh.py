@@ -170,7 +170,7 @@ def surface_walls(vertices, faces, normals, areas, kept, depth, spacing=None):
     longest = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max(axis=1)
     divisions = np.ceil(longest / spacing).astype(int)
     weights = weights.copy()
-    extra_points, extra_weights = [points], [weights]
+    all_points, all_weights = [points], [weights]
     for k in np.unique(divisions[divisions > 1]):
         tri = triangles[divisions == k]
         a, b, c = (vertices[tri[:, i]] for i in range(3))
@@ -184,11 +184,11 @@ def surface_walls(vertices, faces, normals, areas, kept, depth, spacing=None):
         length = np.linalg.norm(normal, axis=2, keepdims=True)
         # where the corners' normals cancel (a fold of the mesh) the point stays on the surface
         normal = np.divide(normal, length, out=np.zeros_like(normal), where=length > 1e-9)
-        extra_points.append((surface + depth * normal).reshape(-1, 3))
-        extra_weights.append(np.repeat(share, len(bary)))
+        all_points.append((surface + depth * normal).reshape(-1, 3))
+        all_weights.append(np.repeat(share, len(bary)))
         # the corners stand for the triangle's corner points now, not a third of it each
         np.add.at(weights, position[tri].ravel(), np.repeat(share - area / 3.0, 3))
-    return np.concatenate(extra_points), np.concatenate(extra_weights)
+    return np.concatenate(all_points), np.concatenate(all_weights)
 
 
 def hidden_vertices(vertices, faces, normals, candidates, reach=0.1, cell=0.01):

@@ -296,9 +296,10 @@ def inscribed_ellipsoid(
         free.remove(kept)
     if level is not None and up in free:
         free.remove(up)
-    across = int(np.argmax(np.abs(rotation[0])))
-    if midline and across in free and abs(rotation[0, across]) > MIDLINE_ALIGNED:
-        free.remove(across)
+    if midline:
+        across = int(np.argmax(np.abs(rotation[0])))  # the frame's axis nearest world x
+        if across in free and abs(rotation[0, across]) > MIDLINE_ALIGNED:
+            free.remove(across)
     # Searched: the free coordinates of the centre and, when filling, the shape the growth starts
     # from (log ratios of two semi-axes to the third), which decides the maximal ellipsoid it reaches.
     shaped = [] if fill is None else [k for k in range(3) if k != kept][1:] if span else [1, 2]
