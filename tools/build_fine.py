@@ -44,6 +44,7 @@ from .reference_topology_fine import (
     FINE_CHAINS,
     FINE_CLEARANCE,
     FINE_DEPTH,
+    FINE_OUTSIDE_COST,
     FINE_SPECS,
     FINE_WALL_SPACING,
 )
@@ -157,7 +158,11 @@ def topology_doc(base):
         "spread further into what the others leave empty; the breast is not centred on the bust section. They keep "
         f"clear of points {FINE_WALL_SPACING * 1000:g} mm apart on the body's triangles, not only of its vertices: "
         "the heavy bodies' meshes are stretched (triangles up to 97 mm long), and a thin part slipped out between "
-        "the vertices (`wall_spacing`, core.fitting.body_mesh.surface_walls). What each "
+        "the vertices (`wall_spacing`, core.fitting.body_mesh.surface_walls). They may reach "
+        f"{FINE_DEPTH * 1000:g} mm outside the skin, as the 40, but pay for the outside they cover: placed, a part "
+        "pays for each cell outside the body what a cell inside that no other part fills is worth to it "
+        f"(`outside_cost` {FINE_OUTSIDE_COST:g}), so it takes the shape that fills the body rather than the one that "
+        "bulges out of it most. What each "
         "change measured, and what was tried and did not pay: `docs/topology_fine_tried.md`. The shipped sets "
         "on it are `female-fine` and `male-fine` (`--references female-fine`); the 40 stay the default and "
         "reproduce the paper's tables. Every rule of the 40 holds: mirror twins, right-handed frames, girth flags "

@@ -436,6 +436,7 @@ def _fit_notes(spec):
         ("clearance", ""),
         ("shared", ""),
         ("wall_spacing", " m"),
+        ("outside_cost", ""),
     ):
         if getattr(spec, attr) is not None and getattr(spec, attr) != getattr(defaults, attr):
             items.append(f"{attr} {getattr(spec, attr):g}{unit}")

@@ -61,6 +61,7 @@ class Spec:
     clearance: float = None  # fraction of the height kept clear of sections it does not follow (None: the fit's)
     shared: float = None  # what volume other parts cover is worth to it on the second pass (None: the fit's)
     wall_spacing: float = None  # m: keeps clear of points this far apart on the body's triangles (None: vertices)
+    outside_cost: float = None  # what covering the body's outside costs it against the inside it fills (None: 0)
 
 
 # The waist's sides are centred on its section (see core.fitting.inscribed.inscribed_ellipsoid's ``level``); the
@@ -346,6 +347,7 @@ def fit_settings(spec, kept=None):
         clearance=spec.clearance,
         shared=spec.shared,
         wall_spacing=spec.wall_spacing,
+        outside_cost=spec.outside_cost,
     )
 
 

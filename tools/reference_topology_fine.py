@@ -372,10 +372,14 @@ EXTRA_SPECS = (
     ),
 )
 
-# How far a part may reach outside the body surface: 4 mm instead of the 40's 5 (mittens stay inside their hull).
-# With the pieces packed closer, the last millimetre adds about as much volume outside the body (excess) as it
-# fills inside it: 5 mm gave 93.1 % coverage and 5.4 % excess on the Base Mannequin, 3 mm 90.8 % and 3.0 %.
-FINE_DEPTH = 0.004
+# How far a part may reach outside the body surface: 5 mm, as the 40's (mittens stay inside their hull), and what a
+# part pays for the outside it covers: a cell outside the body costs what a cell inside that no other part fills is
+# worth. Placed for the inside alone, the parts bulged out wherever the depth let them, and the last millimetre added
+# about as much volume outside the body (excess) as it filled inside (5 mm gave 93.1 % coverage and 5.4 % excess on
+# the Base Mannequin, 3 mm 90.8 % and 3.0 %); paying for the outside, 5 mm fills more than 4 mm did free on every RM
+# but one (equal), with at most 3.6 % excess (docs/topology_fine_tried.md has the figures).
+FINE_DEPTH = 0.005
+FINE_OUTSIDE_COST = 1.0
 
 # With more pieces there is less room to leave: each part keeps 0.0125 of the height clear of the sections it does not
 # follow (the 40's keep 0.025) and, placed the second time, values volume another part covers too at 0.05 of the rest
@@ -398,6 +402,7 @@ FINE_SPECS = tuple(
         clearance=FINE_CLEARANCE,
         shared=FINE_SHARED,
         wall_spacing=None if spec.mitten else FINE_WALL_SPACING,
+        outside_cost=None if spec.mitten else FINE_OUTSIDE_COST,
         level=None if spec.label in FREE_OF_LEVEL else spec.level,
     )
     for spec in SPECS + EXTRA_SPECS

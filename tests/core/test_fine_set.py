@@ -118,6 +118,17 @@ def test_fine_parts_keep_clear_of_the_bodys_triangles_and_the_40s_of_its_vertice
     assert all(trace.fit.wall_spacing is None for trace in base.traces.values() if trace.fit.mitten)
 
 
+@pytest.mark.parametrize("name", SHIPPED_SETS)
+def test_fine_parts_pay_for_the_outside_they_cover_and_the_40s_do_not(name):
+    """Placed for the inside they fill alone, the fine parts bulged out of the body wherever the depth let them
+    (docs/topology_fine_tried.md): the fine bases record what covering the outside costs for every part but the
+    mittens; the 40 pay nothing, as they were traced."""
+    base = Mannequin.load(SHIPPED_SETS[name] / "base_mannequin.json")
+    costs = {trace.fit.outside_cost for trace in base.traces.values() if not trace.fit.mitten}
+    assert costs == ({1.0} if name in TWINS else {None})
+    assert all(trace.fit.outside_cost is None for trace in base.traces.values() if trace.fit.mitten)
+
+
 def test_the_manifest_names_the_fine_set_and_its_topology(fine):
     manifest = json.loads((SHIPPED_SETS[fine.name] / "reference_set.json").read_text(encoding="utf-8"))
     assert manifest["name"] == fine.name and manifest["sex"] == named_reference_set(TWINS[fine.name]).manifest.sex

@@ -6,8 +6,9 @@ import pytest
 
 from devkit.toy import rotation_from_vector
 from ellimann_addon.core.fitting.body_mesh import hidden_vertices, surface_walls, vertex_areas, vertex_normals
-from ellimann_addon.core.fitting.inscribed import _grow, hull_surface, inscribed_ellipsoid, principal_frame
-from ellimann_addon.core.geometry.ellipsoid import fibonacci_sphere
+from ellimann_addon.core.fitting.inscribed import _grow, cell_share, hull_surface, inscribed_ellipsoid, principal_frame
+from ellimann_addon.core.fitting.mannequin_fit import _dilated
+from ellimann_addon.core.geometry.ellipsoid import fibonacci_sphere, to_frame
 from ellimann_addon.core.geometry.frames import is_rotation
 from ellimann_addon.core.geometry.mesh import icosphere
 
@@ -168,6 +169,36 @@ def test_fill_weights_draw_the_part_to_the_volume_that_counts():
     assert middle[0] == pytest.approx(box_middle, abs=1e-12)
 
 
+def test_a_cost_for_the_outside_picks_an_ellipsoid_that_reaches_out_less():
+    # a box body whose surface a part may overstep by 10 mm: free, the part fills the box and that margin all round;
+    # paying for the cells outside, it settles for less of both, and it is what it pays for that it keeps lowest
+    rng = np.random.default_rng(0)
+    half, depth, spacing = np.array([0.1, 0.05, 0.05]), 0.01, 0.01
+    surface = rng.uniform(-1.0, 1.0, (6000, 3))
+    face = rng.integers(0, 3, len(surface))
+    surface[np.arange(len(surface)), face] = np.sign(surface[np.arange(len(surface)), face])
+    points, walls = surface * half, surface * (half + depth)
+    axis = np.arange(-0.13, 0.13, spacing)
+    grid = np.stack(np.meshgrid(axis, axis, axis, indexing="ij"), axis=-1).reshape(-1, 3)
+    inside = np.all(np.abs(grid) < half, axis=1)
+    cells = np.concatenate([grid[inside], grid[~inside & np.all(np.abs(grid) < half + 0.02, axis=1)]])
+    body = int(inside.sum())
+    fit = dict(frame="fixed", inside_fraction=0.0, margin=0.3, fill=cells, fill_spacing=spacing)
+    covered = {}
+    for cost in (0.0, 3.0):
+        weight = np.where(np.arange(len(cells)) < body, 1.0, -cost)
+        rotation, center, semi, _ = inscribed_ellipsoid(
+            points, np.ones(len(points)), walls, np.ones(len(walls)), np.eye(3), fill_weight=weight, **fit
+        )
+        share = cell_share(to_frame(cells, center, rotation), semi, spacing)
+        covered[cost] = share[:body].sum(), share[body:].sum()
+        if cost == 0.0:
+            assert semi == pytest.approx(half + depth, rel=0.01)
+    (free_in, free_out), (paid_in, paid_out) = covered[0.0], covered[3.0]
+    assert paid_out < 0.5 * free_out and paid_in > 0.8 * free_in
+    assert paid_in - 3.0 * paid_out > free_in - 3.0 * free_out
+
+
 def test_hull_surface_samples_the_hull_and_its_area():
     corners = np.array([[x, y, z] for x in (-1.0, 1.0) for y in (-1.0, 1.0) for z in (-1.0, 1.0)])
     inner = np.random.default_rng(2).uniform(-0.9, 0.9, (50, 3))
@@ -266,3 +297,11 @@ def test_hidden_vertices_are_those_that_cannot_see_out():
 def test_unknown_frame_is_refused():
     with pytest.raises(ValueError, match="frame is 'sideways'"):
         principal_frame(np.eye(3), np.ones(3), frame="sideways")
+
+
+def test_a_grid_mask_dilated_holds_every_cell_within_that_many_cells_every_way():
+    mask = np.random.default_rng(4).uniform(size=(9, 8, 7)) > 0.97
+    grown = _dilated(mask, 2)
+    index = np.argwhere(np.ones(mask.shape, dtype=bool))
+    chebyshev = np.abs(index[:, None, :] - np.argwhere(mask)[None]).max(axis=2).min(axis=1)
+    assert np.array_equal(grown.ravel(), chebyshev <= 2) and mask.sum() > 3

@@ -81,10 +81,12 @@ def test_a_trace_for_an_unknown_part_or_a_bad_setting_is_refused():
         Mannequin.from_dict(data)
 
 
-def test_a_parts_own_clearance_shared_and_wall_spacing_are_written_only_when_set_and_checked():
+def test_a_parts_own_fit_settings_are_written_only_when_set_and_checked():
     plain = FitSettings()
-    assert not {"clearance", "shared", "wall_spacing"} & set(plain.to_dict())  # older files read the same
-    own = FitSettings(clearance=0.0125, shared=0.05, wall_spacing=0.01)
+    assert not {"clearance", "shared", "wall_spacing", "outside_cost"} & set(
+        plain.to_dict()
+    )  # older files read the same
+    own = FitSettings(clearance=0.0125, shared=0.05, wall_spacing=0.01, outside_cost=1.0)
     assert FitSettings.from_dict(own.to_dict(), "1.a Cranium") == own
     for key, value, accepted in (
         ("clearance", 0.3, "0 to 0.2"),
@@ -92,6 +94,8 @@ def test_a_parts_own_clearance_shared_and_wall_spacing_are_written_only_when_set
         ("shared", True, "0 to 1"),
         ("wall_spacing", 0.0, "0.001 to 0.1"),
         ("wall_spacing", float("nan"), "0.001 to 0.1"),
+        ("outside_cost", -1.0, "0 to 10"),
+        ("outside_cost", "1", "0 to 10"),
     ):
         with pytest.raises(MannequinError, match=f"traces.fit.{key}: must be null or a number from {accepted}"):
             FitSettings.from_dict({key: value}, "1.a Cranium")

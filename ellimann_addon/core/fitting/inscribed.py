@@ -249,7 +249,8 @@ def inscribed_ellipsoid(
     ``fill_spacing`` sampling the body's volume; if given, the centre is chosen for the
     ellipsoid to cover most of them (by :func:`cell_share`) within the box, instead of for the largest ellipsoid: a part
     fills its region rather than settling where the body is thickest. ``fill_weight`` (p,): what
-    covering each point is worth (default 1), e.g. less where other parts already cover it. ``midline``: the centre
+    covering each point is worth (default 1), e.g. less where other parts already cover it, or less than nothing
+    outside the body. ``midline``: the centre
     stays in the box's middle across the frame's axis along world x (a central part, which the mannequin makes
     symmetric about that middle afterwards: fitted off it, it would be moved into a body it was not fitted to).
     Returns (rotation, center, semi_axes, kept axis index).
@@ -333,7 +334,8 @@ def inscribed_ellipsoid(
             # Trials within TIE of the best are equal: different starting shapes often grow into the same
             # ellipsoid, equal up to rounding, and rounding must not pick one. The first of them is taken.
             k = int(np.argmax(values >= values.max() - TIE * abs(values.max())))
-            if values[k] <= best * (1.0 + 1e-9):
+            # a move must gain a little: above the best, also when a cover that pays for the outside is negative
+            if values[k] <= best * (1.0 + 1e-9 if best >= 0.0 else 1.0 - 1e-9):
                 break
             x, (best, semi) = trials[k], results[k]
         step = 0.5 * step

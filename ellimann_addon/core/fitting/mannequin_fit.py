@@ -85,6 +85,14 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
     normals = vertex_normals(body.vertices, body.faces)
     volume = BodyVolume(body.vertices, body.faces).grid(spacing)
     inside = volume.origin + spacing * np.argwhere(volume.inside)
+    # Parts that pay for covering the outside are placed over the cells round the body too: every cell a part may
+    # share (as far out as its depth and half a cell, cell_share's edge) and half a cell more, from an inside centre.
+    costed = [trace.fit for trace in traces.values() if trace.fit.outside_cost and not trace.fit.mitten]
+    if costed:
+        reach = max(fit.depth for fit in costed) + spacing
+        ring = _dilated(volume.inside, int(np.ceil(reach / spacing))) & ~volume.inside
+        inside = np.concatenate([inside, volume.origin + spacing * np.argwhere(ring)])
+    body_cells = int(volume.inside.sum())  # the cells of ``inside`` past these are outside the body
     bottom, height = body.vertices[:, 2].min(), np.ptp(body.vertices[:, 2])
     n = len(topology)
     rotation, center, semi_axes = np.tile(np.eye(3), (n, 1, 1)), np.zeros((n, 3)), np.ones((n, 3))
@@ -133,12 +141,16 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
                 # the surface moved out by depth: the part may reach that far outside the body
                 walls, wall_areas = surface(walls, fit.depth, fit.wall_spacing)
             weight = np.ones(len(inside))
-            if round_:
+            costs_outside = bool(fit.outside_cost) and not fit.mitten
+            if round_ or costs_outside:
                 rest = np.ones(n, dtype=bool)
                 rest[[i, twins[i]]] = False
                 others = covers.max(axis=0, where=rest[:, None], initial=0.0)  # shares are >= 0; no copy of covers
+            if round_:
                 shared = constants.fill_shared if fit.shared is None else fit.shared
                 weight = 1.0 + (shared - 1.0) * others
+            if costs_outside:  # the outside another part covers already costs nothing more
+                weight[body_cells:] = -fit.outside_cost * (1.0 - others[body_cells:])
             for key in part.depends:
                 if key in constants.section_fractions and (part.girth or key == "Sh"):
                     near = (
@@ -146,6 +158,7 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
                         < constants.slab * height
                     )
                     weight = np.where(near, weight * constants.slab_weight, weight)
+            cells = len(inside) if costs_outside else body_cells
             rotation[i], center[i], semi_axes[i], kept_out[i] = inscribed_ellipsoid(
                 points,
                 weights,
@@ -160,8 +173,8 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
                 ceiling=ceiling,
                 level=level,
                 span=fit.span,
-                fill=inside,
-                fill_weight=weight,
+                fill=inside[:cells],
+                fill_weight=weight[:cells],
                 fill_spacing=spacing,
                 midline=part.side == "C",
             )
@@ -173,3 +186,17 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
     return Mannequin(
         topology, rotation, center, semi_axes, section_fractions=constants.section_fractions, **fields
     ).check(), [kept_out[twins[i]] if part.side == "R" else kept_out[i] for i, part in enumerate(topology)]
+
+
+def _dilated(mask, cells):
+    """``mask`` (a 3-d bool grid) grown by ``cells`` cells every way (a cube of them round each true cell)."""
+    for axis in range(3):
+        grown = mask.copy()
+        for shift in range(1, cells + 1):
+            ahead = [slice(None)] * 3
+            behind = [slice(None)] * 3
+            ahead[axis], behind[axis] = slice(shift, None), slice(None, -shift)
+            grown[tuple(ahead)] |= mask[tuple(behind)]
+            grown[tuple(behind)] |= mask[tuple(ahead)]
+        mask = grown
+    return mask

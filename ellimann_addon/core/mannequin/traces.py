@@ -39,8 +39,12 @@ class FitSettings:
     # m: besides the body's vertices, it keeps clear of points this far apart on the triangles with longer edges
     # (core.fitting.body_mesh.surface_walls); None: of the vertices only
     wall_spacing: float = None
+    # what covering a cell outside the body costs the part when it is placed, in cells inside that no other part
+    # fills (core.fitting.mannequin_fit); None: nothing, it is placed for the inside it fills alone
+    outside_cost: float = None
 
-    _DEFAULTED = ("clearance", "shared", "wall_spacing")  # written only when set: traces made before them read the same
+    # written only when set: traces made before them read the same
+    _DEFAULTED = ("clearance", "shared", "wall_spacing", "outside_cost")
 
     def to_dict(self):
         out = asdict(self)
@@ -66,7 +70,7 @@ class FitSettings:
         return cls(**values)
 
 
-_LIMITS = {"clearance": (0.0, 0.2), "shared": (0.0, 1.0), "wall_spacing": (0.001, 0.1)}
+_LIMITS = {"clearance": (0.0, 0.2), "shared": (0.0, 1.0), "wall_spacing": (0.001, 0.1), "outside_cost": (0.0, 10.0)}
 
 
 def _fit_value(part, key, value):
