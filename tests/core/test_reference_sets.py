@@ -83,9 +83,8 @@ def test_a_trace_for_an_unknown_part_or_a_bad_setting_is_refused():
 
 def test_a_parts_own_fit_settings_are_written_only_when_set_and_checked():
     plain = FitSettings()
-    assert not {"clearance", "shared", "wall_spacing", "outside_cost"} & set(
-        plain.to_dict()
-    )  # older files read the same
+    # written only when set: older files read the same
+    assert not {"clearance", "shared", "wall_spacing", "outside_cost"} & set(plain.to_dict())
     own = FitSettings(clearance=0.0125, shared=0.05, wall_spacing=0.01, outside_cost=1.0)
     assert FitSettings.from_dict(own.to_dict(), "1.a Cranium") == own
     for key, value, accepted in (
