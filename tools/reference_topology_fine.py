@@ -392,7 +392,7 @@ FREE_OF_LEVEL = ("Breast",)
 
 # The parts keep clear of points 10 mm apart on the body's triangles, not only of its vertices: the heavy bodies'
 # meshes are stretched (triangles up to 97 mm long on the chubby ones), and a thin part slipped out between the
-# vertices (the Upper Gluteus reached 22.7 mm out of Tall Chubby's lumbar shelf, against the 4 mm allowed).
+# vertices (the Upper Gluteus reached 22.7 mm out of Tall Chubby's lumbar shelf, against the 4 mm then allowed).
 FINE_WALL_SPACING = 0.01
 
 FINE_SPECS = tuple(

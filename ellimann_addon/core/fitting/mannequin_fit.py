@@ -84,26 +84,26 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
     areas = vertex_areas(body.vertices, body.faces)
     normals = vertex_normals(body.vertices, body.faces)
     volume = BodyVolume(body.vertices, body.faces).grid(spacing)
-    inside = volume.origin + spacing * np.argwhere(volume.inside)
+    cells = volume.origin + spacing * np.argwhere(volume.inside)  # the body's, then (if any part pays) those round it
+    body_cells = len(cells)
     # Parts that pay for covering the outside are placed over the cells round the body too: every cell a part may
     # share (as far out as its depth and half a cell, cell_share's edge) and half a cell more, from an inside centre.
-    costed = [trace.fit for trace in traces.values() if trace.fit.outside_cost and not trace.fit.mitten]
-    if costed:
-        reach = max(fit.depth for fit in costed) + spacing
+    paying = [trace.fit for trace in traces.values() if _pays_outside(trace.fit)]
+    if paying:
+        reach = max(fit.depth for fit in paying) + spacing
         ring = _dilated(volume.inside, int(np.ceil(reach / spacing))) & ~volume.inside
-        inside = np.concatenate([inside, volume.origin + spacing * np.argwhere(ring)])
-    body_cells = int(volume.inside.sum())  # the cells of ``inside`` past these are outside the body
+        cells = np.concatenate([cells, volume.origin + spacing * np.argwhere(ring)])
     bottom, height = body.vertices[:, 2].min(), np.ptp(body.vertices[:, 2])
     n = len(topology)
     rotation, center, semi_axes = np.tile(np.eye(3), (n, 1, 1)), np.zeros((n, 3)), np.ones((n, 3))
     kept_out = [None] * n
     fitted = [i for i, part in enumerate(topology) if part.side != "R"]
     twins = topology.twin_indices
-    covers = np.zeros((n, len(inside)))  # share of each cell inside each part (inscribe.cell_share)
+    covers = np.zeros((n, len(cells)))  # share of each cell inside each part (inscribe.cell_share)
     obstacles = {i: obstacle_indices(traces[topology.names[i]]) for i in fitted}
 
     def cover(i):
-        return cell_share(to_frame(inside, center[i], rotation[i]), semi_axes[i], spacing)
+        return cell_share(to_frame(cells, center[i], rotation[i]), semi_axes[i], spacing)
 
     surfaces = {}  # most parts keep clear of the same surface: sampled once per obstacles, depth and spacing
 
@@ -140,25 +140,25 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
             else:
                 # the surface moved out by depth: the part may reach that far outside the body
                 walls, wall_areas = surface(walls, fit.depth, fit.wall_spacing)
-            weight = np.ones(len(inside))
-            costs_outside = bool(fit.outside_cost) and not fit.mitten
-            if round_ or costs_outside:
+            weight = np.ones(len(cells))
+            pays = _pays_outside(fit)
+            if round_ or pays:
                 rest = np.ones(n, dtype=bool)
                 rest[[i, twins[i]]] = False
                 others = covers.max(axis=0, where=rest[:, None], initial=0.0)  # shares are >= 0; no copy of covers
             if round_:
                 shared = constants.fill_shared if fit.shared is None else fit.shared
                 weight = 1.0 + (shared - 1.0) * others
-            if costs_outside:  # the outside another part covers already costs nothing more
+            if pays:  # the outside another part covers already costs nothing more
                 weight[body_cells:] = -fit.outside_cost * (1.0 - others[body_cells:])
             for key in part.depends:
                 if key in constants.section_fractions and (part.girth or key == "Sh"):
                     near = (
-                        np.abs(inside[:, 2] - bottom - constants.section_fractions[key] * height)
+                        np.abs(cells[:, 2] - bottom - constants.section_fractions[key] * height)
                         < constants.slab * height
                     )
                     weight = np.where(near, weight * constants.slab_weight, weight)
-            cells = len(inside) if costs_outside else body_cells
+            placed_over = len(cells) if pays else body_cells
             rotation[i], center[i], semi_axes[i], kept_out[i] = inscribed_ellipsoid(
                 points,
                 weights,
@@ -173,8 +173,8 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
                 ceiling=ceiling,
                 level=level,
                 span=fit.span,
-                fill=inside[:cells],
-                fill_weight=weight[:cells],
+                fill=cells[:placed_over],
+                fill_weight=weight[:placed_over],
                 fill_spacing=spacing,
                 midline=part.side == "C",
             )
@@ -186,6 +186,11 @@ def fit_mannequin(body, topology, traces, reference=None, kept=None, constants=N
     return Mannequin(
         topology, rotation, center, semi_axes, section_fractions=constants.section_fractions, **fields
     ).check(), [kept_out[twins[i]] if part.side == "R" else kept_out[i] for i, part in enumerate(topology)]
+
+
+def _pays_outside(fit):
+    """Whether a part pays for the outside it covers: a mitten never does (it fills between the fingers)."""
+    return bool(fit.outside_cost) and not fit.mitten
 
 
 def _dilated(mask, cells):
