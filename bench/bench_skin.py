@@ -1,12 +1,13 @@
 """What a skin costs at each level (``core.skin.surface.build_skin``), now against an older commit in the same run.
 
 Each tree (this one, and ``BEFORE``: the skin as it first landed, checked out in a temporary git worktree) runs
-``build_skin`` on the five female Reference Mannequins at the preview (10 mm) and final (5 mm) levels in a process
-of its own; the trees alternate over ROUNDS rounds so that the machine's load falls on both alike. Printed per
-level: the median CPU seconds of one skin (user + system of that process), the vertices, and the older tree's
-median over now's. Exact mode on the skin (``exact_skin``, Table 2.5's first request) is timed in this tree only.
+``build_skin`` on the five Reference Mannequins of a shipped set (``--set``, default female) at the preview (10 mm)
+and final (5 mm) levels in a process of its own; the trees alternate over ROUNDS rounds so that the machine's load
+falls on both alike. Printed per level: the median CPU seconds of one skin (user + system of that process), the
+vertices, and the older tree's median over now's. Exact mode on the skin (``exact_skin``, Table 2.5's first
+request) is timed in this tree only.
 
-``python -m bench.bench_skin [--rounds N] [--before COMMIT]``
+``python -m bench.bench_skin [--rounds N] [--before COMMIT] [--set NAME]``
 """
 
 import argparse
@@ -33,7 +34,7 @@ from ellimann_addon.core.synthesis.shipped import named_reference_set
 figures = {}
 for level, voxel in %r.items():
     rows = []
-    for mannequin in named_reference_set("female").mannequins:
+    for mannequin in named_reference_set(%r).mannequins:
         start = time.process_time()
         skin = build_skin(mannequin, SkinSettings(voxel))
         rows.append((time.process_time() - start, len(skin.vertices)))
@@ -42,10 +43,9 @@ print(json.dumps(figures))
 """
 
 
-def run_tree(tree):
-    done = subprocess.run(
-        [sys.executable, "-c", TREE_SCRIPT % LEVELS], cwd=tree, capture_output=True, text=True, check=False
-    )
+def run_tree(tree, set_name):
+    script = TREE_SCRIPT % (LEVELS, set_name)
+    done = subprocess.run([sys.executable, "-c", script], cwd=tree, capture_output=True, text=True, check=False)
     lines = [line for line in done.stdout.splitlines() if line.startswith("{")]
     if not lines:
         print(f"  {tree}: no figures (exit {done.returncode}): {done.stderr.strip().splitlines()[-1:]}")
@@ -71,7 +71,7 @@ def exact_seconds():
     return rows
 
 
-def run(rounds=ROUNDS, before=BEFORE):
+def run(rounds=ROUNDS, before=BEFORE, set_name="female"):
     figures = {"now": {level: [] for level in LEVELS}, before: {level: [] for level in LEVELS}}
     with tempfile.TemporaryDirectory(prefix="ellimann-bench-skin-") as scratch:
         trees = {"now": REPO}
@@ -83,13 +83,13 @@ def run(rounds=ROUNDS, before=BEFORE):
         try:
             for _ in range(rounds):
                 for name, tree in trees.items():
-                    result = run_tree(tree) or {}
+                    result = run_tree(tree, set_name) or {}
                     for level, rows in result.items():
                         figures[name][level] += rows
         finally:
             if old is not None:
                 subprocess.run(["git", "-C", str(REPO), "worktree", "remove", "--force", str(old)], check=False)
-    print(f"A skin of each of the five female RMs, {rounds} round(s) per tree: median CPU s (vertices)")
+    print(f"A skin of each of the five {set_name} RMs, {rounds} round(s) per tree: median CPU s (vertices)")
     for level, voxel in LEVELS.items():
         now = [seconds for seconds, _ in figures["now"][level]]
         then = [seconds for seconds, _ in figures[before][level]]
@@ -108,8 +108,9 @@ def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m bench.bench_skin", description=__doc__.split("\n")[0])
     parser.add_argument("--rounds", type=int, default=ROUNDS)
     parser.add_argument("--before", default=BEFORE, help=f"the older commit (default {BEFORE})")
+    parser.add_argument("--set", default="female", help="the shipped reference set (default female)")
     args = parser.parse_args(argv)
-    run(args.rounds, args.before)
+    run(args.rounds, args.before, args.set)
 
 
 if __name__ == "__main__":

@@ -7,7 +7,11 @@ per cent of the Euclidean distance in the few centimetres the blend and the mesh
 plain minimum over all pieces, lowered where two *neighbours* meet by the polynomial smooth minimum of width
 ``blend``: smin(a, b) = min(a, b) - k h^2 / 4, h = max(k - |a - b|, 0) / k. It never raises the field, so the
 skin holds every piece, and it adds at most k / 4 where two surfaces cross. Pieces that are not neighbours (an
-arm beside the torso, the two thighs, a hand at the hip) meet in a plain crease, with no webbing.
+arm beside the torso, the two thighs, a hand at the hip) meet in a plain crease, with no webbing; where they do
+not touch but come nearer than the skin's gap (a voxel and a quarter) and one of them is off the trunk (a limb, the
+head), each is cut back from the other to half the gap (``apart_pairs``): a voxel would otherwise join them, and an
+arm joined to the flank below the shoulder it hangs from makes a handle through the body. The trunk's pieces are
+one body: a gap between two of them (the left and right trapezius under the neck) would open a tunnel.
 
 Sampling: the field on a coarse grid (``COARSE`` times the spacing) decides which coarse cells can hold the
 surface (some corner nearer than the cell's reach); only their nodes are sampled at half the spacing, which
@@ -32,6 +36,13 @@ ONSET = 1.0  # times the fillet's depth: the span over which a fillet's emergenc
 # other (farther piece < 1.25 widths): up to FULL it is whole; beyond FADE nothing needs a piece's distance.
 FULL, FADE = 1.25, 1.5
 MAX_BLEND = 0.04  # m: the widest blend (the trunk's big pieces)
+# The regions off the trunk: a piece of one may be kept apart from others. The trunk's (neck, shoulders, chest,
+# abdomen, hips) are one body, and a region of one's own topology the skin does not know is taken as the trunk's.
+OFF_TRUNK_REGIONS = frozenset(("head", "arms", "hands", "legs", "feet"))
+# Pieces that do not touch are kept this many voxels apart: a 6-connected mesh separates two insides when every
+# grid line between them meets an outside node, which a gap of a voxel holds; the rest is the distances' slack.
+GAP = 1.25
+SURFACE_SAMPLES = 512  # points on a piece's surface by which apart_pairs judges whether two pieces touch
 
 
 @dataclass(frozen=True)
@@ -136,6 +147,45 @@ def blend_widths(semi_axes, pairs, blend):
     return np.minimum(blend * np.minimum(thinnest[pairs[:, 0]], thinnest[pairs[:, 1]]), MAX_BLEND)
 
 
+def apart_pairs(rotation, center, semi_axes, pairs, widths, gap, off_trunk):
+    """(S, 2) part indices that do not blend (not in ``pairs``), not both on the trunk (``off_trunk``: a bool per
+    part), do not touch, and come nearer than ``gap`` plus how far their fillets with others may bulge (a quarter of
+    their widest blend ``widths`` each): the skin keeps them ``gap`` apart. Touching is judged on SURFACE_SAMPLES
+    points of each piece's surface, by the other's distance bound there."""
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    bulge = np.zeros(len(center))
+    for (i, j), width in zip(pairs, widths):
+        bulge[[i, j]] = np.maximum(bulge[[i, j]], 0.25 * width)
+    lo, hi = bounds(rotation, center, semi_axes)
+    reach = gap + bulge[:, None] + bulge[None, :]
+    near = np.all(
+        (lo[:, None] <= hi[None, :] + reach[..., None]) & (lo[None, :] <= hi[:, None] + reach[..., None]), axis=2
+    )
+    near[tuple(pairs.T)] = False
+    near &= np.logical_or.outer(off_trunk, off_trunk)
+    direction = _sphere_points(SURFACE_SAMPLES)
+    apart = []
+    for i, j in zip(*np.nonzero(np.triu(near, 1))):
+        on_i = center[i] + (direction * semi_axes[i]) @ rotation[i].T
+        on_j = center[j] + (direction * semi_axes[j]) @ rotation[j].T
+        nearest = min(
+            piece_distance(on_i, rotation[j], center[j], semi_axes[j]).min(),
+            piece_distance(on_j, rotation[i], center[i], semi_axes[i]).min(),
+        )
+        if 0.0 < nearest < reach[i, j]:
+            apart.append((i, j))
+    return np.array(apart, dtype=np.int64).reshape(-1, 2)
+
+
+def _sphere_points(count):
+    """``count`` nearly evenly spread unit vectors (a Fibonacci lattice)."""
+    k = np.arange(count) + 0.5
+    z = 1.0 - 2.0 * k / count
+    angle = np.pi * (1.0 + 5.0**0.5) * k
+    r = np.sqrt(1.0 - z * z)
+    return np.stack([r * np.cos(angle), r * np.sin(angle), z], axis=1)
+
+
 def field_grid(rotation, center, semi_axes, spacing, blend):
     """The fine grid around the pieces: a margin of the widest blend and two cells, whole coarse cells on every
     axis."""
@@ -146,16 +196,32 @@ def field_grid(rotation, center, semi_axes, spacing, blend):
     return Grid(lo, float(spacing), tuple(int(n) for n in cells * COARSE + 1))
 
 
+def skin_pieces(mannequin, blend, voxel):
+    """The PieceField of ``mannequin``'s skin at ``blend`` meshed at ``voxel`` (m): neighbours blended
+    (``blend_pairs``), pieces that do not touch kept GAP voxels apart (``apart_pairs``)."""
+    arrays = (mannequin.rotation, mannequin.center, mannequin.semi_axes)
+    pairs = blend_pairs(mannequin.topology)
+    widths = blend_widths(mannequin.semi_axes, pairs, blend)
+    off_trunk = np.array([part.region in OFF_TRUNK_REGIONS for part in mannequin.topology])
+    gap = GAP * voxel
+    return PieceField(*arrays, pairs, widths, apart_pairs(*arrays, pairs, widths, gap, off_trunk), gap)
+
+
 class PieceField:
     """The pieces' arrays and padded boxes, and the field on the marked nodes of a grid."""
 
-    def __init__(self, rotation, center, semi_axes, pairs, widths):
+    def __init__(self, rotation, center, semi_axes, pairs, widths, apart=None, gap=0.0):
         self.rotation, self.center, self.semi_axes = rotation, center, semi_axes
         self.pairs, self.widths = pairs, widths
+        self.apart, self.gap = (np.zeros((0, 2), dtype=np.int64) if apart is None else apart), gap
         self.lo, self.hi = bounds(rotation, center, semi_axes)
         self.margin = np.zeros(len(center))  # each piece's widest blend: its distances are needed that far out
         for (i, j), width in zip(pairs, widths):
             self.margin[[i, j]] = np.maximum(self.margin[[i, j]], width)
+
+    def without_gaps(self):
+        """This field with no pieces kept apart."""
+        return PieceField(self.rotation, self.center, self.semi_axes, self.pairs, self.widths)
 
     def distance(self, i, points):
         return piece_distance(points, self.rotation[i], self.center[i], self.semi_axes[i])
@@ -167,9 +233,9 @@ class PieceField:
         index = np.full(len(self.center), -1)
         index[keep] = np.arange(len(keep))
         among = (index[self.pairs[:, 0]] >= 0) & (index[self.pairs[:, 1]] >= 0)
-        pieces = PieceField(
-            self.rotation[keep], self.center[keep], self.semi_axes[keep], index[self.pairs[among]], self.widths[among]
-        )
+        apart = self.apart[(index[self.apart[:, 0]] >= 0) & (index[self.apart[:, 1]] >= 0)]
+        arrays = (self.rotation[keep], self.center[keep], self.semi_axes[keep])
+        pieces = PieceField(*arrays, index[self.pairs[among]], self.widths[among], index[apart], self.gap)
         return pieces, keep
 
     def field(self, grid, marked, reach):
@@ -214,18 +280,30 @@ class PieceField:
     def _combine(self, size, select, reach):
         """The field on ``size`` nodes, those in a box given by ``select(lo, hi)`` -> (ascending nodes, points);
         the nodes' x must ascend with them (a grid's flat order, or points sorted by x)."""
-        flat = np.full(size, FAR)
-        nearest_piece = np.full(size, -1, dtype=np.int32)
         near = []  # each piece's nodes (ascending), their points and its distances there
         for i in range(len(self.center)):
             margin = FADE * self.margin[i] + reach
             nodes, points = select(self.lo[i] - margin, self.hi[i] + margin)
-            distance = self.distance(i, points)
+            near.append((nodes, points, self.distance(i, points)))
+        # A piece apart from another is lifted to half the gap on their bisector: lift = (gap + d_i - d_j) / 2,
+        # the most over its partners (-inf where none is near); its distance is cut to max(d, lift), and no fillet
+        # of it with a third piece reaches below its lift, so the gap stays open.
+        lift = [None] * len(near)
+        for i, j in self.apart:
+            rows_i, rows_j = _shared(near[i], near[j])
+            a, b = near[i][2][rows_i], near[j][2][rows_j]
+            for piece, rows, value in ((i, rows_i, 0.5 * (self.gap + a - b)), (j, rows_j, 0.5 * (self.gap + b - a))):
+                if lift[piece] is None:
+                    lift[piece] = np.full(len(near[piece][0]), -np.inf)
+                lift[piece][rows] = np.maximum(lift[piece][rows], value)
+        near = [(n, p, d if up is None else np.maximum(d, up)) for (n, p, d), up in zip(near, lift)]
+        flat = np.full(size, FAR)
+        nearest_piece = np.full(size, -1, dtype=np.int32)
+        for i, (nodes, _, distance) in enumerate(near):
             current = flat[nodes]
             closer = distance < current
             nearest_piece[nodes[closer]] = i
             flat[nodes] = np.where(closer, distance, current)
-            near.append((nodes, points, distance))
         nearest = flat.copy()  # the plain minimum over every piece
         # Each pair's fillet (the polynomial smooth minimum's) reaches below the plain minimum by some depth; the
         # pairs' depths are joined by a POWER-norm: their maximum where one pair blends, smooth where two meet.
@@ -233,32 +311,41 @@ class PieceField:
         for (i, j), width in zip(self.pairs, self.widths):
             if width <= 0.0:  # a plain union
                 continue
-            if len(near[j][0]) < len(near[i][0]):
-                i, j = j, i
-            (nodes_i, points_i, d_i), (nodes_j, points_j, d_j) = near[i], near[j]
-            if not len(nodes_j):
-                continue
-            # the nodes both pieces have, among those of the smaller list within the other's x range (the nodes
-            # ascend, so x does too)
-            first, last = np.searchsorted(points_i[:, 0], (points_j[0, 0], points_j[-1, 0]), side="left"), None
-            first, last = first[0], np.searchsorted(points_i[:, 0], points_j[-1, 0], side="right")
-            candidates = nodes_i[first:last]
-            position = np.minimum(np.searchsorted(nodes_j, candidates), len(nodes_j) - 1)
-            shared = np.flatnonzero(nodes_j[position] == candidates)
-            rows = first + shared
-            a, b = d_i[rows], d_j[position[shared]]
+            rows_i, rows_j = _shared(near[i], near[j])
+            a, b = near[i][2][rows_i], near[j][2][rows_j]
             blending = np.abs(a - b) < width  # elsewhere the fillet is nil
-            nodes, a, b = nodes_i[rows[blending]], a[blending], b[blending]
+            rows_i, rows_j = rows_i[blending], rows_j[blending]
+            nodes, a, b = near[i][0][rows_i], a[blending], b[blending]
             # faded out between FULL and FADE widths from the farther piece, so that the field stays
             # continuous where the nodes whose distances are known end
             fade = _smoothstep((FADE * width - np.maximum(a, b)) / ((FADE - FULL) * width))
             lowered = fade * blend_amount(a, b, width)
+            for piece, rows in ((i, rows_i), (j, rows_j)):
+                if lift[piece] is not None:  # not into a gap
+                    lowered = np.minimum(lowered, np.maximum(np.minimum(a, b) - lift[piece][rows], 0.0))
             # how far the pair's fillet reaches below the front; its onset rounded over a span that vanishes
             # with the fillet, so that a pair whose pieces do not meet adds nothing
             reach_below = _soft_positive(lowered - (np.minimum(a, b) - nearest[nodes]), ONSET * lowered)
             power[nodes] += reach_below**POWER
         flat -= power ** (1.0 / POWER)
         return flat, nearest_piece
+
+
+def _shared(near_i, near_j):
+    """The rows of the nodes two pieces' lists (nodes ascending, points, distances) both hold: (rows in i's,
+    rows in j's). Searched among the shorter list's nodes within the longer's x range (x ascends with the
+    nodes)."""
+    swap = len(near_j[0]) < len(near_i[0])
+    (nodes_i, points_i, _), (nodes_j, points_j, _) = (near_j, near_i) if swap else (near_i, near_j)
+    if not len(nodes_j):
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    first = np.searchsorted(points_i[:, 0], points_j[0, 0], side="left")
+    last = np.searchsorted(points_i[:, 0], points_j[-1, 0], side="right")
+    candidates = nodes_i[first:last]
+    position = np.minimum(np.searchsorted(nodes_j, candidates), len(nodes_j) - 1)
+    shared = np.flatnonzero(nodes_j[position] == candidates)
+    rows_i, rows_j = first + shared, position[shared]
+    return (rows_j, rows_i) if swap else (rows_i, rows_j)
 
 
 def _box_nodes(grid, marked, lo, hi):
@@ -272,12 +359,13 @@ def _box_nodes(grid, marked, lo, hi):
     return np.ravel_multi_index(index, grid.shape), grid.origin + grid.spacing * np.stack(index, axis=1)
 
 
-def sample_field(rotation, center, semi_axes, pairs, widths, spacing):
-    """The field on the fine grid: (values (nx, ny, nz), Grid, the nearest piece of each node (flat, -1: none
-    near)). Levels from COARSE times the spacing down, each half the last: a level samples only the nodes of the
-    cells the level above found the surface may cross; the other nodes hold +-FAR (their cell's sign)."""
-    pieces = PieceField(rotation, center, semi_axes, pairs, widths)
-    grid = field_grid(rotation, center, semi_axes, spacing, FADE * max(widths, default=0.0))
+def sample_field(pieces, spacing):
+    """The field of ``pieces`` (a PieceField) on the fine grid: (values (nx, ny, nz), Grid, the nearest piece of
+    each node (flat, -1: none near)). Levels from COARSE times the spacing down, each half the last: a level samples
+    only the nodes of the cells the level above found the surface may cross; the other nodes hold +-FAR (their
+    cell's sign)."""
+    blend = FADE * max(pieces.widths, default=0.0)
+    grid = field_grid(pieces.rotation, pieces.center, pieces.semi_axes, spacing, blend)
     step = COARSE
     level = Grid(grid.origin, spacing * step, tuple((n - 1) // step + 1 for n in grid.shape))
     marked = np.ones(level.shape, dtype=bool)

@@ -15,7 +15,7 @@ from ..geometry.ellipsoid import bounds
 from ..geometry.mesh import convex_hull_2d, polygon_perimeter, section_segments
 from ..measure.body import measure_body_mesh
 from ..measure.extra import SIDES, MannequinLandmarks, mannequin_tilt
-from .field import FADE, Grid, PieceField, blend_pairs, blend_widths
+from .field import FADE, Grid, skin_pieces
 
 SECTION_COARSE = 0.004  # m between the samples of a section plane whose grid edges bracket the surface
 ROOT_STEPS = 8  # regula-falsi steps along each bracketing edge
@@ -66,11 +66,9 @@ class SkinField:
 
     def __init__(self, mannequin, settings):
         self.mannequin = mannequin
-        pairs = blend_pairs(mannequin.topology)
-        self.widths = blend_widths(mannequin.semi_axes, pairs, settings.blend)
-        arrays = (mannequin.rotation, mannequin.center, mannequin.semi_axes)
-        self.pieces = PieceField(*arrays, pairs, self.widths)
-        self.lo, self.hi = bounds(*arrays)
+        self.pieces = skin_pieces(mannequin, settings.blend, settings.voxel)
+        self.widths = self.pieces.widths
+        self.lo, self.hi = bounds(mannequin.rotation, mannequin.center, mannequin.semi_axes)
         self.girth = mannequin.topology.girth_mask
         self.reach = FADE * max(self.widths, default=0.0) + MARGIN  # how far the surface can stand off a piece
 

@@ -6,6 +6,10 @@ The pieces stay the mannequin's truth for collisions and m_T; the skin is for th
 draping on a smooth body. Cavities the pieces enclose (a pocket between the trunk's ellipsoids) are filled: only
 the outer surface is kept. A body that falls apart into several outer surfaces (a piece that touches no other)
 is refused, naming the pieces of the loose part.
+
+Pieces that do not touch are kept a gap apart (``core.skin.field.apart_pairs``) unless that makes the skin worse:
+where the pieces join all round a gap (an upper arm that overlaps the ribs beside an elbow kept off them), it is a
+tunnel, and the skin is made again without gaps; the one with fewer handles is kept (the first, if as many).
 """
 
 from dataclasses import dataclass
@@ -14,11 +18,11 @@ from functools import cached_property
 import numpy as np
 
 from ..errors import ElliMannError
-from ..geometry.mesh import connected_labels, directed_edges, volume
+from ..geometry.mesh import connected_labels, directed_edges, euler_characteristic, volume
 from ..measure.body import measure_body_mesh
 from ..pose.kinematics import bone_matrices, require_joints
 from .contour import marching_cubes
-from .field import FADE, blend_pairs, blend_widths, sample_field
+from .field import FADE, blend_pairs, blend_widths, sample_field, skin_pieces
 from .settings import SkinSettings, check_skin_size
 from .skinning import skinning_weights
 from .weights import follow_pieces, piece_motions, piece_weights
@@ -80,15 +84,38 @@ def build_skin(mannequin, settings=None):
     piece, or a body whose outer surface falls apart."""
     settings = settings or SkinSettings()
     check_skin(mannequin, settings)
-    pairs = blend_pairs(mannequin.topology)
-    widths = blend_widths(mannequin.semi_axes, pairs, settings.blend)
+    pieces = skin_pieces(mannequin, settings.blend, settings.voxel)
+    pieces, (vertices, faces, owner) = gapped_mesh(pieces, settings.voxel, mannequin.topology.names)
     arrays = (mannequin.rotation, mannequin.center, mannequin.semi_axes)
-    values, grid, nearest = sample_field(*arrays, pairs, widths, settings.voxel)
+    vertex_pieces, weights = piece_weights(vertices, owner, *arrays, pieces.pairs, pieces.widths)
+    return Skin(mannequin, vertices, faces, vertex_pieces, weights, settings)
+
+
+def gapped_mesh(pieces, voxel, names):
+    """(the PieceField meshed, its :func:`outer_mesh`): ``pieces`` with their gaps, or without them where the
+    gaps make a skin that is not a sphere and without has fewer handles, or where with them the body falls apart
+    (a piece held on by less than a gap); SkinError if it falls apart without them too."""
+    try:
+        surface = outer_mesh(pieces, voxel, names)
+    except SkinError:
+        if not len(pieces.apart):
+            raise
+        surface = None
+    if len(pieces.apart) and (surface is None or euler_characteristic(*surface[:2]) != 2):
+        joined = pieces.without_gaps()
+        again = outer_mesh(joined, voxel, names)
+        if surface is None or euler_characteristic(*again[:2]) > euler_characteristic(*surface[:2]):
+            return joined, again
+    return pieces, surface
+
+
+def outer_mesh(pieces, voxel, names):
+    """(vertices, faces, each vertex's nearest piece) of the outer surface of ``pieces``' field (a PieceField) at
+    ``voxel``; SkinError as :func:`outer_surface`."""
+    values, grid, nearest = sample_field(pieces, voxel)
     vertices, faces, inner = marching_cubes(values, grid.origin, grid.spacing)
-    vertices, faces, inner = outer_surface(vertices, faces, inner, nearest, mannequin.topology.names)
-    owner = nearest[inner]
-    pieces, weights = piece_weights(vertices, owner, *arrays, pairs, widths)
-    return Skin(mannequin, vertices, faces, pieces, weights, settings)
+    vertices, faces, inner = outer_surface(vertices, faces, inner, nearest, names)
+    return vertices, faces, nearest[inner]
 
 
 def check_skin(mannequin, settings=None):
