@@ -18,7 +18,7 @@ from functools import cached_property
 import numpy as np
 
 from ..errors import ElliMannError
-from ..geometry.mesh import connected_labels, directed_edges, euler_characteristic, volume
+from ..geometry.mesh import connected_labels, directed_edges, volume
 from ..measure.body import measure_body_mesh
 from ..pose.kinematics import bone_matrices, require_joints
 from .contour import marching_cubes
@@ -101,12 +101,19 @@ def gapped_mesh(pieces, voxel, names):
         if not len(pieces.apart):
             raise
         surface = None
-    if len(pieces.apart) and (surface is None or euler_characteristic(*surface[:2]) != 2):
+    if len(pieces.apart) and (surface is None or _euler(surface) != 2):
         joined = pieces.without_gaps()
         again = outer_mesh(joined, voxel, names)
-        if surface is None or euler_characteristic(*again[:2]) > euler_characteristic(*surface[:2]):
+        if surface is None or _euler(again) > _euler(surface):
             return joined, again
     return pieces, surface
+
+
+def _euler(surface):
+    """The Euler characteristic of a closed triangle mesh (every edge on two faces, as the meshing makes it):
+    V - E + F with E = 3F / 2."""
+    vertices, faces = surface[:2]
+    return len(vertices) - len(faces) // 2
 
 
 def outer_mesh(pieces, voxel, names):
