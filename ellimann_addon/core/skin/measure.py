@@ -62,7 +62,9 @@ def body_measurements(skin, fractions=None):
 
 
 class SkinField:
-    """The skin's field of a mannequin at its settings, sampled where a measurement needs it."""
+    """The skin's field of a mannequin at its settings, sampled where a measurement needs it. It keeps the gaps
+    build_skin keeps; where build_skin gives them up (a skin with fewer handles without them), its mesh measures
+    a little otherwise near the arms, which exact mode's last round, on the mesh, makes up."""
 
     def __init__(self, mannequin, settings):
         self.mannequin = mannequin
