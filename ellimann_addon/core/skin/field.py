@@ -151,7 +151,8 @@ def apart_pairs(rotation, center, semi_axes, pairs, widths, gap, off_trunk):
     """(S, 2) part indices that do not blend (not in ``pairs``), not both on the trunk (``off_trunk``: a bool per
     part), do not touch, and come nearer than ``gap`` plus how far their fillets with others may bulge (a quarter of
     their widest blend ``widths`` each): the skin keeps them ``gap`` apart. Touching is judged on SURFACE_SAMPLES
-    points of each piece's surface, by the other's distance bound there."""
+    points of each piece's surface, by the other's distance bound there (an overlap under a millimetre between
+    the samples may be missed: those pieces are then cut apart by that much more)."""
     pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
     bulge = np.zeros(len(center))
     for (i, j), width in zip(pairs, widths):
@@ -161,16 +162,15 @@ def apart_pairs(rotation, center, semi_axes, pairs, widths, gap, off_trunk):
     near = np.all(
         (lo[:, None] <= hi[None, :] + reach[..., None]) & (lo[None, :] <= hi[:, None] + reach[..., None]), axis=2
     )
-    near[tuple(pairs.T)] = False
+    near[pairs[:, 0], pairs[:, 1]] = near[pairs[:, 1], pairs[:, 0]] = False
     near &= np.logical_or.outer(off_trunk, off_trunk)
     direction = _sphere_points(SURFACE_SAMPLES)
+    surface = center[:, None, :] + np.einsum("sk,pk,pjk->psj", direction, semi_axes, rotation)
     apart = []
     for i, j in zip(*np.nonzero(np.triu(near, 1))):
-        on_i = center[i] + (direction * semi_axes[i]) @ rotation[i].T
-        on_j = center[j] + (direction * semi_axes[j]) @ rotation[j].T
         nearest = min(
-            piece_distance(on_i, rotation[j], center[j], semi_axes[j]).min(),
-            piece_distance(on_j, rotation[i], center[i], semi_axes[i]).min(),
+            piece_distance(surface[i], rotation[j], center[j], semi_axes[j]).min(),
+            piece_distance(surface[j], rotation[i], center[i], semi_axes[i]).min(),
         )
         if 0.0 < nearest < reach[i, j]:
             apart.append((i, j))
@@ -215,9 +215,15 @@ class PieceField:
         self.pairs, self.widths = pairs, widths
         self.apart, self.gap = (np.zeros((0, 2), dtype=np.int64) if apart is None else apart), gap
         self.lo, self.hi = bounds(rotation, center, semi_axes)
-        self.margin = np.zeros(len(center))  # each piece's widest blend: its distances are needed that far out
+        self.margin = np.zeros(len(center))  # each piece's widest blend
         for (i, j), width in zip(pairs, widths):
             self.margin[[i, j]] = np.maximum(self.margin[[i, j]], width)
+        # how far out each piece's distances are needed: as far as its fillets fade out, and for a piece kept apart
+        # as far as its partner's fillets may still be held back by it (its lift above -gap / 2, see _combine)
+        self.extent = FADE * self.margin
+        for i, j in self.apart:
+            self.extent[j] = max(self.extent[j], 2.0 * gap + FADE * self.margin[i])
+            self.extent[i] = max(self.extent[i], 2.0 * gap + FADE * self.margin[j])
 
     def without_gaps(self):
         """This field with no pieces kept apart."""
@@ -282,12 +288,13 @@ class PieceField:
         the nodes' x must ascend with them (a grid's flat order, or points sorted by x)."""
         near = []  # each piece's nodes (ascending), their points and its distances there
         for i in range(len(self.center)):
-            margin = FADE * self.margin[i] + reach
+            margin = self.extent[i] + reach
             nodes, points = select(self.lo[i] - margin, self.hi[i] + margin)
             near.append((nodes, points, self.distance(i, points)))
         # A piece apart from another is lifted to half the gap on their bisector: lift = (gap + d_i - d_j) / 2,
         # the most over its partners (-inf where none is near); its distance is cut to max(d, lift), and no fillet
-        # of it with a third piece reaches below its lift, so the gap stays open.
+        # of it with a third piece reaches below its lift where the lift is above 0 (so the gap stays open), eased
+        # off to nothing by -gap / 2 (below 0 the fillet's sign is the same either way: only the gap is touched).
         lift = [None] * len(near)
         for i, j in self.apart:
             rows_i, rows_j = _shared(near[i], near[j])
@@ -322,7 +329,9 @@ class PieceField:
             lowered = fade * blend_amount(a, b, width)
             for piece, rows in ((i, rows_i), (j, rows_j)):
                 if lift[piece] is not None:  # not into a gap
-                    lowered = np.minimum(lowered, np.maximum(np.minimum(a, b) - lift[piece][rows], 0.0))
+                    up = lift[piece][rows]
+                    held = np.minimum(lowered, np.maximum(np.minimum(a, b) - up, 0.0))
+                    lowered += _smoothstep((up + 0.5 * self.gap) / (0.5 * self.gap)) * (held - lowered)
             # how far the pair's fillet reaches below the front; its onset rounded over a span that vanishes
             # with the fillet, so that a pair whose pieces do not meet adds nothing
             reach_below = _soft_positive(lowered - (np.minimum(a, b) - nearest[nodes]), ONSET * lowered)

@@ -91,7 +91,8 @@ class SkinSettings:
 METHOD = (
     "signed-distance bound of each ellipsoid; neighbours in the body blended by the polynomial smooth minimum "
     "(width: blend times the thinner piece's smallest semi-axis, at most 4 cm), the blends joined by a 4-norm; "
-    "pieces that do not touch, one off the trunk, kept 1.25 voxels apart unless that leaves more handles; "
+    "pieces that do not touch, one off the trunk, kept 1.25 voxels apart unless that leaves more handles or "
+    "parts the body; "
     "marching cubes with a watertight table"
 )
 

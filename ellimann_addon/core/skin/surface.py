@@ -103,7 +103,12 @@ def gapped_mesh(pieces, voxel, names):
         surface = None
     if len(pieces.apart) and (surface is None or _euler(surface) != 2):
         joined = pieces.without_gaps()
-        again = outer_mesh(joined, voxel, names)
+        try:
+            again = outer_mesh(joined, voxel, names)
+        except SkinError:
+            if surface is None:
+                raise
+            return pieces, surface
         if surface is None or _euler(again) > _euler(surface):
             return joined, again
     return pieces, surface
