@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry.ellipsoid import bounds
+from ..geometry.ellipsoid import bounds, sample_surface
 from ..mannequin.skeleton import PARENTS, bone_problems, part_bones
 
 COARSE = 4  # fine nodes per coarse cell edge (a power of 2)
@@ -164,8 +164,7 @@ def apart_pairs(rotation, center, semi_axes, pairs, widths, gap, off_trunk):
     )
     near[pairs[:, 0], pairs[:, 1]] = near[pairs[:, 1], pairs[:, 0]] = False
     near &= np.logical_or.outer(off_trunk, off_trunk)
-    direction = _sphere_points(SURFACE_SAMPLES)
-    surface = center[:, None, :] + np.einsum("sk,pk,pjk->psj", direction, semi_axes, rotation)
+    surface = sample_surface(rotation, center, semi_axes, SURFACE_SAMPLES)
     apart = []
     for i, j in zip(*np.nonzero(np.triu(near, 1))):
         nearest = min(
@@ -175,15 +174,6 @@ def apart_pairs(rotation, center, semi_axes, pairs, widths, gap, off_trunk):
         if 0.0 < nearest < reach[i, j]:
             apart.append((i, j))
     return np.array(apart, dtype=np.int64).reshape(-1, 2)
-
-
-def _sphere_points(count):
-    """``count`` nearly evenly spread unit vectors (a Fibonacci lattice)."""
-    k = np.arange(count) + 0.5
-    z = 1.0 - 2.0 * k / count
-    angle = np.pi * (1.0 + 5.0**0.5) * k
-    r = np.sqrt(1.0 - z * z)
-    return np.stack([r * np.cos(angle), r * np.sin(angle), z], axis=1)
 
 
 def field_grid(rotation, center, semi_axes, spacing, blend):
