@@ -17,6 +17,7 @@ from ellimann_addon.core.geometry.ellipsoid import sample_surface
 from ellimann_addon.core.geometry.mesh import euler_characteristic, is_closed_manifold, section_segments, volume
 from ellimann_addon.core.measure.body import measure_body_mesh
 from ellimann_addon.core.skin import field
+from ellimann_addon.core.skin import surface as surface_module
 from ellimann_addon.core.skin.contour import marching_cubes
 from ellimann_addon.core.skin.exact import MESH_TOLERANCE_CM, exact_skin
 from ellimann_addon.core.skin.field import PieceField, apart_pairs, blend_pairs, blend_widths, sample_field, skin_pieces
@@ -201,6 +202,36 @@ def test_a_gap_that_would_part_the_body_is_given_up():
         outer_mesh(parted, 0.01, names)
     used, (vertices, faces, _) = gapped_mesh(parted, 0.01, names)  # without: the voxel joins them (one body)
     assert len(used.apart) == 0 and volume(vertices, faces) > 0.0
+
+
+def test_a_subset_of_the_pieces_keeps_their_gaps():
+    rotation, center, semi_axes, pairs = sphere_ring(0.003)
+    arrays = (rotation, center, semi_axes)
+    widths = blend_widths(semi_axes, pairs, SkinSettings().blend)
+    gap = field.GAP * 0.01
+    whole = PieceField(*arrays, pairs, widths, apart_pairs(*arrays, pairs, widths, gap, np.ones(8, bool)), gap)
+    reordered, _ = whole.subset(np.arange(8)[::-1])  # every piece, numbered the other way round
+    assert [0, 7] in whole.apart.tolist()
+    assert sorted(map(sorted, reordered.apart.tolist())) == sorted(map(sorted, (7 - whole.apart).tolist()))
+    grid = np.linspace(-0.1, 0.1, 21)
+    points = np.stack(np.meshgrid(grid, grid, [-0.01, 0.0, 0.01]), axis=-1).reshape(-1, 3)
+    assert np.array_equal(whole.at(points, 0.02)[0], reordered.at(points, 0.02)[0])
+    # the two ends alone: still half the gap apart on their bisector
+    ends, _ = whole.subset([0, 7])
+    middle = 0.5 * (center[0] + center[7])
+    assert len(ends.apart) == 1 and ends.at(middle[None], 0.02)[0][0] >= 0.5 * gap - 1e-9
+
+
+@pytest.mark.parametrize(("without", "kept"), [(0, "with"), (2, "without"), (-2, "with")])
+def test_a_skin_without_gaps_is_kept_only_with_fewer_handles(monkeypatch, without, kept):
+    pieces = PieceField(*sphere_ring(0.003)[:3], np.zeros((0, 2), np.int64), np.zeros(0), np.array([[0, 7]]), 0.01)
+
+    def closed_mesh(euler):  # only the counts matter: V - F / 2
+        return np.zeros((euler + 2, 3)), np.zeros((4, 3), np.int64), np.zeros(euler + 2, np.int64)
+
+    monkeypatch.setattr(surface_module, "outer_mesh", lambda used, *_: closed_mesh(0 if len(used.apart) else without))
+    used, _ = gapped_mesh(pieces, 0.01, [str(k) for k in range(8)])
+    assert ("with" if len(used.apart) else "without") == kept
 
 
 @pytest.mark.parametrize("case", ["female Table 2.5", "male-fine Average"])
