@@ -73,7 +73,9 @@ def fill_curve(body, grid, mannequin, outset=0.002, clearance=CLEARANCE, reach=R
     balls = []
     while heap and len(balls) < most and (target is None or curve[-1][0] < target):
         _, k = heapq.heappop(heap)
-        gain, cells = value(k)  # values only fall as balls are added: re-valued when it comes up
+        # re-valued when it comes up: a value falls by the cells inside that other balls took (and rises a little by
+        # the outside they already paid for, which the order does not chase)
+        gain, cells = value(k)
         if gain <= 0:
             continue
         if heap and gain < -heap[0][0]:
