@@ -20,7 +20,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ellimann_addon.core.fitting.body_mesh import read_obj
-from ellimann_addon.core.geometry.volume import occupancy
+from ellimann_addon.core.geometry.volume import IOU_MARGIN, IOU_SPACING, occupancy
 from ellimann_addon.core.mannequin.model import Mannequin
 
 from .bodies import RM_BODIES
@@ -28,7 +28,6 @@ from .coverage import BodyVolume
 from .overlap import standing_in
 from .reference_sets import BUILD_SETS
 
-SPACING = 0.005  # m: the grid, as tools/overlap.py's
 REACH = 0.04  # m: the deepest a ball's centre lies (radius up to REACH + outset)
 CLEARANCE = 0.0125  # of the height, either side of a section: the fine topology's
 
@@ -103,7 +102,7 @@ def main(argv=None):
         mannequin = Mannequin.load(build_set.out / f"{name}.json")
         mesh = read_obj(build_set.refmodels / f"{name}.obj", up="z")
         body = BodyVolume(mesh.vertices, mesh.faces)
-        grid = body.grid(SPACING)
+        grid = body.grid(IOU_SPACING, margin=IOU_MARGIN)  # tools/overlap.py's
         curve, balls = fill_curve(
             body, grid, standing_in(grid, mannequin), args.outset / 1000, most=args.most, target=args.target
         )
