@@ -11,7 +11,7 @@ from devkit.extra_before import MannequinLandmarksBefore, _farthest_distance, ma
 from devkit.toy import make_toy_mannequin
 from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
 from ellimann_addon.core.mannequin.skeleton import JOINT_NAMES
-from ellimann_addon.core.measure.band_search import extreme_over_band, extremes_over_bands
+from ellimann_addon.core.measure.band_search import BAND_SAMPLES, extreme_over_band, extremes_over_bands
 from ellimann_addon.core.measure.extra import (
     EXTRA_MEASUREMENTS,
     SIDES,
@@ -27,7 +27,7 @@ from ellimann_addon.core.synthesis.shipped import FEMALE_SET, MALE_SET, named_re
 SAME_CM = 1e-6
 
 
-def search(functions, bands, points=()):
+def search(functions, bands, points=(), samples=BAND_SAMPLES):
     """extremes_over_bands with one plain function of the height per family."""
 
     def evaluate(family, heights):
@@ -37,7 +37,7 @@ def search(functions, bands, points=()):
             out[rows] = function(heights[rows])
         return out
 
-    return extremes_over_bands(evaluate, bands, points)
+    return extremes_over_bands(evaluate, bands, points, samples)
 
 
 def test_smooth_extremes_kinks_jumps_and_square_roots():
@@ -61,13 +61,28 @@ def test_smooth_extremes_kinks_jumps_and_square_roots():
     assert at_points == pytest.approx([1.0, 0.6711], abs=1e-12)
 
 
-def test_every_local_dip_refined_when_asked():
-    """Two dips of near-equal depth, the grid's best sample beside the shallower one: refining only that cell
-    finds the shallower dip; refining beside every local minimum of the grid finds the deeper one."""
+def test_every_local_dip_is_refined():
+    """Two dips of near-equal depth, the grid's best sample beside the shallower one: both searches refine beside
+    every local minimum of the grid and find the deeper one (refining only the best cell found the shallower)."""
     dips = lambda t: np.minimum((t - 0.2) ** 2, (t - 0.75) ** 2 - 0.001)  # noqa: E731
-    assert extreme_over_band(dips, 0.0, 1.0, False, samples=7) == pytest.approx(0.0, abs=1e-9)
-    value, where = extreme_over_band(dips, 0.0, 1.0, False, samples=7, where=True, every=True)
+    value, where = extreme_over_band(dips, 0.0, 1.0, False, samples=7, where=True)
     assert value == pytest.approx(-0.001, abs=1e-9) and where == pytest.approx(0.75, abs=1e-4)
+    assert search([dips], [(0, 0.0, 1.0, False, ())], samples=7)[0] == pytest.approx([-0.001], abs=1e-9)
+
+
+def test_a_break_is_never_sampled_on():
+    """A function that jumps at a break is sampled only beside it (END_PROBE inside each piece): which side of
+    the break a sample falls on is never left to its last bits, and the limit either side counts."""
+    heights = []
+
+    def jump(z):
+        heights.extend(np.ravel(z))
+        return np.where(z < 0.5, 1.0, 2.0) + np.abs(z - 0.5)
+
+    extremes, _ = search([jump], [(0, 0.0, 1.0, False, (0.5,))])
+    assert extremes == pytest.approx([1.0], abs=1e-9)  # the limit below the break
+    assert not np.any(np.asarray(heights) == 0.5)
+    assert extreme_over_band(jump, 0.0, 1.0, False, breaks=(0.5,)) == pytest.approx(1.0, abs=1e-9)
 
 
 def test_the_neck_joints_are_smpls():

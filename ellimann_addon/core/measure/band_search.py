@@ -15,46 +15,43 @@ MAX_BRACKET_STEPS = 60  # a smooth search's bound (halving from a cell: some 25 
 
 
 def _band_grid(low, high, breaks, samples):
-    """The band [low, high] cut at ``breaks`` and each piece sampled on a grid: (pieces, per piece)."""
+    """The band [low, high] cut at ``breaks`` and each piece sampled on a grid: (pieces, per piece). A piece's grid
+    runs from END_PROBE inside its first end to END_PROBE inside its last: the function is never sampled on a
+    break, where a section gains or loses a piece (an ellipse shrunk to a point) and which side of the break a
+    height falls on is decided by the last bits of how the break and the section were computed (a neck's girth
+    jumped by 4 mm so between two BLAS kernels); beside it, the section is the piece's own limit either way."""
     cuts = np.unique(np.clip(np.concatenate([[low, high], np.asarray(breaks, float)]), low, high))
     per_piece = max(4, samples // max(len(cuts) - 1, 1))
+    start, stop = cuts[:-1], cuts[1:]
+    inset = np.where(stop - start > 4.0 * END_PROBE, END_PROBE, 0.25 * (stop - start))
     t = np.linspace(0.0, 1.0, per_piece)
-    return cuts[:-1, None] + (cuts[1:] - cuts[:-1])[:, None] * t
-
-
-def _best_cells(grid, values):
-    """Per piece: its best sample (smallest value) and the samples either side, clipped at the piece's ends:
-    (a, x, b) heights and (fa, fx, fb) values."""
-    best = np.argmin(values, axis=1)
-    rows, last = np.arange(len(grid)), grid.shape[1] - 1
-    around = [np.maximum(best - 1, 0), best, np.minimum(best + 1, last)]
-    return [grid[rows, i] for i in around], [values[rows, i] for i in around]
+    return (start + inset)[:, None] + ((stop - inset) - (start + inset))[:, None] * t
 
 
 def _local_cells(grid, values):
-    """Every local minimum of each piece's samples (no larger than either neighbour) and the samples either side,
-    clipped at the piece's ends: (a, b) heights."""
+    """Every local minimum of each piece's samples (no larger than either neighbour, finite) and the samples either
+    side, clipped at the piece's ends: (piece row of each, (a, x, b) heights, (fa, fx, fb) values). Every one is
+    refined, not only the best: which of two dips of near-equal depth the grid deems deeper is decided by its last
+    bits, and the two may differ by millimetres once refined."""
     padded = np.pad(values, ((0, 0), (1, 1)), constant_values=np.inf)
     rows, index = np.nonzero((values <= padded[:, :-2]) & (values <= padded[:, 2:]) & np.isfinite(values))
-    return grid[rows, np.maximum(index - 1, 0)], grid[rows, np.minimum(index + 1, grid.shape[1] - 1)]
+    around = [np.maximum(index - 1, 0), index, np.minimum(index + 1, grid.shape[1] - 1)]
+    return rows, [grid[rows, i] for i in around], [values[rows, i] for i in around]
 
 
-def extreme_over_band(
-    function, low, high, largest, breaks=(), samples=BAND_SAMPLES, where=False, steps=GOLDEN_STEPS, every=False
-):
+def extreme_over_band(function, low, high, largest, breaks=(), samples=BAND_SAMPLES, where=False, steps=GOLDEN_STEPS):
     """Largest (or smallest) value of a 1-D ``function`` (vectorised over an array of heights) on [low, high].
 
     The band is cut at ``breaks`` (where the function may have a kink or a narrow dip: the ends of the pieces
-    a mannequin's section meets) and each piece sampled on a grid; golden-section search then refines every
-    grid cell beside a piece's best sample, all pieces at once, and the best of everything is returned. For a
-    function with kinks anywhere (a mesh's girths); a smooth one is refined faster by :func:`extremes_over_bands`.
-    ``steps``: golden-section steps (each narrows the bracket of two grid cells 0.618x); ``every``: refine beside
-    every local extreme of the grid, not only the best (a function with several dips of near-equal depth: which
-    one is deepest is then never decided by the grid's last bits)."""
+    a mannequin's section meets) and each piece sampled on a grid; golden-section search then refines the grid
+    cells beside every local extreme of each piece's samples (:func:`_local_cells`), all at once, and the best of
+    everything is returned. For a function with kinks anywhere (a mesh's girths); a smooth one is refined faster
+    by :func:`extremes_over_bands`. ``steps``: golden-section steps (each narrows the bracket of two grid cells
+    0.618x)."""
     grid = _band_grid(low, high, breaks, samples)
     sign = -1.0 if largest else 1.0
     values = sign * function(grid.ravel()).reshape(grid.shape)
-    a, b = _local_cells(grid, values) if every else _best_cells(grid, values)[0][::2]
+    _, (a, _, b), _ = _local_cells(grid, values)
     ratio = (np.sqrt(5.0) - 1.0) / 2.0
     c, d = b - ratio * (b - a), a + ratio * (b - a)
     fc, fd = sign * function(c), sign * function(d)
@@ -78,11 +75,11 @@ def extremes_over_bands(evaluate, bands, points=(), samples=BAND_SAMPLES):
 
     ``evaluate(family, heights)``: values at arrays of (family index, height); ``bands``: (family, low, high,
     largest, breaks) each; ``points``: (family, height) pairs evaluated with the grids (one call for both).
-    Each band is gridded as :func:`extreme_over_band` grids it and the cell beside each piece's best sample
-    refined by steps of a few probes per bracket in one call (:func:`_probes`: a piece's end checked, the
-    parabola's vertex, even cuts where a step did not halve the bracket) until it is BRACKET_DONE wide.
-    Between breaks a girth is smooth but for kinks, so a bracket closes in a handful of steps instead of golden
-    section's 40. Returns (the extremes [float], the values at ``points`` (p,))."""
+    Each band is gridded as :func:`extreme_over_band` grids it and the cells beside every local extreme of each
+    piece's samples refined by steps of a few probes per bracket in one call (:func:`_probes`: a piece's end
+    checked, the parabola's vertex, even cuts where a step did not halve the bracket) until it is BRACKET_DONE
+    wide. Between breaks a girth is smooth but for kinks, so a bracket closes in a handful of steps instead of
+    golden section's 40. Returns (the extremes [float], the values at ``points`` (p,))."""
     grids = [_band_grid(low, high, breaks, samples) for _, low, high, _, breaks in bands]
     signs = np.array([-1.0 if band[3] else 1.0 for band in bands])
     band_of_sample = np.concatenate([np.full(grid.size, i) for i, grid in enumerate(grids)]).astype(int)
@@ -94,14 +91,18 @@ def extremes_over_bands(evaluate, bands, points=(), samples=BAND_SAMPLES):
         np.concatenate([grid.ravel() for grid in grids] + [point_height]),
     )
     grid_values, at_points = values[: len(band_of_sample)] * signs[band_of_sample], values[len(band_of_sample) :]
-    cells, start = [], 0
-    for grid in grids:
-        cells.append(_best_cells(grid, grid_values[start : start + grid.size].reshape(grid.shape)))
+    heights, fvalues, band_of, ends, start = [[], [], []], [[], [], []], [], [[], []], 0
+    for i, grid in enumerate(grids):
+        rows, around, found = _local_cells(grid, grid_values[start : start + grid.size].reshape(grid.shape))
         start += grid.size
-    heights = [np.concatenate([c[0][j] for c in cells]) for j in range(3)]
-    fvalues = [np.concatenate([c[1][j] for c in cells]) for j in range(3)]
-    band_of = np.concatenate([np.full(len(grid), i) for i, grid in enumerate(grids)]).astype(int)
-    ends = [np.concatenate([grid[:, j] for grid in grids]) for j in (0, -1)]
+        for j in range(3):
+            heights[j].append(around[j])
+            fvalues[j].append(found[j])
+        band_of.append(np.full(len(rows), i))
+        ends[0].append(grid[rows, 0])
+        ends[1].append(grid[rows, -1])
+    heights, fvalues, ends = ([np.concatenate(x) for x in group] for group in (heights, fvalues, ends))
+    band_of = np.concatenate(band_of).astype(int)
     best = _refine_brackets(
         lambda rows, z: signs[band_of[rows]] * evaluate(families[band_of[rows]], z), heights, fvalues, ends
     )

@@ -59,6 +59,4 @@ def tightest_tilt(smallest):
     beside every local minimum among them (a mannequin's pieces give several, of near-equal depth; the tape's
     girth has kinks where a section gains a piece: no parabola)."""
     low, high = np.radians(NECK_TILT_RANGE)
-    return extreme_over_band(
-        smallest, low, high, False, samples=NECK_TILT_SAMPLES, where=True, steps=NECK_TILT_STEPS, every=True
-    )
+    return extreme_over_band(smallest, low, high, False, samples=NECK_TILT_SAMPLES, where=True, steps=NECK_TILT_STEPS)

@@ -212,7 +212,8 @@ def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXT
 
     All at once first; if that misses any, one measurement at a time (in EXTRA_MEASUREMENTS order), each kept
     only if it and those kept before are met with the five: one that the pieces cannot reach (or only by
-    giving up the five) is left where the reference set puts it, and named in the misses. The joints ride on
+    giving up the five) is left where the reference set puts it, and named in the misses; of the two results, the
+    nearer to the request is returned (``_how_far``). The joints ride on
     their anchor pieces in every measured round (the neck is measured square to their tilt)."""
     result = _meet(mannequin, extra, tolerance_cm, max_rounds)
     if not result[2]:
@@ -226,7 +227,18 @@ def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXT
     final, measured, _ = _meet(current, kept, tolerance_cm, max_rounds) if kept else (current, None, [])
     if measured is None:
         measured = _all_measured(final)
-    return final, measured, _misses(measured, extra)
+    one_at_a_time = (final, measured, _misses(measured, extra))
+    # never worse than all at once: one left where the set puts it may lie centimetres off, all at once millimetres
+    return min(result, one_at_a_time, key=lambda found: _how_far(found[1], found[2], extra))
+
+
+def _how_far(measured, misses, extra):
+    """How far a result of meet_extra is from its request, to choose between two: whether the five miss, then the
+    largest miss of the given extra measurements (cm)."""
+    return (
+        any(miss.key in MEASUREMENTS for miss in misses),
+        max(abs(measured[key] - extra[key]) for key in extra),
+    )
 
 
 def _all_measured(mannequin):
