@@ -140,6 +140,16 @@ def test_lanes_side_by_side_share_the_cores_blas_threads_unless_set(monkeypatch)
     assert "OMP_NUM_THREADS" not in matrix._lane_env()
 
 
+def test_one_lane_runs_on_an_old_blas_kernel_unless_one_is_set(monkeypatch):
+    monkeypatch.delenv("OPENBLAS_CORETYPE", raising=False)
+    kernels = {lane.blender: lane.kernel for lane in matrix.LANES}
+    assert kernels["5.3"] == matrix.OLD_KERNEL and kernels["5.0"] == ""  # the core suite runs on each
+    assert matrix._lane_env(1, matrix.OLD_KERNEL)["OPENBLAS_CORETYPE"] == matrix.OLD_KERNEL
+    assert "OPENBLAS_CORETYPE" not in matrix._lane_env(1)
+    monkeypatch.setenv("OPENBLAS_CORETYPE", "Haswell")
+    assert matrix._lane_env(1, matrix.OLD_KERNEL)["OPENBLAS_CORETYPE"] == "Haswell"
+
+
 def test_no_two_test_files_share_a_name():
     """A lane runs tests/core and tests/blender in one pytest, which imports test files by their base name."""
     tests = pathlib.Path(__file__).resolve().parents[1]

@@ -57,10 +57,12 @@ class Mannequin:
         # a copy (mannequins never share one); anything but a dict is left for problems() to name
         fractions = SECTION_FRACTIONS if self.section_fractions is None else self.section_fractions
         self.section_fractions = dict(fractions) if isinstance(fractions, dict) else fractions
-        self.rotation = np.asarray(self.rotation, dtype=float)
-        self.center = np.asarray(self.center, dtype=float)
-        self.semi_axes = np.asarray(self.semi_axes, dtype=float)
-        self.joints = None if self.joints is None else np.asarray(self.joints, dtype=float)
+        # C-contiguous whatever they came as (a JSON's frames are a transposed view): numpy's sums of products
+        # (einsum) take their order from the layout, and a pickled copy (a Dask worker's) is C-contiguous
+        self.rotation = np.ascontiguousarray(self.rotation, dtype=float)
+        self.center = np.ascontiguousarray(self.center, dtype=float)
+        self.semi_axes = np.ascontiguousarray(self.semi_axes, dtype=float)
+        self.joints = None if self.joints is None else np.ascontiguousarray(self.joints, dtype=float)
 
     def __len__(self):
         return len(self.topology)
