@@ -308,16 +308,19 @@ def read_chart(path, sex=None, statistics=None, ranges_by_set=None, extrapolate=
     for i, name in enumerate(names):
         if i == label_column:
             continue
-        if units[i] is False:
-            raise SizingError(f"{path}: column {name!r} has a unit ElliMann does not know; use cm, mm or in")
-        if chart_mapping(name) is None:
+        mapping = chart_mapping(name)
+        if mapping is None:
             near = difflib.get_close_matches(name.casefold(), [n.casefold() for n in CHART], n=1)
             hint = f" (did you mean {near[0]!r}?)" if near else ""
             raise SizingError(
                 f"{path}: column {name!r} is not a measurement ElliMann knows{hint}; rename it to one of the "
                 "names in docs/formats/measurement_files.md, or remove the column"
             )
-        if units[i] is None:
+        if mapping.key is None:  # recognised, not used: its unit does not matter
+            units[i] = units[i] or "-"
+        elif units[i] is False:
+            raise SizingError(f"{path}: column {name!r} has a unit ElliMann does not know; use cm, mm or in")
+        elif units[i] is None:
             raise SizingError(
                 f"{path}: column {name!r} has no unit; add a unit row (unit, cm, cm, ...) or write it "
                 f"'{name} (cm)' (ElliMann never guesses one)"

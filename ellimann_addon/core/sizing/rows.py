@@ -21,6 +21,23 @@ from .predict import PredictionError, conditional_mean, statistics_for
 UNITS = {"cm": 1.0, "mm": 0.1, "inch": 2.54}  # cm per unit: the units the formats define
 PREDICTOR_LIMITS = {"neck_base": (15.0, 90.0), "biacromial": (10.0, 80.0)}  # cm, as ABSURD_LIMITS for the others
 LIMITS = {**ABSURD_LIMITS, **EXTRA_ABSURD_LIMITS, **PREDICTOR_LIMITS}
+# Where an adult's values lie (cm; wider than any survey's 1st-99th percentiles, narrower than LIMITS): a value
+# outside, that another unit brings inside, was written in that unit (the file's unit is wrong, or the value).
+ADULT_CM = {
+    "He": (120.0, 230.0),
+    "Sh": (25.0, 80.0),
+    "Br": (60.0, 200.0),
+    "Wa": (45.0, 200.0),
+    "Hi": (60.0, 200.0),
+    "neck": (20.0, 60.0),
+    "upper_arm": (15.0, 60.0),
+    "thigh": (30.0, 110.0),
+    "calf": (20.0, 70.0),
+    "crotch_height": (50.0, 110.0),
+    "arm_length": (40.0, 95.0),
+    "neck_base": (25.0, 70.0),
+    "biacromial": (25.0, 55.0),
+}
 
 
 class SizingError(ElliMannError):
@@ -123,13 +140,16 @@ def outside_every_set(request, ranges_by_set):
 
 
 def unit_hint(key, value, unit):
-    """A line saying which other unit makes ``value`` (in ``unit``) plausible for ``key``, or ''."""
-    low, high = LIMITS[key]
+    """'' when ``value`` (in ``unit``) is an adult's ``key`` or no other unit makes it one; else a line saying
+    which unit does."""
+    low, high = ADULT_CM[key]
+    if low <= value * UNITS[unit] <= high:
+        return ""
     fits = [other for other, scale in UNITS.items() if other != unit and low <= value * scale <= high]
     if not fits:
         return ""
     other = fits[0]
-    return f"; as {other} it would be {value * UNITS[other]:.4g} cm: is the file's unit {other}, not {unit}?"
+    return f"as {other} it would be {value * UNITS[other]:.4g} cm: is the file's unit {other}, not {unit}?"
 
 
 def classify(entries, lookup):
@@ -174,11 +194,17 @@ def _fill(row, given, predictors, where, sex, statistics, ranges_by_set, extrapo
             if not (isinstance(value, float) and math.isfinite(value)) or value <= 0:
                 raise SizingError(f"{where}: {name} = {value!r} is not a positive number; give it in {unit}")
             cm = value * UNITS[unit]
+            hint = unit_hint(key, value, unit)
+            if hint:
+                low, high = ADULT_CM[key]
+                raise SizingError(
+                    f"{where}: {name} = {value:g} {unit} is {cm:.4g} cm, not an adult's {key} ({low:g}-{high:g} cm); "
+                    + hint
+                )
             low, high = LIMITS[key]
             if not low <= cm <= high:
                 raise SizingError(
-                    f"{where}: {name} = {value:g} {unit} is {cm:.4g} cm, not a plausible {key} "
-                    f"({low:g}-{high:g} cm){unit_hint(key, value, unit)}"
+                    f"{where}: {name} = {value:g} {unit} is {cm:.4g} cm, not a plausible {key} ({low:g}-{high:g} cm)"
                 )
             out[key] = cm
     row.given = dict(given)
