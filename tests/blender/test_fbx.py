@@ -136,3 +136,17 @@ def test_bad_options_write_nothing(tmp_path, avatar, options, words):
     with pytest.raises(ElliMannError, match=words.replace("(", r"\(")):
         write_fbx(tmp_path / "x.fbx", mannequin, skin, **options)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_cut_short_fbx_is_not_whole(tmp_path, avatar):
+    from ellimann_addon.core.files import incomplete
+
+    mannequin, skin, request = avatar
+    path = tmp_path / "whole.fbx"
+    write_fbx(path, mannequin, skin, request=request)
+    data = path.read_bytes()
+    assert incomplete(path) is None
+    (tmp_path / "cut.fbx").write_bytes(data[: len(data) // 2])
+    assert incomplete(tmp_path / "cut.fbx") == "it does not end with the FBX footer"
+    (tmp_path / "text.fbx").write_bytes(b"; FBX 7.4.0 project file\n")
+    assert incomplete(tmp_path / "text.fbx") == "it does not start with the binary FBX signature"
