@@ -17,7 +17,7 @@ import xml.etree.ElementTree as ElementTree
 
 from .formula import FormulaError, evaluate_all
 from .names import CHART, CHART_LABELS, chart_mapping, freesewing_mapping, seamly_mapping
-from .rows import UNITS, MeasurementFile, SizeRow, SizingError, build_row
+from .rows import UNITS, MeasurementFile, SizeRow, SizingError, build_row, set_ranges
 
 MAX_BYTES = 16 * 1024 * 1024  # a measurement file is kilobytes; a chart of thousands of sizes is still far below
 SIZE_STEP_CM = 2.0  # a multisize table's size step, and its height step (the tools' own: the grading's unit)
@@ -197,6 +197,7 @@ def read_vst(path, sex=None, statistics=None, ranges_by_set=None, extrapolate=Fa
     if not table:
         raise SizingError(f"{path}: no <m> measurements (a table before format 0.4 must be saved again by the tools)")
     scale = UNITS[unit]
+    ranges_by_set = ranges_by_set if ranges_by_set is not None else set_ranges(sex)  # read once for the run
     rows = []
     for height in run_heights:
         for size in run_sizes:
@@ -326,6 +327,7 @@ def read_chart(path, sex=None, statistics=None, ranges_by_set=None, extrapolate=
                 f"'{name} (cm)' (ElliMann never guesses one)"
             )
         columns.append(i)
+    ranges_by_set = ranges_by_set if ranges_by_set is not None else set_ranges(sex)  # read once for the run
     rows = []
     for cells in body:
         label = cells[label_column].strip() if label_column < len(cells) else ""
