@@ -84,7 +84,8 @@ def incomplete(path, kind=None):
     block chain from the header to the ENDB block (Blender 4.x and 5.x layouts; zstd files: the
     frames listed in the seek table Blender appends; gzip: the decompressed blocks); .glb: the
     length in the header is the file's and the chunks fill it; .json/.xml: it parses; .png: it
-    ends with IEND; .obj: it ends with a complete line; .npz: its zip directory reads. Any other kind: it is not empty.
+    ends with IEND; .obj: it ends with a complete line; .npz: its zip directory reads; .fbx (binary): its signature
+    and its footer. Any other kind: it is not empty.
     """
     kind = kind_of(path) if kind is None else kind
     try:
@@ -229,7 +230,19 @@ def _npz(stream, size):
     return None
 
 
+FBX_MAGIC = b"Kaydara FBX Binary  \x00"
+FBX_FOOTER = bytes.fromhex("f85a8c6adef5d97eece90ce3758f290b")  # the last 16 bytes of a binary FBX file
+
+
+def _fbx(stream, size):
+    if stream.read(len(FBX_MAGIC)) != FBX_MAGIC:
+        return "it does not start with the binary FBX signature"
+    stream.seek(max(size - len(FBX_FOOTER), 0))
+    return None if stream.read(len(FBX_FOOTER)) == FBX_FOOTER else "it does not end with the FBX footer"
+
+
 _CHECKS = {"blend": _blend, "glb": _glb, "json": _json, "xml": _xml, "png": _png, "obj": _obj, "npz": _npz}
+_CHECKS["fbx"] = _fbx
 CHECKED_KINDS = tuple(_CHECKS)  # the extensions :func:`incomplete` checks beyond "not empty"
 
 

@@ -139,6 +139,7 @@ FLOORS = {
     "pose": 4,
     "fitting": 5,
     "skin": 5,
+    "sizing": 5,
     "formats": 6,
     "drape": 6,
 }

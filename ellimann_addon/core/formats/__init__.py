@@ -1,5 +1,7 @@
 """File formats ElliMann writes without Blender, and the table of every format (floor 6: everything below).
 
+- avatar: an avatar for garment tools: the skin on the 24 bones (SMPL or Mixamo names), T- or A-pose, the pieces
+  as a collision proxy, a decimated skin measured again
 - bvh: BVH motion-capture clips read with numpy, their units said, their bones matched
 - core_writers: OBJ, JSON and MJCF mannequin files by extension, with a skin or not
 - mjcf: MJCF (MuJoCo) of a mannequin's convex pieces
