@@ -33,14 +33,17 @@ SURVEY_ROWS = 3  # rows of ANSUR II with their extra measurements (seconds each)
 
 
 def environment(kernel=None, threads=None, old_cpu=False, base=None):
-    """A copy of ``base`` (default os.environ) with OpenBLAS's ``kernel`` and ``threads`` (None: unset, the library's
-    own choice) and, with ``old_cpu``, numpy's SIMD dispatch above its baseline turned off (numpy's exp, log, sin
-    ... then take the code paths of a CPU without AVX2 or AVX-512, whose last bits differ)."""
+    """A copy of ``base`` (default os.environ) with OpenBLAS's ``kernel`` (None: as ``base`` has it, "": unset, the
+    library's own pick for this CPU) and ``threads`` (None: unset, the library's own choice) and, with ``old_cpu``,
+    numpy's SIMD dispatch above its baseline turned off (numpy's exp, log, sin ... then take the code paths of a CPU
+    without AVX2 or AVX-512, whose last bits differ)."""
     env = dict(os.environ if base is None else base)
-    for name in (*BLAS_THREADS, "OPENBLAS_CORETYPE", "NPY_DISABLE_CPU_FEATURES"):
+    for name in (*BLAS_THREADS, "NPY_DISABLE_CPU_FEATURES"):
         env.pop(name, None)
-    if kernel:
-        env["OPENBLAS_CORETYPE"] = kernel
+    if kernel is not None:
+        env.pop("OPENBLAS_CORETYPE", None)
+        if kernel:
+            env["OPENBLAS_CORETYPE"] = kernel
     if threads:
         for name in BLAS_THREADS:
             env[name] = str(threads)

@@ -23,8 +23,8 @@ SAME_WITHIN = 1e-9  # m for geometry, cm for measurements: what another CPU or B
 def runs(tmp_path_factory):
     base = dict(os.environ, PYTHONPATH=str(ROOT))
     envs = {
-        "default": environment(base=base),
-        "one thread": environment(threads=1, base=base),
+        "default": environment(kernel="", base=base),
+        "one thread": environment(kernel="", threads=1, base=base),
         "old cpu": environment(kernel=OLD_KERNEL, threads=2, old_cpu=True, base=base),
     }
     folders = {}
