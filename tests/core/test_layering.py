@@ -139,6 +139,7 @@ FLOORS = {
     "pose": 4,
     "fitting": 5,
     "skin": 5,
+    "body": 5,
     "formats": 6,
     "drape": 6,
 }
