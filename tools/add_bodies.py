@@ -15,12 +15,12 @@ import sys
 
 import numpy as np
 
-from ellimann_addon.core.body.bodies import BODIES_FILE, from_meshes, read_bodies
 from ellimann_addon.core.files import atomic_write_text
 from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.synthesis.bodies import BODIES_FILE, BodyLabels, from_meshes, read_bodies
 from ellimann_addon.core.synthesis.manifest import MANIFEST_FILE, read_manifest
 
-from .bodies import LABELS_FILE, load_skeletons
+from ..synthesis.bodies import LABELS_FILE, load_skeletons
 from .reference_sets import BUILD_SETS, TRACING_FOLDER
 
 WEIGHTS_FILE = "skin_weights.npz"
@@ -33,6 +33,11 @@ def body_labels(folder=TRACING_FOLDER):
     with np.load(pathlib.Path(folder) / WEIGHTS_FILE) as weights:
         bones = (weights["vertex_bone_indices"], weights["vertex_bone_weights"], weights["bone_labels"])
     return np.array(data["labels"]), list(data["region_names"]), bones
+
+
+def shipped_body_labels():
+    """The shared topology's BodyLabels (core.synthesis.bodies), as the builders keep the bodies with."""
+    return BodyLabels(*body_labels())
 
 
 def meshes(folder, names):

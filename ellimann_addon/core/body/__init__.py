@@ -1,8 +1,7 @@
 """The body skin: the reference set's own body meshes interpolated for a request and corrected on the mesh until
-it measures the request (floor 5: everything below).
+it measures the request (floor 5: everything below). The bodies themselves are the reference set's
+(core.synthesis.bodies).
 
-- bodies: a set's bodies (one topology) stored compactly beside its RMs (``bodies.npz``): mean, offsets, labels,
-  bone weights on the 24 joints, each body's joints and measurements; reading, writing and their checks
 - model: the body model, a request's measurements -> vertices and joints (IDW over the bodies; replaceable)
 - deform: the smooth deformations the correction moves along (a displacement basis linear in its parameters)
 - tape: the measurements the correction aims at, by the body-mesh measurer's own code

@@ -16,10 +16,9 @@ from ..constants import MEASUREMENTS
 from ..geometry.mesh import volume
 from ..measure.extra import EXTRA_MEASUREMENTS
 from ..pose.kinematics import bone_matrices
-from ..synthesis.manifest import read_manifest
-from .bodies import BodiesError, read_bodies
-from .correct import PROMISE_CM, BodySkinError, correct
-from .deform import Deformation
+from ..synthesis.bodies import load_set_bodies
+from .correct import LIMITS, PROMISE_CM, BodySkinError, correct
+from .deform import PARAMETERS, Deformation
 from .mesh_checks import fold_problems
 from .model import IdwBodyModel
 from .tape import Tape
@@ -78,6 +77,18 @@ class BodySkin:
         ]
 
 
+def largest_change(found, request):
+    """What the correction changed most (relative to its limit), in words: "scaling the Wa section by 0.82 for
+    Wa 63.0 cm (the bodies give 76.8 cm)"."""
+    keys = [key for key in PARAMETERS if key in request]
+    share = [abs(found.theta[PARAMETERS.index(key)]) / LIMITS[key] for key in keys]
+    key = keys[int(np.argmax(share))]
+    theta = found.theta[PARAMETERS.index(key)]
+    how = f"moving each arm {abs(theta) * 100:.1f} cm" if key == "Sh" else f"scaling by {1.0 + theta:.2f}"
+    start = found.start[key]
+    return f"{key} {request[key]:.1f} cm is {request[key] - start:+.1f} cm from the bodies' {start:.1f} cm: {how}"
+
+
 class BodySkinMaker:
     """Makes body skins from a set's ``bodies`` (SetBodies) with a body ``model`` (default IDW over them, the
     set's ``ranges`` for its metric). The tape and the topology's checks are made once."""
@@ -123,7 +134,7 @@ class BodySkinMaker:
         if check:
             problems = fold_problems(vertices, corrected, self.bodies.faces)
             if problems:
-                raise BodySkinError(f"body skin: the correction would fold the mesh ({problems[0]})")
+                raise BodySkinError(f"body skin: {largest_change(found, asked)} would fold the mesh ({problems[0]})")
         weights = getattr(self.model, "weights", None)
         return BodySkin(
             corrected,
@@ -136,19 +147,6 @@ class BodySkinMaker:
             found.rounds,
             time.perf_counter() - started,
         )
-
-
-def load_set_bodies(folder):
-    """The SetBodies of a reference-set folder, or None for a set without bodies (an old folder, a hand-traced
-    set); BodiesError for a manifest that names a bodies file that cannot be read."""
-    folder = pathlib.Path(folder)
-    manifest = read_manifest(folder)
-    if manifest is None or manifest.bodies is None:
-        return None
-    path = folder / manifest.bodies
-    if not path.is_file():
-        raise BodiesError(f"{path}: is missing (the manifest names it as the set's bodies)")
-    return read_bodies(path)
 
 
 def body_skin_maker(reference):

@@ -30,6 +30,7 @@ from ..errors import ElliMannError
 from ..files import atomic_write_bytes
 from ..mannequin.skeleton import JOINT_COUNT, JOINT_INDEX
 from ..measure.body import ALL_MEASUREMENTS, check_mesh, measure_body_mesh
+from .manifest import read_manifest
 
 BODIES_FILE = "bodies.npz"
 BODIES_FORMAT = "ellimann-bodies"
@@ -176,6 +177,17 @@ class SetBodies:
         return pathlib.Path(path)
 
 
+@dataclass(frozen=True)
+class BodyLabels:
+    """What a set's bodies carry besides their shape, for their topology: each vertex's ``region`` (V,) into
+    ``region_names`` (the arms: ARM_REGIONS with _L/_R) and the body model's ``bones``: (bone indices (V, k),
+    bone weights (V, k), bone labels) of MakeHuman's rig."""
+
+    region: np.ndarray
+    region_names: tuple
+    bones: tuple
+
+
 def from_meshes(names, vertices, faces, region, region_names, weights, joints, fractions=None):
     """SetBodies of N bodies (``vertices`` (N, V, 3) m, ElliMann's axes, sharing ``faces``): each one's
     measurements taken by core.measure.body with the arms known from ``region``; ``weights``: (bone indices
@@ -285,3 +297,16 @@ def read_bodies(path):
         arrays["measured_cm"].astype(float),
         dict(zip(FRACTION_KEYS, (float(f) for f in arrays["fractions"]))),
     )
+
+
+def load_set_bodies(folder):
+    """The SetBodies of a reference-set folder, or None for a set without bodies (an old folder, a hand-traced
+    set); BodiesError for a manifest that names a bodies file that cannot be read."""
+    folder = pathlib.Path(folder)
+    manifest = read_manifest(folder)
+    if manifest is None or manifest.bodies is None:
+        return None
+    path = folder / manifest.bodies
+    if not path.is_file():
+        raise BodiesError(f"{path}: is missing (the manifest names it as the set's bodies)")
+    return read_bodies(path)
