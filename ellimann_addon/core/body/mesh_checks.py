@@ -9,6 +9,9 @@ from ..constants import GIRTHS
 from ..geometry.mesh import convex_hull_2d, euler_characteristic, face_normals, is_closed_manifold
 
 MIN_AREA_SHARE = 0.05  # a triangle crushed below this share of its area before the correction is a fold
+# turned triangles a correction may leave in a crease (the armpits' hold a few nearly upright ones that turn over
+# when the arms come in by a centimetre or two) before the mesh counts as folded: 0.1 % of them
+FOLD_ALLOWANCE = 0.001
 CLEARANCE_BAND = 0.004  # m: the vertices this near a girth's height stand for its section
 
 
@@ -23,16 +26,17 @@ def surface_problems(vertices, faces):
     return problems
 
 
-def fold_problems(before, after, faces):
+def fold_problems(before, after, faces, allowance=0.0):
     """One line per kind of fold the deformation ``before`` -> ``after`` made: triangles turned over (their
-    normal turned by more than a right angle) or crushed (below MIN_AREA_SHARE of their area)."""
+    normal turned by more than a right angle) or crushed (below MIN_AREA_SHARE of their area), when more than
+    ``allowance`` (a share of the triangles) are."""
     old, new = face_normals(before, faces), face_normals(after, faces)
     turned = np.einsum("ij,ij->i", old, new) <= 0.0
     old_area, new_area = np.linalg.norm(old, axis=1), np.linalg.norm(new, axis=1)
     crushed = new_area < MIN_AREA_SHARE * old_area
     problems = []
     for what, bad in (("turned over", turned), ("crushed", crushed & ~turned)):
-        if bad.any():
+        if bad.sum() > allowance * len(faces):
             z = after[faces[bad]].mean(axis=1)[:, 2]
             problems.append(f"{int(bad.sum())} triangles {what} between z = {z.min():.3f} and {z.max():.3f} m")
     return problems

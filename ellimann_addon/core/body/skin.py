@@ -19,7 +19,7 @@ from ..pose.kinematics import bone_matrices
 from ..synthesis.bodies import load_set_bodies
 from .correct import LIMITS, PROMISE_CM, BodySkinError, correct
 from .deform import PARAMETERS, Deformation
-from .mesh_checks import fold_problems
+from .mesh_checks import FOLD_ALLOWANCE, fold_problems
 from .model import IdwBodyModel
 from .tape import Tape
 
@@ -132,7 +132,7 @@ class BodySkinMaker:
                 corrected, moved_joints = deformation.apply(found.theta)
                 measured = found.measured
         if check:
-            problems = fold_problems(vertices, corrected, self.bodies.faces)
+            problems = fold_problems(vertices, corrected, self.bodies.faces, FOLD_ALLOWANCE)
             if problems:
                 raise BodySkinError(f"body skin: {largest_change(found, asked)} would fold the mesh ({problems[0]})")
         weights = getattr(self.model, "weights", None)
