@@ -37,6 +37,7 @@ from ellimann_addon.core.synthesis.manifest import MANIFEST_FILE, read_manifest
 from . import build_reference as br
 from . import coverage
 from . import reference_topology as rt
+from .add_bodies import shipped_body_labels
 from .bodies import RM_BODIES, body_measurements, load_labels, load_skeletons, read_bodies
 from .reference_sets import FEMALE, FEMALE_FINE, MALE_FINE, TRACING_FOLDER
 from .reference_topology_fine import (
@@ -106,6 +107,7 @@ def build(build_set, traced=None, log=print, workers=2):
         name=build_set.name,
         sex=build_set.sex,
         base_stem=br.BASE_FILE,
+        body_labels=shipped_body_labels(),  # the bodies kept with the set (bodies.npz, tools/add_bodies.py)
         provenance=_provenance(build_set),
     )
     shifts = {br.BASE_FILE: base_shift, **built.report.shifts}

@@ -30,6 +30,7 @@ from ellimann_addon.core.mannequin.model import Mannequin
 
 from . import build_reference as br
 from . import coverage
+from .add_bodies import shipped_body_labels
 from .bodies import RM_BODIES, body_measurements, load_labels, load_skeletons, read_bodies
 from .reference_sets import FEMALE, MALE, TRACING_FOLDER
 
@@ -69,6 +70,7 @@ def build(log=print):
         name=MALE.name,
         sex=MALE.sex,
         base_stem=br.BASE_FILE,
+        body_labels=shipped_body_labels(),  # the bodies kept with the set (bodies.npz, tools/add_bodies.py)
         provenance=PROVENANCE,
     )
     built, base, rms = built_set.report, built_set.base, built_set.mannequins

@@ -59,6 +59,7 @@ from ellimann_addon.core.mannequin.clean import register_to_world, registration_
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.mannequin.traces import PartTrace
 from ellimann_addon.core.measure.tailor import section_heights
+from ellimann_addon.core.synthesis.bodies import BODIES_FILE
 from ellimann_addon.core.synthesis.manifest import MANIFEST_FILE, legacy_manifest, read_manifest
 
 from . import coverage
@@ -200,6 +201,7 @@ def shipped_manifest(refmodels):
     }
     manifest = legacy_manifest()
     manifest.base = BASE_FILE
+    manifest.bodies = BODIES_FILE  # the RMs' bodies, for the body skin (tools/add_bodies.py)
     manifest.provenance = {
         "built_by": "python -m tools.build_reference",
         "bodies": "../shared/refmodels (Anny 0.6.2)",
@@ -651,6 +653,10 @@ def main(argv=None):
 
     mannequins = {BASE_FILE: base, **rms}
     changed = save_all(mannequins, args.out, shipped_manifest(args.refmodels))
+    from .add_bodies import set_bodies  # the set's bodies beside its RMs, as the manifest names them
+    from .reference_sets import FEMALE
+
+    set_bodies(FEMALE, list(RM_BODIES)).save(pathlib.Path(args.out) / BODIES_FILE)
     args.docs.mkdir(parents=True, exist_ok=True)
     for name, text in docs.items():
         atomic_write_text(args.docs / name, text)

@@ -140,6 +140,7 @@ FLOORS = {
     "fitting": 5,
     "skin": 5,
     "sizing": 5,
+    "body": 5,
     "formats": 6,
     "drape": 6,
 }

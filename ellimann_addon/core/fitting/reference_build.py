@@ -20,6 +20,7 @@ go through: mirrored and registered with them, moved by the refinement as points
 
 import csv
 import math
+import pathlib
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
@@ -41,6 +42,7 @@ from ..mannequin.clean import (
 )
 from ..mannequin.joints import anchor_indices, follow_pieces
 from ..measure.tailor import as_dict, section_heights
+from ..synthesis.bodies import BODIES_FILE, BodiesError, from_meshes
 from ..synthesis.manifest import STEM, Manifest, targets_range, write_reference_set
 from ..synthesis.refine import FACTOR_LIMITS, refine
 from .body_mesh import mesh_problem
@@ -108,11 +110,13 @@ class BuiltReferenceSet:
     base: object
     manifest: Manifest
     report: BuildReport
+    bodies: object = None  # the bodies it was built from (core.synthesis.bodies.SetBodies), when given their labels
 
     @classmethod
-    def assemble(cls, rms, report, targets, name, sex=None, base_stem=BASE_STEM, provenance=None):
+    def assemble(cls, rms, report, targets, name, sex=None, base_stem=BASE_STEM, provenance=None, bodies=None):
         """The set of the cleaned ``rms`` ({stem: RM}) and ``report`` (its base relabelled): each made the set's
-        (``reference_set`` = ``name``), and their manifest, its ranges the targets' min-max."""
+        (``reference_set`` = ``name``), and their manifest, its ranges the targets' min-max; ``bodies`` (SetBodies)
+        kept as the set's bodies file."""
         stems = list(rms)
         manifest = Manifest(
             name=name,
@@ -123,13 +127,18 @@ class BuiltReferenceSet:
             ranges_cm=targets_range({stem: targets[stem] for stem in stems}),
             targets_cm={stem: dict(targets[stem]) for stem in stems},
             provenance={**(provenance or {}), "labelled_against": report.reference},
+            bodies=BODIES_FILE if bodies is not None else None,
         )
         mannequins = {stem: rm.copy(reference_set=name) for stem, rm in rms.items()}
-        return cls(mannequins, report.base.copy(reference_set=name), manifest, report)
+        return cls(mannequins, report.base.copy(reference_set=name), manifest, report, bodies)
 
     def write(self, folder):
-        """Write the set into ``folder`` (each file atomically, the manifest last); returns the paths."""
-        return write_reference_set(folder, self.mannequins, self.manifest, base=self.base)
+        """Write the set into ``folder`` (each file atomically, its bodies before the manifest, the manifest last);
+        returns the paths."""
+        written = []
+        if self.bodies is not None:
+            written.append(self.bodies.save(pathlib.Path(folder) / self.manifest.bodies))
+        return written + write_reference_set(folder, self.mannequins, self.manifest, base=self.base)
 
 
 def traced_mesh(base):
@@ -376,6 +385,7 @@ def build_reference_set(
     sex=None,
     base_stem=BASE_STEM,
     provenance=None,
+    body_labels=None,
 ):
     """N Reference Mannequins from ``base`` (a Mannequin with traces) and ``bodies`` (BodyMesh, N >= 3).
 
@@ -386,6 +396,8 @@ def build_reference_set(
     process fits it, so the result does not depend on it; with more than one, ``cancel`` is polled between
     bodies). ``name`` (default: the base's set's), ``sex``, ``base_stem`` (the base's file) and ``provenance``
     (where the base and bodies came from; the build adds the RM it labelled against) go into the manifest.
+    ``body_labels`` (core.synthesis.bodies.BodyLabels of the bodies' topology): the bodies are kept with the set
+    (``bodies.npz``, for the body skin: core.body), each with its joints; without, the set has no bodies.
     Returns a BuiltReferenceSet. Raises ReferenceBuildError (one line) before any work for bad input, or when an
     RM cannot meet its targets.
     """
@@ -460,4 +472,26 @@ def build_reference_set(
             report.fill[body.name] = fill_shares(volume.grid(settings.check_spacing), rms[body.name])
         report.seconds["coverage check"] = time.perf_counter() - started
     tell(steps, "built")
-    return BuiltReferenceSet.assemble(rms, report, targets, name, sex, base_stem, provenance)
+    kept = None if body_labels is None else keep_bodies(bodies, body_labels, base.section_fractions)
+    return BuiltReferenceSet.assemble(rms, report, targets, name, sex, base_stem, provenance, kept)
+
+
+def keep_bodies(bodies, labels, fractions):
+    """SetBodies of the BodyMesh list ``bodies`` with ``labels`` (BodyLabels); ReferenceBuildError (one line) for
+    bodies without joints or that cannot make a body skin (another topology, wrong axes or units)."""
+    missing = [body.name for body in bodies if body.joints is None]
+    if missing:
+        raise ReferenceBuildError(f"bodies: {', '.join(missing)} have no joints (a body skin is posed on them)")
+    try:
+        return from_meshes(
+            [body.name for body in bodies],
+            np.stack([body.vertices for body in bodies]),
+            bodies[0].faces,
+            labels.region,
+            list(labels.region_names),
+            labels.bones,
+            np.stack([body.joints for body in bodies]),
+            fractions,
+        )
+    except BodiesError as error:
+        raise ReferenceBuildError(str(error)) from None

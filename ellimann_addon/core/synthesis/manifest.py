@@ -4,7 +4,8 @@
     {"format": "ellimann-reference-set", "version": 1, "name": str, "sex": "female" | "male" | null,
      "base": stem or null, "mannequins": [stems] (N >= 3), "measurements": ["He", "Sh", "Br", "Wa", "Hi"],
      "section_fractions": {"Sh", "Br", "Wa", "Hi": fraction of He}, "ranges_cm": {key: [lo, hi]},
-     "absurd_limits_cm": {key: [lo, hi]}, "targets_cm": {stem: {key: cm}}, "provenance": {...}}
+     "absurd_limits_cm": {key: [lo, hi]}, "targets_cm": {stem: {key: cm}}, "provenance": {...},
+     "bodies": file name (optional: the body meshes the RMs were traced from, core.body.bodies)}
 
 A folder without a manifest is the legacy layout: the five female RMs of Table 2.3 and the constants of
 core/constants.py (:func:`legacy_manifest`).
@@ -27,6 +28,7 @@ MIN_MANNEQUINS = 3
 SEXES = ("female", "male", None)
 STEM = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")  # a file name in the folder, no path
 SECTIONS = tuple(SECTION_FRACTIONS)
+BODIES_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*\.npz$")  # the bodies file, in the folder
 
 
 def _pairs(limits):
@@ -44,9 +46,10 @@ class Manifest:
     absurd_limits_cm: dict = field(default_factory=lambda: _pairs(ABSURD_LIMITS))
     targets_cm: dict = field(default_factory=dict)
     provenance: dict = field(default_factory=dict)
+    bodies: str = None  # the set's bodies file in the folder (core.body.bodies), or None: a set without bodies
 
     def to_dict(self):
-        return {
+        data = {
             "format": MANIFEST_FORMAT,
             "version": MANIFEST_VERSION,
             "name": self.name,
@@ -60,6 +63,9 @@ class Manifest:
             "targets_cm": self.targets_cm,
             "provenance": self.provenance,
         }
+        if self.bodies is not None:  # a set without bodies writes the manifest it always wrote
+            data["bodies"] = self.bodies
+        return data
 
     @classmethod
     def from_dict(cls, data, source=MANIFEST_FILE):
@@ -111,6 +117,9 @@ class Manifest:
         provenance = data.get("provenance", {})
         if not isinstance(provenance, dict):
             raise bad("provenance", "must be an object")
+        bodies = data.get("bodies")
+        if bodies is not None and (not isinstance(bodies, str) or not BODIES_NAME.match(bodies)):
+            raise bad("bodies", f"{bodies!r:.40} is not a file name in the folder (letters, digits, _ . -; .npz)")
         return cls(
             name,
             list(stems),
@@ -121,6 +130,7 @@ class Manifest:
             absurd,
             targets,
             provenance,
+            bodies,
         )
 
 

@@ -1,0 +1,125 @@
+"""Dev tool (not shipped): the body skin's pictures for docs/body_skin.md, Workbench renders (tools/render.py).
+
+    .venv/bin/python -m tools.body_skin_pictures [--only NAME ...] [--out DIR]
+
+- ``body_skin_lineup.png``, ``body_skin_lineup_male.png``: the body skin at each RM's targets, both shipped sets;
+- ``body_skin_table_2_5.png``: the ten Table 2.5 requests (the paper's test requests), female set;
+- ``body_skin_twin_held_out.png``: the neutral reference body (not one of the shipped set's five) beside its body
+  skin from the five measurements it measures, front and side;
+- ``body_skin_poses.png``: the Average's body skin in every still pose and three walk frames.
+"""
+
+import argparse
+from pathlib import Path
+
+import bpy
+
+import ellimann_addon
+from ellimann_addon.blender.bridge.convert import mesh_from_arrays
+from ellimann_addon.blender.bridge.skin import SKIN_COLOR
+from ellimann_addon.core.body.correct import BodySkinError
+from ellimann_addon.core.body.skin import BodySkinMaker
+from ellimann_addon.core.constants import MEASUREMENTS, TABLE_2_5
+from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.pose.motion import clamped_motion
+from ellimann_addon.core.pose.standard import STILL_POSES
+from ellimann_addon.core.synthesis.bodies import load_set_bodies
+from ellimann_addon.core.synthesis.shipped import named_reference_set, reference_folder
+from tools.build_reference import DEFAULT_REFMODELS
+from tools.render import Slot, render
+
+IMAGES = Path(__file__).resolve().parent.parent / "docs" / "images"
+BODY_COLOR = (0.62, 0.64, 0.7, 1.0)
+WALK_FRAMES = (0, 6, 12)
+PICTURES = ("lineup", "lineup_male", "table_2_5", "twin", "poses")
+
+
+def maker(set_name):
+    reference = named_reference_set(set_name)
+    return reference, BodySkinMaker(load_set_bodies(reference_folder(set_name)), ranges=reference.ranges)
+
+
+def skin_object(name, vertices, faces, color=SKIN_COLOR):
+    mesh = mesh_from_arrays(name, vertices, faces)
+    mesh.shade_smooth()
+    obj = bpy.data.objects.new(name, mesh)
+    obj.color = color
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
+def lineup(set_name, out):
+    reference, made = maker(set_name)
+    slots = []
+    for stem in reference.names:
+        skin = made.make(reference.manifest.targets_cm[stem])
+        slots.append(Slot(solid=[skin_object(stem, skin.vertices, skin.faces)]))
+    return render(out, slots, resolution=(2400, 1000))
+
+
+def table_2_5(out):
+    _, made = maker("female")
+    slots = []
+    for k, request in enumerate(TABLE_2_5):
+        try:
+            skin = made.make(dict(zip(MEASUREMENTS, request)) if not isinstance(request, dict) else request)
+        except BodySkinError as error:
+            print(f"Table 2.5 #{k + 1}: {error}")
+            continue
+        slots.append(Slot(solid=[skin_object(f"T{k + 1}", skin.vertices, skin.faces)]))
+    return render(out, slots, resolution=(4000, 900))
+
+
+def twin(out):
+    _, made = maker("female")
+    body = read_obj(DEFAULT_REFMODELS / "reference_female.obj", up="z")
+    request = made.tape.measure(body.vertices, MEASUREMENTS)
+    skin = made.make(request)
+    shift = [0.0, 0.0, body.vertices[:, 2].min()]
+    body_object = skin_object("Reference body", body.vertices, body.faces, BODY_COLOR)
+    skinned = skin_object("Body skin", skin.vertices + shift, skin.faces)
+    slots = [Slot(solid=[body_object]), Slot(solid=[skinned]), Slot(solid=[body_object], turn=90.0)]
+    slots.append(Slot(solid=[skinned], turn=90.0))
+    return render(out, slots, resolution=(2000, 1000))
+
+
+def poses(out):
+    reference, made = maker("female")
+    skin = made.make(reference.manifest.targets_cm["average"])
+    shown = [(name, clamped_motion(name, skin.joints)[0][0]) for name in STILL_POSES]
+    walk = clamped_motion("walk", skin.joints)[0]
+    shown += [(f"walk {k}", walk[k]) for k in WALK_FRAMES]
+    slots = []
+    for name, pose in shown:
+        pose = pose.copy(translation=pose.translation * [0.0, 0.0, 1.0])  # in place: the slots stay apart
+        obj = skin_object(name, skin.posed(pose), skin.faces)
+        slots.append(Slot(solid=[obj], turn=0.0 if name in ("a_pose", "t_pose", "attention") else 90.0))
+    return render(out, slots, resolution=(3200, 1000))
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m tools.body_skin_pictures", description=__doc__.splitlines()[0])
+    parser.add_argument("--only", nargs="+", choices=PICTURES, default=list(PICTURES))
+    parser.add_argument("--out", type=Path, default=IMAGES)
+    args = parser.parse_args(argv)
+    ellimann_addon.register()
+    try:
+        jobs = {
+            "lineup": lambda: lineup("female", args.out / "body_skin_lineup.png"),
+            "lineup_male": lambda: lineup("male", args.out / "body_skin_lineup_male.png"),
+            "table_2_5": lambda: table_2_5(args.out / "body_skin_table_2_5.png"),
+            "twin": lambda: twin(args.out / "body_skin_twin_held_out.png"),
+            "poses": lambda: poses(args.out / "body_skin_poses.png"),
+        }
+        for name in args.only:
+            bpy.ops.wm.read_homefile(use_empty=True)
+            print(f"wrote {jobs[name]()}")
+    finally:
+        ellimann_addon.unregister()
+    return 0
+
+
+if __name__ == "__main__":
+    from ellimann_addon.blender.services import teardown
+
+    teardown.exit_with(main())
