@@ -47,7 +47,7 @@ def atomic_write_stream(path, write):
         problem = (
             f"{os.path.getsize(temp)} of {written} bytes reached the disk"
             if os.path.getsize(temp) != written
-            else incomplete(temp, kind_of(path))
+            else incomplete(temp, extension_of(path))
         )
         if problem:
             raise OSError(errno.EIO, f"the file written is incomplete: {problem}", path)
@@ -72,8 +72,9 @@ def atomic_write_text(path, text):
 # ------------------------------------------------------------------------------------------------ whole files
 
 
-def kind_of(path):
-    """The file kind :func:`incomplete` checks, from the extension: "blend", "glb", "json", …"""
+def extension_of(path):
+    """A path's extension, lower case, without the dot ("" if none): the file kind :func:`incomplete` checks
+    ("blend", "glb", "json", …) and the format ``core.formats.table.format_of`` names."""
     return os.path.splitext(os.fspath(path))[1].lower().lstrip(".")
 
 
@@ -87,7 +88,7 @@ def incomplete(path, kind=None):
     ends with IEND; .obj: it ends with a complete line; .npz: its zip directory reads; .fbx (binary): its signature
     and its footer. Any other kind: it is not empty.
     """
-    kind = kind_of(path) if kind is None else kind
+    kind = extension_of(path) if kind is None else kind
     try:
         size = os.path.getsize(path)
         if not size:

@@ -1,44 +1,66 @@
-"""Mannequin files the core writes without Blender: OBJ (Y up), ElliMann's JSON and MJCF (MuJoCo's XML).
+"""Mannequin files the core writes without Blender: OBJ (Y up), ElliMann's JSON and MJCF (MuJoCo's XML), at rest or
+posed, with a skin or not: the writers of those rows of ``core.formats.table``, each writing one mannequin to
+paths of its format, atomically.
 
-Formats are named by what a user types (``--format json,mjcf``); each has one file extension (``core.formats.table``).
+With a ``skin``: the .obj holds the skin alone, the .json records how it was made (its ``skin`` section), the MJCF
+draws it over the pieces. Posed (``frames``, a list of ``core.pose.kinematics.Pose``): the .json is the rest
+mannequin with a ``pose`` section (``core.formats.posed_files``), the .xml an articulated body with the frames as
+keyframes, the .obj the posed pieces (or skin) of a still pose.
 """
 
-import os
+import json
 
 import numpy as np
 
 from ..errors import ElliMannError
+from ..files import atomic_write_text
 from .mjcf import write_mjcf
 from .obj import write_obj, write_skin_obj
-from .table import CORE_FORMATS, FORMATS, format_of
-
-EXTENSIONS = {name: FORMATS[name].extension for name in CORE_FORMATS}  # format -> file extension (core.formats.table)
+from .posed_files import pose_section
 
 
-def core_format(path):
-    """The core format a path's extension names ("obj", "json", "mjcf"), or None."""
-    kind = format_of(path)
-    return kind.name if kind is not None and not kind.needs_blender else None
-
-
-def write_core_file(mannequin, path, cushions=False, skin=None):
-    """Write ``mannequin`` to an .obj, .json or .xml (MJCF), atomically; ``cushions``: cushion pairs as their hull
-    meshes (OBJ) or convex mesh geoms (MJCF). ``skin`` (a ``core.skin.surface.Skin`` of these pieces): the .obj
-    holds the skin alone, the .json records how it was made (its ``skin`` section), the MJCF draws it over the
-    pieces."""
-    kind = core_format(path)
+def write_json_files(mannequin, paths, *, skin=None, frames=None, fps=None, **_):
+    """ElliMann's JSON: the mannequin (recording how its skin was made), with its pose section when posed."""
     mannequin = with_skin_record(mannequin, skin)
-    if kind == "json":
-        mannequin.save(path)
-    elif kind == "obj" and skin is not None:
-        write_skin_obj(skin, path)
-    elif kind == "obj":
-        write_obj(mannequin, path, cushions=cushions)
-    elif kind == "mjcf":
-        write_mjcf(mannequin, path, cushions=cushions, skin=skin)
-    else:
-        raise ElliMannError(f"path: {os.fspath(path)!r} is not an .obj, .json or .xml file")
-    return os.fspath(path)
+    for path in paths:
+        if frames is None:
+            mannequin.save(path)
+        else:
+            data = mannequin.to_dict()
+            data["pose"] = pose_section(frames, fps)
+            atomic_write_text(path, json.dumps(data, indent=1) + "\n")
+    return paths
+
+
+def write_obj_files(mannequin, paths, *, cushions=False, skin=None, frames=None, **_):
+    """OBJ (Y up): the pieces (cushion pairs as their hull meshes with ``cushions``), or the skin alone; posed, a
+    still pose only (an OBJ holds no animation)."""
+    if frames is not None and len(frames) > 1:
+        raise ElliMannError(
+            f"pose: a .obj file holds no animation; write the {len(frames)} frames of "
+            f"'{frames[0].name.rsplit(' ', 1)[0]}' to .json or .xml (keyframes), or pose a still pose"
+        )
+    pose = frames[0] if frames else None
+    for path in paths:
+        if skin is not None:
+            write_skin_obj(skin, path, pose)
+        else:
+            write_obj(mannequin, path, pose, cushions)
+    return paths
+
+
+def write_mjcf_files(mannequin, paths, *, cushions=False, skin=None, frames=None, **_):
+    """MJCF: the convex pieces welded to the world (cushion pairs as convex mesh geoms with ``cushions``), the skin
+    drawn over them; posed, an articulated body with the frames as keyframes."""
+    mannequin = with_skin_record(mannequin, skin)
+    for path in paths:
+        if frames is None:
+            write_mjcf(mannequin, path, cushions=cushions, skin=skin)
+        else:
+            from .mjcf_articulated import write_articulated_mjcf
+
+            write_articulated_mjcf(mannequin, path, frames, cushions, skin)
+    return paths
 
 
 def with_skin_record(mannequin, skin):

@@ -1,4 +1,5 @@
-"""Posed mannequin files the core writes without Blender (``--pose``): .json, MJCF .xml and .obj.
+"""Posed mannequin files (``--pose``), as the core's writers write them (``core.formats.core_writers``): .json, MJCF
+.xml and .obj; the pose section of a .json, and reading a pose file.
 
 - ``.json``: the rest mannequin with its joints (what ``Mannequin.load`` reads, measurements the rest pose's)
   plus a ``pose`` section: ``{"version": 1, "name", "fps" (motions), "frames": [Pose.to_dict(), ...]}``; a still
@@ -16,12 +17,7 @@ bodies, the .obj holds the posed skin alone.
 import json
 
 from ..errors import ElliMannError
-from ..files import atomic_write_text
 from ..pose.kinematics import Pose
-from .core_writers import with_skin_record
-from .mjcf_articulated import write_articulated_mjcf
-from .obj import write_obj, write_skin_obj
-from .table import FORMATS, format_of
 
 POSE_SECTION_VERSION = 1
 
@@ -58,30 +54,3 @@ def read_pose(path):
             f"pose: the pose section of {path} must have version {POSE_SECTION_VERSION} and a non-empty list of frames"
         )
     return [Pose.from_dict(frame) for frame in section["frames"]]
-
-
-def write_posed(mannequin, frames, path, cushions=False, fps=None, skin=None):
-    """Write ``mannequin`` in ``frames`` (a list of Pose; the walk cycle's frames, or one pose) to a .json, .xml
-    or .obj, atomically, with its ``skin`` if given. ElliMannError (nothing written) for another format or an
-    animation in a .obj."""
-    kind = format_of(path)
-    if kind is None or kind.posed_writer != "core":
-        names = ", ".join(f".{f.extension}" for f in FORMATS.values() if f.posed_writer == "core")
-        raise ElliMannError(f"path: {path!r}: the core writes posed {names} files")
-    if len(frames) > 1 and not kind.animated:
-        raise ElliMannError(
-            f"pose: a .{kind.extension} file holds no animation; write the {len(frames)} frames "
-            f"of '{frames[0].name.rsplit(' ', 1)[0]}' to .json or .xml (keyframes), or pose a still pose"
-        )
-    mannequin = with_skin_record(mannequin, skin)
-    if kind.name == "json":
-        data = mannequin.to_dict()
-        data["pose"] = pose_section(frames, fps)
-        atomic_write_text(path, json.dumps(data, indent=1) + "\n")
-    elif kind.name == "mjcf":
-        write_articulated_mjcf(mannequin, path, frames, cushions, skin)
-    elif skin is not None:
-        write_skin_obj(skin, path, frames[0])
-    else:
-        write_obj(mannequin, path, frames[0], cushions)
-    return path

@@ -1,88 +1,109 @@
-"""The mannequin file formats, in one table: each format's name (``--format``), its file extension, who writes
-it (the core: OBJ, JSON and MJCF, ``core.formats.core_writers``; Blender: .blend and .glb,
-``blender.services.files.write_mannequin``) and so whether it needs the bpy module, the function that writes it
-and what its whole-file check verifies (every file is written to a temporary name and put in place only once
-``core.files.incomplete`` finds it whole, so a write cut short never replaces a file). The command line, the
-writers and the export operator read it; the formats ElliMann defines have a page each in docs/formats/."""
+"""The mannequin file formats, in one table: each format's name (``--format``), its file extension, what it is, whether
+it holds an animation, whether writing it needs the bpy module (at rest and posed), what its whole-file check
+verifies (every file is written to a temporary name and put in place only once ``core.files.incomplete`` finds it
+whole, so a write cut short never replaces a file) and the function that writes it.
+
+A path's format is decided here once (:func:`format_of`, :func:`check_outputs`), and every list of formats in a help
+or an error text is made from the table (:func:`listing`). The core writes .obj, .json and MJCF
+(``core.formats.core_writers``); Blender writes .blend and .glb, and the Blender layer binds its writer to those rows
+when it is loaded (:func:`bind_writer`): the core never imports it. The formats ElliMann defines have a page each in
+docs/formats/.
+
+Every row's ``write(mannequin, paths, *, cushions, skin, measured, frames, fps)`` writes one mannequin (its
+``skin``, if any; in ``frames``, a list of ``core.pose.kinematics.Pose``, if posed) to each of ``paths``, all of
+that row's format, and returns them.
+"""
 
 import os
 from dataclasses import dataclass
 
+from ..errors import ElliMannError
+from ..files import extension_of
 
-@dataclass(frozen=True)
+
+@dataclass(eq=False)
 class Format:
     name: str  # what a user types (``--format json,mjcf``)
     extension: str  # the file extension, without the dot
-    writer: str  # "core" (numpy only) or "blender" (needs bpy)
     title: str  # what it is, for help texts
-    posed_writer: str  # who writes it posed (``--pose``): "core" (core.formats.posed_files) or "blender"
-    animated: bool  # holds an animation (the walk cycle)
-    written_by: str  # the function that writes it at rest (dotted, under ellimann_addon; posed: posed_files/posing)
+    animated: bool  # holds an animation (the walk cycle, a clip)
+    blender: bool  # writing it at rest needs the bpy module
+    blender_posed: bool  # writing it posed needs the bpy module
     whole_file: str  # what core.files.incomplete checks of it before it replaces anything
+    write: object = None  # its writer (see the module's docstring); Blender's rows: bound by the Blender layer
+
+    @property
+    def aliases(self):
+        """The other name ``--format`` takes for it: its extension where that is not its name (xml for mjcf)."""
+        return (self.extension,) if self.extension != self.name else ()
 
     @property
     def needs_blender(self):
-        return self.writer == "blender"
+        return self.blender
 
     def needs_blender_for(self, posed):
         """Whether writing it (posed, with ``posed``) needs the bpy module."""
-        return (self.posed_writer if posed else self.writer) == "blender"
+        return self.blender_posed if posed else self.blender
+
+    def writer(self):
+        """Its writer; ElliMannError if it is Blender's and the Blender layer is not loaded."""
+        if self.write is None:
+            raise ElliMannError(f"writing a .{self.extension} file needs Blender (the bpy module)")
+        return self.write
 
 
-WHOLE_FILE_CHECK = "core.files.incomplete"  # the one whole-file check, by extension (``kind``)
+def _json_files(mannequin, paths, **settings):
+    from .core_writers import write_json_files  # the writers' modules are loaded when a file is written
+
+    return write_json_files(mannequin, paths, **settings)
+
+
+def _obj_files(mannequin, paths, **settings):
+    from .core_writers import write_obj_files
+
+    return write_obj_files(mannequin, paths, **settings)
+
+
+def _mjcf_files(mannequin, paths, **settings):
+    from .core_writers import write_mjcf_files
+
+    return write_mjcf_files(mannequin, paths, **settings)
+
+
+WHOLE_FILE_CHECK = "core.files.incomplete"  # the one whole-file check, by extension
 FORMATS = {
     f.name: f
     for f in (
         Format(
             "blend",
             "blend",
-            "blender",
             "Blender file",
-            "blender",
             True,
-            "blender.services.files.write_blender_file",
+            True,
+            True,
             "its block chain reaches the ENDB block (zstd: the frames its seek table lists; gzip: every block)",
         ),
         Format(
             "glb",
             "glb",
-            "blender",
             "binary glTF with ElliMann's extras",
-            "blender",
             True,
-            "blender.services.files.export_gltf",
+            True,
+            True,
             "the length in its header is the file's and its chunks fill it",
         ),
-        Format(
-            "obj",
-            "obj",
-            "core",
-            "Wavefront OBJ (Y up)",
-            "core",
-            False,
-            "core.formats.obj.write_obj",
-            "it ends with a complete line",
-        ),
+        Format("obj", "obj", "Wavefront OBJ (Y up)", False, False, False, "it ends with a complete line", _obj_files),
         Format(
             "json",
             "json",
-            "core",
             "ElliMann's mannequin JSON",
-            "core",
             True,
-            "core.mannequin.model.Mannequin.save",
+            False,
+            False,
             "it parses as JSON (reading it, Mannequin.load checks every field)",
+            _json_files,
         ),
-        Format(
-            "mjcf",
-            "xml",
-            "core",
-            "MJCF, for MuJoCo",
-            "core",
-            True,
-            "core.formats.mjcf.write_mjcf",
-            "it parses as XML",
-        ),
+        Format("mjcf", "xml", "MJCF, for MuJoCo", True, False, False, "it parses as XML", _mjcf_files),
     )
 }
 # The batch's own one-file format (``batch --format npz``): every mannequin of a batch, not one per file, so not a
@@ -90,29 +111,67 @@ FORMATS = {
 BATCH_FILE = Format(
     "npz",
     "npz",
-    "core",
     "every mannequin of a batch in one compressed NumPy archive",
-    "core",
     False,
-    "core.formats.npz_bundle.BatchFileWriter",
+    False,
+    False,
     "its zip directory reads (reading it, read_batch_file checks every array's shape)",
 )
-CORE_FORMATS = tuple(name for name, f in FORMATS.items() if not f.needs_blender)  # obj, json, mjcf
-BLENDER_FORMATS = tuple(name for name, f in FORMATS.items() if f.needs_blender)  # blend, glb
-EXTENSIONS = {name: f.extension for name, f in FORMATS.items()}  # format -> file extension
-
-
-def extension_of(path):
-    """A path's extension, lower case, without the dot ("" if none)."""
-    return os.path.splitext(os.fspath(path))[1].lower().lstrip(".")
+CORE_FORMATS = tuple(name for name, f in FORMATS.items() if not f.blender)  # obj, json, mjcf
+BLENDER_FORMATS = tuple(name for name, f in FORMATS.items() if f.blender)  # blend, glb
 
 
 def format_of(path):
-    """The Format a path's extension names, or None."""
+    """The Format a path's extension names, or None: where every path's format is decided."""
     extension = extension_of(path)
     return next((f for f in FORMATS.values() if f.extension == extension), None)
 
 
-def needs_blender(paths, posed=False):
-    """Whether writing ``paths`` (posed, with ``posed``) needs the bpy module."""
-    return any(f is not None and f.needs_blender_for(posed) for f in map(format_of, paths))
+def format_named(name, batch=False):
+    """The Format ``--format`` names by ``name`` or an alias (``batch``: the batch file too), or None."""
+    name = name.strip().lower().lstrip(".")
+    rows = [*FORMATS.values(), *([BATCH_FILE] if batch else [])]
+    return next((f for f in rows if name == f.name or name in f.aliases), None)
+
+
+def listing(rows=None, what="extension"):
+    """The formats as a help or an error text says them: ".blend, .glb, .obj, .json or .xml (MJCF)" (``what``
+    "extension") or "blend, glb, obj, json, mjcf (xml)" ("name")."""
+    rows = list(FORMATS.values() if rows is None else rows)
+    if what == "name":
+        return ", ".join(f.name + (f" ({', '.join(f.aliases)})" if f.aliases else "") for f in rows)
+    words = [f".{f.extension}" + (f" ({f.name.upper()})" if f.aliases else "") for f in rows]
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " or " + words[-1]
+
+
+def check_outputs(paths, animated=False):
+    """{path: Format} of output ``paths``, decided once; ElliMannError naming the path for one whose extension names
+    no format, and, with ``animated`` (a walk, a clip), for a format that holds no animation."""
+    formats = {}
+    for path in paths:
+        kind = format_of(path)
+        if kind is None:
+            raise ElliMannError(f"{os.fspath(path)!r}: an output file must end in {listing()}")
+        if animated and not kind.animated:
+            moving = listing([f for f in FORMATS.values() if f.animated])
+            raise ElliMannError(f"{os.fspath(path)!r}: a .{kind.extension} file holds no animation; write {moving}")
+        formats[os.fspath(path)] = kind
+    return formats
+
+
+def bind_writer(names, write):
+    """The Blender layer's writer for the rows ``names`` (it needs bpy, which the core never imports)."""
+    for name in names:
+        FORMATS[name].write = write
+
+
+def write_files(mannequin, formats, **settings):
+    """Write ``mannequin`` to every path of ``formats`` ({path: Format}, :func:`check_outputs`), the paths of one
+    writer together (Blender's .blend and .glb from one scene); ``settings``: cushions, skin, measured, frames, fps.
+    Returns the paths."""
+    groups = {}
+    for path, kind in formats.items():
+        groups.setdefault(id(kind.writer()), (kind.writer(), []))[1].append(path)
+    for write, paths in groups.values():
+        write(mannequin, paths, **settings)
+    return list(formats)

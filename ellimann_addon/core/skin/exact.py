@@ -27,12 +27,13 @@ from ..mannequin.joints import anchor_indices, follow_pieces
 from ..measure.extra import EXTRA_MEASUREMENTS, mannequin_extra_measurements
 from ..measure.tailor import as_dict
 from ..synthesis.extra_refine import ExtraRequestError, extra_request_problems, meet_extra
+from ..synthesis.misses import SKIN_MISS_CM
 from ..synthesis.refine import refine
 from .measure import body_measurements, field_measurements, mesh_measurements
 from .surface import build_skin
 
 SKIN_TOLERANCE_CM = 0.03  # the loop's aim on the surface: 0.3 mm (the promise on the mesh is 1 mm)
-MESH_TOLERANCE_CM = 0.1  # what the skin's mesh must measure within
+MESH_TOLERANCE_CM = SKIN_MISS_CM  # what the skin's mesh must measure within
 EXTRA_AIM_CM = 0.05  # the loop's aim on the mesh with extra measurements: half the promise, a margin for the last
 MAX_ROUNDS = 8
 EXTRA_MAX_ROUNDS = 10

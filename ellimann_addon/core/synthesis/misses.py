@@ -11,6 +11,7 @@ from ..measure.extra import EXTRA_MEASUREMENTS
 from .refine import EXACT_TOLERANCE
 
 MISS_CM = 0.1  # a given extra measurement further off than this (1 mm) is a miss
+SKIN_MISS_CM = 0.1  # a measurement a skin's mesh misses by more than this (1 mm) in exact mode is a miss
 
 
 @dataclass(frozen=True)
@@ -77,4 +78,27 @@ def missed_text(missed):
         + f" (tolerance {EXACT_TOLERANCE * 100:g}%"
         + (f", the extra measurements {MISS_CM * 10:g} mm" if extra else "")
         + "; the mannequin is the closest it found)"
+    )
+
+
+def skin_misses(measured, requested):
+    """The measurements asked (``requested``, {key: cm}: the five and the extra ones) that a skin measuring
+    ``measured`` on its mesh misses by more than SKIN_MISS_CM, as :class:`Miss`."""
+    return [
+        Miss(key, float(measured[key]), float(wanted))
+        for key, wanted in requested.items()
+        if abs(measured[key] - wanted) > SKIN_MISS_CM
+    ]
+
+
+def skin_missed_text(missed, rounds):
+    """One line for a skin's misses: "exact mode on the skin missed Br by +0.12 cm (skin 101.13 cm for 101.25 cm)
+    (tolerance 1 mm on its mesh; the closest skin found in 3 rounds)"."""
+    return (
+        "exact mode on the skin missed "
+        + ", ".join(
+            f"{miss.key} by {miss.off_cm:+.2f} cm (skin {miss.measured:.2f} cm for {miss.requested:g} cm)"
+            for miss in missed
+        )
+        + f" (tolerance {SKIN_MISS_CM * 10:g} mm on its mesh; the closest skin found in {rounds} rounds)"
     )

@@ -1,0 +1,114 @@
+"""Making what a checked job asks (``core.job.request``): the mannequin synthesized (segmented IDW, exact mode, the
+extra measurements met), its skin (in exact mode its pieces refined until the skin measures the request), its poses
+(a standard pose, a pose file, a clip retargeted and clamped), and what was measured and missed, in one
+``core.job.result.Result``. ``synth``, ``pose``, the Synthesize operator and its live steps call :func:`make`; a
+batch synthesizes its rows together (``core.synthesis.batch.synthesize_chunk``, on Dask too) and finishes each row
+with :func:`finish`."""
+
+from ..measure.extra import EXTRA_MEASUREMENTS
+from ..measure.tailor import as_dict
+from ..synthesis.misses import request_misses, skin_misses
+from ..synthesis.synthesize import IDW_EXTRA_NOTE, meet_extra_request, synthesize_checked
+from .result import Result, SkinMade
+
+
+def make(job, progress=None, bones=False):
+    """The :class:`Result` of ``job``; ``progress(fraction, message)`` is told as the slow parts go (a skin);
+    ``bones``: the skin's bone weights made too (for a rig: the slow part of a skin with joints)."""
+    if job.request.mannequin is not None:
+        mannequin = job.request.mannequin
+        return finish(job, mannequin, None, progress, bones)
+    mannequin, measured = synthesize_one(job)
+    return finish(job, mannequin, measured, progress, bones)
+
+
+def synthesize_one(job):
+    """(Mannequin, measured {the five and the extra ones asked: cm}) of a job's request: synthesized, and in exact
+    mode its extra measurements met."""
+    batch = synthesize_checked(job.reference, job.values[None], job.options)
+    mannequin, measured, _ = meet_extra_request(
+        batch.mannequin(0, job.options.name), as_dict(batch.measured[0]), job.extra, job.options.mode, False
+    )
+    return mannequin, measured
+
+
+def finish(job, mannequin, measured, progress=None, bones=False):
+    """The :class:`Result` of ``job`` for its synthesized ``mannequin`` (measuring ``measured``: the five and the
+    extra ones asked, cm; None for a mannequin already made): its skin, poses and misses."""
+    report = progress or (lambda fraction, message: None)
+    mode = job.options.mode
+    request = None if job.values is None else {**job.five, **job.extra}
+    warnings = list(job.warnings)
+    if job.extra and mode != "exact":
+        warnings.append(IDW_EXTRA_NOTE)
+    skin = None
+    if job.skin is not None:
+        mannequin, measured, skin = _skin(job, mannequin, measured, report)
+        if bones and mannequin.joints is not None:
+            report(0.8, "weighting it to the bones")
+            skin.skin.bones()
+    if request is None:
+        missed = []
+    elif skin is not None:
+        missed = skin_misses(skin.measured, request) if skin.exact else []
+    else:
+        missed = request_misses(measured, job.values, job.extra, mode)
+    frames, notes = None, []
+    if job.pose is not None:
+        frames, clamped, notes = pose_frames(job.pose, mannequin)
+        warnings += clamped
+    result = Result(
+        mannequin, measured, request, mode, skin, frames, job.pose.fps if job.pose else None, missed, warnings, notes
+    )
+    if missed:
+        result.warnings.append(result.missed_text())
+    report(0.9, "done")
+    return result
+
+
+def _skin(job, mannequin, measured, report):
+    """(pieces, their measurements, SkinMade): in exact mode the pieces refined until their skin measures the
+    request (``core.skin.exact``), else the skin of the pieces as they are, measured on its mesh."""
+    from ..skin.exact import exact_skin  # the skin's code, loaded only when a skin is asked
+    from ..skin.measure import body_measurements, mesh_measurements
+    from ..skin.surface import build_skin
+
+    settings = job.skin
+    if measured is None:  # a mannequin already made: its skin made again, as its file records
+        report(0.0, f"making the skin ({settings.voxel_mm:g} mm voxels)")
+        return mannequin, measured, SkinMade(build_skin(mannequin, settings), {}, False)
+    if job.options.mode == "exact":
+        report(0.0, f"refining the pieces until their skin measures the request ({settings.voxel_mm:g} mm voxels)")
+        made = exact_skin(mannequin, settings, job.five, dict(job.extra) or None)
+        measured = {**measured, **made.pieces_measured}
+        skin = SkinMade(made.skin, dict(made.skin_measured), True, made.rounds, made.converged)
+        return made.mannequin, measured, skin
+    report(0.0, f"making the skin ({settings.voxel_mm:g} mm voxels)")
+    skin = build_skin(mannequin, settings)
+    on_mesh = mesh_measurements(skin)
+    if job.extra:
+        values = body_measurements(skin).values
+        on_mesh.update({key: values.get(key, float("nan")) for key in EXTRA_MEASUREMENTS if key in job.extra})
+    return mannequin, measured, SkinMade(skin, on_mesh, False)
+
+
+def pose_frames(source, mannequin):
+    """(frames, warnings, notes) of a pose source (``core.job.request.PoseSource``) on ``mannequin``: a clip
+    retargeted onto its joints and clamped to their ranges (warnings: what was clamped; notes: where the feet
+    went), a pose file's frames or a standard pose made on its joints; ElliMannError naming the joint (and frame) of
+    a pose beyond the limits (a clip's are clamped)."""
+    from ..pose.kinematics import check_limits, require_joints
+    from ..pose.standard import standard_motion
+
+    if source.clip is not None:
+        from ..pose.clip import clip_onto
+
+        clip = source.clip
+        onto = clip_onto(mannequin, clip.motion, clip.match, source.ask.keep_on_floor, clip.name)
+        return onto.poses, onto.clamp_lines(), [onto.floor_line("" if source.ask.keep_on_floor else source.ask.floor_hint)]
+    joints = require_joints(mannequin)
+    frames = source.frames if source.frames is not None else standard_motion(source.name, joints, source.fps)
+    for index, frame in enumerate(frames):
+        check_limits(frame, joints, index if len(frames) > 1 else None)
+    return frames, [], []
+

@@ -1,0 +1,174 @@
+"""What a user can ask of ElliMann in one job, checked whole before any work starts.
+
+A :class:`Request` holds everything: the five measurements and any extra ones (cm), the reference set, the
+synthesis options, cushions, the skin and its settings, a pose (a standard pose, a pose file or a BVH clip) and the
+files to write; or, instead of measurements, a mannequin already made (``pose IN.json``). :func:`check` turns it
+into a :class:`Job` or refuses it in one line (ElliMannError): a request out of its limits, extra measurements that
+contradict the five, a path whose format is unknown or needs Blender where there is none, an animation for a format
+that holds none, a pose without joints, a skin voxel too fine for memory or too coarse for a piece. Nothing is
+made, let alone written, for a request that would be refused halfway. ``synth``, ``pose``, every row of ``batch``
+and the Synthesize operator build their jobs here; ``core.job.make`` makes them.
+"""
+
+from dataclasses import dataclass, field
+
+from ..errors import ElliMannError
+from ..formats.table import check_outputs
+from ..measure.extra import EXTRA_MEASUREMENTS
+from ..measure.tailor import as_dict
+from ..pose.kinematics import require_joints
+from ..synthesis.extra_refine import ExtraRequestError, extra_request_problems
+from ..synthesis.options import SynthesisOptions
+from ..synthesis.request import checked_request
+
+
+@dataclass(frozen=True)
+class PoseAsk:
+    """A pose as asked: a standard pose's name, a pose .json or a BVH clip (``source``), its frames per second
+    (``fps``; None: the walk's default, or a clip's own rate), whose bone names a clip uses (``rig``) and whether a
+    clip's lowest foot is held on the floor (``floor_hint``: how the caller's user asks that, said where a clip's
+    feet leave the floor)."""
+
+    source: str
+    fps: float | None = None
+    rig: str = "auto"
+    keep_on_floor: bool = False
+    floor_hint: str = ""
+
+
+@dataclass(frozen=True)
+class Request:
+    """One mannequin as a user asks for it. ``measurements``: the five {He, Sh, Br, Wa, Hi: cm}; ``extra``: any of
+    the extra measurements {key: cm}; ``references``: a loaded ``core.synthesis.reference_set.ReferenceSet``;
+    ``skin``: a ``core.skin.settings.SkinSettings`` (None: no skin); ``outputs``: the paths to write (formats by
+    their extensions, ``core.formats.table``). ``mannequin``: one already made, posed (and skinned) as it is,
+    instead of one synthesized from measurements."""
+
+    measurements: dict | None = None
+    references: object = None
+    extra: dict = field(default_factory=dict)
+    options: SynthesisOptions = field(default_factory=SynthesisOptions)
+    cushions: bool = False
+    skin: object = None
+    pose: PoseAsk | None = None
+    outputs: tuple = ()
+    mannequin: object = None
+
+
+@dataclass(frozen=True)
+class PoseSource:
+    """A pose ask read: the frames of a pose file, or the clip of a .bvh (``core.formats.bvh.BvhClip``), or neither
+    (a standard pose), its frames per second and whether it moves (more than one frame)."""
+
+    ask: PoseAsk
+    fps: float
+    frames: list | None = None
+    clip: object = None
+    animated: bool = False
+
+    @property
+    def name(self):
+        return self.ask.source
+
+
+@dataclass
+class Job:
+    """A checked :class:`Request`: the five as a (5,) array in MEASUREMENTS order (None for a mannequin already
+    made), the extra ones in EXTRA_MEASUREMENTS order, the range warnings, the pose's source read and each output
+    path's format (its row of ``core.formats.table``, decided here once)."""
+
+    request: Request
+    values: object
+    extra: dict
+    warnings: list
+    pose: PoseSource | None
+    formats: dict  # {path: Format}
+
+    @property
+    def reference(self):
+        return self.request.references
+
+    @property
+    def options(self):
+        return self.request.options
+
+    @property
+    def five(self):
+        return None if self.values is None else as_dict(self.values)
+
+    @property
+    def skin(self):
+        return self.request.skin
+
+    def needs_blender(self):
+        """The first output that needs Blender to be written (posed as asked), or None."""
+        posed = self.pose is not None
+        return next((path for path, kind in self.formats.items() if kind.needs_blender_for(posed)), None)
+
+
+def check(request, blender=True):
+    """The :class:`Job` of ``request``, or ElliMannError (one line) for anything that would refuse it later;
+    ``blender``: whether Blender's writers can run here (a .blend or .glb output is refused without them)."""
+    request.options.checked()
+    made = request.mannequin
+    if made is None:
+        reference = request.references
+        values, warnings = checked_request(request.measurements, reference.ranges, reference.absurd_limits)
+        extra = checked_extra(as_dict(values), request.extra)
+    else:
+        values, warnings, extra = None, [], {}
+    pose = read_pose_ask(request.pose)
+    formats = check_outputs(request.outputs, animated=pose is not None and pose.animated)
+    job = Job(request, values, extra, warnings, pose, formats)
+    needs = job.needs_blender()
+    if needs is not None and not blender:
+        raise ElliMannError(f"writing {needs} needs Blender: the bpy module is not installed")
+    if pose is not None:
+        if made is not None:
+            require_joints(made)
+        elif request.references.joints is None:
+            raise ElliMannError(
+                f"joints: the {request.references.name} set's Reference Mannequins have none, so its mannequins "
+                "cannot be posed: synthesize from a set with joints (the shipped sets have them)"
+            )
+    if request.skin is not None:
+        from ..skin.surface import check_skin  # the skin's code, loaded only when a skin is asked
+
+        for mannequin in [made] if made is not None else request.references.mannequins:
+            check_skin(mannequin, request.skin)
+    return job
+
+
+def checked_extra(five, extra):
+    """The extra measurements asked, as floats in EXTRA_MEASUREMENTS order; ExtraRequestError (one line) for one
+    that is not a measurement, out of its limits or contradicting the five."""
+    unknown = [key for key in extra if key not in EXTRA_MEASUREMENTS]
+    if unknown:
+        raise ExtraRequestError(f"{unknown[0]}: not a measurement (one of {', '.join(EXTRA_MEASUREMENTS)})")
+    problems = extra_request_problems(five, extra)
+    if problems:
+        raise ExtraRequestError(problems[0])
+    return {key: float(extra[key]) for key in EXTRA_MEASUREMENTS if key in extra}
+
+
+def read_pose_ask(ask):
+    """The :class:`PoseSource` of a PoseAsk (None for None): a .bvh clip read (its bones matched by ``ask.rig``), a
+    pose .json read, or a standard pose's name checked. ElliMannError naming the file or the name."""
+    if ask is None:
+        return None
+    from ..pose.standard import MOTIONS, WALK_FPS, check_pose_name
+
+    lowered = ask.source.lower()
+    if lowered.endswith(".bvh"):
+        from ..formats.bvh import read_bvh
+
+        clip = read_bvh(ask.source, ask.rig, ask.fps)
+        return PoseSource(ask, clip.motion.fps, clip=clip, animated=clip.motion.frames > 1)
+    fps = WALK_FPS if ask.fps is None else ask.fps
+    if lowered.endswith(".json"):
+        from ..formats.posed_files import read_pose
+
+        frames = read_pose(ask.source)
+        return PoseSource(ask, fps, frames=frames, animated=len(frames) > 1)
+    check_pose_name(ask.source)
+    return PoseSource(ask, fps, animated=ask.source in MOTIONS)
