@@ -21,6 +21,7 @@ import argparse
 import contextlib
 import sys
 
+from .. import VERSION
 from ..core.errors import ElliMannError
 from . import batch, demo, drape, measure, population, pose, references, synth
 from .output import INTERRUPTED, MISSED, PROG, UsageError, one_line, say
@@ -35,6 +36,7 @@ def build_parser():
         prog=PROG,
         description="ElliMann: measurement-driven mannequins from convex ellipsoids and cushions (measurements in cm).",
     )
+    parser.add_argument("--version", action="version", version=f"{PROG} {VERSION}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for command in SUBCOMMANDS:
         command.add_parser(commands)

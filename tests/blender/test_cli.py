@@ -18,11 +18,11 @@ import pytest
 from devkit import synthetic
 from devkit.cli_runs import assert_one_line_error, python_m, run
 from ellimann_addon import cli
-from ellimann_addon.blender.services.files import EXTRAS_KEY, read_glb_json
 from ellimann_addon.cli import drape as drape_cli
 from ellimann_addon.cli import writing
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.drape.settings import DrapeSettings
+from ellimann_addon.core.formats.glb import EXTRAS_KEY, read_glb_json
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
 from ellimann_addon.core.synthesis.synthesize import relative_error
@@ -442,7 +442,7 @@ def test_batch_writes_mjcf_and_glb_with_extras(tmp_path, capsys, references):
     out = tmp_path / "out"
     code, _, err = run(["batch", source, "-o", str(out), "--format", "mjcf,glb", "--references", references], capsys)
     assert code == 0, err
-    assert sorted(p.name for p in out.iterdir()) == ["average.glb", "average.xml", "report.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["average.glb", "average.xml", "made_from", "report.csv"]
     assert read_report(out / "report.csv")[0]["files"].split() == [str(out / "average.xml"), str(out / "average.glb")]
     assert "<mujoco" in (out / "average.xml").read_text()
     doc = read_glb_json(out / "average.glb")
@@ -662,7 +662,7 @@ def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_
         f"{out / 'report.csv'}; run it again with --resume to finish"
     )
     assert [(r["line"], r["status"]) for r in read_report(out / "report.csv")] == [("2", "ok"), ("5", "error")]
-    assert sorted(p.name for p in out.iterdir()) == ["average.json", "report.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["average.json", "made_from", "report.csv"]
     first = (out / "average.json").stat()
     monkeypatch.setattr(writing, "write", real)
     code, stdout, err = run(["batch", source, "-o", str(out), "--resume", "--references", references], capsys)
@@ -709,7 +709,7 @@ def test_a_killed_batch_leaves_a_partial_report_and_resume_cleans_up_and_finishe
     assert "5 of 5 mannequins written" in again.stdout and "(1 already complete, kept)" in again.stdout
     assert (out / "m0.json").stat().st_ino == kept
     assert Mannequin.load(out / "m1.json").measurements["He"] == 151.0  # written again, whole
-    assert sorted(p.name for p in out.iterdir()) == [f"m{i}.json" for i in range(5)] + ["report.csv"]
+    assert sorted(p.name for p in out.iterdir()) == [f"m{i}.json" for i in range(5)] + ["made_from", "report.csv"]
     assert [r["status"] for r in read_report(out / "report.csv")] == ["ok"] * 5
 
 
