@@ -474,6 +474,11 @@ def test_demo_writes_files_report_and_lineup(tmp_path, capsys, references):
     assert "| 10 | 165.25 | 47.25 | 135.75 | 122.25 | 117.5 |" in markdown and "max, paper IDW" in markdown
     assert (out / "lineup.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "10 mannequins" in stdout
+    assert "the body's right blue, its left pink, the central pieces grey" in markdown  # the picture's colours said
+    from ellimann_addon.blender.bridge.convert import SIDE_COLORS
+
+    (r, _, b, _), (r2, _, b2, _) = SIDE_COLORS["R"], SIDE_COLORS["L"]
+    assert b > r and r2 > b2 and abs(SIDE_COLORS["C"][0] - SIDE_COLORS["C"][2]) < 0.1  # and they are those colours
 
 
 # ------------------------------------------------------------------------------------------------ Blender's chatter
