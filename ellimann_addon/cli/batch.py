@@ -47,7 +47,8 @@ def add_parser(commands):
         "crotch_height, arm_length: the keys measure --json prints; an empty "
         "cell leaves it to the reference set). Writes the files and "
         "DIR/report.csv (requested vs measured), row by row into "
-        "DIR/report.partial.csv while it runs. Bad or failed rows are "
+        "DIR/report.partial.csv while it runs. A column it does not read is "
+        "named before any row is made (a misspelt one is refused). Bad or failed rows are "
         "reported and skipped; the exit code is 1 if any row failed, 3 if "
         "exact mode missed a row's request, 130 if interrupted.",
     )
@@ -74,8 +75,10 @@ def add_parser(commands):
     batch.add_argument(
         "--resume",
         action="store_true",
-        help="skip rows whose files (every --format) are already in DIR and whole, e.g. after an "
-        "interrupted run with the same CSV and options; without it every row is written again",
+        help="keep the rows whose files (every --format) are already in DIR, whole, and were made from the same "
+        "row and settings (DIR/made_from/NAME.json records what each row was made from), e.g. after an interrupted "
+        "run; a row whose request, reference set or options changed is made again and the report says why; without "
+        "it every row is written again",
     )
     arguments.add_synthesis_options(batch)
     arguments.add_pose_option(batch)

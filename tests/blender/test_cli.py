@@ -181,6 +181,8 @@ def test_synth_blender_formats_with_cushions(tmp_path, capsys, references):
     assert len(objects) == pairs + singles
     code, stdout, _ = run(["measure", str(tmp_path / "m.blend"), "--json"], capsys)
     assert code == 0 and five(json.loads(stdout)) == pytest.approx(VALUES, rel=1e-4)
+    code, stdout, _ = run(["measure", str(tmp_path / "m.glb"), "--json"], capsys)  # the .glb synth wrote: its extras
+    assert code == 0 and json.loads(stdout) == pytest.approx(VALUES, rel=1e-4)
     bpy.ops.wm.open_mainfile(filepath=str(tmp_path / "m.blend"))
     cushions = [o for o in bpy.data.objects if o.ellimann.kind == "CUSHION"]
     assert len(cushions) == pairs
@@ -305,7 +307,7 @@ def test_measure_refuses_what_it_cannot_read(tmp_path, capsys):
     assert_one_line_error(code, err, "not valid JSON")
     (tmp_path / "m.txt").write_text("x")
     code, _, err = run(["measure", str(tmp_path / "m.txt")], capsys)
-    assert_one_line_error(code, err, ".json or .blend")
+    assert_one_line_error(code, err, ".json, .blend or .glb")
     bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "empty.blend"))
     code, _, err = run(["measure", str(tmp_path / "empty.blend"), "--json"], capsys)
     assert_one_line_error(code, err, "no ElliMann mannequin")
@@ -410,11 +412,14 @@ def test_batch_shards_agree_on_duplicate_names_across_the_whole_csv(tmp_path, ca
     assert "line 3: skipped: name: 'same' is already used on line 2" in errors[2]
     assert Mannequin.load(out / "same.json").measurements["He"] == 150.0  # not overwritten by line 3
     assert sorted(p.name for p in out.iterdir()) == [
+        "made_from",
         "other.json",
         "report-1-of-2.csv",
         "report-2-of-2.csv",
         "same.json",
     ]
+    assert sorted(p.name for p in (out / "made_from").iterdir()) == ["other.json", "same.json"]
+    assert json.loads((out / "made_from" / "same.json").read_text())["request_cm"]["He"] == 150.0
     statuses = {}
     for shard in (1, 2):
         statuses.update({r["line"]: r["status"] for r in read_report(out / f"report-{shard}-of-2.csv")})
