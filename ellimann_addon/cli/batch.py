@@ -165,11 +165,11 @@ def _run(args, formats, shard, shards, table, reference_of, options, cluster, po
     mine = len(range(shard - 1, table.count, shards))
     progress = output.Progress(mine, "batch", quiet=args.quiet)
     # one batch file per reference set: mannequins.npz, or mannequins-NAME.npz when the rows name several
-    bundles = Bundles(args.output, suffix, args.mode, len(table.references) > 1) if NPZ in formats else None
+    made = Provenance(args.output, args)  # what each row's files are made from (--resume compares it)
+    bundles = Bundles(args.output, suffix, args.mode, len(table.references) > 1, made) if NPZ in formats else None
     rows = (row for index, row in enumerate(table.rows(reference_of, NAME_PATTERN)) if index % shards == shard - 1)
     reading, window = chunks(rows), collections.deque()  # chunks read and sent, in the CSV's order
     announced = Announcer(report.path)
-    made = Provenance(args.output, args)  # what each row's files are made from (--resume compares it)
     try:
         while True:
             while len(window) < (cluster.window if cluster is not None else 1):
@@ -392,8 +392,8 @@ class Bundles:
     """``--format npz``: one streamed batch file per reference set (``BatchFileWriter``), fed a chunk at a time
     with the rows whose files were written, in the CSV's order."""
 
-    def __init__(self, folder, suffix, mode, tagged):
-        self.folder, self.suffix, self.mode, self.tagged = folder, suffix, mode, tagged
+    def __init__(self, folder, suffix, mode, tagged, made=None):
+        self.folder, self.suffix, self.mode, self.tagged, self.made = folder, suffix, mode, tagged, made
         self.writers, self.marked = {}, []
 
     def path_of(self, reference):
@@ -434,7 +434,10 @@ class Bundles:
         if id(reference) not in self.writers:
             path = self.path_of(reference)
             with writing.writing(path):
-                self.writers[id(reference)] = BatchFileWriter(path, reference.topology, self.mode, JOINT_NAMES)
+                made_from = self.made.bundle_record(reference) if self.made is not None else None
+                self.writers[id(reference)] = BatchFileWriter(
+                    path, reference.topology, self.mode, JOINT_NAMES, made_from=made_from
+                )
         return self.writers[id(reference)]
 
     def finish(self):

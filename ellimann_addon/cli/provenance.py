@@ -12,7 +12,7 @@ written once they all are, so a run killed in between leaves no record, and the 
 
 One small file per row: every shard (``--shard``) writes its own rows' records, and a record is read only when its
 row comes, so a batch's memory stays flat. The batch file (``--format npz``) is not a row's file: it is written again
-on every run, whole, from the rows as they are now.
+on every run, whole, from the rows as they are now; its ``made_from_json`` says what (:meth:`Provenance.bundle_record`).
 """
 
 import hashlib
@@ -27,6 +27,7 @@ from ..core.synthesis.manifest import MANIFEST_FILE
 
 RECORD_FOLDER = "made_from"
 RECORD_FORMAT = "ellimann.batch-row"
+BUNDLE_FORMAT = "ellimann.batch-file"  # the batch file's made_from_json (docs/formats/batch_npz.md)
 RECORD_VERSION = 1
 NOT_COMPARED = ("ellimann",)  # recorded for the reader, not a reason to make a row again
 SAID = 20  # rows made again said on stderr, before the rest go to the report only
@@ -107,6 +108,17 @@ class Provenance:
             key for key in new if key not in ("request_cm", "references", *NOT_COMPARED) and new[key] != old.get(key)
         ]
         return f"{', '.join(reasons)} changed" if reasons else None
+
+    def bundle_record(self, reference):
+        """What a batch file (``--format npz``, one per reference set) is made from: the reference set and the
+        settings every row shares (each row's request is in the file's ``requests_cm``)."""
+        return {
+            "format": BUNDLE_FORMAT,
+            "version": RECORD_VERSION,
+            "references": {key: value for key, value in self._identity(reference).items() if key != "folder"},
+            **self.settings,
+            "ellimann": VERSION,
+        }  # no folder: the same mannequins from the same set give the same bytes wherever the set lies
 
     def forget(self, name):
         """Remove ``name``'s record (before its files are written again)."""

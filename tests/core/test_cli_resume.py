@@ -143,3 +143,17 @@ def test_an_extra_measurement_asked_is_part_of_the_row(tmp_path, capsys):
     source.write_text("name,He,Sh,Br,Wa,Hi,neck\nx1,165,41.5,101.25,82.75,117.5,30\n", encoding="utf-8")
     batch(str(source), out, capsys, "--mode", "idw", "--resume")
     assert "redone (--resume: neck changed)" in report(out)[0]["message"]
+
+
+def test_the_batch_file_says_what_it_was_made_from(tmp_path, capsys):
+    from ellimann_addon.core.formats.npz_bundle import read_batch_file
+
+    out = tmp_path / "out"
+    batch(write_csv(tmp_path / "a.csv", TABLE_ROW), out, capsys, "--format", "npz,json", "--mode", "idw")
+    made = json.loads(str(read_batch_file(out / "mannequins.npz")["made_from_json"]))
+    row = json.loads((out / RECORD_FOLDER / "x1.json").read_text())
+    assert made["format"] == "ellimann.batch-file" and made["mode"] == "idw"
+    assert made["references"] == {key: row["references"][key] for key in ("name", "sha256")}  # no folder
+    assert {key: made[key] for key in ("metric", "power", "normalize", "cushions", "skin", "pose")} == {
+        key: row[key] for key in ("metric", "power", "normalize", "cushions", "skin", "pose")
+    }
