@@ -55,7 +55,11 @@ def measured_batch(tree, csv_path, out, mode):
     return float(seconds), int(kilobytes) * 1024, int(code)  # Linux gives ru_maxrss in KiB
 
 
-def run(rows=(2_000, 20_000), mode="exact", old=None, old_rows=None, keep=None):
+def run(rows=(2_000, 20_000), mode="exact", old=None, old_rows=None, keep=None, quick=False):
+    """``quick``: 20 and 50 rows, this tree only (checks that it runs); returns the exit codes."""
+    if quick:
+        rows, old = (20, 50), None
+    codes = []
     folder = pathlib.Path(keep or tempfile.mkdtemp(prefix="ellimann-bench-batch-"))
     folder.mkdir(parents=True, exist_ok=True)
     largest = max([*rows, *(old_rows or ())])
@@ -74,6 +78,7 @@ def run(rows=(2_000, 20_000), mode="exact", old=None, old_rows=None, keep=None):
                     with source.open() as lines, csv_path.open("w") as prefix:
                         prefix.writelines(itertools.islice(lines, count + 1))
                 seconds, peak, code = measured_batch(tree, csv_path, folder / "out", mode)
+                codes.append(code)
                 first = first or peak
                 print(
                     f"{label:<10} {count:>9,} {seconds:>8.1f} {1e3 * seconds / count:>7.3f} {peak / 1e9:>8.3f} "
@@ -84,6 +89,7 @@ def run(rows=(2_000, 20_000), mode="exact", old=None, old_rows=None, keep=None):
         if keep is None:
             shutil.rmtree(folder, ignore_errors=True)
     print(f"load after: {_load()}")
+    return codes
 
 
 def _load():

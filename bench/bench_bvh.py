@@ -23,19 +23,21 @@ def seconds(fn):
     return time.perf_counter() - start, result
 
 
-def run():
+def run(quick=False):
+    """``quick``: a 60-frame clip (checks that it runs)."""
+    frames = 60 if quick else FRAMES
     average = Mannequin.load(REFERENCE_FOLDER / "average.json")
     folder = Path(tempfile.mkdtemp(prefix="ellimann-bench-bvh-"))
-    clip = clips.convention_clip("mixamo", average.joints, frames=FRAMES)
+    clip = clips.convention_clip("mixamo", average.joints, frames=frames)
     path = bvh.write_bvh(folder / "clip.bvh", clip)
     reading, read = seconds(lambda: read_bvh(path))
     retargeting, onto = seconds(lambda: clip_onto(average, read.motion, read.match, name=read.name))
     to_json, _ = seconds(lambda: write_posed(average, onto.poses, folder / "clip.json"))
     to_mjcf, _ = seconds(lambda: write_posed(average, onto.poses, folder / "clip.xml"))
     core = reading + retargeting
-    print(f"{FRAMES} frames, {len(read.motion.names)} bones:")
+    print(f"{frames} frames, {len(read.motion.names)} bones:")
     print(f"  read and matched (numpy)         {reading:6.2f} s")
-    print(f"  retargeted and clamped (numpy)   {retargeting:6.2f} s ({1e3 * retargeting / FRAMES:.2f} ms a frame)")
+    print(f"  retargeted and clamped (numpy)   {retargeting:6.2f} s ({1e3 * retargeting / frames:.2f} ms a frame)")
     print(f"  written: .json {to_json:.2f} s, MJCF keyframes {to_mjcf:.2f} s")
     blender = _blender(path, average)
     if blender is not None:

@@ -62,7 +62,11 @@ SKINS = ("preview", "final")  # the skin as the collider, at these levels (core.
 SKIN_SAMPLE = 4  # the skin's vertices measured against the dense body: every 4th (25,800 at preview take ~20 s)
 
 
-def run(frames=FRAMES, repeat=REPEAT, sweep=SWEEP, kinds=("tube_dress", "t_shirt"), skins=SKINS):
+def run(frames=FRAMES, repeat=REPEAT, sweep=SWEEP, kinds=("tube_dress", "t_shirt"), skins=SKINS, quick=False):
+    """``quick``: the tube dress, 2 frames, once, on one cushion collider and the dense body, no skin (checks that it
+    runs)."""
+    if quick:
+        frames, repeat, sweep, kinds, skins = 2, 1, SWEEP[:1], ("tube_dress",), ()
     source = REFERENCE_FOLDER / f"{BODY}.json"
     body_path = REFMODELS / f"{BODY}.obj"
     if not source.is_file() or not body_path.is_file():

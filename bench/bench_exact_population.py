@@ -29,6 +29,7 @@ SEED = 0
 CHUNK = 20_000
 BEFORE_ROWS = 200_000
 SHOWN = 8  # misses listed
+QUICK_ROWS = 500
 ISSUE_REQUESTS = ((167.1, 48.06, 98.98, 81.81, 103.24), (167.1, 49.0, 98.98, 81.81, 103.24))
 REPO = pathlib.Path(__file__).resolve().parents[1]
 
@@ -109,8 +110,12 @@ def before(commit, rows, count):
     return json.loads(lines[-1]) if lines else None
 
 
-def run(rows=ROWS, commit=None, before_rows=BEFORE_ROWS):
+def run(rows=ROWS, commit=None, before_rows=BEFORE_ROWS, quick=False):
+    """``quick``: QUICK_ROWS rows, no older commit (checks that it runs)."""
     from ellimann_addon.core.synthesis.shipped import named_reference_set
+
+    if quick:
+        rows, commit = QUICK_ROWS, None
     from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 
     issue = synthesize_batch(named_reference_set("female"), np.array(ISSUE_REQUESTS))
@@ -126,6 +131,8 @@ def run(rows=ROWS, commit=None, before_rows=BEFORE_ROWS):
 
     now = synthesize_all(requests, progress=progress)
     show("now", now)
+    if quick:
+        return now
     if commit:
         count = min(len(requests), before_rows)
         old = before(commit, rows, count)

@@ -77,17 +77,20 @@ def measured_as_before():
         refine_extra.mannequin_extra_measurements, refine_extra.MannequinLandmarks = saved
 
 
-def run():
+def run(quick=False):
+    """``quick``: one RM and one synthesized mannequin per set, one meet_extra, one body, 3 population rows, each
+    once (checks that it runs)."""
+    repeat, meets = (1, 1) if quick else (3, MEET_PER_SET)
     print(f"{'mannequin':<28} {'before ms':>9} {'now ms':>7} {'ratio':>6} {'max |diff| cm':>13}")
     ratios, worst, sets = [], {}, {}
     for set_name in (FEMALE_SET, MALE_SET):
         reference = named_reference_set(set_name)
-        grid = synthesized(reference)
+        grid = synthesized(reference, 243 if quick else GRID_STEP)
         sets[set_name] = grid
-        for label, mannequins in (("RM", reference.mannequins), ("synthesized", grid)):
+        for label, mannequins in (("RM", reference.mannequins[: 1 if quick else None]), ("synthesized", grid)):
             for mannequin in mannequins:
-                before, old = best_time(lambda m=mannequin: mannequin_extra_measurements_before(m))
-                now, new = best_time(lambda m=mannequin: mannequin_extra_measurements(m))
+                before, old = best_time(lambda m=mannequin: mannequin_extra_measurements_before(m), repeat)
+                now, new = best_time(lambda m=mannequin: mannequin_extra_measurements(m), repeat)
                 difference = max(abs(new[key] - old[key]) for key in EXTRA_MEASUREMENTS)
                 worst[(set_name, label)] = max(worst.get((set_name, label), 0.0), difference)
                 ratios.append(before / now)
@@ -104,7 +107,7 @@ def run():
     print(f"{'mannequin':<28} {'before s':>8} {'now s':>6} {'ratio':>6} {'max |diff| cm':>13}  misses now")
     totals = [0.0, 0.0]
     for set_name, grid in sets.items():
-        for mannequin in grid[:MEET_PER_SET]:
+        for mannequin in grid[:meets]:
             start = mannequin_extra_measurements(mannequin)
             extra = {key: start[key] * change for key, change in zip(EXTRA_MEASUREMENTS, EXTRA_CHANGE)}
             with measured_as_before():
@@ -118,12 +121,12 @@ def run():
                 f"{difference:13.1e}  {misses or 'none'}"
             )
     print(
-        f"meet_extra: {totals[0] / totals[1]:.1f}x faster over {2 * MEET_PER_SET} mannequins "
-        f"({totals[0] / (2 * MEET_PER_SET):.2f} s -> {totals[1] / (2 * MEET_PER_SET):.2f} s per mannequin)"
+        f"meet_extra: {totals[0] / totals[1]:.1f}x faster over {2 * meets} mannequins "
+        f"({totals[0] / (2 * meets):.2f} s -> {totals[1] / (2 * meets):.2f} s per mannequin)"
     )
 
-    bodies()
-    population()
+    bodies(BODIES[:1] if quick else BODIES, repeat=1 if quick else 2)
+    population(3 if quick else 12)
 
 
 def population(rows=12):
@@ -160,22 +163,22 @@ def population(rows=12):
     )
 
 
-def bodies():
+def bodies(names=BODIES, repeat=2):
     print(
         f"\nmeasure_body_mesh:\n{'body':<17} {'triangles':>9} {'before s':>8} {'now s':>6} {'ratio':>6} "
         f"{'max |diff| cm':>13}"
     )
     totals = [0.0, 0.0]
-    for name in BODIES:
+    for name in names:
         mesh = read_obj(TRACING_FOLDER / f"{name}.obj", up="z")
         with every_triangle_cut():
-            before, old = best_time(lambda m=mesh: body_measure.measure_body_mesh(m.vertices, m.faces), repeat=2)
-        now, new = best_time(lambda m=mesh: body_measure.measure_body_mesh(m.vertices, m.faces), repeat=2)
+            before, old = best_time(lambda m=mesh: body_measure.measure_body_mesh(m.vertices, m.faces), repeat=repeat)
+        now, new = best_time(lambda m=mesh: body_measure.measure_body_mesh(m.vertices, m.faces), repeat=repeat)
         totals[0] += before
         totals[1] += now
         difference = max(abs(new.values[key] - old.values[key]) for key in old.values)
         print(f"{name:<17} {len(mesh.faces):9d} {before:8.2f} {now:6.2f} {before / now:6.1f} {difference:13.1e}")
-    print(f"measure_body_mesh: {totals[0] / totals[1]:.1f}x faster over the six bodies")
+    print(f"measure_body_mesh: {totals[0] / totals[1]:.1f}x faster over {len(names)} bodies")
 
 
 if __name__ == "__main__":

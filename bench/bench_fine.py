@@ -46,12 +46,13 @@ def average(reference):
     return reference.mannequins[reference.names.index("average")]
 
 
-def costs(reference):
-    """{cost: seconds} of one set (see the module's docstring)."""
+def costs(reference, quick=False):
+    """{cost: seconds} of one set (see the module's docstring); ``quick``: 9 requests, each timed once."""
     mannequin = average(reference)
     girth = mannequin.topology.girth_mask
     args = (mannequin.rotation, mannequin.center, mannequin.semi_axes, girth, reference.section_fractions)
-    requests = grid(reference)
+    requests = grid(reference)[:: 27 if quick else 1]
+    repeat, count = (1, 1) if quick else (5, 30)
     pairs = mannequin.topology.cushion_pairs
 
     def live_step():
@@ -61,14 +62,16 @@ def costs(reference):
     rig = PosingRig(mannequin, subdivisions=CUSHION_LEVEL)
     sitting = standard_pose("sit", mannequin.joints)
     return {
-        "m_T (one mannequin)": best_of(lambda: tailor_measurements(*args), repeat=5, number=20),
-        "exact mode (243 requests)": best_of(lambda: synthesize_batch(reference, requests, mode="exact"), repeat=2),
-        "live step": median_ms(live_step)[0] * 1e-3,
-        "posing (sit, cushions level 4)": median_ms(lambda: rig.pose(sitting))[0] * 1e-3,
+        "m_T (one mannequin)": best_of(lambda: tailor_measurements(*args), repeat=repeat, number=1 if quick else 20),
+        f"exact mode ({len(requests)} requests)": best_of(
+            lambda: synthesize_batch(reference, requests, mode="exact"), repeat=1 if quick else 2
+        ),
+        "live step": median_ms(live_step, count)[0] * 1e-3,
+        "posing (sit, cushions level 4)": median_ms(lambda: rig.pose(sitting), count)[0] * 1e-3,
     }
 
 
-def drape_seconds(mannequins, repeat=2):
+def drape_seconds(mannequins, repeat=2, frames=DRAPE_FRAMES):
     """Seconds per simulated frame of the tube dress on each mannequin (best of ``repeat``, interleaved), or None
     without the bpy module."""
     try:
@@ -87,20 +90,23 @@ def drape_seconds(mannequins, repeat=2):
             for k, mannequin in enumerate(mannequins):
                 with blender_output():
                     empty_scene()
-                    result = drape.drape(mannequin, "tube_dress", drape.DrapeSettings(frames=DRAPE_FRAMES))
+                    result = drape.drape(mannequin, "tube_dress", drape.DrapeSettings(frames=frames))
                 best[k] = min(best[k], result.seconds_per_frame)
         return best
     finally:
         ellimann_addon.unregister()
 
 
-def exactness(reference):
-    """(converged share, largest relative error %) of exact mode on the set's 243 grid."""
-    result = synthesize_batch(reference, grid(reference), mode="exact")
+def exactness(reference, step=1):
+    """(converged share, largest relative error %) of exact mode on the set's 243 grid (every ``step``-th request)."""
+    result = synthesize_batch(reference, grid(reference)[::step], mode="exact")
     return float(result.converged.mean()), float(result.relative_error().max())
 
 
-def run():
+def run(quick=False):
+    """``quick``: one round of a few requests, a 2-frame drape, exact mode on every 27th request (checks that it
+    runs)."""
+    rounds, frames = (1, 2) if quick else (ROUNDS, DRAPE_FRAMES)
     coarse, fine = (named_reference_set(name) for name in PAIRS[0])
     print(
         f"costs on the Average RM: {coarse.name} ({len(coarse.topology)} parts, "
@@ -109,14 +115,14 @@ def run():
     )
     started = time.perf_counter()
     first, second = {}, {}
-    for _ in range(ROUNDS):  # the two sets in turn, the best of each: load drifts
+    for _ in range(rounds):  # the two sets in turn, the best of each: load drifts
         for best, reference in ((first, coarse), (second, fine)):
-            for key, seconds in costs(reference).items():
+            for key, seconds in costs(reference, quick).items():
                 best[key] = min(best.get(key, np.inf), seconds)
-    drape = drape_seconds([average(coarse), average(fine)])
+    drape = drape_seconds([average(coarse), average(fine)], 1 if quick else 2, frames)
     if drape is not None:
-        first[f"drape (tube dress, s/frame over {DRAPE_FRAMES} frames)"] = drape[0]
-        second[f"drape (tube dress, s/frame over {DRAPE_FRAMES} frames)"] = drape[1]
+        first[f"drape (tube dress, s/frame over {frames} frames)"] = drape[0]
+        second[f"drape (tube dress, s/frame over {frames} frames)"] = drape[1]
     print(f"| cost | {coarse.name} | {fine.name} | ratio |")
     print("|---|---|---|---|")
     for key in first:
@@ -127,7 +133,7 @@ def run():
     print(f"exact mode on the 243 grid (target: every request within {100 * EXACT_TOLERANCE:g} %):")
     for names in PAIRS:
         for name in names:
-            converged, worst = exactness(named_reference_set(name))
+            converged, worst = exactness(named_reference_set(name), 27 if quick else 1)
             print(f"  {name:12s} converged {converged:.1%}, largest relative error {worst:.5f} %")
 
 

@@ -35,11 +35,12 @@ LABELS = {
 }
 
 
-def run_tree(tree):
-    """The cases' ms of one run of ``tree`` (live_step.py in a fresh process), or None if it failed."""
+def run_tree(tree, quick=False):
+    """The cases' ms of one run of ``tree`` (live_step.py in a fresh process; ``quick``: three steps), or None if it
+    failed."""
     env = dict(os.environ, PYTHONPATH=str(tree))
     done = subprocess.run(
-        [sys.executable, str(REPO / "bench" / "live_step.py")],
+        [sys.executable, str(REPO / "bench" / "live_step.py"), *(["--quick"] if quick else [])],
         cwd=str(tree),
         env=env,
         capture_output=True,
@@ -61,7 +62,10 @@ def worktree(commit, folder):
     return folder if done.returncode == 0 else None
 
 
-def run(commits=BASELINES, rounds=ROUNDS):
+def run(commits=BASELINES, rounds=ROUNDS, quick=False):
+    """``quick``: this tree only, one round of three steps (checks that it runs)."""
+    if quick:
+        commits, rounds = (), 1
     with tempfile.TemporaryDirectory(prefix="ellimann-bench-live-") as scratch:
         trees = {}
         for commit in commits:
@@ -76,7 +80,7 @@ def run(commits=BASELINES, rounds=ROUNDS):
             rigged = {}
             for _ in range(rounds):
                 for name, tree in trees.items():
-                    result = run_tree(tree)
+                    result = run_tree(tree, quick)
                     for case in CASES if result else ():
                         figures[name][case] += result.get(case) or []
                     rigged[name] = bool(result and result.get("rig"))
@@ -85,12 +89,13 @@ def run(commits=BASELINES, rounds=ROUNDS):
                 if name != "now":
                     subprocess.run(["git", "-C", str(REPO), "worktree", "remove", "--force", str(tree)], check=False)
     report(figures, rigged, rounds)
+    return figures
 
 
 def report(figures, rigged, rounds):
     names = list(figures)
     print(
-        f"Live step, 15 He steps x {rounds} rounds per tree; armature built: "
+        f"Live step, He steps x {rounds} rounds per tree; armature built: "
         + ", ".join(f"{name} {'yes' if rigged.get(name) else 'no'}" for name in names)
     )
     for column, title in ((0, "wall"), (1, "CPU (this process)")):

@@ -26,20 +26,21 @@ def timed(function):
     return (time.perf_counter() - wall) * 1e3, (time.process_time() - cpu) * 1e3
 
 
-def steps(bpy, props, skin):
-    """[wall, CPU] ms of each slider step of one run (Skin on or off)."""
+def steps(bpy, props, skin, values=STEPS):
+    """[wall, CPU] ms of each slider step of one run (Skin on or off) over He ``values``."""
     props.live, props.skin = False, skin
     props.mode, props.output, props.skin_level = "EXACT", "CUSHIONS", "PREVIEW"
     for key, value in AVERAGE.items():
         setattr(props, key, value)
     bpy.ops.ellimann.synthesize_mannequin()
     props.live = True
-    times = [timed(lambda value=value: setattr(props, "he", float(value))) for value in STEPS]
+    times = [timed(lambda value=value: setattr(props, "he", float(value))) for value in values]
     props.live = False
     return times
 
 
-def run(rounds=ROUNDS):
+def run(rounds=ROUNDS, quick=False):
+    """``quick``: one round of three steps (checks that it runs)."""
     import bpy
 
     import ellimann_addon
@@ -65,10 +66,11 @@ def run(rounds=ROUNDS):
         props = bpy.context.scene.ellimann_synthesis
         props.reference_set = "FEMALE"
         runs = {False: [], True: []}
+        rounds, values = (1, STEPS[::7]) if quick else (rounds, STEPS)
         settle = []
         for _ in range(rounds):
             for skin in (False, True):
-                runs[skin] += steps(bpy, props, skin)
+                runs[skin] += steps(bpy, props, skin, values)
                 if bpy.app.timers.is_registered(skin_live._settle_timer):
                     bpy.app.timers.unregister(skin_live._settle_timer)
                 if bpy.app.timers.is_registered(live._settle_timer):
@@ -83,11 +85,13 @@ def run(rounds=ROUNDS):
         live.remove_follower(measured)
         live.add_follower(original)
         ellimann_addon.unregister()
-    report(runs, follower_times, settle, rounds, LIVE_STEP_BUDGET)
+    report(runs, follower_times, settle, rounds, LIVE_STEP_BUDGET, len(values))
 
 
-def report(runs, follower_times, settle, rounds, budget):
-    print(f"Live step with cushions and the armature, 15 He steps x {rounds} rounds, runs alternating")
+def report(runs, follower_times, settle, rounds, budget, count=None):
+    print(
+        f"Live step with cushions and the armature, {count or len(STEPS)} He steps x {rounds} rounds, runs alternating"
+    )
     for column, title in ((0, "wall"), (1, "CPU (this process)")):
         without = statistics.median(pair[column] for pair in runs[False])
         with_skin = statistics.median(pair[column] for pair in runs[True])

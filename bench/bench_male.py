@@ -28,9 +28,10 @@ def male_grid(reference):
     return np.array(list(itertools.product(*[quartile_points(key, reference.ranges) for key in MEASUREMENTS])))
 
 
-def run():
+def run(quick=False):
+    """``quick``: every 27th request of the grid (9), one repetition (checks that it runs)."""
     reference = named_reference_set(MALE_SET)
-    requests = male_grid(reference)
+    requests = male_grid(reference)[:: 27 if quick else 1]
     print(
         f"reference set: {reference.name} ({len(reference)} RMs), section heights "
         + ", ".join(f"{k} {v:g}" for k, v in reference.section_fractions.items())
@@ -57,4 +58,4 @@ def run():
                 f"{synthesis.EXACT_TOLERANCE * 100:g}% (largest error {result.relative_error().max():.1e}%); "
                 f"largest |factor - 1|: {spread.max():.2f}%"
             )
-    population_scale(reference, requests)
+    population_scale(reference, requests, repeat=1 if quick else 5)

@@ -26,7 +26,9 @@ def median_ms(fn, count=30):
     return float(np.median(times)) * 1e3, float(np.max(times)) * 1e3
 
 
-def run():
+def run(quick=False):
+    """``quick``: a few calls of each (checks that it runs)."""
+    count, cycles = (2, 1) if quick else (30, 5)
     reference = load_reference_set()
     mannequin = synthesize_batch(reference, [REQUEST]).mannequin(0)
     pairs = mannequin.topology.cushion_pairs
@@ -35,7 +37,7 @@ def run():
         result = synthesize_batch(reference, [REQUEST])
         cushion_vertices(result.rotation[0], result.center[0], result.semi_axes[0], pairs, LIVE_CUSHION_LEVEL)
 
-    live, live_max = median_ms(live_step)
+    live, live_max = median_ms(live_step, count)
     print(
         f"live synthesis step (exact mode + {len(pairs)} cushions' vertices at level {LIVE_CUSHION_LEVEL}): "
         f"{live:7.2f} ms median, {live_max:.2f} max"
@@ -47,8 +49,8 @@ def run():
         rig = PosingRig(mannequin, subdivisions=level)
         built = (time.perf_counter() - start) * 1e3
         vertices = sum(len(m.vertices) for m in rig.meshes)
-        posing, posing_max = median_ms(lambda r=rig: r.pose(sitting))
-        cycle, _ = median_ms(lambda r=rig: [r.pose(f) for f in frames], count=5)
+        posing, posing_max = median_ms(lambda r=rig: r.pose(sitting), count)
+        cycle, _ = median_ms(lambda r=rig: [r.pose(f) for f in frames], count=cycles)
         verdict = "under" if posing < TARGET_MS else "OVER"
         print(
             f"pose {len(mannequin)} pieces + {len(rig.meshes)} cushion meshes (level {level}, {vertices:,} vertices): "

@@ -42,8 +42,10 @@ class Stopwatch:
         return original
 
 
-def run():
-    names = list(REFERENCE_MEASUREMENTS)
+def run(quick=False):
+    """``quick``: three bodies (a set's fewest), one process only (checks that it runs)."""
+    names = list(REFERENCE_MEASUREMENTS)[: 3 if quick else None]
+    targets = {name: REFERENCE_MEASUREMENTS[name] for name in names}
     paths = [REFMODELS / f"{name}.obj" for name in names]
     if not all(p.is_file() for p in paths):
         print(f"skipped: the bodies of {REFMODELS} are not there")
@@ -64,28 +66,31 @@ def run():
         )
     ]
     started = time.perf_counter()
-    serial, report = reference_build.build_reference_set(base, bodies, REFERENCE_MEASUREMENTS, workers=1)
+    built = reference_build.build_reference_set(base, bodies, targets, workers=1)
+    serial, report = built.mannequins, built.report
     one = time.perf_counter() - started
     for module, name, original in originals:
         setattr(module, name, original)
 
     fit = watch.seconds["fit bodies"]
     rows = [
-        ("read 5 OBJ files", read),
-        ("fit 5 bodies (core.fitting.mannequin_fit)", fit),
+        (f"read {len(bodies)} OBJ files", read),
+        (f"fit {len(bodies)} bodies (core.fitting.mannequin_fit)", fit),
         ("  of which: inscribe each part (core.fitting.inscribed pattern search)", watch.seconds["inscribe parts"]),
         ("  of which: the rest (volume grid, normals, part covers)", fit - watch.seconds["inscribe parts"]),
         ("refine to targets (core.synthesis.refine)", watch.seconds["refine to targets"]),
         ("clean together", watch.seconds["clean together"]),
         ("check coverage (core.geometry.volume, 5 mm grid)", report.seconds.get("coverage check", 0.0)),
     ]
-    print(f"five-body build, one process: {one:.1f} s")
+    print(f"{len(bodies)}-body build, one process: {one:.1f} s")
     for label, seconds in rows:
         print(f"  {label:64s} {seconds:7.1f} s  {seconds / one:6.1%}")
+    if quick:
+        return serial
 
     workers = max(2, min(len(bodies), os.cpu_count() or 1))
     started = time.perf_counter()
-    parallel, _ = reference_build.build_reference_set(base, bodies, REFERENCE_MEASUREMENTS, workers=workers)
+    parallel = reference_build.build_reference_set(base, bodies, targets, workers=workers).mannequins
     many = time.perf_counter() - started
     diff = max(
         float(np.abs(getattr(serial[n], a) - getattr(parallel[n], a)).max())

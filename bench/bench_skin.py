@@ -34,7 +34,7 @@ from ellimann_addon.core.synthesis.shipped import named_reference_set
 figures = {}
 for level, voxel in %r.items():
     rows = []
-    for mannequin in named_reference_set(%r).mannequins:
+    for mannequin in named_reference_set(%r).mannequins[:%r]:
         start = time.process_time()
         skin = build_skin(mannequin, SkinSettings(voxel))
         rows.append((time.process_time() - start, len(skin.vertices)))
@@ -43,8 +43,8 @@ print(json.dumps(figures))
 """
 
 
-def run_tree(tree, set_name):
-    script = TREE_SCRIPT % (LEVELS, set_name)
+def run_tree(tree, set_name, levels=LEVELS, count=None):
+    script = TREE_SCRIPT % (levels, set_name, count)
     done = subprocess.run([sys.executable, "-c", script], cwd=tree, capture_output=True, text=True, check=False)
     lines = [line for line in done.stdout.splitlines() if line.startswith("{")]
     if not lines:
@@ -53,7 +53,7 @@ def run_tree(tree, set_name):
     return json.loads(lines[-1])
 
 
-def exact_seconds():
+def exact_seconds(levels=LEVELS):
     import time
 
     from ellimann_addon.core.constants import TABLE_2_5
@@ -64,33 +64,38 @@ def exact_seconds():
 
     mannequin, _, _ = synthesize(named_reference_set("female"), TABLE_2_5[0])
     rows = {}
-    for level, voxel in LEVELS.items():
+    for level, voxel in levels.items():
         start = time.process_time()
         result = exact_skin(mannequin, SkinSettings(voxel))
         rows[level] = (time.process_time() - start, result.rounds, result.converged)
     return rows
 
 
-def run(rounds=ROUNDS, before=BEFORE, set_name="female"):
-    figures = {"now": {level: [] for level in LEVELS}, before: {level: [] for level in LEVELS}}
+def run(rounds=ROUNDS, before=BEFORE, set_name="female", quick=False):
+    """``quick``: this tree only, one round, the preview level, one RM (checks that it runs)."""
+    levels, count = ({"preview": LEVELS["preview"]}, 1) if quick else (LEVELS, None)
+    rounds = 1 if quick else rounds
+    figures = {"now": {level: [] for level in levels}, before: {level: [] for level in levels}}
     with tempfile.TemporaryDirectory(prefix="ellimann-bench-skin-") as scratch:
         trees = {"now": REPO}
-        old = worktree(before, pathlib.Path(scratch) / before)
-        if old is None:
-            print(f"  {before}: cannot check it out here (skipped)")
-        else:
+        old = None if quick else worktree(before, pathlib.Path(scratch) / before)
+        if old is not None:
             trees[before] = old
+        elif not quick:
+            print(f"  {before}: cannot check it out here (skipped)")
         try:
             for _ in range(rounds):
                 for name, tree in trees.items():
-                    result = run_tree(tree, set_name) or {}
+                    result = run_tree(tree, set_name, levels, count) or {}
                     for level, rows in result.items():
                         figures[name][level] += rows
         finally:
             if old is not None:
                 subprocess.run(["git", "-C", str(REPO), "worktree", "remove", "--force", str(old)], check=False)
-    print(f"A skin of each of the five {set_name} RMs, {rounds} round(s) per tree: median CPU s (vertices)")
-    for level, voxel in LEVELS.items():
+    print(
+        f"A skin of each of {count or 'the five'} {set_name} RMs, {rounds} round(s) per tree: median CPU s (vertices)"
+    )
+    for level, voxel in levels.items():
         now = [seconds for seconds, _ in figures["now"][level]]
         then = [seconds for seconds, _ in figures[before][level]]
         vertices = statistics.median(count for _, count in figures["now"][level]) if now else 0
@@ -100,8 +105,9 @@ def run(rounds=ROUNDS, before=BEFORE, set_name="female"):
             line += f"   {before} {statistics.median(then):6.2f} s ({ratio:.2f}x now)"
         print(line)
     print("Exact mode on the skin, Table 2.5's first request (this tree): CPU s, rounds, met within 1 mm")
-    for level, (seconds, count, converged) in exact_seconds().items():
-        print(f"  {level:<8} {seconds:6.2f} s  {count} round(s)  {'met' if converged else 'NOT met'}")
+    for level, (seconds, rounds_made, converged) in exact_seconds(levels).items():
+        print(f"  {level:<8} {seconds:6.2f} s  {rounds_made} round(s)  {'met' if converged else 'NOT met'}")
+    return figures
 
 
 def main(argv=None):

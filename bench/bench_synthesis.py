@@ -161,9 +161,11 @@ def reference_version():
         return "unknown"
 
 
-def run():
+def run(quick=False):
+    """``quick``: every 27th request of the grid (9), one repetition, a few slider steps (checks that it runs)."""
     reference, label = shipped_or_synthetic()
-    requests = grid()
+    requests = grid()[::27] if quick else grid()
+    repeat = 1 if quick else 3
     girth = reference.topology.girth_mask
     n = len(reference.topology)
     version = f", reference_blends at {reference_version()}" if label.startswith("shipped") else ""
@@ -208,14 +210,14 @@ def run():
             f"{np.percentile(ratio, 99):.1f}%, max {ratio.max():.1f}%; centre shift 99th percentile "
             f"{np.percentile(shift, 99):.2f} cm, max {shift.max():.2f} cm"
         )
-    print("\nthroughput (core, one process, best of 3):")
+    print(f"\nthroughput (core, one process, best of {repeat}):")
     batch = len(requests)
-    t_idw = best_of(lambda: synthesis.interpolate(reference, requests), repeat=3)
-    t_paper = best_of(lambda: synthesis.interpolate(reference, requests, normalize="none"), repeat=3)
+    t_idw = best_of(lambda: synthesis.interpolate(reference, requests), repeat=repeat)
+    t_paper = best_of(lambda: synthesis.interpolate(reference, requests, normalize="none"), repeat=repeat)
     rotation, center, semi_axes = synthesis.interpolate(reference, requests)
-    t_mt = best_of(lambda: tailor_measurements(rotation, center, semi_axes, girth), repeat=3)
-    t_exact = best_of(lambda: synthesis.synthesize_batch(reference, requests, mode="exact"), repeat=3)
-    t_old = best_of(lambda: old_exact(reference, requests), repeat=3)
+    t_mt = best_of(lambda: tailor_measurements(rotation, center, semi_axes, girth), repeat=repeat)
+    t_exact = best_of(lambda: synthesis.synthesize_batch(reference, requests, mode="exact"), repeat=repeat)
+    t_old = best_of(lambda: old_exact(reference, requests), repeat=repeat)
     for name, seconds in (
         (f"paper IDW, batched {batch}", t_paper),
         (f"proportional IDW, batched {batch}", t_idw),
@@ -229,10 +231,10 @@ def run():
         f"  exact mode costs {t_exact / t_idw:.2f}x proportional IDW, m_T {t_mt / t_idw:.2f}x (wall time; the CPU "
         f"time ratios below are steadier)"
     )
-    population_scale(reference, requests)
-    exact_parts(reference, requests)
-    exact_parts(reference, requests[121:122], repeat=30)
-    one = requests[121:122]
+    population_scale(reference, requests, repeat=1 if quick else 5)
+    exact_parts(reference, requests, repeat=1 if quick else 5)
+    one = requests[len(requests) // 2 :][:1]  # the grid's middle request (121 of 243)
+    exact_parts(reference, one, repeat=1 if quick else 30)
     t_one = {}
     for name, fn in (
         ("idw, paper", lambda: synthesis.synthesize_batch(reference, one, mode="idw", normalize="none")),
@@ -240,7 +242,7 @@ def run():
         ("exact, before", lambda: old_exact(reference, one)),
         ("exact, now", lambda: synthesis.synthesize_batch(reference, one, mode="exact")),
     ):
-        t_one[name] = best_of(fn, repeat=5, number=5)
+        t_one[name] = best_of(fn, repeat=1 if quick else 5, number=1 if quick else 5)
         print(f"  one request, {name:<18} (with m_T) {t_one[name] * 1e3:8.2f} ms")
     print(f"  one request, exact: {t_one['exact, before'] / t_one['exact, now']:.1f}x faster than before")
     singles = []
@@ -253,7 +255,7 @@ def run():
         f"{np.median(singles) * 1e3:.2f} ms, max {np.max(singles) * 1e3:.2f} ms"
     )
 
-    blender(reference, exact)
+    blender(reference, exact, quick)
 
 
 def _searching_before(centre, k, active, warm=None, structure=False):
@@ -388,8 +390,10 @@ def exact_parts(reference, requests, repeat=5):
     print(f"  exact mode besides IDW and m_T: {best['  neither IDW nor m_T'] / best['  IDW']:.2f}x IDW")
 
 
-def blender(reference, exact):
-    """Building, measuring and moving collections, live updates and files in Blender (bpy module)."""
+def blender(reference, exact, quick=False):
+    """Building, measuring and moving collections, live updates and files in Blender (bpy module); ``quick``: a few
+    mannequins and slider steps, one repetition."""
+    repeat, steps = (1, 3) if quick else (3, 21)
     os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="ellimann-bench-"))
     import bpy
 
@@ -404,16 +408,16 @@ def blender(reference, exact):
     try:
         with blender_output():
             bpy.ops.wm.read_homefile(use_empty=True)
-        mannequins = [exact.mannequin(i) for i in range(40)]
+        mannequins = [exact.mannequin(i) for i in range(min(40, len(exact.measured)))]
         start = time.perf_counter()
         collections = [convert.mannequin_to_collection(m) for m in mannequins]
         t_build = (time.perf_counter() - start) / len(mannequins)
         print(f"\nBlender ({len(reference.topology)} ellipsoids per mannequin):")
         print(f"  build a mannequin collection       {1 / t_build:10,.0f} mannequins/s  ({t_build * 1e3:7.2f} ms)")
-        measure_in_blender(bpy, convert, collections)
-        target = collections[0]
-        t_update = (
-            best_of(lambda: [convert.update_collection_geometry(target, m) for m in mannequins[1:11]], repeat=3) / 10
+        measure_in_blender(bpy, convert, collections, repeat)
+        target, moved = collections[0], mannequins[1:11]
+        t_update = best_of(lambda: [convert.update_collection_geometry(target, m) for m in moved], repeat=repeat) / len(
+            moved
         )
         print(f"  move one in place (live update)     {t_update * 1e3:8.2f} ms")
 
@@ -431,7 +435,7 @@ def blender(reference, exact):
             with blender_output():
                 bpy.ops.ellimann.synthesize_mannequin()
                 props.live = True
-                for value in np.linspace(150.0, 170.0, 21):
+                for value in np.linspace(150.0, 170.0, steps):
                     start = time.perf_counter()
                     props.he = float(value)
                     times.append(time.perf_counter() - start)
@@ -440,40 +444,44 @@ def blender(reference, exact):
                 f"  live update from the panel (exact) {np.median(times):8.2f} ms median, {times.max():.2f} ms max "
                 f"over {len(times)} slider steps"
             )
-            live_with_cushions(bpy, props)
+            live_with_cushions(bpy, props, steps)
             for kind in ("json", "blend", "glb", "obj"):
                 path = os.path.join(folder, f"m.{kind}")
-                if kind == "json":  # the core writes it, without Blender
-                    t = best_of(lambda path=path: write_core_file(mannequins[0], path), repeat=3)
+                if kind in ("json", "obj"):  # the core writes them, without Blender
+                    t = best_of(lambda path=path: write_core_file(mannequins[0], path), repeat=repeat)
                 else:
-                    t = best_of(lambda path=path: files.write_mannequin(mannequins[0], [path]), repeat=3)
+                    t = best_of(lambda path=path: files.write_mannequin(mannequins[0], [path]), repeat=repeat)
                 print(f"  write .{kind:<5} (one mannequin)          {t * 1e3:8.2f} ms")
     finally:
         ellimann_addon.unregister()
 
 
-def measure_in_blender(bpy, convert, collections):
+def measure_in_blender(bpy, convert, collections, repeat=3):
     """m_T of mannequins in the scene: objects -> core arrays -> m_T, and the Measure operator."""
-    t_read = best_of(lambda: [convert.collection_to_mannequin(c) for c in collections], repeat=3) / len(collections)
+    t_read = best_of(lambda: [convert.collection_to_mannequin(c) for c in collections], repeat=repeat) / len(
+        collections
+    )
     read = [convert.collection_to_mannequin(c) for c in collections]
-    t_core = best_of(lambda: [m.measure() for m in read], repeat=3) / len(collections)
-    t_mt = best_of(lambda: [convert.collection_to_mannequin(c).measure() for c in collections], repeat=3) / len(
+    t_core = best_of(lambda: [m.measure() for m in read], repeat=repeat) / len(collections)
+    t_mt = best_of(lambda: [convert.collection_to_mannequin(c).measure() for c in collections], repeat=repeat) / len(
         collections
     )
     print(
         f"  measure (read objects + m_T)       {1 / t_mt:10,.0f} mannequins/s  ({t_mt * 1e3:7.2f} ms: reading "
-        f"{t_read * 1e3:.2f} ms, m_T {t_core * 1e3:.2f} ms, best of 3 each)"
+        f"{t_read * 1e3:.2f} ms, m_T {t_core * 1e3:.2f} ms, best of {repeat} each)"
     )
 
+    shown = collections[:10]
+
     def operator():
-        for collection in collections[:10]:
+        for collection in shown:
             bpy.context.view_layer.objects.active = collection.objects[0]
             bpy.ops.ellimann.measure_mannequin(source="ELLIPSOIDS")
 
     from ellimann_addon.blender.services.chatter import blender_output
 
     with blender_output():  # the operator reports m_T on stdout
-        t_op = best_of(operator, repeat=3) / 10
+        t_op = best_of(operator, repeat=repeat) / len(shown)
     print(f"  Measure operator (ellipsoids)      {1 / t_op:10,.0f} mannequins/s  ({t_op * 1e3:7.2f} ms)")
 
 
@@ -490,7 +498,7 @@ def old_live_update(props, target, output, convert):
         target.name = mannequin.name
 
 
-def live_with_cushions(bpy, props):
+def live_with_cushions(bpy, props, steps=21):
     """Live updates of a cushion mannequin: before (rebuild every cushion) and now (move them in place),
     interleaved over the same slider steps; then the exact rebuild once the slider stops."""
     from ellimann_addon.blender.bridge import convert
@@ -509,7 +517,7 @@ def live_with_cushions(bpy, props):
         bpy.ops.ellimann.synthesize_mannequin()
         props.live = True  # the second one is the live target
         pairs = len(built_objects(props.target, "CUSHION"))
-        for value in np.linspace(150.0, 170.0, 21):
+        for value in np.linspace(150.0, 170.0, steps):
             start = time.perf_counter()
             props.he = float(value)  # the panel's update callback
             now.append(time.perf_counter() - start)

@@ -38,7 +38,9 @@ FRAMES = 48  # 12 settling into the walk, then 36 walking (a stride and a half)
 EDGE = 0.025  # m
 
 
-def run(frames=FRAMES):
+def run(frames=FRAMES, quick=False):
+    """``quick``: 6 frames (checks that it runs)."""
+    frames = 6 if quick else frames
     source = REFERENCE_FOLDER / f"{BODY}.json"
     paths = [REFMODELS / f"{BODY}.obj", REFMODELS / "skeleton.json", REFMODELS / "reference_female_regions.json"]
     if not source.is_file() or not all(p.is_file() for p in paths):

@@ -15,7 +15,8 @@ import time
 
 import numpy as np
 
-STEPS = np.linspace(150.0, 170.0, 15)  # He, cm: 15 slider steps; the other four stay the Average RM's
+STEPS = np.linspace(150.0, 170.0, 3 if "--quick" in sys.argv else 15)  # He, cm: 15 slider steps (--quick: 3); the
+# other four stay the Average RM's
 AVERAGE = {"sh": 43.0, "br": 117.0, "wa": 104.0, "hi": 117.0}
 
 

@@ -4,6 +4,8 @@
 package only through ``register``/``unregister`` so that ``core`` stays importable anywhere.
 """
 
+VERSION = "0.1.0"  # blender_manifest.toml's and pyproject.toml's (tests/core/test_packaging.py): ``ellimann --version``
+
 
 def register():
     from . import blender

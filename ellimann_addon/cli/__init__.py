@@ -8,8 +8,9 @@ in a pose), ``measure`` (m_T of a file), ``demo`` (the paper's Table 2.5 mannequ
 picture), ``drape`` (a garment on a mannequin with Blender's cloth simulation), ``references`` (build or check
 a reference set) and ``population`` (rows sampled from a survey's statistics, for ``batch``); ``distributed`` runs
 ``batch --dask``; what they share is in ``output`` (printed lines, exit codes), ``arguments`` (parser pieces),
-``skinning`` (``--skin``: its options, checks and the skin made), ``writing`` (files, the output folder) and
-``reporting`` (the report CSV). This package needs numpy only: Blender
+``skinning`` (``--skin``: its options, checks and the skin made), ``writing`` (files, the output folder),
+``reporting`` (the report CSV) and ``provenance`` (what a batch row's files were made from, for ``--resume``).
+This package needs numpy only: Blender
 (the bpy module and ``ellimann_addon.blender``) is imported only when a .blend or .glb file, a drape or a picture
 is involved, and a command that needs it without it is refused in one line. What Blender prints is captured
 (``chatter``) and shown only with ``--verbose``. User mistakes end with a one-line reason and a non-zero exit code:
@@ -21,6 +22,7 @@ import argparse
 import contextlib
 import sys
 
+from .. import VERSION
 from ..core.errors import ElliMannError
 from . import batch, demo, drape, measure, population, pose, references, synth
 from .output import INTERRUPTED, MISSED, PROG, UsageError, one_line, say
@@ -35,6 +37,7 @@ def build_parser():
         prog=PROG,
         description="ElliMann: measurement-driven mannequins from convex ellipsoids and cushions (measurements in cm).",
     )
+    parser.add_argument("--version", action="version", version=f"{PROG} {VERSION}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for command in SUBCOMMANDS:
         command.add_parser(commands)

@@ -28,10 +28,12 @@ from ..core.synthesis.synthesize import IDW_EXTRA_NOTE
 from . import arguments, distributed, output, reporting, skinning, writing
 from .batch_csv import MeasurementsCsv
 from .output import PROG, UsageError
+from .provenance import SAID, Provenance
 
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,99}$")
 MAX_WARNING_LINES = 20  # range warnings printed before the rest go to the report only (a population has thousands)
 NPZ = BATCH_FILE.name  # the batch's one-file format (core.formats.npz_bundle), streamed as rows come
+EXTENSION_NAMES = {f.extension: name for name, f in FORMATS.items() if f.extension != name}  # xml: mjcf
 
 
 def add_parser(commands):
@@ -45,7 +47,8 @@ def add_parser(commands):
         "crotch_height, arm_length: the keys measure --json prints; an empty "
         "cell leaves it to the reference set). Writes the files and "
         "DIR/report.csv (requested vs measured), row by row into "
-        "DIR/report.partial.csv while it runs. Bad or failed rows are "
+        "DIR/report.partial.csv while it runs. A column it does not read is "
+        "named before any row is made (a misspelt one is refused). Bad or failed rows are "
         "reported and skipped; the exit code is 1 if any row failed, 3 if "
         "exact mode missed a row's request, 130 if interrupted.",
     )
@@ -54,8 +57,8 @@ def add_parser(commands):
     batch.add_argument(
         "--format",
         default="json",
-        help=f"comma-separated output formats among {','.join(FORMATS)},npz (default json; mjcf "
-        "writes NAME.xml; npz writes every mannequin of the batch into one compressed file "
+        help=f"comma-separated output formats among {','.join(FORMATS)},npz (default json; mjcf (or xml, as "
+        "synth's .xml) writes NAME.xml; npz writes every mannequin of the batch into one compressed file "
         "DIR/mannequins.npz, docs/formats/batch_npz.md)",
     )
     batch.add_argument(
@@ -72,8 +75,10 @@ def add_parser(commands):
     batch.add_argument(
         "--resume",
         action="store_true",
-        help="skip rows whose files (every --format) are already in DIR and whole, e.g. after an "
-        "interrupted run with the same CSV and options; without it every row is written again",
+        help="keep the rows whose files (every --format) are already in DIR, whole, and were made from the same "
+        "row and settings (DIR/made_from/NAME.json records what each row was made from), e.g. after an interrupted "
+        "run; a row whose request, reference set or options changed is made again and the report says why; without "
+        "it every row is written again",
     )
     arguments.add_synthesis_options(batch)
     arguments.add_pose_option(batch)
@@ -101,10 +106,12 @@ def parse_shard(text):
 
 
 def parse_formats(text):
+    """The formats of ``--format``: FORMATS' names, or a file extension (xml: MJCF, as ``synth -o NAME.xml``)."""
     formats = [f.strip().lower().lstrip(".") for f in text.split(",") if f.strip()]
+    formats = [EXTENSION_NAMES.get(f, f) for f in formats]
     unknown = [f for f in formats if f not in FORMATS and f != NPZ]
     if unknown or not formats:
-        raise UsageError(f"--format takes a comma-separated list of {', '.join(FORMATS)}, {NPZ}, got {text!r}")
+        raise UsageError(f"--format takes a comma-separated list of {', '.join(FORMATS)} (or xml), {NPZ}, got {text!r}")
     return list(dict.fromkeys(formats))
 
 
@@ -124,6 +131,8 @@ def run(args):
     table = MeasurementsCsv(args.csv, shard, shards)  # the header checked and the rows counted
     if not table.count:
         raise UsageError(f"{args.csv} has a header but no rows")
+    for warning in table.warnings():  # what of the file is not read, before any row is made
+        output.say(f"{PROG} {args.command}: warning: {warning}")
     check_skin_batch(args, formats, table, sets[""])
     cluster = distributed.connect(args.dask) if args.dask else None  # before anything is written
     try:
@@ -156,7 +165,8 @@ def _run(args, formats, shard, shards, table, reference_of, options, cluster, po
     mine = len(range(shard - 1, table.count, shards))
     progress = output.Progress(mine, "batch", quiet=args.quiet)
     # one batch file per reference set: mannequins.npz, or mannequins-NAME.npz when the rows name several
-    bundles = Bundles(args.output, suffix, args.mode, len(table.references) > 1) if NPZ in formats else None
+    made = Provenance(args.output, args)  # what each row's files are made from (--resume compares it)
+    bundles = Bundles(args.output, suffix, args.mode, len(table.references) > 1, made) if NPZ in formats else None
     rows = (row for index, row in enumerate(table.rows(reference_of, NAME_PATTERN)) if index % shards == shard - 1)
     reading, window = chunks(rows), collections.deque()  # chunks read and sent, in the CSV's order
     announced = Announcer(report.path)
@@ -172,7 +182,7 @@ def _run(args, formats, shard, shards, table, reference_of, options, cluster, po
                 break
             chunk = window[0]
             for row, (result, i) in chunk.outcomes():
-                report.add(_row(args, formats, result, i, row, bundles, pose_file))
+                report.add(_row(args, formats, result, i, row, bundles, pose_file, made))
                 chunk.done += 1
                 progress.step(row.name)
             window.popleft()
@@ -203,9 +213,10 @@ def _run(args, formats, shard, shards, table, reference_of, options, cluster, po
     announced.done()
     report.finish()
     done, failed, missed = report.count("ok", "missed"), report.count("error"), report.count("missed")
+    redone = f"; {report.count('redone')} made again: their row or settings changed" if report.count("redone") else ""
     output.say(
         f"{PROG} batch: {done} of {mine} mannequins written to {args.output}"
-        + (f" ({report.count('kept')} already complete, kept)" if args.resume else "")
+        + (f" ({report.count('kept')} already complete, kept{redone})" if args.resume else "")
         + (f" (shard {shard}/{shards} of {table.count} rows)" if shards > 1 else "")
         + f"; report {report.path}",
         file=sys.stdout,
@@ -282,11 +293,13 @@ class Chunk:
         return list(zip(self.rows, where))
 
 
-def _row(args, formats, result, i, row, bundles=None, pose_file=None):
+def _row(args, formats, result, i, row, bundles=None, pose_file=None, made=None):
     """Write (or, with --resume, keep) the files of one row, and mark it for the batch file; its report row. A
     refused row (``result`` None) or a failure is that row's: one line on stderr and status "error", and the batch
     goes on. A row that asks for extra measurements has them met (exact mode, ``core.synthesis.batch``), and the
-    report gives what each measurement asked came to."""
+    report gives what each measurement asked came to. ``made``: the batch's Provenance: --resume keeps a row's files
+    only when they are all there, whole, and were made from this row and these settings; otherwise they are made
+    again, and the report says why ("redone (--resume: He changed)")."""
     line, name, values, extra = row.line, row.name, row.values, row.extra
     if result is None:
         return reporting.report_row(line, name, "error", row.error, values)
@@ -303,14 +316,27 @@ def _row(args, formats, result, i, row, bundles=None, pose_file=None):
         )
     bundle = bundles.path_of(row.reference) if bundles is not None else None
     listed = paths + ([bundle] if bundle is not None else [])
-    kept = bool(paths) and args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths)
-    kept = kept and (args.skin_settings is None or skinning.files_hold_skin(paths, args.skin_settings))
+    whole = bool(paths) and args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths)
+    changed = made.changed(row) if whole and made is not None else None
+    kept = whole and changed is None
+    if changed:
+        notes.append(f"redone (--resume: {changed})")
+        made.redone += 1
+        if made.redone <= SAID:
+            output.say(
+                f"{PROG} batch: line {line}: {name}'s files were made from another row or settings ({changed}): "
+                "made again"
+            )
     skinned = None
     if not kept:
         try:
+            if paths and made is not None:
+                made.forget(name)  # no record while its files are being written again
             skinned = _write_row(
                 args, paths, mannequin, measured, dict(zip(MEASUREMENTS, values)), extra, pose_file, notes
             )
+            if paths and made is not None:
+                made.write(row)
         except (ElliMannError, OSError, RuntimeError) as error:
             output.say(f"{PROG} batch: line {line}: failed: {output.one_line(error)}")
             return reporting.report_row(line, name, "error", output.one_line(error), values, extra=extra)
@@ -338,7 +364,7 @@ def _row(args, formats, result, i, row, bundles=None, pose_file=None):
         skin_settings=skinned.skin.settings if skinned else None,
         skin_measured=skinned.measured if skinned else None,
     )
-    report["kept"] = kept
+    report["kept"], report["redone"] = kept, bool(changed)
     if bundles is not None:
         bundles.mark(row.reference, result, i, name)
     return report
@@ -366,8 +392,8 @@ class Bundles:
     """``--format npz``: one streamed batch file per reference set (``BatchFileWriter``), fed a chunk at a time
     with the rows whose files were written, in the CSV's order."""
 
-    def __init__(self, folder, suffix, mode, tagged):
-        self.folder, self.suffix, self.mode, self.tagged = folder, suffix, mode, tagged
+    def __init__(self, folder, suffix, mode, tagged, made=None):
+        self.folder, self.suffix, self.mode, self.tagged, self.made = folder, suffix, mode, tagged, made
         self.writers, self.marked = {}, []
 
     def path_of(self, reference):
@@ -408,7 +434,10 @@ class Bundles:
         if id(reference) not in self.writers:
             path = self.path_of(reference)
             with writing.writing(path):
-                self.writers[id(reference)] = BatchFileWriter(path, reference.topology, self.mode, JOINT_NAMES)
+                made_from = self.made.bundle_record(reference) if self.made is not None else None
+                self.writers[id(reference)] = BatchFileWriter(
+                    path, reference.topology, self.mode, JOINT_NAMES, made_from=made_from
+                )
         return self.writers[id(reference)]
 
     def finish(self):

@@ -4,6 +4,7 @@ five, the extra measurements, the reference set, the name) and named, a name an 
 the names seen are kept (for the duplicates), so memory stays flat in the row count."""
 
 import csv
+import difflib
 from typing import NamedTuple
 
 from ..core.constants import MEASUREMENTS
@@ -15,6 +16,8 @@ from . import output
 from .output import UsageError
 
 COLUMNS = MEASUREMENTS + EXTRA_MEASUREMENTS + ("name", "references")
+TYPO_CUTOFF = 0.8  # difflib's ratio: an unknown column this close to a known one is taken for a misspelling of it
+SHOWN_LINES = 5  # rows with more cells than the header named in the warning (the rest counted)
 
 
 class Row(NamedTuple):
@@ -31,19 +34,32 @@ class Row(NamedTuple):
 
 class MeasurementsCsv:
     """A measurements CSV: ``columns`` {canonical name: index} from its header, ``count`` its rows that are not
-    blank, ``references`` the distinct ``references`` cells of the rows of shard ``shard`` of ``shards``."""
+    blank, ``references`` the distinct ``references`` cells of the rows of shard ``shard`` of ``shards``; what is
+    not read, for a warning before any row is made: ``unknown`` (the header's titles that name no column: a
+    misspelling of one is refused, UsageError) and ``overfull`` (the lines of rows with more cells than the header,
+    each refused as its row's error; ``overfull_count`` of them)."""
 
     def __init__(self, path, shard=1, shards=1):
         self.path = path
         try:
             with open(path, newline="", encoding="utf-8-sig") as stream:
                 reader = csv.reader(stream)
-                self.columns = self._columns(next(reader, None))
+                header = next(reader, None)
+                self.columns = self._columns(header)
+                self.width = len(header)
                 self.count, self.references = 0, set()
+                self.overfull, self.overfull_count = [], 0
                 where = self.columns.get("references")
-                for record in reader:
+                for line, record in enumerate(reader, start=2):
                     if not any(cell.strip() for cell in record):
                         continue
+                    filled = [index for index in self.untitled if index < len(record) and record[index].strip()]
+                    self.unknown += [f"(column {index + 1}, no title)" for index in filled]
+                    self.untitled = [index for index in self.untitled if index not in filled]
+                    if self._spilled(record):
+                        self.overfull_count += 1
+                        if len(self.overfull) < SHOWN_LINES:
+                            self.overfull.append(line)
                     if self.count % shards == shard - 1 and where is not None and where < len(record):
                         self.references.add(record[where].strip())
                     self.count += 1
@@ -53,7 +69,7 @@ class MeasurementsCsv:
     def _columns(self, header):
         if not header:
             raise UsageError(f"{self.path} is empty; expected a header row He,Sh,Br,Wa,Hi[,name]")
-        columns = {}
+        columns, self.unknown, self.untitled = {}, [], []
         for index, title in enumerate(header):
             key = title.strip().lower()
             canonical = next((c for c in COLUMNS if c.lower() == key), None)
@@ -61,12 +77,44 @@ class MeasurementsCsv:
                 raise UsageError(f"{self.path}: column {canonical} appears twice in the header")
             if canonical:
                 columns[canonical] = index
+            elif key:
+                self.unknown.append(title.strip())
+            else:  # named in the warning only if a row fills it (a spreadsheet's trailing comma is no column)
+                self.untitled.append(index)
+        for title in self.unknown:
+            near = difflib.get_close_matches(title.lower(), [c.lower() for c in COLUMNS], n=1, cutoff=TYPO_CUTOFF)
+            if near:
+                meant = next(c for c in COLUMNS if c.lower() == near[0])
+                taken = " (it is there too)" if meant in columns else ""
+                raise UsageError(
+                    f"{self.path}: column {title!r} is not one batch reads: did you mean {meant}{taken}? The columns "
+                    f"are {known_columns()}"
+                )
         missing = [m for m in MEASUREMENTS if m not in columns]
         if missing:
             raise UsageError(
                 f"{self.path}: header lacks column(s) {', '.join(missing)}; expected He,Sh,Br,Wa,Hi[,name]"
             )
         return columns
+
+    def _spilled(self, record):
+        """Whether a row has cells (not blank) beyond the header's columns: a comma inside a name, a shifted row."""
+        return any(cell.strip() for cell in record[self.width :])
+
+    def warnings(self):
+        """The lines that say, before any row is made, what of the file is not read."""
+        out = []
+        if self.unknown:
+            out.append(
+                f"{self.path}: column(s) {', '.join(self.unknown)} are not read (the columns are {known_columns()})"
+            )
+        if self.overfull_count:
+            lines = ", ".join(map(str, self.overfull)) + (" …" if self.overfull_count > len(self.overfull) else "")
+            out.append(
+                f"{self.path}: {self.overfull_count} row(s) have more cells than the header's {self.width} (line "
+                f"{lines}): refused (a comma inside a cell needs quotes)"
+            )
+        return out
 
     def rows(self, reference_of, name_pattern):
         """Every row that is not blank, in order, checked and named (:class:`Row`). ``reference_of(text)``: the
@@ -87,6 +135,11 @@ class MeasurementsCsv:
     def _row(self, line, record, reference_of, name_pattern):
         name, reference = self._cell(record, "name"), None
         try:
+            if self._spilled(record):
+                cells = len(record) - next(i for i, cell in enumerate(reversed(record)) if cell.strip())
+                raise MeasurementError(
+                    "row", f"has {cells} cells, the header {self.width} (a comma inside a cell needs quotes)"
+                )
             try:
                 reference = reference_of(self._cell(record, "references"))
             except ReferenceSetError as error:
@@ -136,3 +189,8 @@ class Names:
             if name != key:
                 self.spelled[key] = name
         return row._replace(name=name, error=error)
+
+
+def known_columns():
+    """The columns batch reads, as the help says them."""
+    return f"{','.join(MEASUREMENTS)} (cm), optional {', '.join(EXTRA_MEASUREMENTS)} (cm), name and references"

@@ -84,6 +84,13 @@ def run(args):
     return output.MISSED if missed else 0
 
 
+LINEUP_NOTE = (
+    "`lineup.png`: the ten seen from the front, labelled (1)-(10) as the rows above. Each piece is coloured by the "
+    "side of the body it is on: the body's right blue, its left pink, the central pieces grey (seen from the front a "
+    "mannequin is blue on the viewer's left), as in Blender's viewport (`blender.bridge.convert.SIDE_COLORS`)."
+)
+
+
 def report_markdown(result, reference, args):
     """Requested vs m_T per mannequin, and the error summary beside the paper's IDW."""
     from ..core.synthesis.synthesize import synthesize_batch
@@ -128,4 +135,6 @@ def report_markdown(result, reference, args):
         if paper and label.endswith("IDW"):
             continue
         lines.append(f"| {label} | " + " | ".join(f"{v:.3f}" for v in values) + " |")
+    if args.picture:
+        lines += ["", LINEUP_NOTE]
     return "\n".join(lines) + "\n"

@@ -1,5 +1,6 @@
-"""``ellimann measure``: m_T and the extra measurements of a .json mannequin (no Blender), of a .blend (Blender),
-or of a body mesh (.obj / .ply / .stl, no Blender)."""
+"""``ellimann measure``: m_T and the extra measurements of a .json mannequin (no Blender; one that records a skin:
+its pieces' and, labelled apart, its skin's, made again as the file records it), of a .blend (Blender), of a .glb
+(what its extras record, no Blender) or of a body mesh (.obj / .ply / .stl, no Blender)."""
 
 import json
 import math
@@ -14,8 +15,11 @@ from ..core.measure.body import ALL_MEASUREMENTS, measure_body_mesh
 from ..core.measure.extra import EXTRA_LABELS, mannequin_extra_measurements
 from . import arguments, output, writing
 from .output import UsageError
+from .skinning import describe
 
 LABELS = {**MEASUREMENT_LABELS, **EXTRA_LABELS}
+KEY_WIDTH = max(map(len, ALL_MEASUREMENTS))  # the table's columns line up whatever the keys
+LABEL_WIDTH = max(map(len, LABELS.values()))
 NECK_TILT_LIMITS = (-45.0, 60.0)  # degrees forward: what --neck-tilt accepts
 
 
@@ -25,14 +29,17 @@ def add_parser(commands):
         help="measurements of a mannequin file or a body mesh",
         description="Tailor measurements (m_T and the extra ones, docs/measurements.md) of a "
         ".json or .blend mannequin or of an upright A-pose body mesh "
-        "(.obj, .ply, .stl), in cm.",
+        "(.obj, .ply, .stl), in cm. A .json that records a skin (synth --skin) gives its pieces' "
+        "and its skin's (the skin made again as the file records it, measured on its mesh), "
+        "each labelled; a .glb gives the m_T its extras record.",
     )
     measure.add_argument("file", metavar="FILE")
     measure.add_argument(
         "--json",
         action="store_true",
         help='print {"He": …, "Sh": …, "Br": …, "Wa": …, "Hi": …, "neck": …, …} (a body mesh: '
-        "only the measurements that could be taken)",
+        'only the measurements that could be taken; a .json with a skin adds "skin": {"voxel_mm", "blend", '
+        '"He", …}, what the skin measures)',
     )
     arguments.add_mesh_axes(measure, "a body mesh")
     measure.add_argument(
@@ -78,13 +85,15 @@ def run(args):
             output.say(f"{output.PROG} measure: warning: {path}: {problem}")
         _print(values, args.json, path, f"{path}: body mesh")
         return 0
+    if kind == ".glb":
+        return measure_glb(path, args)
     if kind == ".json":
         mannequin = load_json_mannequin(path)
     elif kind == ".blend":
         mannequin = load_blend_mannequin(path, args.collection)
     else:
         raise UsageError(
-            f"FILE must be a .json or .blend mannequin or a {'/'.join(MESH_EXTENSIONS)} body mesh, got {path!r}"
+            f"FILE must be a .json, .blend or .glb mannequin or a {'/'.join(MESH_EXTENSIONS)} body mesh, got {path!r}"
         )
     if args.references:
         reference = arguments.references(args)
@@ -92,7 +101,63 @@ def run(args):
         mannequin = mannequin.copy(reference_set=reference.name, section_fractions=reference.section_fractions)
     values = dict(mannequin.measure())
     values.update(mannequin_extra_measurements(mannequin))
-    _print(values, args.json, path, f"{mannequin.name or path}: m_T and more")
+    skin = skin_values(mannequin, path) if kind == ".json" and mannequin.skin is not None else None
+    if skin is None:
+        _print(values, args.json, path, f"{mannequin.name or path}: m_T and more")
+        return 0
+    settings, skin_measured = skin
+    if args.json:
+        shown = _shown(values)
+        shown["skin"] = {"voxel_mm": settings.voxel_mm, "blend": settings.blend, **_shown(skin_measured)}
+        print(json.dumps(shown))
+        return 0
+    _print(values, False, path, f"{mannequin.name or path}: its pieces (m_T and more)")
+    how = describe(settings).removeprefix("skin ")
+    title = f"{mannequin.name or path}: its skin ({how}, made again from the pieces as the file records it; its mesh)"
+    _print(skin_measured, False, path, title)
+    return 0
+
+
+def skin_values(mannequin, path):
+    """(SkinSettings, {key: cm}) of the skin a .json records (its ``skin`` section): made again from the pieces (the
+    same pieces give the same skin), measured on its mesh as ``synth --skin`` reports it (the five by m_T's
+    definitions, the extra ones by the body-mesh measurer; one not taken is left out)."""
+    from ..core.skin.measure import body_measurements, mesh_measurements
+    from ..core.skin.settings import SkinSettings
+    from ..core.skin.surface import SkinError, build_skin
+
+    settings = SkinSettings.from_dict(mannequin.skin)
+    try:
+        skin = build_skin(mannequin, settings)
+    except SkinError as error:
+        raise UsageError(f"{path}: its skin cannot be made again: {output.one_line(error)}") from None
+    values = mesh_measurements(skin)
+    values.update(body_measurements(skin).values)
+    return settings, values
+
+
+def measure_glb(path, args):
+    """What a .glb's extras record (``core.formats.glb``, numpy only): its pieces' m_T when it was written."""
+    from ..core.formats.glb import read_glb_json, scene_extras, skin_nodes
+
+    if args.references or args.collection:
+        raise UsageError(f"{path}: a .glb gives the m_T its extras record; --references and --collection do not apply")
+    doc = read_glb_json(path)
+    extras = scene_extras(doc, path)
+    recorded = extras.get("measured_cm")
+    if not isinstance(recorded, dict) or not all(isinstance(recorded.get(key), (int, float)) for key in MEASUREMENTS):
+        raise UsageError(f"{path}: its extras record no m_T (measured_cm)")
+    values = {key: float(recorded[key]) for key in MEASUREMENTS}
+    name = extras.get("name") or path
+    _print(values, args.json, path, f"{name}: m_T of its pieces as the file's extras record it")
+    skins = skin_nodes(doc)
+    if skins and not args.json:
+        voxel = skins[0].get("voxel_mm")
+        made = f" ({voxel:g} mm)" if isinstance(voxel, (int, float)) else ""
+        output.say(
+            f"{output.PROG} measure: {path} also holds a skin{made}, whose measurements it does not record: measure "
+            "the .json or the skin's .obj written with it",
+        )
     return 0
 
 
@@ -123,7 +188,12 @@ def _print(values, as_json, path, title):
     else:
         output.say(title, file=sys.stdout)
         for key in keys:
-            print(f"  {key} {LABELS[key]:<17} {values[key]:9.2f} cm")
+            print(f"  {key:<{KEY_WIDTH}} {LABELS[key]:<{LABEL_WIDTH}} {values[key]:9.2f} cm")
+
+
+def _shown(values):
+    """{key: cm rounded} of the finite measurements in ``values`` (those not taken left out), as --json prints."""
+    return {key: round(values[key], 4) for key in ALL_MEASUREMENTS if key in values and math.isfinite(values[key])}
 
 
 def load_json_mannequin(path):

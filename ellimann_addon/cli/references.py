@@ -1,6 +1,7 @@
 """``ellimann references``: build a reference set from a traced Base Mannequin and N >= 3 body meshes
 (``build``), or check a reference-set folder (``check``). numpy only."""
 
+import argparse
 import hashlib
 import os
 import pathlib
@@ -64,7 +65,9 @@ def add_parser(commands):
         help="a 'name' column (the bodies' file stems) and a column per measurement: "
         f"{', '.join(MEASUREMENTS)} in cm (or target_He, ...)",
     )
-    build.add_argument("-o", "--out", required=True, metavar="DIR", help="the reference-set folder to write")
+    output = build.add_mutually_exclusive_group(required=True)  # -o/--output as every command; --out: its old name
+    output.add_argument("-o", "--output", metavar="DIR", help="the reference-set folder to write")
+    output.add_argument("--out", dest="output", metavar="DIR", help=argparse.SUPPRESS)
     build.add_argument("--name", help="the set's name (default: the folder's name)")
     build.add_argument("--sex", choices=("female", "male"), help="the set's sex, if it has one")
     build.add_argument(
@@ -86,13 +89,17 @@ def add_parser(commands):
         help="check a reference-set folder",
         description="Validity, ranges, symmetry and how each RM meets its targets.",
     )
-    check.add_argument("folder", metavar="DIR")
+    check.add_argument(
+        "folder",
+        metavar="DIR",
+        help="a reference-set folder, or a shipped set's name (female, male, female-fine, male-fine)",
+    )
     arguments.add_verbose(check)
     check.set_defaults(run=run_check, blender=lambda args: None)
 
 
 def run_build(args):
-    out = pathlib.Path(args.out)
+    out = pathlib.Path(args.output)
     base = load_base(args.base)
     base_stem = pathlib.Path(args.base).stem
     stems = [pathlib.Path(p).stem for p in args.bodies]
@@ -142,7 +149,7 @@ def run_build(args):
         key, error = report.worst(stem)
         fill = report.fill.get(stem, {}).get("ellipsoids")
         filled = f", fills {fill['coverage']:.1%} of its body (excess {fill['excess']:.1%})" if fill else ""
-        print(f"{stem}: worst m_T error {error:+.4%} ({key}){filled}")
+        print(f"{stem}: worst m_T error {error:+z.4%} ({key}){filled}")
     print(f"wrote {len(stems)} Reference Mannequins, {base_stem}.json and reference_set.json to {out}")
     return 0
 
@@ -184,17 +191,22 @@ def check_folder(folder):
         wanted = targets.get(name) or rm.measurements
         errors = relative_errors(rm.measure(), wanted)
         key = max(errors, key=lambda k: abs(errors[k]))
-        lines.append(f"{name}: worst m_T error {errors[key]:+.4%} ({key}), asymmetry {asymmetry(rm) * 1e3:.2g} mm")
+        lines.append(f"{name}: worst m_T error {errors[key]:+z.4%} ({key}), asymmetry {asymmetry(rm) * 1e3:.2g} mm")
         if abs(errors[key]) > ACCEPT:
-            problems.append(f"{name}: m_T {key} is off its target by {errors[key]:+.3%} (accepted {ACCEPT:.1%})")
+            problems.append(f"{name}: m_T {key} is off its target by {errors[key]:+z.3%} (accepted {ACCEPT:.1%})")
         problems += [f"{name}: {text}" for text in cleanliness_problems(rm, 1e-6)]
     return lines, problems
 
 
 def run_check(args):
-    if not pathlib.Path(args.folder).is_dir():
-        raise UsageError(f"{args.folder}: no such folder")
-    lines, problems = check_folder(pathlib.Path(args.folder))
+    from ..core.synthesis.shipped import SHIPPED_SETS
+
+    folder = pathlib.Path(args.folder)
+    if not folder.is_dir() and args.folder.casefold() in SHIPPED_SETS:  # a shipped set by its name
+        folder = SHIPPED_SETS[args.folder.casefold()]
+    if not folder.is_dir():
+        raise UsageError(f"{args.folder}: no such folder (nor a shipped set: {', '.join(SHIPPED_SETS)})")
+    lines, problems = check_folder(folder)
     for line in lines:
         print(line)
     for problem in problems:

@@ -112,7 +112,7 @@ class Report:
         self._append(self.writer.writeheader)
 
     def add(self, row):
-        for status in (row["status"], "kept" if row.get("kept") else None):
+        for status in (row["status"], "kept" if row.get("kept") else None, "redone" if row.get("redone") else None):
             if status is not None:
                 self.counts[status] = self.counts.get(status, 0) + 1
         self._append(lambda: self.writer.writerow(row))

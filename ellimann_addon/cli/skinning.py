@@ -6,7 +6,6 @@ IDW the skin of the pieces as they are; the skin's measurements (on its mesh) re
 A skin is made per mannequin and dropped once its files are written: a batch's memory stays flat. The skin's core is
 imported only when a skin is asked: a command without --skin starts as fast as before."""
 
-import json
 import math
 from dataclasses import dataclass
 
@@ -164,7 +163,7 @@ def missed_text(missed, rounds):
     (tolerance 1 mm on its mesh; ...)"."""
     return (
         "exact mode on the skin missed "
-        + ", ".join(f"{key} by {got - want:+.2f} cm (skin {got:.2f} cm for {want:g} cm)" for key, got, want in missed)
+        + ", ".join(f"{key} by {got - want:+z.2f} cm (skin {got:.2f} cm for {want:g} cm)" for key, got, want in missed)
         + f" (tolerance {mesh_tolerance_cm() * 10:g} mm on its mesh; the closest skin found in {rounds} rounds)"
     )
 
@@ -184,33 +183,3 @@ def mesh_tolerance_cm():
     from ..core.skin.exact import MESH_TOLERANCE_CM
 
     return MESH_TOLERANCE_CM
-
-
-def files_hold_skin(paths, settings):
-    """Whether a batch row's files (``--resume``) hold a skin made at ``settings``: its .json's ``skin`` section or its
-    .obj's first line says so. A row written without a skin or with another voxel or blend, or whose formats (.xml,
-    .blend, .glb) cannot tell, is written again."""
-    told = False
-    for path in paths:
-        if path.endswith(".json"):
-            try:
-                with open(path, encoding="utf-8") as stream:
-                    record = json.load(stream).get("skin")
-            except (OSError, ValueError, AttributeError):
-                return False
-            if not isinstance(record, dict) or (record.get("voxel_mm"), record.get("blend")) != (
-                settings.voxel_mm,
-                settings.blend,
-            ):
-                return False
-            told = True
-        elif path.endswith(".obj"):
-            try:
-                with open(path, encoding="utf-8") as stream:
-                    first = stream.readline()
-            except (OSError, UnicodeDecodeError):
-                return False
-            if f": {settings.voxel_mm:g} mm voxels, blend {settings.blend:g};" not in first:
-                return False
-            told = True
-    return told

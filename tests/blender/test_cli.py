@@ -18,11 +18,11 @@ import pytest
 from devkit import synthetic
 from devkit.cli_runs import assert_one_line_error, python_m, run
 from ellimann_addon import cli
-from ellimann_addon.blender.services.files import EXTRAS_KEY, read_glb_json
 from ellimann_addon.cli import drape as drape_cli
 from ellimann_addon.cli import writing
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.drape.settings import DrapeSettings
+from ellimann_addon.core.formats.glb import EXTRAS_KEY, read_glb_json
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
 from ellimann_addon.core.synthesis.synthesize import relative_error
@@ -181,6 +181,8 @@ def test_synth_blender_formats_with_cushions(tmp_path, capsys, references):
     assert len(objects) == pairs + singles
     code, stdout, _ = run(["measure", str(tmp_path / "m.blend"), "--json"], capsys)
     assert code == 0 and five(json.loads(stdout)) == pytest.approx(VALUES, rel=1e-4)
+    code, stdout, _ = run(["measure", str(tmp_path / "m.glb"), "--json"], capsys)  # the .glb synth wrote: its extras
+    assert code == 0 and json.loads(stdout) == pytest.approx(VALUES, rel=1e-4)
     bpy.ops.wm.open_mainfile(filepath=str(tmp_path / "m.blend"))
     cushions = [o for o in bpy.data.objects if o.ellimann.kind == "CUSHION"]
     assert len(cushions) == pairs
@@ -305,7 +307,7 @@ def test_measure_refuses_what_it_cannot_read(tmp_path, capsys):
     assert_one_line_error(code, err, "not valid JSON")
     (tmp_path / "m.txt").write_text("x")
     code, _, err = run(["measure", str(tmp_path / "m.txt")], capsys)
-    assert_one_line_error(code, err, ".json or .blend")
+    assert_one_line_error(code, err, ".json, .blend or .glb")
     bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "empty.blend"))
     code, _, err = run(["measure", str(tmp_path / "empty.blend"), "--json"], capsys)
     assert_one_line_error(code, err, "no ElliMann mannequin")
@@ -410,11 +412,14 @@ def test_batch_shards_agree_on_duplicate_names_across_the_whole_csv(tmp_path, ca
     assert "line 3: skipped: name: 'same' is already used on line 2" in errors[2]
     assert Mannequin.load(out / "same.json").measurements["He"] == 150.0  # not overwritten by line 3
     assert sorted(p.name for p in out.iterdir()) == [
+        "made_from",
         "other.json",
         "report-1-of-2.csv",
         "report-2-of-2.csv",
         "same.json",
     ]
+    assert sorted(p.name for p in (out / "made_from").iterdir()) == ["other.json", "same.json"]
+    assert json.loads((out / "made_from" / "same.json").read_text())["request_cm"]["He"] == 150.0
     statuses = {}
     for shard in (1, 2):
         statuses.update({r["line"]: r["status"] for r in read_report(out / f"report-{shard}-of-2.csv")})
@@ -442,7 +447,7 @@ def test_batch_writes_mjcf_and_glb_with_extras(tmp_path, capsys, references):
     out = tmp_path / "out"
     code, _, err = run(["batch", source, "-o", str(out), "--format", "mjcf,glb", "--references", references], capsys)
     assert code == 0, err
-    assert sorted(p.name for p in out.iterdir()) == ["average.glb", "average.xml", "report.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["average.glb", "average.xml", "made_from", "report.csv"]
     assert read_report(out / "report.csv")[0]["files"].split() == [str(out / "average.xml"), str(out / "average.glb")]
     assert "<mujoco" in (out / "average.xml").read_text()
     doc = read_glb_json(out / "average.glb")
@@ -474,6 +479,11 @@ def test_demo_writes_files_report_and_lineup(tmp_path, capsys, references):
     assert "| 10 | 165.25 | 47.25 | 135.75 | 122.25 | 117.5 |" in markdown and "max, paper IDW" in markdown
     assert (out / "lineup.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "10 mannequins" in stdout
+    assert "the body's right blue, its left pink, the central pieces grey" in markdown  # the picture's colours said
+    from ellimann_addon.blender.bridge.convert import SIDE_COLORS
+
+    (r, _, b, _), (r2, _, b2, _) = SIDE_COLORS["R"], SIDE_COLORS["L"]
+    assert b > r and r2 > b2 and abs(SIDE_COLORS["C"][0] - SIDE_COLORS["C"][2]) < 0.1  # and they are those colours
 
 
 # ------------------------------------------------------------------------------------------------ Blender's chatter
@@ -662,7 +672,7 @@ def test_ctrl_c_in_a_batch_writes_the_report_of_what_was_done_and_exits_130(tmp_
         f"{out / 'report.csv'}; run it again with --resume to finish"
     )
     assert [(r["line"], r["status"]) for r in read_report(out / "report.csv")] == [("2", "ok"), ("5", "error")]
-    assert sorted(p.name for p in out.iterdir()) == ["average.json", "report.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["average.json", "made_from", "report.csv"]
     first = (out / "average.json").stat()
     monkeypatch.setattr(writing, "write", real)
     code, stdout, err = run(["batch", source, "-o", str(out), "--resume", "--references", references], capsys)
@@ -709,7 +719,7 @@ def test_a_killed_batch_leaves_a_partial_report_and_resume_cleans_up_and_finishe
     assert "5 of 5 mannequins written" in again.stdout and "(1 already complete, kept)" in again.stdout
     assert (out / "m0.json").stat().st_ino == kept
     assert Mannequin.load(out / "m1.json").measurements["He"] == 151.0  # written again, whole
-    assert sorted(p.name for p in out.iterdir()) == [f"m{i}.json" for i in range(5)] + ["report.csv"]
+    assert sorted(p.name for p in out.iterdir()) == [f"m{i}.json" for i in range(5)] + ["made_from", "report.csv"]
     assert [r["status"] for r in read_report(out / "report.csv")] == ["ok"] * 5
 
 

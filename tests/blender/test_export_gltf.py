@@ -8,11 +8,12 @@ import numpy as np
 import pytest
 
 from ellimann_addon.blender.bridge import convert
-from ellimann_addon.blender.services.files import EXTRAS_KEY, export_gltf, read_glb_json, write_mannequin
+from ellimann_addon.blender.services.files import export_gltf, write_mannequin
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.errors import ElliMannError, MannequinError
 from ellimann_addon.core.files import atomic_output
 from ellimann_addon.core.formats.core_writers import write_core_file
+from ellimann_addon.core.formats.glb import EXTRAS_KEY, read_glb_json
 from ellimann_addon.core.geometry.quaternion import quaternion_to_rotation
 
 # glTF is Y-up: Blender's exporter maps (x, y, z) -> (x, z, -y).

@@ -17,7 +17,7 @@ from ellimann_addon.blender.features.export.operator import (
     reconcile,
     with_extension,
 )
-from ellimann_addon.blender.services.files import EXTRAS_KEY, read_glb_json
+from ellimann_addon.core.formats.glb import EXTRAS_KEY, read_glb_json
 
 
 def geoms(path):

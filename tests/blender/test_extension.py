@@ -67,3 +67,34 @@ def test_installed_extension_works_and_disables_cleanly(built_zip, tmp_path):
     assert report["first_use"] == report["second_use"] == [[["FINISHED"]] * 3, 60.0]
     assert report["after_disable"] == [] and report["after_second_disable"] == []
     assert "Traceback" not in result.stderr and "Error" not in result.stdout
+
+
+# The README's headless route, through the handler behind ``blender --command extension`` (the bpy module has no
+# ``blender`` executable), in one process; then a fresh one, as the next Blender session.
+INSTALL_HEADLESS = """
+import os, sys
+os.environ["BLENDER_USER_RESOURCES"] = sys.argv[2]
+import bpy
+from bl_pkg import bl_extension_cli
+sys.exit(bl_extension_cli.cli_extension_handler(["install-file", "-r", "user_default", "-e", sys.argv[1]]))
+"""
+FRESH_SESSION = """
+import json, os, sys
+os.environ["BLENDER_USER_RESOURCES"] = sys.argv[1]
+import bpy
+bpy.ops.wm.read_userpref()  # Blender reads them at start; a script on the bpy module must ask (README)
+print(json.dumps([
+    "bl_ext.user_default.ellimann" in bpy.context.preferences.addons,
+    sorted(bpy.ops.ellimann.new_mannequin(name="Fresh")),
+]))
+"""
+
+
+def test_the_headless_install_enables_the_extension_for_the_next_session(built_zip, tmp_path):
+    user = tmp_path / "user"
+    installed = run("-c", INSTALL_HEADLESS, built_zip, user, cwd=tmp_path)
+    assert installed.returncode == 0, installed.stdout + installed.stderr
+    assert (user / "config" / "userpref.blend").is_file()  # -e enabled it and saved the preferences
+    fresh = run("-c", FRESH_SESSION, user, cwd=tmp_path)
+    assert fresh.returncode == 0, fresh.stdout + fresh.stderr
+    assert json.loads(fresh.stdout.strip().splitlines()[-1]) == [True, ["FINISHED"]]

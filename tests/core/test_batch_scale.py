@@ -131,8 +131,10 @@ def test_dask_local_cluster_writes_the_serial_files_byte_for_byte(tmp_path, caps
     assert code == 0, err
     serial, dask = tmp_path / "serial" / "out", tmp_path / "dask" / "out"
     names = sorted(os.listdir(serial))
-    assert names == sorted(os.listdir(dask)) and len(names) == 42
-    for name in names:
+    assert names == sorted(os.listdir(dask)) and len(names) == 43  # 40 rows, the batch file, the report, made_from/
+    files = sorted(p.relative_to(serial) for p in serial.rglob("*") if p.is_file())  # made_from/'s records too
+    assert files == sorted(p.relative_to(dask) for p in dask.rglob("*") if p.is_file()) and len(files) == 82
+    for name in files:
         assert (serial / name).read_bytes() == (dask / name).read_bytes(), name
 
 
@@ -352,7 +354,7 @@ def test_a_batch_streams_in_the_csvs_order_across_chunks_and_reference_sets(tmp_
     assert [row["status"] for row in report] == ["ok"] * 3 + ["error"] + ["ok"] * 4 + ["error", "ok"]
     files = {"female": out / "mannequins-female.npz", "male": out / "mannequins-male.npz"}
     assert sorted(p.name for p in out.iterdir() if p.suffix != ".json") == sorted(
-        [p.name for p in files.values()] + ["report.csv"]
+        [p.name for p in files.values()] + ["made_from", "report.csv"]
     )
     for name, path in files.items():
         expected = [row["name"] for row in report if row["status"] == "ok" and row["references"] == name]

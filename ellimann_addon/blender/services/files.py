@@ -50,6 +50,7 @@ import numpy as np
 from ...core.constants import MEASUREMENTS
 from ...core.errors import ElliMannError
 from ...core.files import atomic_output
+from ...core.formats.glb import EXTRAS_FORMAT, EXTRAS_KEY, EXTRAS_VERSION
 from ...core.formats.table import BLENDER_FORMATS, extension_of
 from ..bridge.built import built_objects, is_stale
 from ..bridge.convert import collection_to_mannequin, objects_recursive
@@ -61,11 +62,6 @@ from .scene import add_mannequin, empty_scene
 from .skin import add_skin, pieces_as_colliders
 
 # ------------------------------------------------------------------------------------------------ glTF
-
-
-EXTRAS_KEY = "ellimann"
-EXTRAS_FORMAT = "ellimann.gltf-extras"
-EXTRAS_VERSION = 1
 
 
 def part_extras(obj):
@@ -193,12 +189,6 @@ def _split_glb(data, path):
     if magic != b"glTF" or kind != b"JSON" or total != len(data) or 20 + length > len(data):
         raise ElliMannError(f"path: {path} is not a whole binary glTF file")
     return json.loads(data[20 : 20 + length]), data[20 + length :]
-
-
-def read_glb_json(path):
-    """The JSON chunk of a .glb file as a dict (for tests and tools that check the extras)."""
-    with open(path, "rb") as stream:
-        return _split_glb(stream.read(), path)[0]
 
 
 # ------------------------------------------------------------------------------------------------ mannequin files

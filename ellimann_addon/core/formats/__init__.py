@@ -4,6 +4,7 @@
   as a collision proxy, a decimated skin measured again
 - bvh: BVH motion-capture clips read with numpy, their units said, their bones matched
 - core_writers: OBJ, JSON and MJCF mannequin files by extension, with a skin or not
+- glb: a .glb's JSON chunk and ElliMann's extras in it, read with the standard library (measure of a .glb)
 - mjcf: MJCF (MuJoCo) of a mannequin's convex pieces
 - mjcf_articulated: MJCF of a mannequin with joints: an articulated body, poses as keyframes
 - mjcf_skin: a skin in MJCF (MuJoCo's deformable skin, drawn only), bound to the world or to the 24 bones

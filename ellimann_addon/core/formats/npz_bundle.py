@@ -45,8 +45,9 @@ _ORDER = (  # the archive's entries, in order (joints and joint_names only where
     "mode",
     "joints",
     "joint_names",
+    "made_from_json",
 )
-_OPTIONAL = ("joints", "joint_names")
+_OPTIONAL = ("joints", "joint_names", "made_from_json")
 _REQUIRED = tuple(key for key in _ORDER if key not in _OPTIONAL)
 
 
@@ -63,8 +64,10 @@ def batch_arrays(
     mode,
     joints=None,
     joint_names=None,
+    made_from=None,
 ):
-    """The arrays of a batch file, by name (shapes checked against each other)."""
+    """The arrays of a batch file, by name (shapes checked against each other); ``made_from``: what the batch made
+    them from (a JSON-able dict: the reference set, the options; ``cli.provenance``), if given."""
     count, parts = len(names), len(topology)
     arrays = {
         "format": np.array(BATCH_FORMAT),
@@ -86,6 +89,8 @@ def batch_arrays(
         joints = np.asarray(joints, dtype=np.float64)
         arrays["joints"] = joints.reshape(count, -1, 3)
         arrays["joint_names"] = np.array(list(joint_names), dtype=str).reshape(arrays["joints"].shape[1])
+    if made_from is not None:
+        arrays["made_from_json"] = np.array(json.dumps(made_from, sort_keys=True))
     return arrays
 
 
@@ -153,8 +158,8 @@ class BatchFileWriter:
         "joints": (np.float64, ("J", 3)),
     }
 
-    def __init__(self, path, topology, mode, joint_names=None):
-        self.path, self.topology, self.mode = os.fspath(path), topology, mode
+    def __init__(self, path, topology, mode, joint_names=None, made_from=None):
+        self.path, self.topology, self.mode, self.made_from = os.fspath(path), topology, mode, made_from
         self.joint_names = None if joint_names is None else list(joint_names)
         self.count, self.width, self.with_joints = 0, 1, None  # rows, longest name, whether rows carry joints
         folder = os.path.dirname(os.path.abspath(self.path))
@@ -214,6 +219,8 @@ class BatchFileWriter:
             }
             if self.with_joints:
                 fixed["joint_names"] = np.array(self.joint_names, dtype=str)
+            if self.made_from is not None:
+                fixed["made_from_json"] = np.array(json.dumps(self.made_from, sort_keys=True))
             entries = []
             for key in _ORDER:  # batch_arrays' order
                 if key == "names":

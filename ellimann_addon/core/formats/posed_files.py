@@ -17,6 +17,7 @@ bodies, the .obj holds the posed skin alone.
 import json
 
 from ..errors import ElliMannError
+from ..files import TooLargeError, read_bytes_within
 from ..pose.kinematics import Pose
 
 POSE_SECTION_VERSION = 1
@@ -37,8 +38,9 @@ def pose_section(frames, fps=None):
 def read_pose(path):
     """The frames of a pose file (a posed mannequin .json, or one pose's own JSON): [Pose, ...]."""
     try:
-        with open(path, encoding="utf-8") as stream:
-            data = json.load(stream)
+        data = json.loads(read_bytes_within(path, what="a pose file").decode("utf-8"))
+    except TooLargeError as error:
+        raise ElliMannError(f"pose: {error}") from None
     except (UnicodeDecodeError, ValueError, RecursionError) as error:
         raise ElliMannError(f"pose: {path} is not a JSON pose file ({' '.join(str(error).split())})") from None
     section = data.get("pose") if isinstance(data, dict) and "pose" in data else None

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..constants import CENTER_LIMIT, FEMALE_SET, SECTION_FRACTIONS, SEMI_AXIS_LIMITS
 from ..errors import MannequinError, Problem
-from ..files import atomic_write_text
+from ..files import TooLargeError, atomic_write_text, read_bytes_within
 from .field_checks import json_type as _json_type
 from .field_checks import measurement_problems, section_fraction_problems
 from .field_checks import short as _short
@@ -319,8 +319,10 @@ class Mannequin:
     def load(cls, path, check=True):
         """Read a mannequin JSON file (UTF-8). Whatever the file holds, a bad one raises MannequinError naming
         the file or the field (OSError if it cannot be opened)."""
-        with open(path, "rb") as stream:
-            raw = stream.read()
+        try:
+            raw = read_bytes_within(path, what="a mannequin file")
+        except TooLargeError as error:
+            raise MannequinError([Problem("", "file", str(error))]) from None
         try:
             text = raw.decode("utf-8")
         except UnicodeDecodeError as error:
