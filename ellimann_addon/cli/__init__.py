@@ -19,7 +19,6 @@ written), 130 when interrupted (Ctrl-C).
 """
 
 import argparse
-import contextlib
 import sys
 
 from .. import VERSION
@@ -54,8 +53,8 @@ def main(argv=None):
     except SystemExit as exit_:  # argparse has printed usage or help
         return int(exit_.code or 0)
     try:
-        needs = args.blender(args)  # what of this command needs Blender, if anything
-        if needs and not blender_available():
+        needs = args.blender(args)  # what of this command needs Blender from the start, if anything (a job's
+        if needs and not blender_available():  # files are checked by the job: synth, pose, batch)
             raise no_blender(needs)
         with _captured(args.verbose, needs):
             return args.run(args)
@@ -68,12 +67,11 @@ def main(argv=None):
 
 
 def _captured(show, blender):
-    """What Blender prints, kept out of ElliMann's lines (``blender.services.chatter.program``) when Blender is used."""
-    if not blender:
-        return contextlib.nullcontext()
-    from ..blender.services.chatter import program
+    """What Blender prints, kept out of ElliMann's lines (``blender.services.chatter.program``): from the start for a
+    command that needs Blender (``blender``), else from its first Blender call, if any (a job writing a .glb)."""
+    from ..blender.services.chatter import program  # no bpy: it is loaded by the first Blender call
 
-    return program(show=show)
+    return program(show=show, lazy=not blender)
 
 
 def main_exit(argv=None):

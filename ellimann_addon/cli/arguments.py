@@ -1,11 +1,10 @@
 """Parser pieces the subcommands share (synthesis options from ``core.synthesis.options``, mesh axes, reference
-sets, poses) and what they turn into: the options, the reference set, the pose frames."""
+sets, poses) and what they turn into for a job (``core.job.request``): the options, the reference set, the pose
+asked."""
 
 import argparse
 
 from ..core.errors import ReferenceSetError
-from ..core.formats.bvh import BvhClip, read_bvh
-from ..core.formats.table import FORMATS
 from ..core.synthesis.options import SYNTHESIS, SynthesisOptions
 from .output import PROG, UsageError, say
 
@@ -106,73 +105,28 @@ def add_pose_option(parser):
     )
 
 
-def check_pose_argument(args, kinds):
-    """Refuse, before any work is done, an unknown pose name, a pose file or clip that cannot be read and an
-    animation for a format of ``kinds`` that holds none. Returns the frames of a pose file, the clip
-    (``core.formats.bvh.BvhClip``) of a .bvh, or None; sets ``args.fps`` (walk's default, or the clip's rate)."""
-    from ..core.pose.standard import MOTIONS, WALK_FPS, check_pose_name
+def pose_ask(args):
+    """The ``core.job.request.PoseAsk`` of --pose, --fps, --rig and --keep-on-floor (None without --pose)."""
+    from ..core.job.request import PoseAsk
 
     if args.pose is None:
         return None
-    source = None
-    if args.pose.lower().endswith(".bvh"):
-        source = read_bvh(args.pose, args.rig, args.fps)
-        args.fps = source.motion.fps
-    elif args.pose.lower().endswith(".json"):
-        from ..core.formats.posed_files import read_pose
-
-        source = read_pose(args.pose)
-    else:
-        check_pose_name(args.pose)
-    args.fps = WALK_FPS if args.fps is None else args.fps
-    frames = source.motion.frames if isinstance(source, BvhClip) else len(source or [])
-    still = [FORMATS[k] for k in kinds if k in FORMATS and not FORMATS[k].animated]  # (npz: batch's own bundle)
-    if still and (args.pose in MOTIONS or frames > 1):
-        raise UsageError(
-            f"--pose {args.pose} is an animation and a .{still[0].extension} file holds none; write "
-            f"{', '.join('.' + f.extension for f in FORMATS.values() if f.animated)}"
-        )
-    return source
+    return PoseAsk(args.pose, args.fps, args.rig, args.keep_on_floor, "; --keep-on-floor holds it on the floor")
 
 
-def pose_frames(args, mannequin, source=None, notes=None):
-    """The frames of ``--pose`` for ``mannequin`` (None without --pose): ``source`` read by check_pose_argument (a
-    pose file's frames, or a clip: retargeted and clamped; what its bones became is said the first time, what was
-    clamped and where the feet went is added to ``notes``, or said when there are none), or the standard pose made
-    on its joints; ElliMannError naming the joint (and frame) of a pose beyond its limits (a clip's are clamped)."""
-    from ..core.pose.kinematics import check_limits, require_joints
-    from ..core.pose.standard import standard_motion
-
-    if args.pose is None:
-        return None
-    if isinstance(source, BvhClip):
-        from ..core.pose.clip import clip_onto
-
-        if not getattr(args, "clip_said", False):  # once per command (batch: not per row)
-            args.clip_said = True
-            for line in source.lines():
-                say(f"{PROG} {args.command}: {line}")
-            if source.match.stiff_line():
-                say(f"{PROG} {args.command}: warning: {source.match.stiff_line()}")
-        onto = clip_onto(mannequin, source.motion, source.match, args.keep_on_floor, source.name)
-        hint = "; --keep-on-floor holds it on the floor" if not args.keep_on_floor else ""
-        clamped = onto.clamp_lines()
-        if notes is not None:
-            notes.extend(clamped + [onto.floor_line(hint)])
-            return onto.poses
-        for line in clamped:
-            say(f"{PROG} {args.command}: warning: {line}")
-        say(f"{PROG} {args.command}: {onto.floor_line(hint)}")
-        return onto.poses
-    joints = require_joints(mannequin)
-    frames = source if source is not None else standard_motion(args.pose, joints, args.fps)
-    for index, frame in enumerate(frames):
-        check_limits(frame, joints, index if len(frames) > 1 else None)
-    return frames
+def say_clip(args, pose):
+    """What a clip's bones became and which will not bend, said once per command (a batch: not per row)."""
+    if pose is None or pose.clip is None:
+        return
+    for line in pose.clip.lines():
+        say(f"{PROG} {args.command}: {line}")
+    if pose.clip.match.stiff_line():
+        say(f"{PROG} {args.command}: warning: {pose.clip.match.stiff_line()}")
 
 
 def synthesis_options(args, name=None):
-    """The SynthesisOptions of the command line (built once per command)."""
+    """The SynthesisOptions of the command line (built once per command), named ``name`` (default: from the
+    request)."""
     return SynthesisOptions(mode=args.mode, metric=args.metric, power=args.power, normalize=args.normalize, name=name)
 
 

@@ -17,15 +17,14 @@ from ..core.constants import MEASUREMENTS
 from ..core.errors import ElliMannError
 from ..core.files import incomplete
 from ..core.formats.npz_bundle import BatchFileWriter
-from ..core.formats.table import BATCH_FILE, FORMATS
+from ..core.formats.table import BATCH_FILE, format_named, listing
+from ..core.job.result import tolerance_text
 from ..core.mannequin.skeleton import JOINT_NAMES
 from ..core.measure.extra import EXTRA_MEASUREMENTS
 from ..core.measure.tailor import as_dict
 from ..core.synthesis.batch import by_reference_set, chunks, synthesize_chunk
-from ..core.synthesis.misses import missed_text, request_misses
-from ..core.synthesis.refine import EXACT_TOLERANCE
-from ..core.synthesis.synthesize import IDW_EXTRA_NOTE
-from . import arguments, distributed, output, reporting, skinning, writing
+from ..core.synthesis.misses import missed_text
+from . import arguments, distributed, jobs, output, reporting, skinning, writing
 from .batch_csv import MeasurementsCsv
 from .output import PROG, UsageError
 from .provenance import SAID, Provenance
@@ -33,7 +32,6 @@ from .provenance import SAID, Provenance
 NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,99}$")
 MAX_WARNING_LINES = 20  # range warnings printed before the rest go to the report only (a population has thousands)
 NPZ = BATCH_FILE.name  # the batch's one-file format (core.formats.npz_bundle), streamed as rows come
-EXTENSION_NAMES = {f.extension: name for name, f in FORMATS.items() if f.extension != name}  # xml: mjcf
 
 
 def add_parser(commands):
@@ -57,8 +55,8 @@ def add_parser(commands):
     batch.add_argument(
         "--format",
         default="json",
-        help=f"comma-separated output formats among {','.join(FORMATS)},npz (default json; mjcf (or xml, as "
-        "synth's .xml) writes NAME.xml; npz writes every mannequin of the batch into one compressed file "
+        help=f"comma-separated output formats among {listing(what='name')}, {NPZ} (default json; mjcf writes "
+        f"NAME.xml, as synth's .xml; {NPZ} writes every mannequin of the batch into one compressed file "
         "DIR/mannequins.npz, docs/formats/batch_npz.md)",
     )
     batch.add_argument(
@@ -83,17 +81,7 @@ def add_parser(commands):
     arguments.add_synthesis_options(batch)
     arguments.add_pose_option(batch)
     skinning.add_skin_options(batch)
-    batch.set_defaults(run=run, blender=needs_blender)
-
-
-def needs_blender(args):
-    """What needs Blender in this command (None: nothing)."""
-    try:
-        formats = parse_formats(args.format)
-    except UsageError:
-        return None
-    blender = [f for f in formats if f in FORMATS and FORMATS[f].needs_blender_for(args.pose is not None)]
-    return f"--format {blender[0]}" if blender else None
+    batch.set_defaults(run=run, blender=lambda args: None)  # the batch's job checks its files
 
 
 def parse_shard(text):
@@ -106,21 +94,23 @@ def parse_shard(text):
 
 
 def parse_formats(text):
-    """The formats of ``--format``: FORMATS' names, or a file extension (xml: MJCF, as ``synth -o NAME.xml``)."""
-    formats = [f.strip().lower().lstrip(".") for f in text.split(",") if f.strip()]
-    formats = [EXTENSION_NAMES.get(f, f) for f in formats]
-    unknown = [f for f in formats if f not in FORMATS and f != NPZ]
-    if unknown or not formats:
-        raise UsageError(f"--format takes a comma-separated list of {', '.join(FORMATS)} (or xml), {NPZ}, got {text!r}")
-    return list(dict.fromkeys(formats))
+    """The formats of ``--format`` (rows of ``core.formats.table``: their names, or an extension, xml for MJCF as
+    ``synth -o NAME.xml``), and whether the batch file (npz) is asked."""
+    words = [word.strip() for word in text.split(",") if word.strip()]
+    found = [format_named(word, batch=True) for word in words]
+    if not words or None in found:
+        raise UsageError(f"--format takes a comma-separated list of {listing(what='name')}, {NPZ}, got {text!r}")
+    kinds = list(dict.fromkeys(found))
+    return [kind for kind in kinds if kind is not BATCH_FILE], BATCH_FILE in kinds
 
 
 def run(args):
-    formats = parse_formats(args.format)
-    pose_file = arguments.check_pose_argument(args, formats)
+    from ..core.job.request import Request
+
+    formats, bundled = parse_formats(args.format)
     shard, shards = parse_shard(args.shard)
-    options = arguments.synthesis_options(args).checked()  # once, before anything is written
-    args.skin_settings = skinning.skin_settings(args)
+    options = arguments.synthesis_options(args)
+    skin = skinning.skin_settings(args)
     sets = {"": arguments.references(args)}  # the command's set, read once, and each other set a row names
 
     def reference_of(chosen):
@@ -133,40 +123,42 @@ def run(args):
         raise UsageError(f"{args.csv} has a header but no rows")
     for warning in table.warnings():  # what of the file is not read, before any row is made
         output.say(f"{PROG} {args.command}: warning: {warning}")
-    check_skin_batch(args, formats, table, sets[""])
+    if skin is not None and bundled:
+        raise UsageError("--skin with --format npz: the batch file holds the pieces only; write json, obj or mjcf")
+    if skin is not None and args.dask:
+        raise UsageError("--skin with --dask: skins are made one row at a time in this process; drop --dask")
+    # the whole command checked once, on the command's set, before anything is written: every row's job is that
+    # one with its own measurements, set and names (rows of another set are checked as they come)
+    reference = sets[""]
+    command = jobs.checked(
+        Request(
+            dict(zip(MEASUREMENTS, reference.measurements[0])),
+            reference,
+            options=options,
+            cushions=args.cushions,
+            skin=skin,
+            pose=arguments.pose_ask(args),
+            outputs=tuple(os.path.join(args.output, f"NAME.{kind.extension}") for kind in formats),
+        )
+    )
+    arguments.say_clip(args, command.pose)
     cluster = distributed.connect(args.dask) if args.dask else None  # before anything is written
     try:
-        return _run(args, formats, shard, shards, table, reference_of, options, cluster, pose_file)
+        return _run(args, command, formats, bundled, shard, shards, table, reference_of, cluster)
     finally:
         if cluster is not None:
             cluster.close()
 
 
-def check_skin_batch(args, formats, table, reference):
-    """Refuse, before anything is written, what --skin cannot do in this batch: the batch file (it holds pieces),
-    Dask (skins are made in this process), a voxel the command's reference set refuses, posing a set without
-    joints."""
-    settings = args.skin_settings
-    if settings is None:
-        return
-    if NPZ in formats:
-        raise UsageError("--skin with --format npz: the batch file holds the pieces only; write json, obj or mjcf")
-    if args.dask:
-        raise UsageError("--skin with --dask: skins are made one row at a time in this process; drop --dask")
-    if args.pose is not None:
-        skinning.require_joints_for_skin(reference.mannequins[0], f"the {reference.name} set's")
-    skinning.check_skins_fit(settings, reference.mannequins)
-
-
-def _run(args, formats, shard, shards, table, reference_of, options, cluster, pose_file):
+def _run(args, command, formats, bundled, shard, shards, table, reference_of, cluster):
     writing.output_folder(args.output, "batch")
     suffix = "" if shards == 1 else f"-{shard}-of-{shards}"
     report = reporting.Report(os.path.join(args.output, f"report{suffix}.csv"))
     mine = len(range(shard - 1, table.count, shards))
     progress = output.Progress(mine, "batch", quiet=args.quiet)
     # one batch file per reference set: mannequins.npz, or mannequins-NAME.npz when the rows name several
-    made = Provenance(args.output, args)  # what each row's files are made from (--resume compares it)
-    bundles = Bundles(args.output, suffix, args.mode, len(table.references) > 1, made) if NPZ in formats else None
+    made = Provenance(args.output, command)  # what each row's files are made from (--resume compares it)
+    bundles = Bundles(args.output, suffix, args.mode, len(table.references) > 1, made) if bundled else None
     rows = (row for index, row in enumerate(table.rows(reference_of, NAME_PATTERN)) if index % shards == shard - 1)
     reading, window = chunks(rows), collections.deque()  # chunks read and sent, in the CSV's order
     announced = Announcer(report.path)
@@ -177,12 +169,12 @@ def _run(args, formats, shard, shards, table, reference_of, options, cluster, po
                 if chunk is None:
                     break
                 announced.rows(chunk)
-                window.append(Chunk(chunk, options, cluster))
+                window.append(Chunk(chunk, command.options, cluster))
             if not window:
                 break
             chunk = window[0]
             for row, (result, i) in chunk.outcomes():
-                report.add(_row(args, formats, result, i, row, bundles, pose_file, made))
+                report.add(_row(args, command, formats, result, i, row, bundles, made))
                 chunk.done += 1
                 progress.step(row.name)
             window.popleft()
@@ -225,9 +217,7 @@ def _run(args, formats, shard, shards, table, reference_of, options, cluster, po
         output.say(f"{PROG} batch: error: {failed} row(s) failed; see {report.path}")
         return 1
     if missed:
-        tolerance = f"{EXACT_TOLERANCE * 100:g}%"
-        if args.skin_settings is not None:
-            tolerance = f"{skinning.mesh_tolerance_cm() * 10:g} mm on the skin"
+        tolerance = tolerance_text(command.skin is not None)
         output.say(
             f"{PROG} batch: warning: exact mode missed the request of {missed} row(s) by more than {tolerance}; "
             f"see {report.path}"
@@ -293,21 +283,26 @@ class Chunk:
         return list(zip(self.rows, where))
 
 
-def _row(args, formats, result, i, row, bundles=None, pose_file=None, made=None):
+def _row(args, command, formats, result, i, row, bundles=None, made=None):
     """Write (or, with --resume, keep) the files of one row, and mark it for the batch file; its report row. A
     refused row (``result`` None) or a failure is that row's: one line on stderr and status "error", and the batch
-    goes on. A row that asks for extra measurements has them met (exact mode, ``core.synthesis.batch``), and the
-    report gives what each measurement asked came to. ``made``: the batch's Provenance: --resume keeps a row's files
-    only when they are all there, whole, and were made from this row and these settings; otherwise they are made
-    again, and the report says why ("redone (--resume: He changed)")."""
+    goes on. The row's job is the ``command``'s with its own request (``core.job.request.row_job``), finished from
+    its synthesized mannequin (``core.job.make.finish``: its skin, poses and misses); a row that asks for extra
+    measurements has them met (exact mode, ``core.synthesis.batch``), and the report gives what each measurement
+    asked came to. ``made``: the batch's Provenance: --resume keeps a row's files only when they are all there,
+    whole, and were made from this row and these settings; otherwise they are made again, and the report says why
+    ("redone (--resume: He changed)")."""
+    from ..core.job.make import finish, synthesized_misses
+    from ..core.job.request import row_job
+
     line, name, values, extra = row.line, row.name, row.values, row.extra
     if result is None:
         return reporting.report_row(line, name, "error", row.error, values)
     if result.error(i) is not None:
         output.say(f"{PROG} batch: line {line}: failed: {result.error(i)}")
         return reporting.report_row(line, name, "error", result.error(i), values, extra=extra)
-    paths = [os.path.join(args.output, f"{name}.{writing.extension(kind)}") for kind in formats if kind != NPZ]
-    notes = list(row.warnings) + ([IDW_EXTRA_NOTE] if extra and args.mode != "exact" else [])
+    paths = [os.path.join(args.output, f"{name}.{kind.extension}") for kind in formats]
+    job = row_job(command, dict(zip(MEASUREMENTS, values)), row.reference, extra, row.warnings, name, paths)
     mannequin = result.mannequin(i, name)
     measured = as_dict(result.measured[i])
     if extra:
@@ -319,73 +314,55 @@ def _row(args, formats, result, i, row, bundles=None, pose_file=None, made=None)
     whole = bool(paths) and args.resume and all(os.path.isfile(path) and incomplete(path) is None for path in paths)
     changed = made.changed(row) if whole and made is not None else None
     kept = whole and changed is None
+    notes = [f"redone (--resume: {changed})"] if changed else []
     if changed:
-        notes.append(f"redone (--resume: {changed})")
         made.redone += 1
         if made.redone <= SAID:
             output.say(
                 f"{PROG} batch: line {line}: {name}'s files were made from another row or settings ({changed}): "
                 "made again"
             )
-    skinned = None
+    made_now = None
     if not kept:
         try:
             if paths and made is not None:
                 made.forget(name)  # no record while its files are being written again
-            skinned = _write_row(
-                args, paths, mannequin, measured, dict(zip(MEASUREMENTS, values)), extra, pose_file, notes
-            )
+            made_now = finish(job, mannequin, measured)
+            if paths:
+                writing.write(made_now, job.formats, args.cushions)
             if paths and made is not None:
                 made.write(row)
         except (ElliMannError, OSError, RuntimeError) as error:
             output.say(f"{PROG} batch: line {line}: failed: {output.one_line(error)}")
             return reporting.report_row(line, name, "error", output.one_line(error), values, extra=extra)
-    if skinned is not None:
-        missed = skinned.misses({**dict(zip(MEASUREMENTS, values)), **extra})
-        text = skinning.missed_text(missed, skinned.rounds) if missed else ""
-    elif args.skin_settings is not None:  # kept with --skin: what its skin and pieces measure is in its files
-        missed, text, measured = [], "", None
+    if made_now is not None:
+        missed, text, measured = made_now.missed, made_now.missed_text(), made_now.measured
+        lines = made_now.warnings + made_now.notes
+    elif job.skin is not None:  # kept with --skin: what its skin and pieces measure is in its files
+        missed, text, measured, lines = [], "", None, list(job.warnings)
     else:
-        missed = request_misses(measured, values, extra, args.mode)
-        text = missed_text(missed) if missed else ""
+        missed = synthesized_misses(job, measured)
+        text, lines = missed_text(missed) if missed else "", list(job.warnings)
     if missed:
-        notes.append(text)
         output.say(f"{PROG} batch: line {line}: warning: {text}")
+    skin = made_now.skin if made_now is not None else None
     report = reporting.report_row(
         line,
         name,
         "missed" if missed else "ok",
-        "; ".join(notes + (["kept (--resume)"] if kept else [])),
+        "; ".join(lines + notes + [text][: bool(missed)] + (["kept (--resume)"] if kept else [])),
         values,
         measured,
         listed,
         row.reference.name,
         extra,
-        skin_settings=skinned.skin.settings if skinned else None,
-        skin_measured=skinned.measured if skinned else None,
+        skin_settings=skin.settings if skin else None,
+        skin_measured=skin.measured if skin else None,
     )
     report["kept"], report["redone"] = kept, bool(changed)
     if bundles is not None:
         bundles.mark(row.reference, result, i, name)
     return report
-
-
-def _write_row(args, paths, mannequin, measured, request, extra, pose_file, notes):
-    """Write one row's files; with --skin, its skin made first (its pieces refined for it in exact mode, their m_T
-    put in ``measured``) and dropped once written. Returns the ``skinning.Skinned``, or None."""
-    skinned = None
-    if args.skin_settings is not None:
-        if args.pose is not None:  # before the skin is made (a row of another reference set)
-            skinning.require_joints_for_skin(mannequin, f"the {mannequin.reference_set} set's")
-        skinned = skinning.make_skin(mannequin, args.skin_settings, args.mode, request, extra)
-        mannequin = skinned.mannequin
-        measured.update(skinned.pieces)
-    if paths:
-        frames = arguments.pose_frames(args, mannequin, pose_file, notes)
-        skin = skinned.skin if skinned else None
-        five = {key: measured[key] for key in MEASUREMENTS}
-        writing.write(mannequin, paths, five, args.cushions, frames, args.fps, skin=skin)
-    return skinned
 
 
 class Bundles:

@@ -4,7 +4,7 @@ import sys
 
 from ..core.errors import MannequinError
 from ..core.formats.table import FORMATS, format_of
-from . import arguments, output, skinning, writing
+from . import arguments, jobs, output, skinning, writing
 from .output import PROG, UsageError
 
 
@@ -30,45 +30,46 @@ def add_parser(commands):
     arguments.add_verbose(pose)
     arguments.add_pose_option(pose)
     skinning.add_skin_options(pose, rebuilt=True)
-    pose.set_defaults(run=run, blender=needs_blender)
-
-
-def needs_blender(args):
-    kind = format_of(args.output)
-    return f"writing {args.output}" if kind is not None and kind.needs_blender_for(True) else None
+    pose.set_defaults(run=run, blender=lambda args: None)  # the job checks its file
 
 
 def run(args):
+    from ..core.job.make import make
+    from ..core.job.request import Request
     from ..core.mannequin.model import Mannequin
 
-    kind = writing.output_kind(args.output)
     if args.pose is None:
         raise UsageError(f"--pose is required: one of the standard poses or a pose .json (see {PROG} pose --help)")
     if format_of(args.input) is not FORMATS["json"]:
         raise UsageError(f"IN must be a mannequin .json file, got {args.input!r}")
-    pose_file = arguments.check_pose_argument(args, [kind])
     try:
         mannequin = Mannequin.load(args.input)
     except MannequinError as error:
         raise UsageError(f"{args.input}: {error}") from None
     settings = skinning.skin_settings(args, mannequin.skin)
-    if settings is not None:
-        skinning.require_joints_for_skin(mannequin, args.input)
-    frames = arguments.pose_frames(args, mannequin, pose_file)
-    skin = None
-    if settings is not None:  # made again from the pieces, as the file records (the same pieces: the same skin)
-        skinning.check_skins_fit(settings, [mannequin])
-        recorded = mannequin.skin and skinning.SkinSettings.from_dict(mannequin.skin)
-        if recorded and recorded != settings:
-            output.say(
-                f"{PROG} pose: {args.input} records its skin at {skinning.describe(recorded)}; made at "
-                f"{skinning.describe(settings)} as asked (another voxel or blend measures a little differently)"
-            )
-        from ..core.skin.surface import build_skin
-
-        skin = build_skin(mannequin, settings)
-    writing.write(mannequin, [args.output], None, args.cushions, frames, args.fps, skin=skin)
+    request = Request(
+        skin=settings,
+        pose=arguments.pose_ask(args),
+        outputs=(args.output,),
+        cushions=args.cushions,
+        mannequin=mannequin,
+    )
+    job = jobs.checked(request)
+    arguments.say_clip(args, job.pose)
+    recorded = mannequin.skin and skinning.SkinSettings.from_dict(mannequin.skin)
+    if settings is not None and recorded and recorded != settings:
+        output.say(
+            f"{PROG} pose: {args.input} records its skin at {skinning.describe(recorded)}; made at "
+            f"{skinning.describe(settings)} as asked (another voxel or blend measures a little differently)"
+        )
+    result = make(job)  # the skin made again from the pieces, as the file records (the same pieces: the same skin)
+    for warning in result.warnings:
+        output.say(f"{PROG} pose: warning: {warning}")
+    for note in result.notes:
+        output.say(f"{PROG} pose: {note}")
+    writing.write(result, job.formats, args.cushions)
+    frames = result.frames
     count = f" ({len(frames)} frames)" if len(frames) > 1 else ""
-    made = f", with its {skinning.describe(settings)}" if skin is not None else ""
+    made = f", with its {skinning.describe(settings)}" if settings is not None else ""
     output.say(f"wrote {args.output}: '{mannequin.name}' in pose {args.pose}{count}{made}", file=sys.stdout)
     return 0

@@ -46,21 +46,20 @@ def file_digest(paths):
 
 
 class Provenance:
-    """The records of a batch writing into ``folder``: the settings every row shares (from the command line
-    ``args``, once) and, per reference set, its identity (digested once)."""
+    """The records of a batch writing into ``folder``: the settings every row shares (its ``command``'s job,
+    ``core.job.request.Job``, once) and, per reference set, its identity (digested once)."""
 
-    def __init__(self, folder, args):
+    def __init__(self, folder, command):
         self.folder = os.path.join(folder, RECORD_FOLDER)
+        options, request = command.options, command.request
         self.settings = {
-            "mode": args.mode,
-            "metric": args.metric,
-            "power": float(args.power),
-            "normalize": args.normalize,
-            "cushions": bool(args.cushions),
-            "skin": None
-            if args.skin_settings is None
-            else {"voxel_mm": args.skin_settings.voxel_mm, "blend": args.skin_settings.blend},
-            "pose": _pose(args),
+            "mode": options.mode,
+            "metric": options.metric,
+            "power": float(options.power),
+            "normalize": options.normalize,
+            "cushions": bool(request.cushions),
+            "skin": None if request.skin is None else {"voxel_mm": request.skin.voxel_mm, "blend": request.skin.blend},
+            "pose": _pose(request.pose),
         }
         self.sets = {}
         self.redone = 0
@@ -148,14 +147,14 @@ def _set_key(recorded):
     return (recorded.get("name"), recorded.get("sha256")) if isinstance(recorded, dict) else None
 
 
-def _pose(args):
+def _pose(ask):
     """The pose part of a record: None, or the pose's name (a standard pose) or its file's digest, with the options
-    that change what a pose file or clip becomes."""
-    if args.pose is None:
+    that change what a pose file or clip becomes (``ask``: a ``core.job.request.PoseAsk``)."""
+    if ask is None:
         return None
-    out = {"name": args.pose, "fps": args.fps}
-    if os.path.isfile(args.pose):
-        out = {"file": os.path.basename(args.pose), "sha256": file_digest([args.pose]), "fps": args.fps}
-        if args.pose.lower().endswith(".bvh"):
-            out.update(rig=args.rig, keep_on_floor=bool(args.keep_on_floor))
+    out = {"name": ask.source, "fps": ask.fps}
+    if os.path.isfile(ask.source):
+        out = {"file": os.path.basename(ask.source), "sha256": file_digest([ask.source]), "fps": ask.fps}
+        if ask.source.lower().endswith(".bvh"):
+            out.update(rig=ask.rig, keep_on_floor=bool(ask.keep_on_floor))
     return out

@@ -5,11 +5,10 @@ import json
 import sys
 
 from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS, RANGES
-from ..core.errors import ElliMannError
-from ..core.formats.table import FORMATS
+from ..core.formats.table import listing
 from ..core.measure.extra import EXTRA_ABSURD_LIMITS, EXTRA_LABELS, EXTRA_MEASUREMENTS
 from ..core.synthesis.request import relative_error
-from . import arguments, output, skinning, writing
+from . import arguments, jobs, output, skinning, writing
 from .output import PROG, UsageError
 
 
@@ -52,7 +51,7 @@ def add_parser(commands):
         "--output",
         required=True,
         metavar="OUT",
-        help="output file: .blend, .glb, .obj, .json (ElliMann's mannequin JSON) or .xml (MJCF, for MuJoCo)",
+        help=f"output file: {listing()} (the format by its extension)",
     )
     synth.add_argument("--name", help="mannequin name (default: 'ElliMann He-Sh-Br-Wa-Hi')")
     synth.add_argument(
@@ -64,20 +63,7 @@ def add_parser(commands):
     arguments.add_synthesis_options(synth)
     arguments.add_pose_option(synth)
     skinning.add_skin_options(synth)
-    synth.set_defaults(run=run, blender=needs_blender)
-
-
-def needs_blender(args):
-    """What needs Blender in this command (None: nothing)."""
-    kind = FORMATS.get(_kind_or_none(args.output))
-    return f"writing {args.output}" if kind is not None and kind.needs_blender_for(args.pose is not None) else None
-
-
-def _kind_or_none(path):
-    try:
-        return writing.output_kind(path)
-    except UsageError:
-        return None
+    synth.set_defaults(run=run, blender=lambda args: None)  # the job checks its files
 
 
 def _wanted(args):
@@ -108,89 +94,72 @@ def _wanted(args):
 
 
 def run(args):
-    from ..core.synthesis.synthesize import synthesize_extra
+    from ..core.job.make import make
+    from ..core.job.request import Request
 
-    kind = writing.output_kind(args.output)
-    pose_file = arguments.check_pose_argument(args, [kind])
-    settings = skinning.skin_settings(args)
     five, extra = _wanted(args)
-    reference = arguments.references(args)
-    try:  # the request is checked here, once, before any work (its warnings come back with the result)
-        options = arguments.synthesis_options(args, args.name)
-        result = synthesize_extra(reference, five, extra, options, measure_extra=False)
-    except ElliMannError as error:
-        raise UsageError(output.one_line(error)) from None
-    mannequin, measured = result.mannequin, result.measured
-    for warning in result.warnings:
-        output.say(f"{PROG} synth: warning: {warning}")
-    skinned = None
-    if settings is not None:  # everything that can refuse the skin is checked before it is made
-        if args.pose is not None:
-            skinning.require_joints_for_skin(mannequin, f"synthesized from the {reference.name} set")
-            arguments.pose_frames(args, mannequin, pose_file, notes=[])
-        skinning.check_skins_fit(settings, [mannequin])
-        skinned = skinning.make_skin(mannequin, settings, args.mode, five, extra)
-        mannequin = skinned.mannequin
-        measured = {**measured, **skinned.pieces}
-    frames = arguments.pose_frames(args, mannequin, pose_file)
-    writing.write(
-        mannequin,
-        [args.output],
-        {key: measured[key] for key in MEASUREMENTS},
-        args.cushions and kind != "json",
-        frames,
-        args.fps,
-        skin=skinned.skin if skinned else None,
+    request = Request(
+        five,
+        arguments.references(args),
+        extra,
+        arguments.synthesis_options(args, args.name),
+        args.cushions,
+        skinning.skin_settings(args),
+        arguments.pose_ask(args),
+        (args.output,),
     )
-    missed = skinned.misses({**five, **extra}) if skinned else []
-    if missed:
-        output.say(f"{PROG} synth: warning: {skinning.missed_text(missed, skinned.rounds)}")
+    job = jobs.checked(request)  # everything that could refuse it, before any work
+    arguments.say_clip(args, job.pose)
+    result = make(job)
+    for warning in result.warnings + [result.missed_text()][: bool(result.missed)]:
+        output.say(f"{PROG} synth: warning: {warning}")
+    for note in result.notes:
+        output.say(f"{PROG} synth: {note}")
+    writing.write(result, job.formats, args.cushions)
     if args.json:
-        print(json.dumps(_result(args, mannequin, five, extra, measured, skinned, missed)))
+        print(json.dumps(_result(args, result)))
     else:
-        output.say(_line(args, mannequin, five, extra, measured, skinned), file=sys.stdout)
-    return output.MISSED if (missed if skinned else result.missed) else 0
+        output.say(_line(args, result), file=sys.stdout)
+    return output.MISSED if result.missed else 0
 
 
-def _line(args, mannequin, five, extra, measured, skinned):
+def _line(args, result):
     """ "wrote OUT: 'NAME' (exact), m_T ... cm, max error ...%"; with a skin, the skin's measurements first and
     the pieces' m_T beside them."""
     posed = f" in pose {args.pose}" if args.pose else ""
-    asked = [five[key] for key in MEASUREMENTS]
-    if skinned is None:
-        achieved = [measured[key] for key in MEASUREMENTS]
-        error = relative_error(achieved, asked).max()
-        extra_line = ""
-        if extra:
-            extra_line = "; " + ", ".join(f"{key} {measured[key]:.2f}" for key in EXTRA_MEASUREMENTS) + " cm"
+    asked = [result.request[key] for key in MEASUREMENTS]
+    extra = [key for key in EXTRA_MEASUREMENTS if key in result.request]
+    shown = result.shown()
+    error = relative_error([shown[key] for key in MEASUREMENTS], asked).max()
+    extra_line = "; " + ", ".join(f"{key} {shown[key]:.2f}" for key in extra) + " cm" if extra else ""
+    name = result.mannequin.name
+    if result.skin is None:
         return (
-            f"wrote {args.output}: '{mannequin.name}'{posed} ({args.mode}), m_T {output.format_me(achieved)} cm, "
+            f"wrote {args.output}: '{name}'{posed} ({args.mode}), m_T {output.format_me(result.five)} cm, "
             f"max error {error:.3f}%{extra_line}"
         )
-    on_skin = [skinned.measured[key] for key in MEASUREMENTS]
-    error = relative_error(on_skin, asked).max()
-    extra_line = "; " + ", ".join(f"{key} {skinned.measured[key]:.2f}" for key in extra) + " cm" if extra else ""
-    rounds = f"; {skinned.rounds} round(s) of exact mode on the skin" if skinned.exact else ""
+    skin = result.skin
+    rounds = f"; {skin.rounds} round(s) of exact mode on the skin" if skin.exact else ""
     return (
-        f"wrote {args.output}: '{mannequin.name}'{posed} ({args.mode}, {skinning.describe(skinned.skin.settings)}), "
-        f"skin {output.format_me(on_skin)} cm, max error {error:.3f}%{extra_line}; pieces' m_T "
-        f"{output.format_me(skinned.pieces)} cm{rounds}"
+        f"wrote {args.output}: '{name}'{posed} ({args.mode}, {skinning.describe(skin.settings)}), "
+        f"skin {output.format_me([shown[key] for key in MEASUREMENTS])} cm, max error {error:.3f}%{extra_line}; "
+        f"pieces' m_T {output.format_me(result.five)} cm{rounds}"
     )
 
 
-def _result(args, mannequin, five, extra, measured, skinned, missed):
+def _result(args, result):
     """The --json object: what was asked, what the pieces measure (m_T, and the extra measurements asked) and, with
     a skin, what the skin measures on its mesh."""
-    asked = {**five, **extra}
+    asked = result.request
 
     def errors(values):
         keys = [key for key in asked if key in values]
         return dict(zip(keys, (float(e) for e in relative_error([values[k] for k in keys], [asked[k] for k in keys]))))
 
-    pieces = {key: measured[key] for key in list(MEASUREMENTS) + [k for k in EXTRA_MEASUREMENTS if k in extra]}
+    pieces = {key: result.measured[key] for key in asked}
     out = {
         "output": args.output,
-        "name": mannequin.name,
+        "name": result.mannequin.name,
         "mode": args.mode,
         "pose": args.pose,
         "requested": asked,
@@ -198,17 +167,17 @@ def _result(args, mannequin, five, extra, measured, skinned, missed):
         "error_pct": errors(pieces),
         "skin": None,
     }
-    if skinned is not None:
-        skin = skinned.skin
+    if result.skin is not None:
+        skin = result.skin
         out["skin"] = {
             **skin.settings.to_dict(),
-            "measured": skinned.measured,
-            "error_pct": errors(skinned.measured),
-            "exact": skinned.exact,
-            "rounds": skinned.rounds,
-            "converged": (skinned.converged and not missed) if skinned.exact else None,
-            "vertices": len(skin.vertices),
-            "faces": len(skin.faces),
-            "volume_l": skin.volume * 1000.0,
+            "measured": skin.measured,
+            "error_pct": errors(skin.measured),
+            "exact": skin.exact,
+            "rounds": skin.rounds,
+            "converged": (skin.converged and not result.missed) if skin.exact else None,
+            "vertices": len(skin.skin.vertices),
+            "faces": len(skin.skin.faces),
+            "volume_l": skin.skin.volume * 1000.0,
         }
     return json.loads(json.dumps(out), parse_constant=lambda constant: None)  # NaN (not taken): null

@@ -1,6 +1,6 @@
-"""Writing files: core formats without Blender, Blender's (.blend, .glb) through ``blender.services`` only when
-asked (bpy is imported only inside the functions that need it); one-line errors naming the file; the output
-folder."""
+"""Writing a job's files by the format table's writers (``core.formats.table``): the core's without Blender,
+Blender's (.blend, .glb) through ``blender.services.writers`` only when asked (bpy is imported only inside the
+functions that need it); one-line errors naming the file; the output folder."""
 
 import contextlib
 import importlib.util
@@ -10,8 +10,7 @@ import tempfile
 
 from ..core.errors import one_line
 from ..core.files import atomic_write_text, clean_stale_temporaries
-from ..core.formats.core_writers import core_format, write_core_file
-from ..core.formats.table import FORMATS, format_of
+from ..core.formats.table import write_files
 from .output import PROG, UsageError, say
 
 
@@ -32,8 +31,10 @@ def no_blender(what):
     )
 
 
-def ensure_registered(what="this"):
-    """Import bpy; under ``python -m`` register the add-on once so ElliMann's properties exist."""
+def blender_writers(what="this"):
+    """Make the format table's Blender rows writable (``blender.services.writers`` binds their writer): import bpy
+    and, under ``python -m``, register only what the writers need of the add-on (the ``ellimann`` properties of
+    objects and collections, ``blender.bridge.props``), not its panels and operators."""
     from ..blender.services.chatter import blender_output
 
     with blender_output():
@@ -41,73 +42,44 @@ def ensure_registered(what="this"):
             import bpy
         except ImportError:
             raise no_blender(what) from None
-
         if not hasattr(bpy.types.Collection, "ellimann"):
-            from .. import register
+            from ..blender.bridge import props
 
-            register()
+            for cls in props.classes:
+                bpy.utils.register_class(cls)
+            props.register_hooks()
+        from ..blender.services import writers  # noqa: F401  (binds the .blend and .glb rows' writer)
     return bpy
 
 
-def output_kind(path):
-    kind = format_of(path)
-    if kind is None:
-        raise UsageError(f"OUT must end in .blend, .glb, .obj, .json or .xml (MJCF), got {path!r}")
-    return kind.name
-
-
-def extension(kind):
-    return FORMATS[kind].extension
-
-
-def write(mannequin, paths, measured, cushions, frames=None, fps=None, skin=None):
-    """Write every path (format from the extension); Blender is loaded only for .blend and .glb. ``frames``: the
-    pose (a list of core.pose.kinematics.Pose) to write the mannequin in, if any; ``skin``: its skin
-    (``core.skin.surface.Skin``, ``--skin``), written with it (``core.formats.core_writers``; .blend and .glb:
-    ``blender.services``).
-
-    A path that cannot be written raises UsageError naming it (not the temporary file behind it).
-    """
-    if frames is not None:
-        return write_posed(mannequin, paths, cushions, frames, fps, measured, skin)
-    for path in paths:
-        if core_format(path):
-            with writing(path):
-                write_core_file(mannequin, path, cushions, skin)
-    blender = [p for p in paths if core_format(p) is None]
+def write(result, formats, cushions=False):
+    """Write a job's ``result`` (``core.job.result.Result``: the mannequin, its skin, its poses) to every path of
+    ``formats`` ({path: Format}, decided once by the job), each by its row's writer (``core.formats.table``);
+    Blender is loaded only for .blend and .glb. A path that cannot be written raises UsageError naming it (not the
+    temporary file behind it)."""
+    posed = result.frames is not None
+    blender = [path for path, kind in formats.items() if kind.needs_blender_for(posed)]
     if blender:
-        ensure_registered(f"writing {blender[0]}")
-        from ..blender.services.files import write_mannequin
-
+        blender_writers(f"writing {blender[0]}")
+    settings = dict(
+        cushions=cushions,
+        skin=result.skin.skin if result.skin is not None else None,
+        measured=result.five if result.measured else None,
+        frames=result.frames,
+        fps=result.fps,
+    )
+    for path, kind in formats.items():  # the core's files one at a time: an error names its file
+        if not kind.needs_blender_for(posed):
+            with writing(path):
+                write_files(result.mannequin, {path: kind}, **settings)
+    if blender:  # Blender's together, from one scene
         try:
-            write_mannequin(mannequin, blender, measured, cushions, skin=skin)
+            write_files(result.mannequin, {path: formats[path] for path in blender}, **settings)
         except OSError as error:  # atomic_output names the file that failed
             if error.filename is None:
                 raise
             raise cannot_write(error.filename, error) from None
-    return paths
-
-
-def write_posed(mannequin, paths, cushions, frames, fps, measured=None, skin=None):
-    """:func:`write` of a posed mannequin (and its ``skin``): .json, .xml and .obj by the core
-    (core.formats.posed_files), .blend and .glb by the Blender rig (``blender.services.posing.write_posed``)."""
-    from ..core.formats.posed_files import write_posed as write_core_posed
-
-    blender = [p for p in paths if format_of(p).needs_blender_for(True)]
-    for path in [p for p in paths if p not in blender]:
-        with writing(path):
-            write_core_posed(mannequin, frames, path, cushions, fps, skin)
-    if blender:
-        ensure_registered(f"writing {blender[0]}")
-        try:
-            from ..blender.services.posing import write_posed as write_blender_posed
-        except ImportError:
-            raise UsageError(
-                f"writing a posed {blender[0]} needs ElliMann's Blender rig, which this build lacks; "
-                "write .json, .xml or .obj"
-            ) from None
-        write_blender_posed(mannequin, frames, blender, cushions, fps, measured, skin=skin)
-    return paths
+    return list(formats)
 
 
 @contextlib.contextmanager

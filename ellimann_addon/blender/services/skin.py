@@ -1,53 +1,25 @@
-"""A mannequin's skin in the scene: made by the core (``core.skin``), written into the mannequin's built Skin
-collection (one object, rebuilt in place: ``bridge.skin``), weighted to the SMPL bones (one vertex group per bone,
-``Skin.bones()``) and bound to the mannequin's armature by an Armature modifier when it has one.
+"""A mannequin's skin in the scene: made by the core's job (``core.job``, ``core.skin``), written into the
+mannequin's built Skin collection (one object, rebuilt in place: ``bridge.skin``), weighted to the SMPL bones (one
+vertex group per bone, ``Skin.bones()``) and bound to the mannequin's armature by an Armature modifier when it has
+one.
 
 With a skin, the pieces stay beside it as colliders: in a .blend they are hidden (viewport and render) and each gets a
 Collision modifier (hidden, not disabled: Blender evaluates them, so cloth collides with them); a .glb keeps them as
 nodes (the skin covers them).
 
-Everything the core computes (the surface, the bone weights) comes before the scene changes: a SkinError leaves the
-file as it was.
+Everything the core computes (the surface, the bone weights: ``core.job.make.make(..., bones=True)``) comes before
+the scene changes: a SkinError leaves the file as it was.
 """
 
 import bpy
 import numpy as np
 
 from ...core.mannequin.skeleton import JOINT_NAMES
-from ...core.skin.exact import exact_skin
-from ...core.skin.surface import build_skin
 from ..bridge.convert import objects_recursive, rig_object
 from ..bridge.skin import write_skin_object
 from .rig import bind_armature, set_bone_weights
 
 COLLIDER_NAME = "ElliMann Collider"
-
-
-def make_skin(mannequin, settings, progress=None):
-    """The core Skin of ``mannequin`` at ``settings``, with its bone weights made when it has joints (the slow parts,
-    before any scene change). ``progress(fraction, message)``: called as the parts finish. SkinError (one line)."""
-    report = progress or (lambda fraction, message: None)
-    report(0.0, f"making the skin ({settings.voxel_mm:g} mm voxels)")
-    skin = build_skin(mannequin, settings)
-    if mannequin.joints is not None:
-        report(0.7, "weighting it to the bones")
-        skin.bones()
-    report(0.9, "writing it")
-    return skin
-
-
-def make_exact_skin(mannequin, settings, request, extra=None, progress=None):
-    """Exact mode on the skin (``core.skin.exact.exact_skin``): pieces near ``mannequin`` whose skin at ``settings``
-    measures ``request`` ({He..Hi: cm}) and ``extra``, the skin weighted to the bones when it has joints (before any
-    scene change). Returns the ExactSkin; ``progress`` as :func:`make_skin`'s."""
-    report = progress or (lambda fraction, message: None)
-    report(0.0, f"refining the pieces until their skin measures the request ({settings.voxel_mm:g} mm voxels)")
-    result = exact_skin(mannequin, settings, request, extra or None)
-    if result.mannequin.joints is not None:
-        report(0.8, "weighting it to the bones")
-        result.skin.bones()
-    report(0.9, "writing it")
-    return result
 
 
 def add_skin(collection, skin):

@@ -52,18 +52,21 @@ def finish(job, mannequin, measured, progress=None, bones=False):
     elif skin is not None:
         missed = skin_misses(skin.measured, request) if skin.exact else []
     else:
-        missed = request_misses(measured, job.values, job.extra, mode)
+        missed = synthesized_misses(job, measured)
     frames, notes = None, []
     if job.pose is not None:
         frames, clamped, notes = pose_frames(job.pose, mannequin)
         warnings += clamped
-    result = Result(
+    report(0.9, "done")
+    return Result(
         mannequin, measured, request, mode, skin, frames, job.pose.fps if job.pose else None, missed, warnings, notes
     )
-    if missed:
-        result.warnings.append(result.missed_text())
-    report(0.9, "done")
-    return result
+
+
+def synthesized_misses(job, measured):
+    """What a job's pieces, measuring ``measured`` ({key: cm}), miss of its request (exact mode only: IDW promises
+    no match), as ``core.synthesis.misses.Miss``."""
+    return request_misses(measured, job.values, job.extra, job.options.mode)
 
 
 def _skin(job, mannequin, measured, report):
@@ -105,10 +108,10 @@ def pose_frames(source, mannequin):
 
         clip = source.clip
         onto = clip_onto(mannequin, clip.motion, clip.match, source.ask.keep_on_floor, clip.name)
-        return onto.poses, onto.clamp_lines(), [onto.floor_line("" if source.ask.keep_on_floor else source.ask.floor_hint)]
+        hint = "" if source.ask.keep_on_floor else source.ask.floor_hint
+        return onto.poses, onto.clamp_lines(), [onto.floor_line(hint)]
     joints = require_joints(mannequin)
     frames = source.frames if source.frames is not None else standard_motion(source.name, joints, source.fps)
     for index, frame in enumerate(frames):
         check_limits(frame, joints, index if len(frames) > 1 else None)
     return frames, [], []
-

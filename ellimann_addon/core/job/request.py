@@ -10,8 +10,11 @@ made, let alone written, for a request that would be refused halfway. ``synth``,
 and the Synthesize operator build their jobs here; ``core.job.make`` makes them.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
+import numpy as np
+
+from ..constants import MEASUREMENTS
 from ..errors import ElliMannError
 from ..formats.table import check_outputs
 from ..measure.extra import EXTRA_MEASUREMENTS
@@ -106,9 +109,10 @@ class Job:
         return next((path for path, kind in self.formats.items() if kind.needs_blender_for(posed)), None)
 
 
-def check(request, blender=True):
+def check(request, blender=True, pose=None):
     """The :class:`Job` of ``request``, or ElliMannError (one line) for anything that would refuse it later;
-    ``blender``: whether Blender's writers can run here (a .blend or .glb output is refused without them)."""
+    ``blender``: whether Blender's writers can run here (a .blend or .glb output is refused without them);
+    ``pose``: the request's pose already read (a batch reads it once for every row), else read here."""
     request.options.checked()
     made = request.mannequin
     if made is None:
@@ -117,7 +121,7 @@ def check(request, blender=True):
         extra = checked_extra(as_dict(values), request.extra)
     else:
         values, warnings, extra = None, [], {}
-    pose = read_pose_ask(request.pose)
+    pose = read_pose_ask(request.pose) if pose is None else pose
     formats = check_outputs(request.outputs, animated=pose is not None and pose.animated)
     job = Job(request, values, extra, warnings, pose, formats)
     needs = job.needs_blender()
@@ -137,6 +141,26 @@ def check(request, blender=True):
         for mannequin in [made] if made is not None else request.references.mannequins:
             check_skin(mannequin, request.skin)
     return job
+
+
+def row_job(command, measurements, references, extra, warnings, name, outputs):
+    """The job of one row of a batch: the ``command``'s (checked whole once by :func:`check`) with the row's
+    ``measurements`` (the five, cm), ``extra`` ones and their range ``warnings`` (checked where the row was read),
+    its reference set, its mannequin's ``name`` and its ``outputs`` (their formats decided here). A row writing no
+    file of its own (a batch file's only) is not posed."""
+    request = replace(
+        command.request,
+        measurements=measurements,
+        references=references,
+        extra=extra,
+        options=command.options.replace(name=name),
+        outputs=tuple(outputs),
+    )
+    pose = command.pose if outputs else None
+    values = np.array([measurements[key] for key in MEASUREMENTS], dtype=float)
+    extra = {key: float(extra[key]) for key in EXTRA_MEASUREMENTS if key in extra}
+    formats = check_outputs(outputs, animated=pose is not None and pose.animated)
+    return Job(request, values, extra, list(warnings), pose, formats)
 
 
 def checked_extra(five, extra):

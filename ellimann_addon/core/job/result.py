@@ -32,9 +32,9 @@ class Result:
     m_T and the extra measurements asked ({key: cm}); ``request``: the five and the extra ones asked ({key: cm};
     None for a mannequin already made); ``skin``: a :class:`SkinMade` or None; ``frames``: the poses (a list of
     ``core.pose.kinematics.Pose``; None without a pose) at ``fps``; ``missed``: what exact mode missed
-    (``core.synthesis.misses.Miss``: the pieces' request, or with a skin the skin's); ``warnings``: the request's
-    (outside the reference range) and the result's (what was missed, extra measurements IDW does not meet);
-    ``notes``: what the pose did to this mannequin (joints clamped, where the feet went)."""
+    (``core.synthesis.misses.Miss``: the pieces' request, or with a skin the skin's; worded by :meth:`missed_text`);
+    ``warnings``: the request's (outside the reference range), extra measurements IDW does not meet, joints a clip
+    was clamped at; ``notes``: where a clip's feet went."""
 
     mannequin: object
     measured: dict

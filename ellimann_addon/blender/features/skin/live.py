@@ -13,10 +13,12 @@ import sys
 import uuid
 
 from ....core.errors import ElliMannError
+from ....core.job.make import make
+from ....core.job.request import Request, check
 from ....core.skin.settings import SkinSettings
 from ...bridge.convert import collection_to_mannequin
 from ...bridge.skin import is_stale_skin, skin_object, write_skin_vertices
-from ...services.skin import add_skin, make_skin
+from ...services.skin import add_skin
 from ..synthesize.live import Debounced, add_follower, remove_follower
 
 STAMP_KEY = "ellimann_skin_stamp"  # on a skin object: which core Skin it holds (_made)
@@ -71,7 +73,7 @@ def settle_skin(scene):
             return None
         if obj is not None and remembered(obj) is not None and not is_stale_skin(obj, mannequin):
             return None
-        skin = make_skin(mannequin, SkinSettings.at_level(LIVE_LEVEL))
+        skin = make(check(Request(mannequin=mannequin, skin=SkinSettings.at_level(LIVE_LEVEL))), bones=True).skin.skin
         obj = add_skin(target, skin)
     except (ElliMannError, RuntimeError) as error:
         message = " ".join(str(error).split())

@@ -7,10 +7,12 @@ import bpy
 from bpy.props import EnumProperty, FloatProperty
 
 from ....core.errors import ElliMannError
+from ....core.job.make import make
+from ....core.job.request import Request, check
 from ....core.skin.settings import SKIN, VOXEL_RANGE_MM, SkinSettings
 from ... import ids
 from ...bridge.convert import rig_object
-from ...services.skin import add_skin, make_skin
+from ...services.skin import add_skin
 from ..base import MannequinOperator, OperatorError, mannequin_or_cancel
 from . import live
 
@@ -72,7 +74,9 @@ class ELLIMANN_OT_build_skin(MannequinOperator, bpy.types.Operator):
         window_manager.progress_begin(0.0, 1.0)
         try:
             settings = settings_of(self.level, self.voxel, self.blend)
-            skin = make_skin(mannequin, settings, lambda fraction, _message: window_manager.progress_update(fraction))
+            job = check(Request(mannequin=mannequin, skin=settings))
+            result = make(job, lambda fraction, _message: window_manager.progress_update(fraction), bones=True)
+            skin = result.skin.skin
             obj = add_skin(collection, skin)  # the core's work is done: from here the scene changes
         except (ElliMannError, RuntimeError) as error:
             raise OperatorError(" ".join(str(error).split())) from None

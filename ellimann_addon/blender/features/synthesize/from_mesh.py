@@ -7,6 +7,8 @@ from mathutils import Vector
 
 from ....core.constants import MEASUREMENTS
 from ....core.errors import ElliMannError
+from ....core.job.make import make
+from ....core.job.request import Request, check
 from ....core.measure.extra import split_measurements
 from ....core.measure.tailor import measurement_line
 from ... import ids
@@ -33,8 +35,6 @@ class ELLIMANN_OT_synthesize_from_mesh(ElliMannOperator, bpy.types.Operator):
         )
 
     def run(self, context):
-        from ....core.synthesis.synthesize import synthesize_extra
-
         obj = context.active_object
         props = context.scene.ellimann_synthesis
         wm = context.window_manager
@@ -54,9 +54,12 @@ class ELLIMANN_OT_synthesize_from_mesh(ElliMannOperator, bpy.types.Operator):
                 )
             five, extra = split_measurements(values)
             try:
-                mannequin, measured, warnings, _ = synthesize_extra(reference, five, extra, options_of(props))
+                job = check(Request(five, reference, extra, options_of(props)))
+                result = make(job)
             except ElliMannError as error:
                 raise OperatorError(str(error)) from None
+            mannequin, measured = result.mannequin, result.measured
+            warnings = result.warnings + ([result.missed_text()] if result.missed else [])
             # beside the body (a synthesized mannequin stands at x = 0): moved in the core, joints and all
             corners = [obj.matrix_world @ Vector(corner) for corner in obj.bound_box]
             leftmost = float(np.min(mannequin.center[:, 0] - mannequin.semi_axes.max(axis=1)))

@@ -76,7 +76,7 @@ def live_update(scene):
         return None
     start = time.perf_counter()
     try:
-        mannequin, measured, warnings = synthesize_request(props, measure_extra=False)
+        mannequin, measured, warnings = synthesize_request(props)
         update_collection_geometry(target, mannequin)
         write_measured(target, measured)
         cushions = built_objects(target, "CUSHION")

@@ -1,15 +1,16 @@
-"""The synthesis request of a scene (``Scene.ellimann_synthesis``): its five fields in cm, and the
-core synthesis it asks for (segmented IDW over the Reference Mannequins, :func:`core.synthesis.synthesize`)."""
+"""The synthesis request of a scene (``Scene.ellimann_synthesis``): its five fields in cm, the extra measurements
+ticked, the reference set and options, as the job the core makes (``core.job``)."""
 
 import bpy
 
 from ....core.constants import FEMALE_SET, MEASUREMENTS
 from ....core.errors import ReferenceSetError
+from ....core.job.make import make
+from ....core.job.request import Request, check
 from ....core.measure.extra import EXTRA_MEASUREMENTS
 from ....core.synthesis.options import SynthesisOptions
 from ....core.synthesis.reference_set import cached_reference_set
 from ....core.synthesis.shipped import FEMALE_FINE_SET, MALE_FINE_SET, MALE_SET, SHIPPED_SETS
-from ....core.synthesis.synthesize import synthesize_extra
 
 FIELDS = {key: key.lower() for key in MEASUREMENTS}  # He -> props.he
 # Each item's number is what a .blend stores: fixed, so that a file saved before the fine sets existed (Folder
@@ -52,14 +53,27 @@ def extra_of(props):
     return {key: float(getattr(props, key)) for key in EXTRA_MEASUREMENTS if getattr(props, f"use_{key}")}
 
 
-def synthesize_request(props, extra=None, measure_extra=True):
-    """(Mannequin, measured {the five and the extra ones: cm}, warnings) of the panel's request; ``extra``
-    overrides the panel's extra measurements (a body's, for Synthesize from Mesh). What exact mode missed is one of
-    the warnings. ``measure_extra=False``: the extra measurements only when some are given (the panel shows no
-    others)."""
-    given = extra_of(props) if extra is None else extra
-    result = synthesize_extra(reference_of(props), request_of(props), given, options_of(props), measure_extra)
-    return result.mannequin, result.measured, result.warnings
+def job_of(props, extra=None, skin=None):
+    """The checked job (``core.job.request``) of the panel's request: its five, the extra measurements ticked (or
+    ``extra``: a body's, for Synthesize from Mesh), its reference set and options, and a ``skin``
+    (``SkinSettings``) if one is asked; ElliMannError naming the field (nothing is made)."""
+    request = Request(
+        request_of(props),
+        reference_of(props),
+        extra_of(props) if extra is None else extra,
+        options_of(props),
+        cushions=props.output == "CUSHIONS",
+        skin=skin,
+    )
+    return check(request)
+
+
+def synthesize_request(props, extra=None):
+    """(Mannequin, measured {the five and the extra ones asked: cm}, warnings) of the panel's request (a live
+    step's: no skin); what exact mode missed is one of the warnings."""
+    result = make(job_of(props, extra))
+    warnings = result.warnings + ([result.missed_text()] if result.missed else [])
+    return result.mannequin, result.measured, warnings
 
 
 def options_of(props):
