@@ -30,6 +30,7 @@ BENCHES = (
     "bench_bvh",
     "bench_batch",
     "bench_fine",
+    "bench_body_skin",
 )
 
 # The benchmarks that need the bpy module (Blender's cloth, the panel, its importer): their quick modes run in

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from devkit import bvh, clips
 from ellimann_addon.core.formats.bvh import read_bvh
-from ellimann_addon.core.formats.posed_files import write_posed
+from ellimann_addon.core.formats.table import write_file
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.pose.clip import clip_onto
 from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
@@ -32,8 +32,8 @@ def run(quick=False):
     path = bvh.write_bvh(folder / "clip.bvh", clip)
     reading, read = seconds(lambda: read_bvh(path))
     retargeting, onto = seconds(lambda: clip_onto(average, read.motion, read.match, name=read.name))
-    to_json, _ = seconds(lambda: write_posed(average, onto.poses, folder / "clip.json"))
-    to_mjcf, _ = seconds(lambda: write_posed(average, onto.poses, folder / "clip.xml"))
+    to_json, _ = seconds(lambda: write_file(average, folder / "clip.json", frames=onto.poses))
+    to_mjcf, _ = seconds(lambda: write_file(average, folder / "clip.xml", frames=onto.poses))
     core = reading + retargeting
     print(f"{frames} frames, {len(read.motion.names)} bones:")
     print(f"  read and matched (numpy)         {reading:6.2f} s")

@@ -25,7 +25,7 @@ from bench.bench_core import best_of
 from devkit.hull_before import hull_perimeter_before
 from devkit.synthetic import shipped_or_synthetic
 from ellimann_addon.core.constants import MEASUREMENTS, PAPER_TABLE_2_4, SECTION_FRACTIONS, quartile_points
-from ellimann_addon.core.formats.core_writers import write_core_file
+from ellimann_addon.core.formats.table import write_file
 from ellimann_addon.core.geometry.ellipsoid import section_at_height
 from ellimann_addon.core.measure.tailor import hull_perimeter, section_heights, tailor_measurements
 from ellimann_addon.core.synthesis import synthesize as synthesis
@@ -448,7 +448,7 @@ def blender(reference, exact, quick=False):
             for kind in ("json", "blend", "glb", "obj"):
                 path = os.path.join(folder, f"m.{kind}")
                 if kind in ("json", "obj"):  # the core writes them, without Blender
-                    t = best_of(lambda path=path: write_core_file(mannequins[0], path), repeat=repeat)
+                    t = best_of(lambda path=path: write_file(mannequins[0], path), repeat=repeat)
                 else:
                     t = best_of(lambda path=path: files.write_mannequin(mannequins[0], [path]), repeat=repeat)
                 print(f"  write .{kind:<5} (one mannequin)          {t * 1e3:8.2f} ms")

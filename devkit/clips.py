@@ -400,7 +400,7 @@ def bytes_per_frame(convention, mannequin, folder, counts=(200, 600)):
     from pathlib import Path
 
     from ellimann_addon.core.formats.bvh import bytes_needed, read_bvh
-    from ellimann_addon.core.formats.posed_files import write_posed
+    from ellimann_addon.core.formats.table import write_file
     from ellimann_addon.core.pose.clip import clip_onto
 
     peaks, sizes = [], []
@@ -409,7 +409,7 @@ def bytes_per_frame(convention, mannequin, folder, counts=(200, 600)):
         path = write_bvh(Path(folder) / "memory.bvh", clip)
         tracemalloc.start()
         read = read_bvh(path)
-        write_posed(mannequin, clip_onto(mannequin, read.motion, read.match).poses, Path(folder) / "memory.json")
+        write_file(mannequin, Path(folder) / "memory.json", frames=clip_onto(mannequin, read.motion, read.match).poses)
         peaks.append(tracemalloc.get_traced_memory()[1])
         tracemalloc.stop()
         channels = 3 * len(clip.names) + 3 * len(clip.positions)

@@ -19,11 +19,12 @@ written), 130 when interrupted (Ctrl-C).
 """
 
 import argparse
+import contextlib
 import sys
 
 from .. import VERSION
 from ..core.errors import ElliMannError
-from . import batch, demo, drape, measure, population, pose, references, synth
+from . import batch, demo, drape, measure, output, population, pose, references, synth
 from .output import INTERRUPTED, MISSED, PROG, UsageError, one_line, say
 from .writing import blender_available, no_blender
 
@@ -56,8 +57,12 @@ def main(argv=None):
         needs = args.blender(args)  # what of this command needs Blender from the start, if anything (a job's
         if needs and not blender_available():  # files are checked by the job: synth, pose, batch)
             raise no_blender(needs)
-        with _captured(args.verbose, needs):
-            return args.run(args)
+        with contextlib.ExitStack() as stack:
+            capture = lambda: stack.enter_context(_captured(args.verbose))  # noqa: E731
+            if needs:
+                capture()
+            with output.blender_capture(capture):  # a job's first Blender call (writing a .glb) starts it
+                return args.run(args)
     except (ElliMannError, OSError) as error:
         say(f"{PROG} {args.command}: error: {one_line(error)}")
         return 1
@@ -66,12 +71,12 @@ def main(argv=None):
         return INTERRUPTED
 
 
-def _captured(show, blender):
-    """What Blender prints, kept out of ElliMann's lines (``blender.services.chatter.program``): from the start for a
-    command that needs Blender (``blender``), else from its first Blender call, if any (a job writing a .glb)."""
-    from ..blender.services.chatter import program  # no bpy: it is loaded by the first Blender call
+def _captured(show):
+    """What Blender prints, kept out of ElliMann's lines (``blender.services.chatter.program``): from the start of a
+    command that needs Blender, else from its first Blender call, if any (a job writing a .glb)."""
+    from ..blender.services.chatter import program
 
-    return program(show=show, lazy=not blender)
+    return program(show=show)
 
 
 def main_exit(argv=None):

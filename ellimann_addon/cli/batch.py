@@ -118,11 +118,6 @@ def run(args):
             sets[chosen] = arguments.references(args, chosen)
         return sets[chosen]
 
-    table = MeasurementsCsv(args.csv, shard, shards)  # the header checked and the rows counted
-    if not table.count:
-        raise UsageError(f"{args.csv} has a header but no rows")
-    for warning in table.warnings():  # what of the file is not read, before any row is made
-        output.say(f"{PROG} {args.command}: warning: {warning}")
     if skin is not None and bundled:
         raise UsageError("--skin with --format npz: the batch file holds the pieces only; write json, obj or mjcf")
     if skin is not None and args.dask:
@@ -139,8 +134,14 @@ def run(args):
             skin=skin,
             pose=arguments.pose_ask(args),
             outputs=tuple(os.path.join(args.output, f"NAME.{kind.extension}") for kind in formats),
-        )
+        ),
+        blender_use=lambda kind: f"--format {kind.name}",
     )
+    table = MeasurementsCsv(args.csv, shard, shards)  # the header checked and the rows counted
+    if not table.count:
+        raise UsageError(f"{args.csv} has a header but no rows")
+    for warning in table.warnings():  # what of the file is not read, before any row is made
+        output.say(f"{PROG} {args.command}: warning: {warning}")
     arguments.say_clip(args, command.pose)
     cluster = distributed.connect(args.dask) if args.dask else None  # before anything is written
     try:

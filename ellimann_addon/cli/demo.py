@@ -31,6 +31,8 @@ def needs_blender(args):
 
 
 def run(args):
+    from ..core.formats.table import check_outputs
+    from ..core.job.result import Result
     from ..core.synthesis.synthesize import synthesize_batch
 
     reference = arguments.references(args)
@@ -42,7 +44,7 @@ def run(args):
         name = f"table_2_5_{i + 1:02d}"
         mannequin = result.mannequin(i)
         paths = [os.path.join(out, f"{name}.{kind}") for kind in ("blend", "json")]
-        writing.write(mannequin, paths, as_dict(result.measured[i]), args.cushions)
+        writing.write(Result(mannequin, as_dict(result.measured[i])), check_outputs(paths), args.cushions)
         misses = request_misses(as_dict(result.measured[i]), result.requests[i], mode=args.mode)
         if misses:
             missed += 1

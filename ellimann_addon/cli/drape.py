@@ -84,7 +84,7 @@ def run(args):
         raise UsageError(f"{args.mannequin}: no such file")
     if kind == ".json":
         mannequin = load_json_mannequin(args.mannequin)
-    bpy = writing.ensure_registered("drape")
+    bpy = writing.blender_module("drape")
     from ..blender.services.chatter import blender_output
     from ..blender.services.drape import WARN_CLOTH_VERTICES, check_cloth_size, drape
     from ..blender.services.scene import add_mannequin, empty_scene

@@ -206,7 +206,7 @@ def load_json_mannequin(path):
 
 
 def load_blend_mannequin(path, collection_name=None):
-    bpy = writing.ensure_registered("reading a .blend file")
+    bpy = writing.blender_module("reading a .blend file")
     from ..blender.bridge.convert import collection_to_mannequin, mannequin_collections
     from ..blender.services.chatter import blender_output
 

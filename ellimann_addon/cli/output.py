@@ -1,6 +1,7 @@
 """ElliMann's printed lines: the program name and exit codes, the one-line usage error, lines made safe for
 a terminal, the m_T line and the progress line."""
 
+import contextlib
 import re
 import sys
 import time
@@ -11,6 +12,26 @@ from ..core.measure.tailor import measurement_line
 PROG = "ellimann"
 MISSED = 3  # exit code: written, but exact mode missed a requested measurement by more than its tolerance
 INTERRUPTED = 130  # exit code after Ctrl-C, as shells report SIGINT
+
+
+_capture = []  # how the running command starts capturing what Blender prints (cli.main), at most once
+
+
+@contextlib.contextmanager
+def blender_capture(start):
+    """While a command runs: ``start()`` captures what Blender prints from then on (``blender_used`` calls it)."""
+    _capture.append([start, False])
+    try:
+        yield
+    finally:
+        _capture.pop()
+
+
+def blender_used():
+    """Before the command's first Blender call: what Blender prints from then on is captured (once)."""
+    if _capture and not _capture[-1][1]:
+        _capture[-1][1] = True
+        _capture[-1][0]()
 
 
 class UsageError(ElliMannError):

@@ -49,11 +49,7 @@ def add_parser(commands):
     population.add_argument("--dask", metavar="ADDRESS", help="with --synthesize: batch's --dask")
     arguments.add_synthesis_options(population)
     arguments.add_pose_option(population)  # with --synthesize: batch's --pose
-    population.set_defaults(run=run, blender=needs_blender)
-
-
-def needs_blender(args):
-    return batch.needs_blender(args) if args.synthesize else None
+    population.set_defaults(run=run, blender=lambda args: None)  # --synthesize: the batch's job checks its files
 
 
 def run(args):

@@ -11,7 +11,7 @@ import tempfile
 from ..core.errors import one_line
 from ..core.files import atomic_write_text, clean_stale_temporaries
 from ..core.formats.table import write_files
-from .output import PROG, UsageError, say
+from .output import PROG, UsageError, blender_used, say
 
 
 def blender_available():
@@ -31,10 +31,11 @@ def no_blender(what):
     )
 
 
-def blender_writers(what="this"):
-    """Make the format table's Blender rows writable (``blender.services.writers`` binds their writer): import bpy
-    and, under ``python -m``, register only what the writers need of the add-on (the ``ellimann`` properties of
-    objects and collections, ``blender.bridge.props``), not its panels and operators."""
+def blender_module(what="this"):
+    """bpy, imported (UsageError naming ``what`` without it), with what ElliMann's Blender code needs of the add-on
+    registered under ``python -m``: the ``ellimann`` properties of objects and collections (``blender.bridge.props``),
+    not its panels and operators (nor, through them, the command line again)."""
+    blender_used()  # what Blender prints from here on is kept out of ElliMann's lines
     from ..blender.services.chatter import blender_output
 
     with blender_output():
@@ -48,6 +49,16 @@ def blender_writers(what="this"):
             for cls in props.classes:
                 bpy.utils.register_class(cls)
             props.register_hooks()
+    return bpy
+
+
+def blender_writers(what="this"):
+    """:func:`blender_module`, and the format table's Blender rows made writable (``blender.services.writers`` binds
+    their writer)."""
+    bpy = blender_module(what)
+    from ..blender.services.chatter import blender_output
+
+    with blender_output():
         from ..blender.services import writers  # noqa: F401  (binds the .blend and .glb rows' writer)
     return bpy
 

@@ -687,12 +687,12 @@ import os, signal, sys, tempfile
 from ellimann_addon.cli import writing, main
 from ellimann_addon.core.files import temp_prefix
 real, calls = writing.write, []
-def killed_on_the_third_row(mannequin, paths, *args, **keywords):
-    calls.append(paths)
+def killed_on_the_third_row(result, formats, *args, **keywords):
+    calls.append(list(formats))
     if len(calls) == 3:  # killed while writing: a temporary is on disk
-        tempfile.mkstemp(prefix=temp_prefix(), suffix=".tmp", dir=os.path.dirname(paths[0]))
+        tempfile.mkstemp(prefix=temp_prefix(), suffix=".tmp", dir=os.path.dirname(calls[-1][0]))
         os.kill(os.getpid(), signal.SIGKILL)
-    return real(mannequin, paths, *args, **keywords)
+    return real(result, formats, *args, **keywords)
 writing.write = killed_on_the_third_row
 from ellimann_addon.blender.services import teardown
 teardown.exit_with(main({argv!r}))

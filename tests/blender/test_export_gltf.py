@@ -12,8 +12,8 @@ from ellimann_addon.blender.services.files import export_gltf, write_mannequin
 from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.errors import ElliMannError, MannequinError
 from ellimann_addon.core.files import atomic_output
-from ellimann_addon.core.formats.core_writers import write_core_file
 from ellimann_addon.core.formats.glb import EXTRAS_KEY, read_glb_json
+from ellimann_addon.core.formats.table import write_file
 from ellimann_addon.core.geometry.quaternion import quaternion_to_rotation
 
 # glTF is Y-up: Blender's exporter maps (x, y, z) -> (x, z, -y).
@@ -108,7 +108,7 @@ def test_every_format_gets_the_usual_permissions(mannequin, tmp_path, umask):
     paths = [tmp_path / f"toy.{ext}" for ext in ("glb", "blend", "obj", "json", "xml")]
     write_mannequin(mannequin, paths[:2])
     for path in paths[2:]:
-        write_core_file(mannequin, path)
+        write_file(mannequin, path)
     modes = {p.suffix: stat.S_IMODE(p.stat().st_mode) for p in paths}
     assert modes == {p.suffix: 0o666 & ~umask for p in paths}  # mkstemp's 0600 would show here
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in paths)

@@ -26,6 +26,7 @@ NUMPY_ONLY = {  # name: slow (more than a few seconds in quick mode)
     "bench_scan_held_out": True,
     "bench_extra": True,
     "bench_skin_exact": True,
+    "bench_body_skin": False,
 }
 
 

@@ -11,7 +11,7 @@ import contextlib
 import csv
 import io
 import json
-import sys
+import os
 import types
 
 import numpy as np
@@ -317,24 +317,26 @@ def test_exact_mode_meets_the_request_on_the_skin_and_measure_of_its_obj_agrees(
 
 
 def test_the_skin_is_passed_down_to_blender_s_writers(tmp_path, monkeypatch):
-    """.blend/.glb go to blender.services (files.write_mannequin at rest, posing.write_posed posed) with the skin,
-    what they do with it is the Blender side's; here the services are stand-ins that record their calls."""
+    """.blend/.glb go to the format table's Blender rows (their writer bound by blender.services.writers) with the
+    skin and the frames, both paths in one call (one scene); here the writer is a stand-in that records its calls."""
     from ellimann_addon.cli import writing
+    from ellimann_addon.core.formats import table
+    from ellimann_addon.core.job.result import Result, SkinMade
     from ellimann_addon.core.synthesis.shipped import named_reference_set
 
     calls = []
-    files = types.ModuleType("ellimann_addon.blender.services.files")
-    files.write_mannequin = lambda mannequin, paths, measured, cushions, skin=None: calls.append(("rest", skin))
-    posing = types.ModuleType("ellimann_addon.blender.services.posing")
-    posing.write_posed = lambda *args, skin=None, **kw: calls.append(("posed", skin))
-    monkeypatch.setitem(sys.modules, "ellimann_addon.blender.services.files", files)
-    monkeypatch.setitem(sys.modules, "ellimann_addon.blender.services.posing", posing)
-    monkeypatch.setattr(writing, "ensure_registered", lambda what="": None)
+
+    def stand_in(mannequin, paths, *, skin=None, frames=None, **_):
+        calls.append(("posed" if frames else "rest", skin, [os.path.basename(path) for path in paths]))
+
+    for name in table.BLENDER_FORMATS:
+        monkeypatch.setattr(table.FORMATS[name], "write", stand_in)
+    monkeypatch.setattr(writing, "blender_writers", lambda what="": None)
     mannequin = named_reference_set("female").mannequins[4]
     skin = build_skin(mannequin, SkinSettings(10.0))
-    writing.write(mannequin, [tmp_path / "a.glb"], None, False, skin=skin)
-    writing.write(
-        mannequin, [tmp_path / "a.blend"], None, False, [standard_pose("sit", mannequin.joints)], 24, skin=skin
-    )
-    assert calls == [("rest", skin), ("posed", skin)]
+    result = Result(mannequin, mannequin.measure(), skin=SkinMade(skin, {}, False))
+    writing.write(result, table.check_outputs([tmp_path / "a.glb", tmp_path / "a.blend"]))
+    result.frames, result.fps = [standard_pose("sit", mannequin.joints)], 24
+    writing.write(result, table.check_outputs([tmp_path / "a.blend"]))
+    assert calls == [("rest", skin, ["a.glb", "a.blend"]), ("posed", skin, ["a.blend"])]
     assert mesh_measurements(skin)["He"] > 150.0

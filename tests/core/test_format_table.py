@@ -1,54 +1,42 @@
-"""The format table (core/formats/table.py): every row names a writer that exists and a whole-file check that
-core.files.incomplete makes, and every format ElliMann defines has its page in docs/formats/ naming its code."""
+"""The format table (core/formats/table.py): every row has a whole-file check that core.files.incomplete makes and
+a writer (the core's rows here, Blender's bound by the Blender layer), a path's format is decided by its extension
+alone, and every format ElliMann defines has its page in docs/formats/ naming its code."""
 
-import ast
-import importlib
 import pathlib
+import sys
 
 import pytest
 
 from ellimann_addon.core import files
-from ellimann_addon.core.formats.table import BATCH_FILE, FORMATS, WHOLE_FILE_CHECK
+from ellimann_addon.core.errors import ElliMannError
+from ellimann_addon.core.formats import table
+from ellimann_addon.core.formats.table import BATCH_FILE, BLENDER_FORMATS, CORE_FORMATS, FORMATS
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 PACKAGE = ROOT / "ellimann_addon"
 ROWS = [*FORMATS.values(), BATCH_FILE]
 
 
-def defined(dotted):
-    """Whether ``dotted`` (under ellimann_addon) names a function or class: imported for the core, read from the
-    source for the Blender layer (which needs bpy to import)."""
-    parts = dotted.split(".")
-    for split in range(len(parts) - 1, 0, -1):
-        path = PACKAGE.joinpath(*parts[:split]).with_suffix(".py")
-        if path.is_file():
-            module, names = parts[:split], parts[split:]
-            break
-    else:
-        return False
-    if module[0] == "core":
-        target = importlib.import_module("ellimann_addon." + ".".join(module))
-        for name in names:
-            target = getattr(target, name, None)
-        return callable(target)
-    tree = ast.parse(path.read_text())
-    for name in names:
-        found = [n for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef)) and n.name == name]
-        if not found:
-            return False
-        tree = found[0]
-    return True
-
-
 @pytest.mark.parametrize("row", ROWS, ids=[row.name for row in ROWS])
-def test_each_row_names_its_writer_and_its_whole_file_check(row):
-    assert defined(row.written_by), row.written_by
+def test_each_row_has_its_whole_file_check_and_the_core_s_rows_their_writer(row):
     assert row.extension in files.CHECKED_KINDS and row.whole_file
-    assert defined(WHOLE_FILE_CHECK)
+    if row.name in CORE_FORMATS:
+        assert callable(row.write) and row.writer() is row.write
+    elif row.name in BLENDER_FORMATS and "ellimann_addon.blender.services.writers" not in sys.modules:
+        with pytest.raises(ElliMannError, match=f"writing a .{row.extension} file needs Blender"):
+            row.writer()  # the Blender layer binds it when loaded (tests/blender/test_export_gltf.py)
 
 
-def test_the_name_check_can_fail():
-    assert not defined("core.formats.obj.write_nothing") and not defined("blender.services.files.no_such")
+def test_a_path_s_format_is_decided_by_its_extension_once_and_refused_in_one_line():
+    formats = table.check_outputs(["a.JSON", "b.xml", "c.glb"])
+    assert [kind.name for kind in formats.values()] == ["json", "mjcf", "glb"]
+    with pytest.raises(ElliMannError, match=r"'d\.stl': an output file must end in \.blend, \.glb, \.obj, \.json or "):
+        table.check_outputs(["d.stl"])
+    with pytest.raises(ElliMannError, match="--pose walk is an animation and a .obj file holds none; write .blend"):
+        table.check_outputs(["e.obj"], "walk")
+    assert table.format_named("XML") is FORMATS["mjcf"] and table.format_named("npz") is None
+    assert table.format_named("npz", batch=True) is BATCH_FILE
+    assert table.listing(what="name") == "blend, glb, obj, json, mjcf (xml)"
 
 
 PAGES = {  # a page per format ElliMann defines, and code each must name

@@ -143,6 +143,7 @@ FLOORS = {
     "body": 5,
     "formats": 6,
     "drape": 6,
+    "job": 7,
 }
 
 

@@ -23,7 +23,6 @@ import sys
 import tempfile
 
 _program = None  # the running _Program, if any
-_pending = None  # a program held back until its first Blender call: its ``show``
 
 
 class _Program:
@@ -92,48 +91,34 @@ class _Program:
 
 
 @contextlib.contextmanager
-def program(show=False, lazy=False):
-    """Run a command with Blender's output captured (``show``: sent to stderr instead of stdout); ``lazy``: from the
-    first Blender call on (:func:`blender_output`), so a command that turns out to need no Blender changes nothing.
+def program(show=False):
+    """Run a command with Blender's output captured (``show``: sent to stderr instead of stdout).
 
     Nested calls are one program. What Blender printed is dropped at the end, unless the block
     ends with an exception other than ElliMann's one-line errors, when it is written to stderr.
     """
-    global _program, _pending
-    if _program is not None or _pending is not None:
+    global _program
+    if _program is not None:
         yield _program
         return
-    _pending = show
-    if not lazy:
-        _start_pending()
+    running = _Program(show)
+    running.start()
+    _program = running
     try:
-        yield _program
+        yield running
     except BaseException as error:
-        running = _program
-        if running is not None and not show and not isinstance(error, (KeyboardInterrupt, SystemExit)):
-            if not _explained(error):
-                text = running.since(0)
-                running.stop()
-                if text:
-                    sys.stderr.write(text if text.endswith("\n") else text + "\n")
-                    sys.stderr.flush()
+        if not show and not isinstance(error, (KeyboardInterrupt, SystemExit)) and not _explained(error):
+            text = running.since(0)
+            running.stop()
+            if text:
+                sys.stderr.write(text if text.endswith("\n") else text + "\n")
+                sys.stderr.flush()
         raise
     finally:
-        running, _program, _pending = _program, None, None
-        if running is not None:
-            running.stop()
-            if running.log is not None:
-                running.log.close()
-
-
-def _start_pending():
-    """Start the program a ``program`` block holds back (its first Blender call)."""
-    global _program
-    if _program is None and _pending is not None:
-        running = _Program(_pending)
-        running.start()
-        _program = running
-    return _program
+        _program = None
+        running.stop()
+        if running.log is not None:
+            running.log.close()
 
 
 def _explained(error):
@@ -145,7 +130,7 @@ def _explained(error):
 @contextlib.contextmanager
 def blender_output():
     """Around a Blender call: its output goes to the program's log (or stderr); see the module docstring."""
-    running = _start_pending()
+    running = _program
     if running is None:
         with _stdout_to_stderr():
             yield

@@ -144,17 +144,21 @@ def listing(rows=None, what="extension"):
     return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " or " + words[-1]
 
 
-def check_outputs(paths, animated=False):
+def check_outputs(paths, motion=None):
     """{path: Format} of output ``paths``, decided once; ElliMannError naming the path for one whose extension names
-    no format, and, with ``animated`` (a walk, a clip), for a format that holds no animation."""
+    no format, and, with ``motion`` (the name of a pose that moves: a walk, a clip), for a format that holds no
+    animation."""
     formats = {}
     for path in paths:
         kind = format_of(path)
         if kind is None:
             raise ElliMannError(f"{os.fspath(path)!r}: an output file must end in {listing()}")
-        if animated and not kind.animated:
+        if motion is not None and not kind.animated:
             moving = listing([f for f in FORMATS.values() if f.animated])
-            raise ElliMannError(f"{os.fspath(path)!r}: a .{kind.extension} file holds no animation; write {moving}")
+            raise ElliMannError(
+                f"{os.fspath(path)!r}: --pose {motion} is an animation and a .{kind.extension} file holds none; "
+                f"write {moving}"
+            )
         formats[os.fspath(path)] = kind
     return formats
 
@@ -175,3 +179,9 @@ def write_files(mannequin, formats, **settings):
     for write, paths in groups.values():
         write(mannequin, paths, **settings)
     return list(formats)
+
+
+def write_file(mannequin, path, **settings):
+    """Write ``mannequin`` to one ``path`` (its format from its extension): :func:`write_files` for a script or a
+    test."""
+    return write_files(mannequin, check_outputs([path]), **settings)[0]

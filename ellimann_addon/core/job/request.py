@@ -19,10 +19,17 @@ from ..errors import ElliMannError
 from ..formats.table import check_outputs
 from ..measure.extra import EXTRA_MEASUREMENTS
 from ..measure.tailor import as_dict
-from ..pose.kinematics import require_joints
 from ..synthesis.extra_refine import ExtraRequestError, extra_request_problems
 from ..synthesis.options import SynthesisOptions
 from ..synthesis.request import checked_request
+
+
+class NeedsBlenderError(ElliMannError):
+    """A job with an output (``path``, of format ``kind``) only Blender writes, where Blender is not available."""
+
+    def __init__(self, path, kind):
+        super().__init__(f"writing {path} needs Blender: the bpy module is not installed")
+        self.path, self.kind = path, kind
 
 
 @dataclass(frozen=True)
@@ -122,15 +129,19 @@ def check(request, blender=True, pose=None):
     else:
         values, warnings, extra = None, [], {}
     pose = read_pose_ask(request.pose) if pose is None else pose
-    formats = check_outputs(request.outputs, animated=pose is not None and pose.animated)
+    formats = check_outputs(request.outputs, pose.name if pose is not None and pose.animated else None)
     job = Job(request, values, extra, warnings, pose, formats)
     needs = job.needs_blender()
     if needs is not None and not blender:
-        raise ElliMannError(f"writing {needs} needs Blender: the bpy module is not installed")
+        raise NeedsBlenderError(needs, formats[needs])
     if pose is not None:
-        if made is not None:
-            require_joints(made)
-        elif request.references.joints is None:
+        if made is not None and made.joints is None:
+            raise ElliMannError(
+                f"joints: '{made.name}' has no joints (a file from before posing, or a collection without a "
+                f"skeleton), so neither it{' nor its skin' if request.skin is not None else ''} can be posed: "
+                "synthesize it again or load a Reference Mannequin"
+            )
+        if made is None and request.references.joints is None:
             raise ElliMannError(
                 f"joints: the {request.references.name} set's Reference Mannequins have none, so its mannequins "
                 "cannot be posed: synthesize from a set with joints (the shipped sets have them)"
@@ -159,7 +170,7 @@ def row_job(command, measurements, references, extra, warnings, name, outputs):
     pose = command.pose if outputs else None
     values = np.array([measurements[key] for key in MEASUREMENTS], dtype=float)
     extra = {key: float(extra[key]) for key in EXTRA_MEASUREMENTS if key in extra}
-    formats = check_outputs(outputs, animated=pose is not None and pose.animated)
+    formats = check_outputs(outputs, pose.name if pose is not None and pose.animated else None)
     return Job(request, values, extra, list(warnings), pose, formats)
 
 
