@@ -19,6 +19,7 @@ from contextlib import contextmanager
 import numpy as np
 
 from devkit.extra_before import MannequinLandmarksBefore, mannequin_extra_measurements_before
+from ellimann_addon.cli import MISSED
 from ellimann_addon.cli import main as ellimann
 from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
 from ellimann_addon.core.fitting.body_mesh import read_obj
@@ -130,6 +131,9 @@ def run(quick=False):
 
 
 def population(rows=12):
+    """``population --extras --synthesize`` timed with main's extra measurements and with today's. Exit 3 (exact mode
+    missed a row's extra measurement: the files are written) is a result to say, not a failure of the bench."""
+
     def once():
         with tempfile.TemporaryDirectory() as folder:
             folder = pathlib.Path(folder)
@@ -151,15 +155,15 @@ def population(rows=12):
                     str(folder / "out"),
                 ]
             )
-            assert code == 0
-            return time.perf_counter() - start
+            assert code in (0, MISSED), code
+            return time.perf_counter() - start, code
 
     with measured_as_before():
-        before = once()
-    now = once()
+        before, before_code = once()
+    now, now_code = once()
     print(
-        f"\npopulation --n {rows} --extras --synthesize: before {before:.1f} s, now {now:.1f} s, "
-        f"{before / now:.1f}x faster"
+        f"\npopulation --n {rows} --extras --synthesize: before {before:.1f} s (exit {before_code}), now {now:.1f} s "
+        f"(exit {now_code}; 3: exact mode missed a row, see its warning above), {before / now:.1f}x faster"
     )
 
 
