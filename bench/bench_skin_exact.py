@@ -16,8 +16,9 @@ import numpy as np
 
 from ellimann_addon.core.constants import MEASUREMENTS, TABLE_2_5
 from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS, mannequin_extra_measurements
+from ellimann_addon.core.settings import LEVELS
 from ellimann_addon.core.skin.exact import exact_skin
-from ellimann_addon.core.skin.settings import LEVELS, SkinSettings
+from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize
 from tools.bodies import body_requests, load_labels

@@ -4,7 +4,7 @@
 package only through ``register``/``unregister`` so that ``core`` stays importable anywhere.
 """
 
-VERSION = "0.1.0"  # blender_manifest.toml's and pyproject.toml's (tests/core/test_packaging.py): ``ellimann --version``
+from .core.constants import VERSION  # noqa: F401  (the package's version: ``ellimann_addon.VERSION``)
 
 
 def register():

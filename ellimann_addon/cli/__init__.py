@@ -22,7 +22,7 @@ import argparse
 import contextlib
 import sys
 
-from .. import VERSION
+from ..core.constants import VERSION
 from ..core.errors import ElliMannError
 from . import batch, demo, drape, measure, output, population, pose, references, synth
 from .output import INTERRUPTED, MISSED, PROG, UsageError, one_line, say

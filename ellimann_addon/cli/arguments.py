@@ -56,7 +56,7 @@ def add_synthesis_options(parser):
 def add_mesh_axes(parser, what, default_up=None):
     """--up and --unit of a command that reads body meshes (``what``: which), as ``core.fitting.body_mesh`` reads
     them; ``default_up`` None: Y for .obj (Blender's OBJ axes), Z for .ply and .stl."""
-    from ..core.fitting.body_mesh import UNITS, UP_AXES
+    from ..core.measure.body import UNITS, UP_AXES
 
     default = f"{default_up}" if default_up else "y for .obj, as Blender writes it; z for .ply and .stl"
     parser.add_argument(

@@ -1,5 +1,6 @@
 """``ellimann drape``: a garment sized from a mannequin, draped with Blender's cloth (Blender), saved as a .blend;
-its options and defaults are the Drape panel's (``core.drape.settings.DRAPE`` and ``DrapeSettings``)."""
+its options and defaults are the Drape panel's (``core.settings.DRAPE``, read into
+``core.drape.settings.DrapeSettings``)."""
 
 import argparse
 import dataclasses
@@ -7,21 +8,18 @@ import os
 import sys
 
 from ..core.constants import CM_PER_M
-from ..core.drape.garments import EDGE_RANGE
-from ..core.drape.settings import DRAPE, DrapeSettings, garment_help
 from ..core.files import atomic_output
 from ..core.geometry.ellipsoid import bounds
 from ..core.pose.kinematics import require_joints
 from ..core.pose.motion import clamped_motion
 from ..core.pose.standard import POSE_NAMES
-from ..core.skin.settings import LEVELS
+from ..core.settings import DRAPE, EDGE_RANGE, LEVELS, garment_help
 from . import arguments, output, writing
 from .measure import load_blend_mannequin, load_json_mannequin
 from .output import PROG, UsageError
 
 
 def add_parser(commands):
-    defaults = DrapeSettings()
     drape = commands.add_parser(
         "drape",
         help="drape a garment on a mannequin with Blender's cloth simulation",
@@ -34,20 +32,20 @@ def add_parser(commands):
     drape.add_argument("mannequin", metavar="MANNEQUIN", help="a .json or .blend mannequin")
     garment = DRAPE["garment"]
     drape.add_argument("--garment", choices=garment.values, default=garment.default, help=garment_help())
-    drape.add_argument("--frames", type=int, help=DRAPE["frames"].help.format(default=defaults.frames))
+    drape.add_argument("--frames", type=int, help=DRAPE["frames"].help.format(default=DRAPE["frames"].default))
     for name in ("collider", "skin_level"):
         option = DRAPE[name]
         drape.add_argument(f"--{name.replace('_', '-')}", choices=option.values, help=option.help)
     drape.add_argument(
         "--cushions",
         action=argparse.BooleanOptionalAction,
-        help=DRAPE["cushions"].help.format(default_text="cushions" if defaults.cushions else "every ellipsoid"),
+        help=DRAPE["cushions"].help.format(default_text="cushions" if DRAPE["cushions"].default else "every ellipsoid"),
     )
     drape.add_argument(
         "--edge",
         type=arguments.number,
         metavar="CM",
-        help=DRAPE["edge"].help.format(default_cm=defaults.edge * CM_PER_M),
+        help=DRAPE["edge"].help.format(default_cm=DRAPE["edge"].default * CM_PER_M),
     )
     drape.add_argument(
         "--pose",
@@ -155,6 +153,8 @@ def motion_of(args, mannequin):
 
 def settings_of(args):
     """DrapeSettings from the command line: what is not given keeps DrapeSettings' default (the panel's too)."""
+    from ..core.drape.settings import DrapeSettings  # the drape's code, loaded only when it runs
+
     low, high = (bound * CM_PER_M for bound in EDGE_RANGE)
     if args.edge is not None and not low <= args.edge <= high:  # in the flag's unit, not DrapeSettings' metres
         raise UsageError(f"--edge: the cloth's edge length must be from {low:g} to {high:g} cm, got {args.edge:g} cm")

@@ -9,9 +9,8 @@ import sys
 
 from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS
 from ..core.errors import MannequinError
-from ..core.fitting.body_mesh import MESH_EXTENSIONS, BodyMeshError, read_body_mesh
 from ..core.mannequin.model import Mannequin
-from ..core.measure.body import ALL_MEASUREMENTS, measure_body_mesh
+from ..core.measure.body import ALL_MEASUREMENTS, MESH_EXTENSIONS, measure_body_mesh
 from ..core.measure.extra import EXTRA_LABELS, mannequin_extra_measurements
 from . import arguments, output, writing
 from .output import UsageError
@@ -163,6 +162,8 @@ def measure_glb(path, args):
 
 def measure_mesh_file(path, args):
     """({key: cm} of what could be measured, [problem lines]) of a body mesh file."""
+    from ..core.fitting.body_mesh import BodyMeshError, read_body_mesh  # a mesh's reader, loaded when one is read
+
     try:
         vertices, faces = read_body_mesh(path, args.up, args.unit)
     except BodyMeshError as error:

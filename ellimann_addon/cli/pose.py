@@ -56,8 +56,12 @@ def run(args):
     )
     job = jobs.checked(request)
     arguments.say_clip(args, job.pose)
-    recorded = mannequin.skin and skinning.SkinSettings.from_dict(mannequin.skin)
-    if settings is not None and recorded and recorded != settings:
+    recorded = None
+    if settings is not None and mannequin.skin:
+        from ..core.skin.settings import SkinSettings  # the skin's code, loaded only when a skin is asked
+
+        recorded = SkinSettings.from_dict(mannequin.skin)
+    if recorded and recorded != settings:
         output.say(
             f"{PROG} pose: {args.input} records its skin at {skinning.describe(recorded)}; made at "
             f"{skinning.describe(settings)} as asked (another voxel or blend measures a little differently)"

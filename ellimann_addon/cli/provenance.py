@@ -19,8 +19,7 @@ import hashlib
 import json
 import os
 
-from .. import VERSION
-from ..core.constants import MEASUREMENTS
+from ..core.constants import MEASUREMENTS, VERSION
 from ..core.files import atomic_write_text
 from ..core.measure.extra import EXTRA_MEASUREMENTS
 from ..core.synthesis.manifest import MANIFEST_FILE

@@ -8,16 +8,6 @@ import pathlib
 import sys
 
 from ..core.constants import MEASUREMENTS
-from ..core.fitting.body_mesh import BodyMeshError, read_obj
-from ..core.fitting.reference_build import (
-    MIN_BODIES,
-    build_reference_set,
-    cleanliness_problems,
-    read_targets,
-    relative_errors,
-    traced_mesh,
-    validate_inputs,
-)
 from ..core.mannequin.clean import asymmetry
 from ..core.synthesis.manifest import STEM, read_manifest
 from ..core.synthesis.reference_set import load_reference_set
@@ -99,6 +89,15 @@ def add_parser(commands):
 
 
 def run_build(args):
+    from ..core.fitting.body_mesh import BodyMeshError, read_obj  # the builder, loaded when it runs
+    from ..core.fitting.reference_build import (
+        MIN_BODIES,
+        build_reference_set,
+        read_targets,
+        traced_mesh,
+        validate_inputs,
+    )
+
     out = pathlib.Path(args.output)
     base = load_base(args.base)
     base_stem = pathlib.Path(args.base).stem
@@ -170,6 +169,8 @@ def _sha256(path):
 
 def check_folder(folder):
     """(lines, problems) of ``references check``: one line per RM, one per problem found."""
+    from ..core.fitting.reference_build import cleanliness_problems, relative_errors
+
     reference = load_reference_set(folder)  # validity: files, topology, symmetry, distinct measurements
     manifest = read_manifest(folder)
     lines, problems = [], []

@@ -3,7 +3,7 @@ synthesis options are from ``SYNTHESIS``) and the settings they ask for (a job's
 and makes it)."""
 
 from ..core.errors import ElliMannError
-from ..core.skin.settings import LEVELS, SKIN, SkinSettings
+from ..core.settings import LEVELS, SKIN
 from .arguments import number
 from .output import UsageError, one_line
 
@@ -50,6 +50,8 @@ def skin_settings(args, recorded=None):
         if given:
             raise UsageError(f"{flag(given[0])} is a setting of the skin: add --skin (or drop {flag(given[0])})")
         return None
+    from ..core.skin.settings import SkinSettings  # the skin's code, loaded only when a skin is asked
+
     base = SkinSettings.from_dict(recorded) if recorded else None
     if args.skin_voxel is not None:
         voxel = args.skin_voxel

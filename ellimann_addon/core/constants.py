@@ -3,6 +3,8 @@
 Measurements are in centimetres (what tailors type); geometry is in metres (Blender's unit).
 """
 
+VERSION = "0.1.0"  # blender_manifest.toml's and pyproject.toml's (tests/core/test_packaging.py): ``ellimann --version``
+
 MEASUREMENTS = ("He", "Sh", "Br", "Wa", "Hi")
 
 MEASUREMENT_LABELS = {

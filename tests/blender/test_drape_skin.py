@@ -21,7 +21,7 @@ from ellimann_addon.core.errors import ElliMannError
 from ellimann_addon.core.geometry.mesh import is_closed_manifold
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.pose.motion import clamped_motion
-from ellimann_addon.core.skin.settings import LEVELS
+from ellimann_addon.core.settings import LEVELS
 from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
 COARSE = {"edge": 0.05, "collider": "skin"}

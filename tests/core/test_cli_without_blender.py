@@ -234,7 +234,8 @@ def test_the_cli_imports_blender_only_inside_functions():
 def test_one_table_for_the_options_of_the_cli_and_the_panels():
     from ellimann_addon.cli import build_parser
     from ellimann_addon.core.drape import garments
-    from ellimann_addon.core.drape.settings import DRAPE, DrapeSettings
+    from ellimann_addon.core.drape.settings import DrapeSettings
+    from ellimann_addon.core.settings import DRAPE
     from ellimann_addon.core.synthesis.options import SYNTHESIS, SynthesisOptions
 
     assert SynthesisOptions() == SynthesisOptions(**{k: o.default for k, o in SYNTHESIS.items()})

@@ -37,7 +37,7 @@ from ...core.drape.colliders import (
     triangle_count,
 )
 from ...core.drape.fit_metrics import BodyPieces, fit_statistics, mesh_distance
-from ...core.drape.settings import FRAME_RANGE, MAX_CLOTH_VERTICES, DrapeSettings  # noqa: F401  (DrapeSettings: public here)
+from ...core.drape.settings import MAX_CLOTH_VERTICES, DrapeSettings  # noqa: F401  (DrapeSettings: public here)
 from ...core.errors import ElliMannError
 from ...core.pose.kinematics import pose_mannequin
 from ..bridge.convert import mesh_from_arrays, new_collection

@@ -31,9 +31,8 @@ import numpy as np
 from ..constants import CM_PER_M
 from ..errors import ElliMannError
 from ..geometry.ellipsoid import axis_extent
+from ..settings import DEFAULT_EDGE, EDGE_RANGE, GARMENT_WORDS
 from .patterns import (  # noqa: F401  (clear_of: public here, garments.clear_of)
-    DEFAULT_EDGE,
-    EDGE_RANGE,
     MIN_CLEARANCE,
     RING_SAMPLES,
     Garment,
@@ -111,20 +110,8 @@ def tube_dress(mannequin, ease=0.06, edge=DEFAULT_EDGE, measurements=None, top=0
 
 # The garments, by the key the CLI and the Drape panel use: builder, the panel's label and description, the
 # command line's words (core.drape.settings.DRAPE["garment"] makes both from here).
-GARMENTS = {
-    "tube_dress": (
-        tube_dress,
-        "Tube Dress",
-        "Strapless tube dress, width max(Br, Hi) plus ease, its top edge pinned",
-        "strapless, pinned at the top edge",
-    ),
-    "t_shirt": (
-        t_shirt,
-        "T-Shirt",
-        "Short-sleeved T-shirt from front, back and sleeve panels, sewn at the shoulders "
-        "and armholes (needs arms hanging clear of the torso)",
-        "sewn at the shoulders and armholes",
-    ),
+GARMENTS = {  # kind: (builder, label, description, the command line's words: core.settings.GARMENT_WORDS)
+    kind: (builder, *GARMENT_WORDS[kind]) for kind, builder in (("tube_dress", tube_dress), ("t_shirt", t_shirt))
 }
 BUILDERS = {kind: builder for kind, (builder, *_) in GARMENTS.items()}
 

@@ -12,10 +12,8 @@ from ..geometry.ellipsoid import section_at_height
 from ..measure.tailor import hull_perimeter, section_heights
 from .fit_metrics import ellipsoid_signed_distance
 
-DEFAULT_EDGE = 0.02  # m, target edge length of the cloth mesh
 MIN_CLEARANCE = 0.005  # m, least initial gap between garment and body
 RING_SAMPLES = 512  # support directions per ring before resampling to the garment's resolution
-EDGE_RANGE = (0.002, 0.2)
 
 
 @dataclass

@@ -1,95 +1,18 @@
-"""Drape settings: :class:`DrapeSettings` (lengths in metres), what Blender's ``drape`` takes, and ``DRAPE``, the
-one table of their defaults, labels and descriptions (the command line's and ``Scene.ellimann_drape``'s)."""
+"""Drape settings: :class:`DrapeSettings` (lengths in metres), what Blender's ``drape`` takes, from
+``core.settings.DRAPE``, the one table of their defaults, labels and descriptions (the command line's and
+``Scene.ellimann_drape``'s)."""
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..constants import COLLIDER_LEVELS
 from ..errors import ElliMannError
-from ..option_table import Choice, Option
-from ..skin.settings import SKIN
+from ..settings import DRAPE, EDGE_RANGE, FRAME_RANGE
 from .colliders import check_subdivisions
-from .garments import EDGE_RANGE, GARMENTS
 
-FRAME_RANGE = (2, 2000)
 # Cloth size: a drape is refused above MAX_CLOTH_VERTICES (about 4 GB; see BYTES_PER_VERTEX in
 # blender/services/drape.py).
 MAX_CLOTH_VERTICES = 50_000
-
-DRAPE = {
-    "garment": Option(
-        "Garment",
-        "tube_dress",
-        "Garment to cut from the mannequin's measurements and drape on it",
-        "{choices}",
-        choices=tuple(
-            Choice(kind, label, description, help) for kind, (_, label, description, help) in GARMENTS.items()
-        ),
-    ),
-    "frames": Option(
-        "Frames",
-        60,
-        "Frames to simulate (from frame 1, at the scene's frame rate)",
-        "frames to simulate (default {default}, at 24 fps)",
-        limits=FRAME_RANGE,
-    ),
-    "edge": Option(
-        "Cloth Edge",
-        0.025,
-        "Edge length of the garment's mesh (smaller: finer folds, slower)",
-        "edge length of the cloth mesh in cm (default {default_cm:g}; smaller is finer and slower)",
-        limits=EDGE_RANGE,
-    ),
-    "collider": Option(
-        "Collider",
-        "pieces",
-        "What the cloth collides with: the convex pieces (fastest) or the smooth skin over them (one closed mesh, "
-        "no seams for the cloth to catch on)",
-        "what the cloth collides with: pieces (the convex pieces, default) or skin (the smooth skin over them, at "
-        "--skin-level)",
-        choices=(
-            Choice("pieces", "Pieces", "The convex pieces: cushions and ellipsoids, or every ellipsoid"),
-            Choice("skin", "Skin", "The smooth skin over the pieces, at the skin level"),
-        ),
-    ),
-    "skin_level": replace(
-        SKIN["skin_level"],
-        default="preview",
-        description="How fine the skin collider is: Preview (10 mm voxels, fits as Final does in the drape "
-        "benchmark and collides faster) or Final (5 mm)",
-        help="the skin collider's level: preview (10 mm voxels, default) or final (5 mm)",
-    ),
-    "cushions": Option(
-        "Cushions",
-        True,
-        "Collide with the cushions and the ellipsoids not in one (off: every ellipsoid)",
-        "collide with the cushions and the ellipsoids not in one; --no-cushions: with every "
-        "ellipsoid (default: {default_text})",
-    ),
-    **{
-        f"{what}_subdivisions": Option(
-            label,
-            2,
-            f"Icosphere level of the {pieces} colliders ({COLLIDER_LEVELS[0]}: "
-            f"coarsest, {COLLIDER_LEVELS[1]}: finest; triangles = 20 * 4^level)",
-            "",
-            limits=COLLIDER_LEVELS,
-        )
-        for what, label, pieces in (
-            ("sphere", "Ellipsoid Resolution", "ellipsoid"),
-            ("cushion", "Cushion Resolution", "cushion"),
-        )
-    },
-}
-
-
-def garment_help():
-    """``--garment``'s help: each garment's own words, the default marked."""
-    option = DRAPE["garment"]
-    return " or ".join(
-        f"{c.value} ({c.help}{'; default' if c.value == option.default else ''})" for c in option.choices
-    )
 
 
 @dataclass

@@ -8,10 +8,9 @@ from ..errors import ElliMannError
 from ..geometry.ellipsoid import axis_extent, section_at_height
 from ..geometry.mesh import face_normals
 from ..measure.tailor import hull_perimeter
+from ..settings import DEFAULT_EDGE, EDGE_RANGE
 from .fit_metrics import ellipsoid_signed_distance
 from .patterns import (
-    DEFAULT_EDGE,
-    EDGE_RANGE,
     MIN_CLEARANCE,
     RING_SAMPLES,
     Garment,

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import ElliMannError
 from ..geometry.mesh import is_closed_manifold, to_scene_axes, unique_rows
-from ..measure.body import UNITS, check_mesh
+from ..measure.body import MESH_EXTENSIONS, UNITS, UP_AXES, check_mesh
 
 
 class BodyMeshError(ElliMannError):
@@ -251,8 +251,6 @@ def hidden_vertices(vertices, faces, normals, candidates, reach=0.1, cell=0.01):
 # point (x, -z, y); ``up="z"`` takes files written in the scene's own axes (as ../shared/refmodels' bodies).
 # PLY (ASCII or binary little-endian) and STL (ASCII or binary) are read in their own axes (Z up, as
 # Blender's importers leave them).
-MESH_EXTENSIONS = (".obj", ".ply", ".stl")
-UP_AXES = ("y", "z")
 
 
 def read_body_mesh(path, up=None, unit="m"):

@@ -10,11 +10,10 @@ skin, bit for bit), so it records no measurement.
 import math
 
 from ..errors import MannequinError, Problem
+from ..settings import BLEND_RANGE, VOXEL_RANGE_MM
 from .field_checks import json_type, short
 
 SKIN_VERSION = 1  # of the ``skin`` section
-VOXEL_RANGE_MM = (1.0, 40.0)  # the skin's voxel, mm
-BLEND_RANGE = (0.0, 3.0)  # how far neighbours blend, times the thinner piece's smallest semi-axis
 FIELDS = ("version", "voxel_mm", "blend", "method")
 
 

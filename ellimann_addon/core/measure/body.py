@@ -227,6 +227,8 @@ def _within(points, hull, margin):
 
 
 UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}  # a mesh file's length units (core.fitting.body_mesh reads them)
+UP_AXES = ("y", "z")  # a mesh file's up axis
+MESH_EXTENSIONS = (".obj", ".ply", ".stl")  # the body meshes core.fitting.body_mesh reads
 
 
 def check_mesh(vertices, faces, up=None, unit=None):

@@ -1,6 +1,6 @@
 """How a skin is made: its voxel (a preview and a final level, or any size in between), how wide neighbours
 blend, and the checks that refuse a skin before any work (a voxel too fine for memory, pieces too thin for it).
-``SKIN`` is the one table of the options (the command line's and the panels')."""
+``core.settings.SKIN`` is the one table of the options (the command line's and the panels')."""
 
 import math
 from dataclasses import dataclass
@@ -9,41 +9,12 @@ import numpy as np
 
 from ..errors import ElliMannError
 from ..geometry.ellipsoid import bounds
-from ..mannequin.skin_record import BLEND_RANGE, SKIN_VERSION, VOXEL_RANGE_MM
-from ..option_table import Choice, Option
+from ..mannequin.skin_record import SKIN_VERSION
+from ..settings import BLEND_RANGE, DEFAULT_BLEND, LEVELS, VOXEL_RANGE_MM
 
-LEVELS = {"preview": 10.0, "final": 5.0}  # voxel, mm
-DEFAULT_BLEND = 0.6  # times the thinner piece's smallest semi-axis (core.skin.field.blend_widths)
 BYTES_PER_NODE = 40  # the field's grid: its values, the marks and the meshing's temporaries (measured, 5 mm)
 MAX_BYTES = 4 * 1024**3  # a skin that would need more is refused before any work
 THIN = 1.5  # a piece must be this many voxels thick (twice its smallest semi-axis) or it may vanish or tear
-
-SKIN = {
-    "skin_level": Option(
-        "Skin Level",
-        "final",
-        "How fine the skin is: Preview (10 mm voxels, for live editing) or Final (5 mm, for export and measuring)",
-        "the skin's level: preview (10 mm voxels) or final (5 mm, default); --skin-voxel sets any size",
-        choices=(
-            Choice("preview", "Preview", "10 mm voxels: fast enough to follow the sliders"),
-            Choice("final", "Final", "5 mm voxels: for export, measuring and draping"),
-        ),
-    ),
-    "skin_voxel": Option(
-        "Voxel",
-        None,
-        "The skin's voxel in millimetres (overrides the level)",
-        "the skin's voxel in mm (default: the level's; {low:g} to {high:g})",
-        limits=VOXEL_RANGE_MM,
-    ),
-    "skin_blend": Option(
-        "Blend",
-        DEFAULT_BLEND,
-        "How far neighbouring pieces blend, in units of the thinner piece's smallest semi-axis (0: a plain union)",
-        "how far neighbouring pieces blend, times the thinner one's smallest semi-axis (default {default:g})",
-        limits=BLEND_RANGE,
-    ),
-}
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,8 @@
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
-from ....core.drape.settings import DRAPE, DrapeSettings
+from ....core.drape.settings import DrapeSettings
+from ....core.settings import DRAPE
 from ..pose.operators import POSE_ITEMS
 
 REST = "REST"

@@ -12,6 +12,7 @@ from bpy.props import BoolProperty, EnumProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper
 
 from ....core.errors import ElliMannError
+from ....core.formats import table
 from ....core.formats.mjcf import write_mjcf
 from ....core.formats.table import FORMATS
 from ... import ids
@@ -40,9 +41,10 @@ NAMES = {"GLB": "glTF", "MJCF": "MJCF"}
 
 
 def format_of(path):
-    """The format a path's extension names ('GLB', 'MJCF'), or None."""
-    extension = os.path.splitext(path)[1].lower()
-    return next((kind for kind, ext in EXTENSIONS.items() if ext == extension), None)
+    """The format a path's extension names ('GLB', 'MJCF': its row of the format table, ``table.format_of``), or
+    None for any other."""
+    kind = table.format_of(path)
+    return kind.name.upper() if kind is not None and kind.name.upper() in EXTENSIONS else None
 
 
 def with_extension(path, kind):
