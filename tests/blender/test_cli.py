@@ -782,3 +782,21 @@ def test_exact_mode_missing_a_request_warns_naming_it_and_exits_3(tmp_path, caps
     code, _, err = run(["batch", source, "-o", str(tmp_path / "out"), "--references", references], capsys)
     assert code == 3 and "line 3: warning: exact mode missed" in err
     assert [r["status"] for r in read_report(tmp_path / "out" / "report.csv")] == ["ok", "missed"]
+
+
+def test_writing_a_glb_registers_the_properties_it_needs_and_no_panel(tmp_path):
+    """``synth -o x.glb`` under ``python -m`` registers ElliMann's object and collection properties (what the
+    writers read), not the add-on's panels and operators (which register the Blender command, which imports the
+    command line again)."""
+    code = (
+        "import sys\nfrom ellimann_addon.cli import main\n"
+        f"code = main(['synth', '--he', '165', '--sh', '41.5', '--br', '101.25', '--wa', '82.75', '--hi', '117.5', "
+        f"'-o', {str(tmp_path / 'x.glb')!r}, '-q'])\n"
+        "import bpy\n"
+        "print(code, hasattr(bpy.types.Collection, 'ellimann'), "
+        "sorted(n for n in dir(bpy.types) if n.startswith(('ELLIMANN_PT', 'ELLIMANN_OT'))))\n"
+        "from ellimann_addon.blender.services import teardown\nteardown.exit_with(0)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert done.stdout.strip().splitlines()[-1] == "0 True []", done.stdout + done.stderr
+    assert (tmp_path / "x.glb").is_file()

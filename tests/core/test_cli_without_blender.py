@@ -247,3 +247,15 @@ def test_one_table_for_the_options_of_the_cli_and_the_panels():
     assert all(getattr(defaults, k) == o.default for k, o in DRAPE.items() if k != "garment")
     with pytest.raises(TypeError):
         SynthesisOptions("exact")  # keyword-only
+
+
+def test_building_the_parser_loads_no_drape_skin_or_fitting_module():
+    """The parser is built from tables on the core's ground floor (core.settings, the format table): what draws,
+    skins or fits is loaded when a command runs it, not to print --help."""
+    code = (
+        "import sys\nfrom ellimann_addon.cli import build_parser\nbuild_parser()\n"
+        "print(sorted(m for m in sys.modules if m.split('.')[:3] in (['ellimann_addon', 'core', 'drape'], "
+        "['ellimann_addon', 'core', 'skin'], ['ellimann_addon', 'core', 'fitting'])))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "[]"
