@@ -22,8 +22,8 @@ import numpy as np
 
 from ellimann_addon.core.body.model import IdwBodyModel
 from ellimann_addon.core.body.skin import BodySkinMaker
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.geometry.volume import IOU_MARGIN, BodyVolume, mesh_voxel_iou
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.skin.exact import exact_skin
 from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import build_skin

@@ -22,7 +22,7 @@ import time
 
 import numpy as np
 
-from ellimann_addon.core.constants import MEASUREMENTS
+from ellimann_addon.core.measurements import MEASUREMENTS
 
 ROWS = 1_000_000
 SEED = 0

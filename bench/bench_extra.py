@@ -21,10 +21,11 @@ import numpy as np
 from devkit.extra_before import MannequinLandmarksBefore, mannequin_extra_measurements_before
 from ellimann_addon.cli import MISSED
 from ellimann_addon.cli import main as ellimann
-from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
+from ellimann_addon.core.constants import quartile_points
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.measure import body as body_measure
-from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS, mannequin_extra_measurements
+from ellimann_addon.core.measure.extra import mannequin_extra_measurements
+from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ellimann_addon.core.synthesis import extra_refine as refine_extra
 from ellimann_addon.core.synthesis import synthesize as synthesis
 from ellimann_addon.core.synthesis.shipped import FEMALE_SET, MALE_SET, named_reference_set

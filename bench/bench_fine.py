@@ -18,9 +18,10 @@ import numpy as np
 
 from bench.bench_core import best_of
 from bench.bench_pose import REQUEST, median_ms
-from ellimann_addon.core.constants import CUSHION_LEVEL, LIVE_CUSHION_LEVEL, MEASUREMENTS, quartile_points
+from ellimann_addon.core.constants import CUSHION_LEVEL, LIVE_CUSHION_LEVEL, quartile_points
 from ellimann_addon.core.geometry.cushion import cushion_vertices
 from ellimann_addon.core.measure.tailor import tailor_measurements
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.pose.posed_pieces import PosingRig
 from ellimann_addon.core.pose.standard import standard_pose
 from ellimann_addon.core.synthesis.shipped import (

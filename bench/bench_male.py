@@ -13,7 +13,8 @@ import time
 import numpy as np
 
 from bench.bench_synthesis import population_scale, table
-from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
+from ellimann_addon.core.constants import quartile_points
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis import synthesize as synthesis
 from ellimann_addon.core.synthesis.shipped import MALE_SET, named_reference_set
 

@@ -14,11 +14,11 @@ README's table by.
 import statistics
 import time
 
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.geometry.volume import IOU_MARGIN, BodyVolume, voxel_iou
 from ellimann_addon.core.measure.body import measure_body_mesh
 from ellimann_addon.core.measure.extra import split_measurements
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize_extra
 from tools.bodies import body_measurements, load_labels

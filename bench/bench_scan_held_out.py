@@ -18,9 +18,9 @@ import statistics
 import numpy as np
 
 from bench.bench_scan import SPACING, twin_overlaps
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.geometry.volume import IOU_MARGIN, BodyVolume
 from ellimann_addon.core.measure.body import measure_body_mesh
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 from tools.bodies import read_bodies
 from tools.build_reference import DEFAULT_REFMODELS

@@ -14,8 +14,9 @@ import time
 
 import numpy as np
 
-from ellimann_addon.core.constants import MEASUREMENTS, TABLE_2_5
-from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS, mannequin_extra_measurements
+from ellimann_addon.core.constants import TABLE_2_5
+from ellimann_addon.core.measure.extra import mannequin_extra_measurements
+from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ellimann_addon.core.settings import LEVELS
 from ellimann_addon.core.skin.exact import exact_skin
 from ellimann_addon.core.skin.settings import SkinSettings

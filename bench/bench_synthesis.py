@@ -24,10 +24,11 @@ import numpy as np
 from bench.bench_core import best_of
 from devkit.hull_before import hull_perimeter_before
 from devkit.synthetic import shipped_or_synthetic
-from ellimann_addon.core.constants import MEASUREMENTS, PAPER_TABLE_2_4, SECTION_FRACTIONS, quartile_points
+from ellimann_addon.core.constants import PAPER_TABLE_2_4, SECTION_FRACTIONS, quartile_points
 from ellimann_addon.core.formats.table import write_file
 from ellimann_addon.core.geometry.ellipsoid import section_at_height
 from ellimann_addon.core.measure.tailor import hull_perimeter, section_heights, tailor_measurements
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis import synthesize as synthesis
 
 VARIANTS = (  # label, synthesize_batch options

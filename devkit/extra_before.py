@@ -11,7 +11,6 @@ from ellimann_addon.core.measure.band_search import extreme_over_band
 from ellimann_addon.core.measure.extra import (
     CALF_BAND,
     CROTCH_FLOOR,
-    EXTRA_MEASUREMENTS,
     MID_PLANE_HEIGHT,
     SIDES,
     THIGH_DROP,
@@ -22,6 +21,7 @@ from ellimann_addon.core.measure.extra import (
 )
 from ellimann_addon.core.measure.neck import neck_band, neck_frame
 from ellimann_addon.core.measure.tailor import hull_perimeter, section_heights
+from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS
 
 
 def _farthest_distance(rotation, center, semi_axes, point):

@@ -3,9 +3,10 @@
 import numpy as np
 from scipy.spatial import ConvexHull
 
-from ellimann_addon.core.constants import GIRTHS, MEASUREMENTS
+from ellimann_addon.core.constants import GIRTHS
 from ellimann_addon.core.geometry.ellipsoid import section_at_height
 from ellimann_addon.core.measure import tailor as measure
+from ellimann_addon.core.measurements import MEASUREMENTS
 
 
 def random_rotations(rng, n):

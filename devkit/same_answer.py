@@ -81,8 +81,8 @@ def _write_rows(path, header, rows):
 
 
 def main(out):
-    from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
-    from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
+    from ellimann_addon.core.constants import quartile_points
+    from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
     from ellimann_addon.core.synthesis.shipped import named_reference_set
 
     pathlib.Path(out).mkdir(parents=True, exist_ok=True)

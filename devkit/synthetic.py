@@ -12,11 +12,12 @@ import pathlib
 import numpy as np
 
 from devkit.toy import TOY_PARTS, rotation_from_vector
-from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS
+from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS
 from ellimann_addon.core.geometry.ellipsoid import axis_extent
 from ellimann_addon.core.geometry.frames import mirror_frame
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.mannequin.topology import Topology
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.synthesize import REFERENCE_NAMES, ReferenceSet, load_reference_set
 
 # Left and central parts of a ~1.6 m body: centre (m), rotation vector, semi-axes (m).

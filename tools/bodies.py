@@ -12,12 +12,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ellimann_addon.core.constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
+from ellimann_addon.core.constants import CM_PER_M, GIRTHS, SECTION_FRACTIONS
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.geometry.mesh import convex_hull_2d, plane_section_points, polygon_perimeter
 from ellimann_addon.core.mannequin.joints import joints_from_makehuman
 from ellimann_addon.core.measure.body import measure_body_mesh
-from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
+from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 
 REFERENCE_BODY = "reference_female"
 RM_BODIES = ("small_slim", "tall_slim", "small_chubby", "tall_chubby", "average")

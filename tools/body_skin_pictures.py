@@ -19,8 +19,9 @@ from ellimann_addon.blender.bridge.convert import mesh_from_arrays
 from ellimann_addon.blender.bridge.skin import SKIN_COLOR
 from ellimann_addon.core.body.correct import BodySkinError
 from ellimann_addon.core.body.skin import BodySkinMaker
-from ellimann_addon.core.constants import MEASUREMENTS, TABLE_2_5
+from ellimann_addon.core.constants import TABLE_2_5
 from ellimann_addon.core.fitting.body_mesh import read_obj
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.pose.motion import clamped_motion
 from ellimann_addon.core.pose.standard import STILL_POSES
 from ellimann_addon.core.synthesis.bodies import load_set_bodies

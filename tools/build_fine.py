@@ -26,12 +26,12 @@ import time
 
 import numpy as np
 
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.files import atomic_write_text
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.fitting.mannequin_fit import FitConstants
 from ellimann_addon.core.fitting.reference_build import BuildSettings, build_reference_set, relative_errors
 from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.manifest import MANIFEST_FILE, read_manifest
 
 from . import build_reference as br

@@ -42,7 +42,7 @@ import zlib
 
 import numpy as np
 
-from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
+from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 from ellimann_addon.core.files import atomic_write_text
 from ellimann_addon.core.fitting.body_mesh import hidden_vertices, read_obj, vertex_normals
 from ellimann_addon.core.fitting.mannequin_fit import FitConstants, fit_mannequin
@@ -59,6 +59,7 @@ from ellimann_addon.core.mannequin.clean import register_to_world, registration_
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.mannequin.traces import PartTrace
 from ellimann_addon.core.measure.tailor import section_heights
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.bodies import BODIES_FILE
 from ellimann_addon.core.synthesis.manifest import MANIFEST_FILE, legacy_manifest, read_manifest
 

@@ -22,10 +22,11 @@ import sys
 
 import numpy as np
 
-from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS
+from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS
 from ellimann_addon.core.fitting.reference_build import display_name
 from ellimann_addon.core.geometry.volume import IOU_MARGIN, IOU_SPACING, BodyVolume, voxel_iou
 from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.manifest import Manifest, targets_range
 from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, ReferenceSet
 from ellimann_addon.core.synthesis.synthesize import synthesize_batch

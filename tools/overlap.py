@@ -16,9 +16,9 @@ import sys
 
 import numpy as np
 
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.geometry import volume
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.settings import LEVELS
 from ellimann_addon.core.skin.exact import exact_skin
 from ellimann_addon.core.skin.settings import SkinSettings

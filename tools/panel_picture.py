@@ -154,9 +154,10 @@ def references_scene(refmodels):
     import bpy
 
     from ellimann_addon.blender.bridge.convert import mannequin_to_collection, mesh_from_arrays
-    from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS
+    from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS
     from ellimann_addon.core.fitting.body_mesh import read_obj
     from ellimann_addon.core.mannequin.model import Mannequin
+    from ellimann_addon.core.measurements import MEASUREMENTS
     from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
     props = bpy.context.scene.ellimann_references

@@ -18,8 +18,8 @@ matplotlib.use("Agg")  # files only, no window
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ellimann_addon.core.constants import MEASUREMENTS  # noqa: E402
 from ellimann_addon.core.formats.npz_bundle import read_batch_file  # noqa: E402
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.population import load_population  # noqa: E402
 
 NAMES = {"He": "height", "Sh": "shoulder width", "Br": "bust", "Wa": "waist", "Hi": "hips"}

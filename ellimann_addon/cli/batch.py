@@ -13,15 +13,14 @@ import sys
 
 import numpy as np
 
-from ..core.constants import MEASUREMENTS
 from ..core.errors import ElliMannError
 from ..core.files import incomplete
 from ..core.formats.npz_bundle import BatchFileWriter
 from ..core.formats.table import BATCH_FILE, format_named, listing
 from ..core.job.result import tolerance_text
 from ..core.mannequin.skeleton import JOINT_NAMES
-from ..core.measure.extra import EXTRA_MEASUREMENTS
 from ..core.measure.tailor import as_dict
+from ..core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ..core.synthesis.batch import by_reference_set, chunks, synthesize_chunk
 from ..core.synthesis.misses import missed_text
 from . import arguments, distributed, jobs, output, reporting, skinning, writing

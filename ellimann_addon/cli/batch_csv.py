@@ -7,9 +7,8 @@ import csv
 import difflib
 from typing import NamedTuple
 
-from ..core.constants import MEASUREMENTS
 from ..core.errors import MeasurementError, ReferenceSetError
-from ..core.measure.extra import EXTRA_MEASUREMENTS
+from ..core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ..core.synthesis.extra_refine import extra_request_problems
 from ..core.synthesis.request import validate_request
 from . import output

@@ -4,8 +4,9 @@ line-up (Blender)."""
 import os
 import sys
 
-from ..core.constants import MEASUREMENTS, TABLE_2_5
+from ..core.constants import TABLE_2_5
 from ..core.measure.tailor import as_dict
+from ..core.measurements import MEASUREMENTS
 from ..core.synthesis.misses import missed_text, request_misses
 from ..core.synthesis.options import PAPER
 from . import arguments, output, reporting, writing

@@ -7,16 +7,16 @@ import math
 import os
 import sys
 
-from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS
 from ..core.errors import MannequinError
 from ..core.mannequin.model import Mannequin
-from ..core.measure.body import ALL_MEASUREMENTS, MESH_EXTENSIONS, measure_body_mesh
-from ..core.measure.extra import EXTRA_LABELS, mannequin_extra_measurements
+from ..core.measure.body import MESH_EXTENSIONS, measure_body_mesh
+from ..core.measure.extra import mannequin_extra_measurements
+from ..core.measurements import ALL_MEASUREMENTS, MEASUREMENT_LABELS, MEASUREMENTS, measurement_line
 from . import arguments, output, writing
 from .output import UsageError
 from .skinning import describe
 
-LABELS = {**MEASUREMENT_LABELS, **EXTRA_LABELS}
+LABELS = {**MEASUREMENT_LABELS, **MEASUREMENT_LABELS}
 KEY_WIDTH = max(map(len, ALL_MEASUREMENTS))  # the table's columns line up whatever the keys
 LABEL_WIDTH = max(map(len, LABELS.values()))
 NECK_TILT_LIMITS = (-45.0, 60.0)  # degrees forward: what --neck-tilt accepts
@@ -179,7 +179,7 @@ def _print(values, as_json, path, title):
     arm or leg pieces) is left out with a warning."""
     five = [values[key] for key in MEASUREMENTS if key in values]
     if not all(math.isfinite(value) for value in five):
-        raise UsageError(f"{path}: m_T is not finite ({output.format_me(five)} cm)")
+        raise UsageError(f"{path}: m_T is not finite ({measurement_line(five)} cm)")
     lost = [key for key in ALL_MEASUREMENTS if key in values and not math.isfinite(values[key])]
     if lost:
         output.say(f"{output.PROG} measure: warning: {path}: {', '.join(lost)} cannot be taken (no such pieces)")

@@ -7,7 +7,6 @@ import sys
 import time
 
 from ..core.errors import ElliMannError, one_line  # noqa: F401  (one_line: output.one_line)
-from ..core.measure.tailor import measurement_line
 
 PROG = "ellimann"
 MISSED = 3  # exit code: written, but exact mode missed a requested measurement by more than its tolerance
@@ -49,11 +48,6 @@ def printable(text):
 def say(text, file=None, end="\n"):
     """Print one of ElliMann's lines (stderr unless ``file``), escaping what a terminal would act on."""
     print(printable(text), file=file or sys.stderr, end=end, flush=True)
-
-
-def format_me(values):
-    """The m_T line (``core.measure.tailor.measurement_line``)."""
-    return measurement_line(values)
 
 
 class Progress:

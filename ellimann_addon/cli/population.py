@@ -7,7 +7,7 @@ import csv
 import io
 import sys
 
-from ..core.constants import MEASUREMENTS
+from ..core.measurements import MEASUREMENTS
 from ..core.synthesis.population import MAX_SAMPLES, load_population, shipped_populations
 from . import arguments, batch, output, writing
 from .output import PROG, UsageError

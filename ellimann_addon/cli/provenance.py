@@ -19,9 +19,9 @@ import hashlib
 import json
 import os
 
-from ..core.constants import MEASUREMENTS, VERSION
+from ..core.constants import VERSION
 from ..core.files import atomic_write_text
-from ..core.measure.extra import EXTRA_MEASUREMENTS
+from ..core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ..core.synthesis.manifest import MANIFEST_FILE
 
 RECORD_FOLDER = "made_from"

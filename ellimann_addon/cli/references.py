@@ -7,8 +7,8 @@ import os
 import pathlib
 import sys
 
-from ..core.constants import MEASUREMENTS
 from ..core.mannequin.clean import asymmetry
+from ..core.measurements import MEASUREMENTS
 from ..core.synthesis.manifest import STEM, read_manifest
 from ..core.synthesis.reference_set import load_reference_set
 from . import arguments, output, writing

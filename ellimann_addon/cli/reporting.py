@@ -9,13 +9,11 @@ import errno
 import io
 import os
 
-from ..core.constants import MEASUREMENTS
-from ..core.measure.extra import EXTRA_MEASUREMENTS
+from ..core.measurements import ALL_MEASUREMENTS, MEASUREMENTS
 from ..core.synthesis.request import relative_error
 from .output import printable
 from .writing import writing
 
-ALL_MEASUREMENTS = MEASUREMENTS + EXTRA_MEASUREMENTS
 REPORT_COLUMNS = (
     ["line", "name", "status", "message"]
     + list(ALL_MEASUREMENTS)

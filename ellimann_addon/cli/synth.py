@@ -4,9 +4,15 @@ own measurements (``--from body.obj``), written as .json/.xml (no Blender) or .b
 import json
 import sys
 
-from ..core.constants import MEASUREMENT_LABELS, MEASUREMENTS, RANGES
+from ..core.constants import RANGES
 from ..core.formats.table import listing
-from ..core.measure.extra import EXTRA_ABSURD_LIMITS, EXTRA_LABELS, EXTRA_MEASUREMENTS
+from ..core.measurements import (
+    EXTRA_ABSURD_LIMITS,
+    EXTRA_MEASUREMENTS,
+    MEASUREMENT_LABELS,
+    MEASUREMENTS,
+    measurement_line,
+)
 from ..core.synthesis.request import relative_error
 from . import arguments, jobs, output, skinning, writing
 from .output import PROG, UsageError
@@ -36,7 +42,8 @@ def add_parser(commands):
             dest=key,
             type=arguments.number,
             metavar="CM",
-            help=f"{EXTRA_LABELS[key]} ({low:g}-{high:g}; optional: met in exact mode, otherwise the reference set's)",
+            help=f"{MEASUREMENT_LABELS[key]} ({low:g}-{high:g}; optional: met in exact mode, otherwise the "
+            "reference set's)",
         )
     synth.add_argument(
         "--from",
@@ -131,19 +138,19 @@ def _line(args, result):
     extra = [key for key in EXTRA_MEASUREMENTS if key in result.request]
     shown = result.shown()
     error = relative_error([shown[key] for key in MEASUREMENTS], asked).max()
-    extra_line = "; " + ", ".join(f"{key} {shown[key]:.2f}" for key in extra) + " cm" if extra else ""
+    extra_line = f"; {measurement_line(shown, extra)} cm" if extra else ""
     name = result.mannequin.name
     if result.skin is None:
         return (
-            f"wrote {args.output}: '{name}'{posed} ({args.mode}), m_T {output.format_me(result.five)} cm, "
+            f"wrote {args.output}: '{name}'{posed} ({args.mode}), m_T {measurement_line(result.five)} cm, "
             f"max error {error:.3f}%{extra_line}"
         )
     skin = result.skin
     rounds = f"; {skin.rounds} round(s) of exact mode on the skin" if skin.exact else ""
     return (
         f"wrote {args.output}: '{name}'{posed} ({args.mode}, {skinning.describe(skin.settings)}), "
-        f"skin {output.format_me([shown[key] for key in MEASUREMENTS])} cm, max error {error:.3f}%{extra_line}; "
-        f"pieces' m_T {output.format_me(result.five)} cm{rounds}"
+        f"skin {measurement_line(shown, MEASUREMENTS)} cm, max error {error:.3f}%{extra_line}; "
+        f"pieces' m_T {measurement_line(result.five)} cm{rounds}"
     )
 
 

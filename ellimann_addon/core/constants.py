@@ -1,19 +1,11 @@
-"""Project-wide constants: measurement names, section heights, the paper's tables.
+"""Project-wide constants: the version, section heights, the paper's tables (the measurements: ``core.measurements``).
 
 Measurements are in centimetres (what tailors type); geometry is in metres (Blender's unit).
 """
 
+from .measurements import MEASUREMENTS
+
 VERSION = "0.1.0"  # blender_manifest.toml's and pyproject.toml's (tests/core/test_packaging.py): ``ellimann --version``
-
-MEASUREMENTS = ("He", "Sh", "Br", "Wa", "Hi")
-
-MEASUREMENT_LABELS = {
-    "He": "Height",
-    "Sh": "Shoulder width",
-    "Br": "Breast perimeter",
-    "Wa": "Waist perimeter",
-    "Hi": "Hip perimeter",
-}
 
 # Section heights as fractions of He above the lowest point of the feet (the paper's Section 2.3.5; the
 # sections and the parts they cut: docs/topology.md); the tools in ../shared/refmodels use the same numbers.
@@ -41,17 +33,6 @@ RANGES = {
     )
     for key in MEASUREMENTS
 }
-
-# Plausibility limits (cm): outside these a request is refused, not extrapolated.
-# Inside them but outside RANGES it is allowed with a warning.
-ABSURD_LIMITS = {
-    "He": (50.0, 250.0),
-    "Sh": (10.0, 100.0),
-    "Br": (30.0, 300.0),
-    "Wa": (30.0, 300.0),
-    "Hi": (30.0, 300.0),
-}
-
 
 # Plausibility limits of a piece (m), the geometry's counterpart of ABSURD_LIMITS: a mannequin with a
 # piece outside them is refused (JSON files, Blender collections, synthesis results), naming the part,

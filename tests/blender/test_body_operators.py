@@ -12,7 +12,7 @@ from ellimann_addon.blender.features.measure.body import RESULT_PROPERTY
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.geometry.mesh import icosphere
 from ellimann_addon.core.measure.body import measure_body_mesh
-from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
+from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS
 from tools.reference_sets import TRACING_FOLDER
 
 
@@ -85,7 +85,8 @@ def test_a_mannequins_exported_obj_measures_as_the_mannequin(tmp_path, capsys):
     1.6 cm here."""
     from devkit.cli_runs import run
     from ellimann_addon.core.mannequin.model import Mannequin
-    from ellimann_addon.core.measure.extra import ISO_ALLOWANCE, mannequin_tilt
+    from ellimann_addon.core.measure.extra import mannequin_tilt
+    from ellimann_addon.core.measurements import ISO_ALLOWANCE
 
     request = ["--he", "160", "--sh", "42", "--br", "100", "--wa", "80", "--hi", "100"]
     for kind in ("json", "obj"):

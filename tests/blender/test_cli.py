@@ -20,11 +20,10 @@ from devkit.cli_runs import assert_one_line_error, python_m, run
 from ellimann_addon import cli
 from ellimann_addon.cli import drape as drape_cli
 from ellimann_addon.cli import writing
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.drape.settings import DrapeSettings
 from ellimann_addon.core.formats.glb import EXTRAS_KEY, read_glb_json
 from ellimann_addon.core.mannequin.model import Mannequin
-from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
+from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ellimann_addon.core.synthesis.synthesize import relative_error
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]

@@ -7,13 +7,13 @@ import pytest
 from devkit.blender_scene import parts, select, state
 from ellimann_addon.blender.bridge.built import BUILT_KEY, built_objects
 from ellimann_addon.blender.bridge.convert import mannequin_to_collection, world_triangles
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.geometry import mesh
 from ellimann_addon.core.geometry.cushion import cushion_mesh
 from ellimann_addon.core.geometry.ellipsoid import volume
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.mannequin.topology import Part, Topology
 from ellimann_addon.core.measure.tailor import measure_meshes, section_heights
+from ellimann_addon.core.measurements import MEASUREMENTS
 
 
 def capsule_mannequin(radius=0.1, length=0.5):

@@ -9,12 +9,12 @@ import pytest
 
 from ellimann_addon.blender.bridge import convert
 from ellimann_addon.blender.services.files import export_gltf, write_mannequin
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.errors import ElliMannError, MannequinError
 from ellimann_addon.core.files import atomic_output
 from ellimann_addon.core.formats.glb import EXTRAS_KEY, read_glb_json
 from ellimann_addon.core.formats.table import write_file
 from ellimann_addon.core.geometry.quaternion import quaternion_to_rotation
+from ellimann_addon.core.measurements import MEASUREMENTS
 
 # glTF is Y-up: Blender's exporter maps (x, y, z) -> (x, z, -y).
 Z_UP_FROM_Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])

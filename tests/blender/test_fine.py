@@ -14,11 +14,11 @@ from ellimann_addon.blender.bridge import convert
 from ellimann_addon.blender.bridge.built import built_objects
 from ellimann_addon.blender.bridge.convert import world_triangles
 from ellimann_addon.blender.features.synthesize.live import live_update
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.formats.glb import EXTRAS_KEY, read_glb_json
 from ellimann_addon.core.geometry import mesh
 from ellimann_addon.core.geometry.cushion import cushion_mesh
 from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 
 REQUESTS = {

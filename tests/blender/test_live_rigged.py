@@ -10,10 +10,11 @@ from ellimann_addon.blender.bridge.built import built_objects, is_stale
 from ellimann_addon.blender.bridge.selection import part_lookup
 from ellimann_addon.blender.features.synthesize import live
 from ellimann_addon.blender.services.rig import split_sources
-from ellimann_addon.core.constants import CUSHION_LEVEL, MEASUREMENTS
+from ellimann_addon.core.constants import CUSHION_LEVEL
 from ellimann_addon.core.geometry.cushion import cushion_vertices
 from ellimann_addon.core.geometry.mesh import convexity_defect, icosphere_level, is_closed_manifold
 from ellimann_addon.core.mannequin.skeleton import JOINT_NAMES
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.pose.posed_pieces import clipped_vertices
 from ellimann_addon.core.synthesis import synthesize as core_synthesis
 

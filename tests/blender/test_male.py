@@ -12,10 +12,11 @@ import pytest
 from devkit.blender_scene import state
 from devkit.cli_runs import assert_one_line_error, run
 from ellimann_addon.blender.bridge import convert
-from ellimann_addon.core.constants import MEASUREMENTS, SECTION_FRACTIONS
+from ellimann_addon.core.constants import SECTION_FRACTIONS
 from ellimann_addon.core.drape.garments import make_garment
 from ellimann_addon.core.formats.glb import EXTRAS_KEY, read_glb_json
 from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.reference_set import load_reference_set
 from ellimann_addon.core.synthesis.shipped import SHIPPED_SETS
 

@@ -17,9 +17,9 @@ from ellimann_addon.blender.services.files import write_mannequin
 from ellimann_addon.blender.services.posing import write_posed
 from ellimann_addon.blender.services.rig import MODIFIER_NAME, apply_pose, build_rig
 from ellimann_addon.blender.services.skin import COLLIDER_NAME
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.geometry.mesh import is_closed_manifold
 from ellimann_addon.core.mannequin.skeleton import JOINT_NAMES
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.pose.motion import clamped_motion
 from ellimann_addon.core.skin.exact import MESH_TOLERANCE_CM
 from ellimann_addon.core.skin.measure import mesh_measurements

@@ -17,16 +17,10 @@ from ellimann_addon.blender.bridge.built import is_stale
 from ellimann_addon.blender.bridge.selection import part_lookup
 from ellimann_addon.blender.features.synthesize import live, panel, presets
 from ellimann_addon.blender.features.synthesize import props as synthesis_props
-from ellimann_addon.core.constants import (
-    ABSURD_LIMITS,
-    CUSHION_LEVEL,
-    MEASUREMENTS,
-    RANGES,
-    REFERENCE_MEASUREMENTS,
-    TABLE_2_5,
-)
+from ellimann_addon.core.constants import CUSHION_LEVEL, RANGES, REFERENCE_MEASUREMENTS, TABLE_2_5
 from ellimann_addon.core.geometry.cushion import cushion_vertices
 from ellimann_addon.core.geometry.mesh import convexity_defect, is_closed_manifold
+from ellimann_addon.core.measurements import ABSURD_LIMITS, MEASUREMENTS
 from ellimann_addon.core.synthesis.reference_set import load_reference_set
 from ellimann_addon.core.synthesis.shipped import SHIPPED_SETS
 from ellimann_addon.core.synthesis.synthesize import synthesize as core_synthesize

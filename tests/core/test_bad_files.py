@@ -13,10 +13,11 @@ from hypothesis import strategies as st
 from devkit import synthetic
 from devkit.poses import make_apose_toy
 from devkit.toy import make_toy_mannequin
-from ellimann_addon.core.constants import ABSURD_LIMITS, CENTER_LIMIT, MEASUREMENTS, SEMI_AXIS_LIMITS
+from ellimann_addon.core.constants import CENTER_LIMIT, SEMI_AXIS_LIMITS
 from ellimann_addon.core.drape import garments
 from ellimann_addon.core.errors import ElliMannError, MannequinError, ReferenceSetError
 from ellimann_addon.core.mannequin.model import FORMAT_VERSION, Mannequin
+from ellimann_addon.core.measurements import ABSURD_LIMITS, MEASUREMENTS
 from ellimann_addon.core.synthesis import synthesize as synthesis
 from ellimann_addon.core.synthesis.manifest import MANIFEST_FILE
 

@@ -20,9 +20,10 @@ from devkit import synthetic
 from devkit.cli_runs import ROOT, assert_one_line_error, run
 from devkit.same_answer import environment
 from ellimann_addon.cli import distributed, output
-from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
+from ellimann_addon.core.constants import quartile_points
 from ellimann_addon.core.formats.npz_bundle import BatchFileError, load_batch_file, read_batch_file
 from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, REFERENCE_NAMES, load_reference_set
 from ellimann_addon.core.synthesis.refine import EXACT_TOLERANCE, FACTOR_LIMITS
 from ellimann_addon.core.synthesis.synthesize import synthesize_batch
@@ -377,7 +378,7 @@ def test_batch_meets_extra_measurements_as_synth_does_and_reports_each(tmp_path,
     batch file holds that mannequin, and the report has requested, measured and error cells for every measurement
     a row asked for; one out of reach is a miss (status, exit code 3, its line), as data."""
     from ellimann_addon.cli import reporting
-    from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
+    from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS
 
     slim = "148,31.11,84.97,63,83"
     source = tmp_path / "in.csv"

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from ellimann_addon.core.body.tape import Tape
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.measure.body import measure_body_mesh
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.bodies import (
     BodiesError,
     from_meshes,

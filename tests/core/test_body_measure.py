@@ -8,23 +8,14 @@ import pytest
 
 from devkit.cli_runs import assert_one_line_error, run
 from devkit.toy import make_toy_mannequin
-from ellimann_addon.core.constants import MEASUREMENTS, SECTION_FRACTIONS
+from ellimann_addon.core.constants import SECTION_FRACTIONS
 from ellimann_addon.core.fitting.body_mesh import BodyMeshError, read_body_mesh
 from ellimann_addon.core.geometry.mesh import icosphere, in_plane, section_segments
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.mannequin.topology import Part, Topology
 from ellimann_addon.core.measure.band_search import extreme_over_band
-from ellimann_addon.core.measure.body import (
-    ALL_MEASUREMENTS,
-    StandingBody,
-    body_neck,
-    hull_girth,
-    measure_body_mesh,
-    section_blobs,
-)
+from ellimann_addon.core.measure.body import StandingBody, body_neck, hull_girth, measure_body_mesh, section_blobs
 from ellimann_addon.core.measure.extra import (
-    EXTRA_MEASUREMENTS,
-    ISO_ALLOWANCE,
     MannequinLandmarks,
     _farthest_points,
     mannequin_extra_measurements,
@@ -33,6 +24,7 @@ from ellimann_addon.core.measure.extra import (
     tightest_mannequin_neck,
 )
 from ellimann_addon.core.measure.neck import HEAD_JOINT, NECK_JOINT, NECK_TILT_DEFAULT, joint_tilt
+from ellimann_addon.core.measurements import ALL_MEASUREMENTS, EXTRA_MEASUREMENTS, ISO_ALLOWANCE, MEASUREMENTS
 from ellimann_addon.core.synthesis.extra_refine import ExtraRequestError, extra_request_problems
 from ellimann_addon.core.synthesis.shipped import named_reference_set, reference_folder
 from ellimann_addon.core.synthesis.synthesize import synthesize_extra

@@ -11,8 +11,7 @@ from ellimann_addon.core.body.correct import PROMISE_CM, BodySkinError
 from ellimann_addon.core.body.deform import PARAMETERS, Deformation, hat
 from ellimann_addon.core.body.mesh_checks import arm_clearance, fold_problems, surface_problems
 from ellimann_addon.core.body.skin import BodySkinMaker
-from ellimann_addon.core.constants import MEASUREMENTS
-from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
+from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ellimann_addon.core.synthesis.bodies import load_set_bodies
 from ellimann_addon.core.synthesis.shipped import named_reference_set, reference_folder
 from tools.reference_sets import SHARED

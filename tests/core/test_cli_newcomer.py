@@ -19,7 +19,7 @@ from ellimann_addon.cli import build_parser
 from ellimann_addon.core.files import MAX_READ_BYTES
 from ellimann_addon.core.formats.glb import EXTRAS_FORMAT, EXTRAS_KEY, EXTRAS_VERSION
 from ellimann_addon.core.mannequin.model import Mannequin
-from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
+from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS
 from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER
 
 REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]

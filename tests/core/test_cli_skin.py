@@ -19,9 +19,9 @@ import pytest
 
 from devkit.cli_runs import assert_one_line_error, run
 from ellimann_addon.cli import build_parser, main, skinning
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.geometry.mesh import euler_characteristic, is_closed_manifold
 from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.pose.standard import standard_pose
 from ellimann_addon.core.settings import LEVELS, SKIN
 from ellimann_addon.core.skin.exact import MESH_TOLERANCE_CM

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from devkit import synthetic
-from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
+from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]

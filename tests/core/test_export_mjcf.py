@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from devkit.toy import make_toy_mannequin
-from ellimann_addon.core.constants import MEASUREMENTS, MJCF_CUSHION_LEVEL
+from ellimann_addon.core.constants import MJCF_CUSHION_LEVEL
 from ellimann_addon.core.drape.fit_metrics import BodyPieces
 from ellimann_addon.core.errors import ElliMannError, MannequinError
 from ellimann_addon.core.formats.mjcf import mannequin_to_mjcf, write_mjcf
@@ -15,6 +15,7 @@ from ellimann_addon.core.geometry import mesh
 from ellimann_addon.core.geometry.cushion import cushion_mesh, cushion_name
 from ellimann_addon.core.geometry.ellipsoid import bounds, contains
 from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.manifest import MANIFEST_FILE
 
 mujoco = pytest.importorskip("mujoco")  # a dev dependency (requirements-dev.txt); CI always has it

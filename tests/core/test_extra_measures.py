@@ -9,11 +9,10 @@ import pytest
 
 from devkit.extra_before import MannequinLandmarksBefore, _farthest_distance, mannequin_extra_measurements_before
 from devkit.toy import make_toy_mannequin
-from ellimann_addon.core.constants import MEASUREMENTS, quartile_points
+from ellimann_addon.core.constants import quartile_points
 from ellimann_addon.core.mannequin.skeleton import JOINT_NAMES
 from ellimann_addon.core.measure.band_search import BAND_SAMPLES, extreme_over_band, extremes_over_bands
 from ellimann_addon.core.measure.extra import (
-    EXTRA_MEASUREMENTS,
     SIDES,
     MannequinLandmarks,
     _farthest_points,
@@ -21,6 +20,7 @@ from ellimann_addon.core.measure.extra import (
     split_measurements,
 )
 from ellimann_addon.core.measure.neck import HEAD_JOINT, NECK_JOINT, joint_tilt, neck_frame
+from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ellimann_addon.core.synthesis import synthesize as synthesis
 from ellimann_addon.core.synthesis.shipped import FEMALE_SET, MALE_SET, named_reference_set
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from devkit.cli_runs import assert_one_line_error, run
-from ellimann_addon.core.constants import GIRTHS, MEASUREMENTS, quartile_points
+from ellimann_addon.core.constants import GIRTHS, quartile_points
 from ellimann_addon.core.errors import ReferenceSetError
 from ellimann_addon.core.fitting.reference_build import cleanliness_problems
 from ellimann_addon.core.geometry.ellipsoid import axis_extent, section_at_height
@@ -20,6 +20,7 @@ from ellimann_addon.core.geometry.frames import is_rotation
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.mannequin.skeleton import PARENTS, bone_names, cross_joint_pairs, part_bones
 from ellimann_addon.core.measure.tailor import section_heights
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.reference_set import load_reference_set
 from ellimann_addon.core.synthesis.shipped import (
     FEMALE_FINE_SET,

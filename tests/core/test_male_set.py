@@ -7,10 +7,11 @@ import json
 import numpy as np
 import pytest
 
-from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, SECTION_FRACTIONS, quartile_points
+from ellimann_addon.core.constants import RANGES, SECTION_FRACTIONS, quartile_points
 from ellimann_addon.core.errors import MannequinError, MeasurementError, ReferenceSetError
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.measure.tailor import section_heights, tailor_measurements
+from ellimann_addon.core.measurements import ABSURD_LIMITS, MEASUREMENTS
 from ellimann_addon.core.synthesis.reference_set import load_reference_set
 from ellimann_addon.core.synthesis.request import validate_request
 from ellimann_addon.core.synthesis.shipped import SHIPPED_SETS, reference_folder

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from devkit.toy import TOY_PARTS, make_toy_mannequin
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.errors import MannequinError
 from ellimann_addon.core.mannequin.model import Mannequin, stack
 from ellimann_addon.core.mannequin.topology import Part, Topology, twin_name
+from ellimann_addon.core.measurements import MEASUREMENTS
 
 
 def problems_of(parts):

@@ -8,11 +8,11 @@ import pytest
 
 from devkit.cli_runs import assert_one_line_error, run
 from devkit.toy import make_toy_mannequin
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.fitting.body_mesh import BodyMesh, connectivity_fingerprint, from_polygons, read_obj
 from ellimann_addon.core.fitting.reference_build import ReferenceBuildError, central_body, validate_inputs
 from ellimann_addon.core.geometry.mesh import from_scene_axes, icosphere
 from ellimann_addon.core.mannequin.traces import FitSettings, PartTrace
+from ellimann_addon.core.measurements import MEASUREMENTS
 
 TARGETS = {"a": (150, 32, 86, 64, 84), "b": (170, 31, 85, 64, 85), "c": (160, 43, 117, 104, 117)}
 

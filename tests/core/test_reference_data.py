@@ -5,13 +5,14 @@ import pathlib
 import numpy as np
 import pytest
 
-from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS
+from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS
 from ellimann_addon.core.geometry.ellipsoid import section_at_height
 from ellimann_addon.core.geometry.frames import axis_agreement, is_rotation
 from ellimann_addon.core.mannequin.clean import asymmetry, landmark_indices
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.mannequin.topology import NAME_PATTERN
 from ellimann_addon.core.measure.tailor import section_heights
+from ellimann_addon.core.measurements import MEASUREMENTS
 
 FOLDER = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"
 DOCS = pathlib.Path(__file__).resolve().parents[2] / "docs"

@@ -7,10 +7,11 @@ import pytest
 
 from devkit.synthetic import make_reference_mannequins, write_reference_folder
 from devkit.toy import make_toy_mannequin
-from ellimann_addon.core.constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, SECTION_FRACTIONS
+from ellimann_addon.core.constants import RANGES, SECTION_FRACTIONS
 from ellimann_addon.core.errors import MannequinError, ReferenceSetError
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.mannequin.traces import FitSettings, PartTrace, format_runs, parse_runs
+from ellimann_addon.core.measurements import ABSURD_LIMITS, MEASUREMENTS
 from ellimann_addon.core.synthesis.manifest import (
     MANIFEST_FILE,
     Manifest,

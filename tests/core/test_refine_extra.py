@@ -6,16 +6,15 @@ with the amount."""
 import numpy as np
 import pytest
 
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.geometry.ellipsoid import axis_extent
 from ellimann_addon.core.measure.extra import (
-    EXTRA_MEASUREMENTS,
     THIGH_DROP,
     MannequinLandmarks,
     mannequin_extra_measurements,
     mannequin_neck,
     neck_plane,
 )
+from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ellimann_addon.core.synthesis.extra_refine import (
     EXTRA_FACTOR_LIMIT,
     MISS_CM,

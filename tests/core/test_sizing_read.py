@@ -10,7 +10,7 @@ import xml.etree.ElementTree as ElementTree
 import numpy as np
 import pytest
 
-from ellimann_addon.core.constants import MEASUREMENTS
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.sizing.readers import read_measurement_file
 from ellimann_addon.core.sizing.rows import SizingError
 from ellimann_addon.core.synthesis.population import load_population

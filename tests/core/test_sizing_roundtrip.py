@@ -7,7 +7,7 @@ import xml.etree.ElementTree as ElementTree
 import pytest
 
 from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS
-from ellimann_addon.core.measure.extra import EXTRA_DEFAULTS
+from ellimann_addon.core.measurements import EXTRA_DEFAULTS
 from ellimann_addon.core.sizing.readers import read_measurement_file
 from ellimann_addon.core.sizing.rows import UNITS, SizingError
 from ellimann_addon.core.sizing.writers import write_chart_row, write_freesewing, write_vit

@@ -10,12 +10,13 @@ import numpy as np
 import pytest
 
 from devkit.mesh_checks import self_intersections, vertex_manifold
-from ellimann_addon.core.constants import MEASUREMENTS, TABLE_2_5
+from ellimann_addon.core.constants import TABLE_2_5
 from ellimann_addon.core.drape.fit_metrics import mesh_distance
 from ellimann_addon.core.errors import ElliMannError
 from ellimann_addon.core.geometry.ellipsoid import sample_surface
 from ellimann_addon.core.geometry.mesh import euler_characteristic, is_closed_manifold, section_segments, volume
 from ellimann_addon.core.measure.body import measure_body_mesh
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.skin import field
 from ellimann_addon.core.skin import surface as surface_module
 from ellimann_addon.core.skin.contour import marching_cubes

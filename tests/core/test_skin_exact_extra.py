@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from bench.bench_skin_exact import GRID, grid_request
-from ellimann_addon.core.constants import MEASUREMENTS, TABLE_2_5
+from ellimann_addon.core.constants import TABLE_2_5
 from ellimann_addon.core.measure.extra import mannequin_extra_measurements
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.skin import exact
 from ellimann_addon.core.skin.exact import MESH_TOLERANCE_CM, exact_skin
 from ellimann_addon.core.skin.measure import body_measurements, mesh_measurements, skin_arms

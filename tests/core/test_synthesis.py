@@ -12,14 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from devkit import synthetic
-from ellimann_addon.core.constants import (
-    ABSURD_LIMITS,
-    GIRTHS,
-    MEASUREMENTS,
-    RANGES,
-    SECTION_FRACTIONS,
-    quartile_points,
-)
+from ellimann_addon.core.constants import GIRTHS, RANGES, SECTION_FRACTIONS, quartile_points
 from ellimann_addon.core.errors import ElliMannError, MeasurementError, ReferenceSetError
 from ellimann_addon.core.geometry.ellipsoid import shape_matrix
 from ellimann_addon.core.geometry.frames import is_rotation
@@ -29,6 +22,7 @@ from ellimann_addon.core.mannequin.skeleton import JOINT_INDEX
 from ellimann_addon.core.mannequin.topology import Topology
 from ellimann_addon.core.measure import tailor as measure
 from ellimann_addon.core.measure.tailor import tailor_measurements
+from ellimann_addon.core.measurements import ABSURD_LIMITS, MEASUREMENTS
 from ellimann_addon.core.synthesis import idw, refine
 from ellimann_addon.core.synthesis import synthesize as synthesis
 from ellimann_addon.core.synthesis.reference_set import ReferenceSet

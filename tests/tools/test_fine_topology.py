@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 from devkit.cli_runs import assert_one_line_error, run
-from ellimann_addon.core.constants import MEASUREMENTS
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.geometry.mesh import icosphere
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.mannequin.skeleton import PART_BONES, part_label
 from ellimann_addon.core.mannequin.topology import Part, Topology
 from ellimann_addon.core.measure.body import measure_body_mesh
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.shipped import FEMALE_FINE_SET, SHIPPED_SETS, named_reference_set
 from ellimann_addon.core.synthesis.synthesize import EXACT_TOLERANCE, synthesize_batch
 from tools import reference_topology as rt

@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 
 from devkit.cli_runs import assert_one_line_error, run
-from ellimann_addon.core.constants import MEASUREMENTS, REFERENCE_MEASUREMENTS
+from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.geometry.mesh import from_scene_axes
 from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, load_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 from tools.build_reference import CHECK_TOLERANCE, DEFAULT_REFMODELS

@@ -12,13 +12,14 @@ import bpy
 import numpy as np
 from mathutils import Matrix
 
-from ...core.constants import FEMALE_SET, MEASUREMENTS, UNIT_SPHERE_LEVEL
+from ...core.constants import FEMALE_SET, UNIT_SPHERE_LEVEL
 from ...core.errors import FrameError, MannequinError, Problem
 from ...core.geometry.ellipsoid import decompose_matrices_world, decompose_matrix_world, matrix_world
 from ...core.geometry.mesh import icosphere
 from ...core.mannequin.model import Mannequin
 from ...core.mannequin.topology import NAME_PATTERN, Part, Topology
 from ...core.mannequin.traces import PartTrace
+from ...core.measurements import MEASUREMENTS
 
 UNIT_SPHERE_NAME = "ElliMann Unit Sphere"
 UNIT_SPHERE_TOLERANCE = 1e-4  # single-precision vertices of the icosphere are within 1e-7

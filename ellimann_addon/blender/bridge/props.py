@@ -8,8 +8,8 @@ marks a collection as a mannequin and keeps its role and measurements.
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatVectorProperty, PointerProperty, StringProperty
 
-from ...core.constants import MEASUREMENT_LABELS, MEASUREMENTS
 from ...core.mannequin.skeleton import JOINT_COUNT
+from ...core.measurements import MEASUREMENT_LABELS, MEASUREMENTS
 
 SIDE_ITEMS = (
     ("L", "Left", "Left side of the body (+X, Blender's .L)"),

@@ -3,7 +3,7 @@ sub-panel hangs under it (``bl_parent_id = ids.PANEL_MAIN``, order from ``ids``)
 
 import bpy
 
-from ...core.constants import MEASUREMENTS
+from ...core.measurements import MEASUREMENTS
 from .. import ids
 from ..bridge.built import built_objects
 from ..bridge.convert import ellipsoid_objects

@@ -47,11 +47,11 @@ import struct
 import bpy
 import numpy as np
 
-from ...core.constants import MEASUREMENTS
 from ...core.errors import ElliMannError
 from ...core.files import atomic_output
 from ...core.formats.glb import EXTRAS_FORMAT, EXTRAS_KEY, EXTRAS_VERSION
 from ...core.formats.table import BLENDER_FORMATS, extension_of
+from ...core.measurements import MEASUREMENTS
 from ..bridge.built import built_objects, is_stale
 from ..bridge.convert import collection_to_mannequin, objects_recursive
 from ..bridge.selection import part_lookup

@@ -16,8 +16,8 @@ pieces' proportional interpolation, for heights).
 
 import numpy as np
 
-from ..constants import MEASUREMENTS
 from ..mannequin.skeleton import JOINT_NAMES
+from ..measurements import MEASUREMENTS
 
 ZERO_DISTANCE = 1e-9  # closer than this is the body's own point
 DEFAULT_POWER = 2.0  # the pieces' default (the paper's)

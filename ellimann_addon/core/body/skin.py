@@ -12,9 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..constants import MEASUREMENTS
 from ..geometry.mesh import volume
-from ..measure.extra import EXTRA_MEASUREMENTS
+from ..measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ..pose.kinematics import bone_matrices
 from ..synthesis.bodies import load_set_bodies
 from .correct import LIMITS, PROMISE_CM, BodySkinError, correct

@@ -11,10 +11,10 @@ chase it).
 
 import numpy as np
 
-from ..constants import CM_PER_M, GIRTHS, MEASUREMENTS
+from ..constants import CM_PER_M, GIRTHS
 from ..geometry.mesh import hull_girth, section_segments
 from ..measure.body import measure_body_mesh
-from ..measure.extra import EXTRA_MEASUREMENTS
+from ..measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 
 
 class Tape:

@@ -6,10 +6,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..constants import MEASUREMENTS
 from ..errors import ElliMannError, MeasurementError
 from ..geometry.ellipsoid import section_at_height
 from ..measure.tailor import hull_perimeter, section_heights
+from ..measurements import MEASUREMENTS
 from .fit_metrics import ellipsoid_signed_distance
 
 MIN_CLEARANCE = 0.005  # m, least initial gap between garment and body

@@ -27,7 +27,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..constants import ABSURD_LIMITS, MEASUREMENTS
 from ..errors import ElliMannError, one_line
 from ..geometry.frames import is_rotation
 from ..geometry.volume import GRID_SPACING, BodyVolume, fill_shares
@@ -42,6 +41,7 @@ from ..mannequin.clean import (
 )
 from ..mannequin.joints import anchor_indices, follow_pieces
 from ..measure.tailor import as_dict, section_heights
+from ..measurements import ABSURD_LIMITS, MEASUREMENTS
 from ..synthesis.bodies import BODIES_FILE, BodiesError, from_meshes
 from ..synthesis.manifest import STEM, Manifest, targets_range, write_reference_set
 from ..synthesis.refine import FACTOR_LIMITS, refine

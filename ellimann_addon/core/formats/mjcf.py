@@ -24,12 +24,13 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from ..constants import CUSHION_LEVELS, MEASUREMENTS, MJCF_CUSHION_LEVEL
+from ..constants import CUSHION_LEVELS, MJCF_CUSHION_LEVEL
 from ..errors import ElliMannError
 from ..files import atomic_write_text
 from ..geometry.cushion import mannequin_cushions
 from ..geometry.mesh import check_subdivision_level
 from ..geometry.quaternion import rotation_to_quaternion
+from ..measurements import MEASUREMENTS
 from .mjcf_skin import add_skin, skin_comment
 
 # Contact and integration defaults for a static mannequin that objects fall onto. MuJoCo's own

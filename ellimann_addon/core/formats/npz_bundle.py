@@ -18,11 +18,11 @@ import zipfile
 
 import numpy as np
 
-from ..constants import MEASUREMENTS
 from ..errors import ElliMannError, MannequinError
 from ..files import atomic_write_bytes, atomic_write_stream, temp_prefix
 from ..mannequin.model import Mannequin
 from ..mannequin.topology import Topology
+from ..measurements import MEASUREMENTS
 
 BATCH_FORMAT = "ellimann-batch"
 BATCH_VERSION = 1

@@ -5,8 +5,8 @@ extra measurements met), its skin (in exact mode its pieces refined until the sk
 batch synthesizes its rows together (``core.synthesis.batch.synthesize_chunk``, on Dask too) and finishes each row
 with :func:`finish`."""
 
-from ..measure.extra import EXTRA_MEASUREMENTS
 from ..measure.tailor import as_dict
+from ..measurements import EXTRA_MEASUREMENTS
 from ..synthesis.misses import request_misses, skin_misses
 from ..synthesis.synthesize import IDW_EXTRA_NOTE, meet_extra_request, synthesize_checked
 from .result import Result, SkinMade

@@ -14,11 +14,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..constants import MEASUREMENTS
 from ..errors import ElliMannError
 from ..formats.table import check_outputs
-from ..measure.extra import EXTRA_MEASUREMENTS
 from ..measure.tailor import as_dict
+from ..measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ..synthesis.extra_refine import ExtraRequestError, extra_request_problems
 from ..synthesis.options import SynthesisOptions
 from ..synthesis.request import checked_request

@@ -4,7 +4,7 @@ from it."""
 
 from dataclasses import dataclass, field
 
-from ..constants import MEASUREMENTS
+from ..measurements import MEASUREMENTS
 from ..synthesis.misses import SKIN_MISS_CM, missed_text, skin_missed_text
 from ..synthesis.refine import EXACT_TOLERANCE
 

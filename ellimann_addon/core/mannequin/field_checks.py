@@ -4,8 +4,9 @@ values."""
 
 import math
 
-from ..constants import ABSURD_LIMITS, MEASUREMENTS, SECTION_FRACTIONS
+from ..constants import SECTION_FRACTIONS
 from ..errors import Problem
+from ..measurements import ABSURD_LIMITS, MEASUREMENTS
 
 
 def measurement_problems(measurements):

@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..constants import MEASUREMENTS
 from ..errors import MannequinError, Problem
+from ..measurements import MEASUREMENTS
 from .field_checks import short
 
 SIDES = ("L", "R", "C")

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
+from ..constants import CM_PER_M, GIRTHS, SECTION_FRACTIONS
 from ..geometry.mesh import (
     boundary_edges,
     connected_labels,
@@ -22,23 +22,14 @@ from ..geometry.mesh import (
     in_plane,
     section_segments,
 )
+from ..measurements import ALL_MEASUREMENTS
 from .band_search import extreme_over_band
 from .body_neck import body_neck
-from .extra import (
-    CALF_BAND,
-    CROTCH_FLOOR,
-    EXTRA_MEASUREMENTS,
-    MID_PLANE_HEIGHT,
-    NECK_BAND,
-    SIDES,
-    THIGH_DROP,
-    UPPER_ARM_FRACTION,
-)
+from .extra import CALF_BAND, CROTCH_FLOOR, MID_PLANE_HEIGHT, NECK_BAND, SIDES, THIGH_DROP, UPPER_ARM_FRACTION
 
 ARM_SCAN_STEP = 0.005  # He between the sections that find the arms
 ARM_MARGIN = 0.01  # m beyond the body's run before a vertex counts as an arm's
 HEIGHT_RANGE_M = (0.5, 2.5)  # a standing adult or child in metres
-ALL_MEASUREMENTS = MEASUREMENTS + EXTRA_MEASUREMENTS
 
 
 @dataclass

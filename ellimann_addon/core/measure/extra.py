@@ -22,54 +22,12 @@ measured and their mean reported.
 
 import numpy as np
 
-from ..constants import CM_PER_M, MEASUREMENTS
+from ..constants import CM_PER_M
 from ..geometry.ellipsoid import axis_extent, section_at_height
+from ..measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from .band_search import BAND_SAMPLES, extremes_over_bands
 from .neck import NECK_BAND, NECK_TILT_DEFAULT, joint_tilt, neck_band, neck_frame, tightest_tilt
 from .tailor import hull_perimeter, section_heights
-
-EXTRA_MEASUREMENTS = ("neck", "upper_arm", "thigh", "calf", "crotch_height", "arm_length")
-EXTRA_LABELS = {
-    "neck": "Neck girth",
-    "upper_arm": "Upper-arm girth",
-    "thigh": "Thigh girth",
-    "calf": "Calf girth",
-    "crotch_height": "Crotch height",
-    "arm_length": "Arm length",
-}
-EXTRA_GIRTHS = ("neck", "upper_arm", "thigh", "calf")
-# Plausibility limits (cm) of a request, as ABSURD_LIMITS for the five.
-EXTRA_ABSURD_LIMITS = {
-    "neck": (15.0, 80.0),
-    "upper_arm": (10.0, 80.0),
-    "thigh": (20.0, 140.0),
-    "calf": (15.0, 90.0),
-    "crotch_height": (20.0, 130.0),
-    "arm_length": (20.0, 120.0),
-}
-# What the female Average Reference Mannequin measures (cm): the panel's starting values.
-EXTRA_DEFAULTS = {
-    "neck": 24.1,
-    "upper_arm": 23.6,
-    "thigh": 56.0,
-    "calf": 42.6,
-    "crotch_height": 72.0,
-    "arm_length": 57.8,
-}
-# ISO 20685 allowances (cm): how far two ways of measuring one body may differ.
-ISO_ALLOWANCE = {
-    "He": 0.4,
-    "Sh": 0.4,
-    "Br": 0.9,
-    "Wa": 0.9,
-    "Hi": 0.9,
-    "neck": 0.9,
-    "upper_arm": 0.9,
-    "thigh": 0.9,
-    "calf": 0.9,
-    "crotch_height": 0.4,
-    "arm_length": 0.4,
-}
 
 MID_PLANE_HEIGHT = 0.25  # He: where x_c is taken
 CROTCH_FLOOR = 0.2  # He: the crotch is searched above this

@@ -16,11 +16,12 @@ a rigorous bound and Newton steps, each smooth piece by closed form and Gauss-Le
 
 import numpy as np
 
-from ..constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
+from ..constants import CM_PER_M, GIRTHS, SECTION_FRACTIONS
 from ..geometry.ellipse_support import hull_boundary
 from ..geometry.ellipsoid import axis_extent, section_at_height, section_shape
 from ..geometry.mesh import convex_hull_2d, plane_section_points, polygon_perimeter
 from ..geometry.section_hull import HullStructure, hull_perimeter
+from ..measurements import MEASUREMENTS
 
 _CHUNK = 256  # mannequins per batch chunk (bounds the temporary arrays to tens of MB)
 
@@ -147,13 +148,6 @@ def _measure_chunk(rotation, center, semi_axes, girth, fractions, warm=None, fol
 def as_dict(values):
     """(5,) array in MEASUREMENTS order -> {"He": ..., ...} of plain floats."""
     return {key: float(value) for key, value in zip(MEASUREMENTS, values)}
-
-
-def measurement_line(values):
-    """ "He 165.00, Sh 41.50, Br 101.25, Wa 82.75, Hi 117.50": the one way m_T (or a request) is written in a line
-    (command line, status bar, operator reports); ``values``: a dict keyed by MEASUREMENTS or 5 numbers in cm."""
-    values = [values[key] for key in MEASUREMENTS] if isinstance(values, dict) else list(values)
-    return ", ".join(f"{key} {value:.2f}" for key, value in zip(MEASUREMENTS, values))
 
 
 def section_hulls(rotation, center, semi_axes, girth, samples=256, fractions=None):

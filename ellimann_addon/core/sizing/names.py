@@ -17,8 +17,7 @@ is generated from these tables (``mapping_markdown``; tests/core/test_sizing_doc
 
 from dataclasses import dataclass
 
-from ..constants import MEASUREMENTS
-from ..measure.extra import EXTRA_MEASUREMENTS
+from ..measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 
 KEYS = MEASUREMENTS + EXTRA_MEASUREMENTS  # ElliMann's eleven
 PREDICTORS = ("neck_base", "biacromial")  # survey columns a file may give that only help predict a missing one

@@ -8,9 +8,8 @@ values; the other rows of a run go on (``MeasurementFile.failed`` lists the ones
 import math
 from dataclasses import dataclass, field
 
-from ..constants import ABSURD_LIMITS, MEASUREMENTS
 from ..errors import ElliMannError
-from ..measure.extra import EXTRA_ABSURD_LIMITS, EXTRA_MEASUREMENTS
+from ..measurements import ABSURD_LIMITS, EXTRA_ABSURD_LIMITS, EXTRA_MEASUREMENTS, MEASUREMENTS
 from ..synthesis.extra_refine import extra_request_problems
 from ..synthesis.manifest import read_manifest
 from ..synthesis.request import checked_request

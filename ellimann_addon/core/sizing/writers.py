@@ -13,14 +13,13 @@ import math
 import pathlib
 from xml.sax.saxutils import quoteattr
 
-from ..constants import MEASUREMENT_LABELS
 from ..files import atomic_write_text
-from ..measure.extra import EXTRA_LABELS
+from ..measurements import MEASUREMENT_LABELS
 from .names import CHART_LABELS, ELLIMANN_CUSTOM, FREESEWING, FREESEWING_ELLIMANN, KEYS, SEAMLY
 from .rows import UNITS, SizingError
 
 DIGITS = 4  # decimals of a written value in its unit (0.1 um in cm): a round trip is exact to that
-LABELS = {**MEASUREMENT_LABELS, **EXTRA_LABELS}
+LABELS = {**MEASUREMENT_LABELS, **MEASUREMENT_LABELS}
 
 
 def _name_for(table, key):

@@ -21,11 +21,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..constants import MEASUREMENTS
 from ..errors import ElliMannError
 from ..mannequin.joints import anchor_indices, follow_pieces
-from ..measure.extra import EXTRA_MEASUREMENTS, mannequin_extra_measurements
+from ..measure.extra import mannequin_extra_measurements
 from ..measure.tailor import as_dict
+from ..measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ..synthesis.extra_refine import ExtraRequestError, extra_request_problems, meet_extra
 from ..synthesis.misses import SKIN_MISS_CM
 from ..synthesis.refine import refine

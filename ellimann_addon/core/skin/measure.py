@@ -10,11 +10,12 @@ nearest to it; it counts in a girth when that piece does.
 
 import numpy as np
 
-from ..constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
+from ..constants import CM_PER_M, GIRTHS, SECTION_FRACTIONS
 from ..geometry.ellipsoid import bounds
 from ..geometry.mesh import convex_hull_2d, polygon_perimeter, section_segments
 from ..measure.body import measure_body_mesh
 from ..measure.extra import SIDES, MannequinLandmarks, mannequin_tilt
+from ..measurements import MEASUREMENTS
 from .field import FADE, Grid, skin_pieces
 
 SECTION_COARSE = 0.004  # m between the samples of a section plane whose grid edges bracket the surface

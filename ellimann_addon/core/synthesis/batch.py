@@ -8,10 +8,9 @@ import math
 
 import numpy as np
 
-from ..constants import MEASUREMENTS
 from ..errors import ElliMannError, one_line
-from ..measure.extra import EXTRA_MEASUREMENTS
 from ..measure.tailor import as_dict
+from ..measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from .synthesize import Synthesis, meet_extra_request, synthesize_checked
 
 CHUNK = 256  # rows synthesized per core batch (and per Dask task)

@@ -29,7 +29,8 @@ from ..constants import SECTION_FRACTIONS
 from ..errors import ElliMannError
 from ..files import atomic_write_bytes
 from ..mannequin.skeleton import JOINT_COUNT, JOINT_INDEX
-from ..measure.body import ALL_MEASUREMENTS, check_mesh, measure_body_mesh
+from ..measure.body import check_mesh, measure_body_mesh
+from ..measurements import ALL_MEASUREMENTS
 from .manifest import read_manifest
 
 BODIES_FILE = "bodies.npz"

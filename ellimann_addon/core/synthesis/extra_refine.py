@@ -13,16 +13,11 @@ with the five re-met by ``core.synthesis.refine.refine`` after every round (the 
 
 import numpy as np
 
-from ..constants import MEASUREMENTS
 from ..errors import ElliMannError
 from ..geometry.ellipsoid import axis_extent, linear_image
 from ..mannequin.joints import anchor_indices, follow_pieces
 from ..measure.extra import (
     CALF_BAND,
-    EXTRA_ABSURD_LIMITS,
-    EXTRA_GIRTHS,
-    EXTRA_LABELS,
-    EXTRA_MEASUREMENTS,
     SIDES,
     THIGH_DROP,
     UPPER_ARM_FRACTION,
@@ -31,6 +26,7 @@ from ..measure.extra import (
     neck_plane,
 )
 from ..measure.tailor import tailor_measurements
+from ..measurements import EXTRA_ABSURD_LIMITS, EXTRA_GIRTHS, EXTRA_MEASUREMENTS, MEASUREMENT_LABELS, MEASUREMENTS
 from .misses import MISS_CM, Miss
 from .refine import refine
 
@@ -59,7 +55,7 @@ def extra_request_problems(request, extra):
             continue
         low, high = EXTRA_ABSURD_LIMITS[key]
         if not (np.isfinite(value) and low <= value <= high):
-            problems.append(f"{key} ({EXTRA_LABELS[key]}) must be {low:g}-{high:g} cm, got {value:g}")
+            problems.append(f"{key} ({MEASUREMENT_LABELS[key]}) must be {low:g}-{high:g} cm, got {value:g}")
     if problems:
         return problems
     he, hi, br = request["He"], request["Hi"], request["Br"]

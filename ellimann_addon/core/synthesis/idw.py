@@ -3,11 +3,12 @@ and the interpolated geometry (see ``core.synthesis.synthesize`` for the method)
 
 import numpy as np
 
-from ..constants import MEASUREMENTS, RANGES
+from ..constants import RANGES
 from ..errors import MannequinError, Problem
 from ..geometry.frames import SAGITTAL_REFLECTION, rotation_mean, symmetrize_central
 from ..mannequin.joints import JOINT_SIDES, anchor_indices, mirror_joints
 from ..mannequin.skeleton import JOINT_ANCHORS, JOINT_COUNT, JOINT_NAMES
+from ..measurements import MEASUREMENTS
 from .options import DEFAULT_NORMALIZE, DEFAULT_POWER
 
 ZERO_DISTANCE = 1e-9  # closer than this (cm, or range units) is the RM's own point

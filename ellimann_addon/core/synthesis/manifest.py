@@ -17,9 +17,10 @@ import pathlib
 import re
 from dataclasses import dataclass, field
 
-from ..constants import ABSURD_LIMITS, FEMALE_SET, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
+from ..constants import FEMALE_SET, RANGES, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 from ..errors import ReferenceSetError
 from ..files import atomic_write_text
+from ..measurements import ABSURD_LIMITS, MEASUREMENTS
 
 MANIFEST_FILE = "reference_set.json"
 MANIFEST_FORMAT = "ellimann-reference-set"

@@ -6,8 +6,7 @@ alone."""
 import math
 from dataclasses import dataclass
 
-from ..constants import MEASUREMENTS
-from ..measure.extra import EXTRA_MEASUREMENTS
+from ..measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from .refine import EXACT_TOLERANCE
 
 MISS_CM = 0.1  # a given extra measurement further off than this (1 mm) is a miss

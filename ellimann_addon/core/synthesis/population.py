@@ -16,8 +16,8 @@ import pathlib
 
 import numpy as np
 
-from ..constants import ABSURD_LIMITS, MEASUREMENTS
 from ..errors import ElliMannError
+from ..measurements import ABSURD_LIMITS, MEASUREMENTS
 
 POPULATION_FORMAT = "ellimann-population"
 POPULATION_VERSION = 1

@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 
-from ..constants import ABSURD_LIMITS, MEASUREMENTS, RANGES, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
+from ..constants import RANGES, REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 from ..errors import MannequinError, ReferenceSetError
 from ..geometry.frames import SAGITTAL_REFLECTION
 from ..mannequin.clean import asymmetry
@@ -16,6 +16,7 @@ from ..mannequin.joints import anchor_indices
 from ..mannequin.model import Mannequin
 from ..mannequin.skeleton import bone_problems, joint_limb_roots, limb_directions, limb_roots, part_bones
 from ..measure.tailor import tailor_measurements
+from ..measurements import ABSURD_LIMITS, MEASUREMENTS
 from .idw import ZERO_DISTANCE, axis_scale, normalized_points
 from .manifest import MANIFEST_FILE, legacy_manifest, read_manifest
 from .options import is_number

@@ -5,10 +5,11 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from ..constants import CM_PER_M, GIRTHS, MEASUREMENTS, SECTION_FRACTIONS
+from ..constants import CM_PER_M, GIRTHS, SECTION_FRACTIONS
 from ..geometry.ellipsoid import axis_extent, section_extent
 from ..geometry.section_hull import HullStructure
 from ..measure.tailor import followed_measurements, section_heights, tailor_measurements
+from ..measurements import MEASUREMENTS
 
 # Exact mode.
 EXACT_TOLERANCE = 1e-5  # relative m_T error at which refinement stops (0.001 %)

@@ -5,8 +5,9 @@ import math
 
 import numpy as np
 
-from ..constants import ABSURD_LIMITS, MEASUREMENTS, RANGES
+from ..constants import RANGES
 from ..errors import MeasurementError
+from ..measurements import ABSURD_LIMITS, MEASUREMENTS
 from .options import is_number
 
 

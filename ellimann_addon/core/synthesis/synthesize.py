@@ -60,12 +60,13 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..constants import CENTER_LIMIT, FEMALE_SET, MEASUREMENTS, SEMI_AXIS_LIMITS
+from ..constants import CENTER_LIMIT, FEMALE_SET, SEMI_AXIS_LIMITS
 from ..errors import ElliMannError, MannequinError
 from ..mannequin.joints import anchor_indices, follow_pieces
 from ..mannequin.model import Mannequin
 from ..measure.extra import mannequin_extra_measurements
 from ..measure.tailor import as_dict, followed_measurements, tailor_measurements
+from ..measurements import MEASUREMENTS
 from .extra_refine import ExtraRequestError, extra_request_problems, meet_extra
 from .idw import idw_weights, interpolate, interpolate_joints
 from .misses import missed_text, request_misses

@@ -5,7 +5,8 @@ import json
 
 import bpy
 
-from ....core.measure.body import ALL_MEASUREMENTS, measure_body_mesh
+from ....core.measure.body import measure_body_mesh
+from ....core.measurements import measurement_line
 from ... import ids
 from ...bridge.convert import world_triangles
 from ...bridge.selection import owning_mannequin
@@ -27,7 +28,7 @@ def measure_object(obj, fractions=None):
 
 
 def values_line(values):
-    return ", ".join(f"{key} {values[key]:.2f}" for key in ALL_MEASUREMENTS if key in values) + " cm"
+    return f"{measurement_line(values)} cm"
 
 
 class ELLIMANN_OT_measure_body(ElliMannOperator, bpy.types.Operator):

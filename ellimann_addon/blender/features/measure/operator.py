@@ -5,7 +5,8 @@ from bpy.props import BoolProperty, EnumProperty
 
 from ....core.geometry.cushion import cushion_name
 from ....core.measure.extra import mannequin_extra_measurements
-from ....core.measure.tailor import as_dict, measure_meshes, measurement_line, section_hulls, tailor_measurements
+from ....core.measure.tailor import as_dict, measure_meshes, section_hulls, tailor_measurements
+from ....core.measurements import measurement_line
 from ... import ids
 from ...bridge.built import built_collection, built_objects, is_stale, new_section_object, remove_built
 from ...bridge.convert import ellipsoid_objects, world_triangles, write_measured

@@ -4,14 +4,13 @@ import json
 
 import bpy
 
-from ....core.constants import MEASUREMENT_LABELS, MEASUREMENTS
-from ....core.measure.extra import EXTRA_LABELS
+from ....core.measurements import MEASUREMENT_LABELS, MEASUREMENTS
 from ... import ids
 from ...bridge.selection import active_mannequin
 from ..base import SubPanel
 from .body import RESULT_PROPERTY
 
-LABELS = {**MEASUREMENT_LABELS, **EXTRA_LABELS}
+LABELS = {**MEASUREMENT_LABELS, **MEASUREMENT_LABELS}
 
 
 class ELLIMANN_PT_measure(SubPanel, bpy.types.Panel):

@@ -13,7 +13,6 @@ import threading
 import bpy
 from bpy.props import IntProperty
 
-from ....core.constants import MEASUREMENTS
 from ....core.errors import ElliMannError, MannequinError
 from ....core.fitting.reference_build import (
     BASE_STEM,
@@ -22,6 +21,7 @@ from ....core.fitting.reference_build import (
     traced_mesh,
     validate_inputs,
 )
+from ....core.measurements import MEASUREMENTS
 from ....core.synthesis.manifest import MANIFEST_FILE
 from ... import ids
 from ...bridge.bodies import body_mesh

@@ -3,7 +3,7 @@ the folder, Build Reference Set and its progress."""
 
 import bpy
 
-from ....core.constants import MEASUREMENTS
+from ....core.measurements import MEASUREMENTS
 from ... import ids
 from ..base import SubPanel
 

@@ -11,7 +11,8 @@ from bpy.props import (
     StringProperty,
 )
 
-from ....core.constants import ABSURD_LIMITS, MEASUREMENTS, REFERENCE_MEASUREMENTS
+from ....core.constants import REFERENCE_MEASUREMENTS
+from ....core.measurements import ABSURD_LIMITS, MEASUREMENTS
 
 SEX_ITEMS = (
     ("NONE", "Unspecified", "The set has no sex recorded"),

@@ -5,12 +5,11 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-from ....core.constants import MEASUREMENTS
 from ....core.errors import ElliMannError
 from ....core.job.make import make
 from ....core.job.request import Request, check
 from ....core.measure.extra import split_measurements
-from ....core.measure.tailor import measurement_line
+from ....core.measurements import MEASUREMENTS, measurement_line
 from ... import ids
 from ...services.rig import build_rig, check_rig
 from ...services.scene import add_mannequin
@@ -77,7 +76,7 @@ class ELLIMANN_OT_synthesize_from_mesh(ElliMannOperator, bpy.types.Operator):
         self.report(
             {"INFO"},
             f"'{obj.name}': {values_line(values)}; twin '{collection.name}': "
-            f"{measurement_line(measured)}" + "".join(f", {key} {measured[key]:.2f}" for key in extra) + " cm",
+            f"{measurement_line(measured, [*MEASUREMENTS, *extra])} cm",
         )
         return {"FINISHED"}
 

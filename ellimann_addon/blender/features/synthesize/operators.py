@@ -4,10 +4,9 @@ Skin is ticked); it becomes the target that Live updates (:mod:`.live`)."""
 
 import bpy
 
-from ....core.constants import MEASUREMENTS
 from ....core.errors import ElliMannError
 from ....core.job.make import make
-from ....core.measure.tailor import measurement_line
+from ....core.measurements import MEASUREMENTS, measurement_line
 from ....core.synthesis.synthesize import relative_error
 from ... import ids
 from ...bridge.convert import ellipsoid_objects
@@ -55,7 +54,7 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
             self.report({"WARNING"}, warning)
         shown = result.shown()
         worst = relative_error({key: shown[key] for key in MEASUREMENTS}, request_of(props)).max()
-        values = measurement_line(shown) + "".join(f", {key} {shown[key]:.2f}" for key in extra_of(props))
+        values = measurement_line(shown, [*MEASUREMENTS, *extra_of(props)])
         self.report(
             {"INFO"},
             f"Synthesized '{collection.name}' ({len(ellipsoid_objects(collection))} ellipsoids, "

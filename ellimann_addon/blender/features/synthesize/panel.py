@@ -2,8 +2,7 @@
 
 import bpy
 
-from ....core.constants import MEASUREMENT_LABELS, MEASUREMENTS
-from ....core.measure.extra import EXTRA_MEASUREMENTS
+from ....core.measurements import EXTRA_MEASUREMENTS, MEASUREMENT_LABELS, MEASUREMENTS
 from ... import ids
 from ..base import SubPanel
 from .presets import ELLIMANN_MT_measurement_presets

@@ -4,8 +4,14 @@ and the options; every change of a field makes a live update when Live is on (:m
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, PointerProperty, StringProperty
 
-from ....core.constants import ABSURD_LIMITS, MEASUREMENT_LABELS, RANGES, REFERENCE_MEASUREMENTS
-from ....core.measure.extra import EXTRA_ABSURD_LIMITS, EXTRA_DEFAULTS, EXTRA_LABELS, EXTRA_MEASUREMENTS
+from ....core.constants import RANGES, REFERENCE_MEASUREMENTS
+from ....core.measurements import (
+    ABSURD_LIMITS,
+    EXTRA_ABSURD_LIMITS,
+    EXTRA_DEFAULTS,
+    EXTRA_MEASUREMENTS,
+    MEASUREMENT_LABELS,
+)
 from ....core.synthesis.options import SYNTHESIS
 from ..skin.operator import level_property
 from .live import on_request_change
@@ -123,7 +129,7 @@ def _extra_fields():
     fields = {}
     for key in EXTRA_MEASUREMENTS:
         low, high = EXTRA_ABSURD_LIMITS[key]
-        label = EXTRA_LABELS[key]
+        label = MEASUREMENT_LABELS[key]
         fields[f"use_{key}"] = BoolProperty(
             name=label,
             default=False,

@@ -3,11 +3,11 @@ ticked, the reference set and options, as the job the core makes (``core.job``).
 
 import bpy
 
-from ....core.constants import FEMALE_SET, MEASUREMENTS
+from ....core.constants import FEMALE_SET
 from ....core.errors import ReferenceSetError
 from ....core.job.make import make
 from ....core.job.request import Request, check
-from ....core.measure.extra import EXTRA_MEASUREMENTS
+from ....core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ....core.synthesis.options import SynthesisOptions
 from ....core.synthesis.reference_set import cached_reference_set
 from ....core.synthesis.shipped import FEMALE_FINE_SET, MALE_FINE_SET, MALE_SET, SHIPPED_SETS
