@@ -16,7 +16,8 @@ END = "<!-- end of the table -->"
 def table():
     """The page's table, a row per measurement."""
     lines = [
-        "| key | label | kind | where it is taken | a request may ask (cm) | ISO 20685 allowance (cm) | the panel starts at |",
+        "| key | label | kind | where it is taken | a request may ask (cm) | ISO 20685 allowance (cm) "
+        "| the panel starts at |",
         "|---|---|---|---|---|---|---|",
     ]
     for row in TABLE:
