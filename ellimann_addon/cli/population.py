@@ -1,6 +1,5 @@
 """``ellimann population``: N rows of measurements sampled from a survey's statistics (``core.synthesis.population``)
-into
-a CSV that ``batch`` reads; with --synthesize DIR the mannequins too, through batch."""
+into a CSV that ``batch`` reads; with --synthesize DIR the mannequins too, through batch."""
 
 import argparse
 import csv

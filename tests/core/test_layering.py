@@ -270,3 +270,15 @@ def test_every_folder_of_the_package_has_a_one_line_readme():
     assert missing == []
     long = [str(f.relative_to(PACKAGE.parent)) for f in folders if len((f / "README.md").read_text().splitlines()) != 1]
     assert long == []
+
+
+def test_the_floors_are_written_once_here_and_said_alike_everywhere():
+    """FLOORS (above) is the house plan; each package's __init__ says its floor ("(floor N") and
+    docs/architecture.md's tree gives it beside the package's name: a test, not a reader, finds one that moved."""
+    import re
+
+    architecture = (PACKAGE.parent / "docs" / "architecture.md").read_text()
+    for package, floor in FLOORS.items():
+        doc = ast.get_docstring(ast.parse((CORE / package / "__init__.py").read_text())) or ""
+        assert re.search(rf"\(floor {floor}\b", " ".join(doc.split())), package
+        assert re.search(rf"^\s+{package}/\s+{floor}\s", architecture, re.M), package

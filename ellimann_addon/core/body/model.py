@@ -4,14 +4,13 @@ joints)): the correction (core.body.correct) never looks inside it.
 
 ``IdwBodyModel``: the set's bodies averaged with inverse-distance weights of the request from each body's own
 measurements (Eq. 2.1 as the pieces use it, over whole bodies; the distance in cm, or in the set's ranges with
-``metric="normalized"``), power 2. Held out on the six female bodies (docs/body_skin.md) whole-body weights beat
-the alternatives after the correction: ``segmented`` (tried, not the default: 0.826 against 0.842 mean IoU) is the
-pieces' segmented IDW, each joint's bone takes its
-weights from the distance in its own measurements (the head and neck He; the arms and collars He, Sh; the chest
-He, Br; the belly He, Wa; the pelvis and legs He, Hi: the shipped topology's dependency of each part on its
-bone), bodies that coincide there sharing by their whole distance; a vertex's weights are its bones' weighted by
-its bone weights (smooth: no seam). ``scale_height``: each body first scaled vertically to the request's He (the
-pieces' proportional interpolation, for heights).
+``metric="normalized"``), power 2. Held out on the six female bodies (docs/body_skin.md) whole-body weights beat the
+alternatives after the correction: ``segmented`` (tried, not the default: 0.826 against 0.842 mean IoU) is the pieces'
+segmented IDW, each joint's bone takes its weights from the distance in its own measurements (the head and neck He; the
+arms and collars He, Sh; the chest He, Br; the belly He, Wa; the pelvis and legs He, Hi: the shipped topology's
+dependency of each part on its bone), bodies that coincide there sharing by their whole distance; a vertex's weights are
+its bones' weighted by its bone weights (smooth: no seam). ``scale_height``: each body first scaled vertically to the
+request's He (the pieces' proportional interpolation, for heights).
 """
 
 import numpy as np

@@ -1,6 +1,5 @@
 """What the garments are made of (``core.drape.garments``, ``core.drape.t_shirt``): the Garment mesh, pattern sizes,
-body
-rings (convex hulls of the horizontal sections, offset outward), grids of faces, and :func:`clear_of`."""
+body rings (convex hulls of the horizontal sections, offset outward), grids of faces, and :func:`clear_of`."""
 
 from dataclasses import dataclass, field, replace
 

@@ -1,21 +1,18 @@
 """MJCF of a mannequin with joints: an articulated body that MuJoCo simulates.
 
-One MuJoCo body per bone (SMPL's 24, named as ``core.mannequin.skeleton.JOINT_NAMES``), nested as the skeleton is,
-each at
-its joint centre with world-aligned axes at rest; its pieces are its geoms: native ``ellipsoid`` geoms, and with
-``cushions`` each cushion pair as a ``mesh`` geom (MuJoCo collides with a mesh's convex hull, which is the
-cushion), the cushions that cross a joint split there into two halves, one per bone (``core.pose.posed_pieces``). The
-root
-(Pelvis) has a free joint; every other joint is one hinge (knees, elbows, toes) or three hinges about its joint
-frame's x, y, z (``skeleton.joint_frames``), applied in that order, so a pose's Euler angles in the joint frame
-(``pose.joint_angles``) are exactly the hinges' values, with the anatomical ``range`` limits
-(``skeleton.limits``). Three hinges rather than a ball: a ball joint's range is one cone angle, not the
-asymmetric ranges of a hip or a shoulder. Masses come from the geoms' volumes at ``density`` (kg/m^3), scaled so
-that the pieces' overlaps count once (:func:`overlap_share`). The mannequin's pieces collide with the floor and
-with anything added, not with each other (they overlap at rest). Poses become keyframes (``<key name="t_pose"
-qpos=...>``; a motion gives one key per frame, ``walk 0``, ``walk 1``, ...); the model itself is in the rest
-pose. With a skin (``--skin``) the file holds it bound to the 24 bodies, which move it as ``Skin.posed`` does
-(``core.formats.mjcf_skin``).
+One MuJoCo body per bone (SMPL's 24, named as ``core.mannequin.skeleton.JOINT_NAMES``), nested as the skeleton is, each
+at its joint centre with world-aligned axes at rest; its pieces are its geoms: native ``ellipsoid`` geoms, and with
+``cushions`` each cushion pair as a ``mesh`` geom (MuJoCo collides with a mesh's convex hull, which is the cushion), the
+cushions that cross a joint split there into two halves, one per bone (``core.pose.posed_pieces``). The root (Pelvis)
+has a free joint; every other joint is one hinge (knees, elbows, toes) or three hinges about its joint frame's x, y, z
+(``skeleton.joint_frames``), applied in that order, so a pose's Euler angles in the joint frame (``pose.joint_angles``)
+are exactly the hinges' values, with the anatomical ``range`` limits (``skeleton.limits``). Three hinges rather than a
+ball: a ball joint's range is one cone angle, not the asymmetric ranges of a hip or a shoulder. Masses come from the
+geoms' volumes at ``density`` (kg/m^3), scaled so that the pieces' overlaps count once (:func:`overlap_share`). The
+mannequin's pieces collide with the floor and with anything added, not with each other (they overlap at rest). Poses
+become keyframes (``<key name="t_pose" qpos=...>``; a motion gives one key per frame, ``walk 0``, ``walk 1``, ...); the
+model itself is in the rest pose. With a skin (``--skin``) the file holds it bound to the 24 bodies, which move it as
+``Skin.posed`` does (``core.formats.mjcf_skin``).
 """
 
 import xml.etree.ElementTree as ET

@@ -9,9 +9,8 @@
 - Sh: the section at the shoulder height through all ellipsoids; distance between the two
   outermost points along X (the paper's Y), again from support functions.
 
-The integral is evaluated exactly up to floating point (``core.geometry.section_hull``: kinks of max_i h_i from a
-grid scan with
-a rigorous bound and Newton steps, each smooth piece by closed form and Gauss-Legendre quadrature).
+The integral is evaluated exactly up to floating point (``core.geometry.section_hull``: kinks of max_i h_i from a grid
+scan with a rigorous bound and Newton steps, each smooth piece by closed form and Gauss-Legendre quadrature).
 """
 
 import numpy as np
@@ -70,9 +69,9 @@ def tailor_measurements(rotation, center, semi_axes, girth, fractions=None):
 def followed_measurements(rotation, center, semi_axes, girth, fractions=None, warm=None):
     """m_T of a batch (B, n, ...) as :func:`tailor_measurements`, and where the outermost piece of each girth section
     changes (a :class:`core.geometry.section_hull.HullStructure` of B * 3 sections, mannequin by mannequin in GIRTHS
-    order, pieces by
-    part index), for measuring the same mannequins again after a small change. With ``warm`` (such a structure)
-    the girths follow it instead of searching (``hull_perimeter``'s warm): for a refinement's steps, not a result.
+    order, pieces by part index), for measuring the same mannequins again after a small change. With ``warm`` (such a
+    structure) the girths follow it instead of searching (``hull_perimeter``'s warm): for a refinement's steps, not a
+    result.
     """
     rotation, center, semi_axes = (np.asarray(a, dtype=float) for a in (rotation, center, semi_axes))
     girth = np.asarray(girth, dtype=bool)

@@ -1,6 +1,5 @@
-"""Exact mode for the extra measurements: degrees of freedom of their own (a neck, the upper arms, the thighs,
-the calves, the leg and arm lengths), alternated with the five's refinement (``core.synthesis.refine``) until every
-given
+"""Exact mode for the extra measurements: degrees of freedom of their own (a neck, the upper arms, the thighs, the
+calves, the leg and arm lengths), alternated with the five's refinement (``core.synthesis.refine``) until every given
 measurement is met.
 
 Each extra measurement moves only its own pieces: a girth widens the section of the pieces it cuts (horizontal;
@@ -206,11 +205,11 @@ def meet_extra(mannequin, extra, tolerance_cm=EXTRA_TOLERANCE_CM, max_rounds=EXT
     extra measurements off by more than MISS_CM and, where refine could not keep them, the five off by more than
     FIVE_TOLERANCE_CM (a list of :class:`core.synthesis.misses.Miss`).
 
-    All at once first; if that misses any, one measurement at a time (in EXTRA_MEASUREMENTS order), each kept
-    only if it and those kept before are met with the five: one that the pieces cannot reach (or only by
-    giving up the five) is left where the reference set puts it, and named in the misses; of the two results, the
-    nearer to the request is returned (``_how_far``). The joints ride on
-    their anchor pieces in every measured round (the neck is measured square to their tilt)."""
+    All at once first; if that misses any, one measurement at a time (in EXTRA_MEASUREMENTS order), each kept only if it
+    and those kept before are met with the five: one that the pieces cannot reach (or only by giving up the five) is
+    left where the reference set puts it, and named in the misses; of the two results, the nearer to the request is
+    returned (``_how_far``). The joints ride on their anchor pieces in every measured round (the neck is measured square
+    to their tilt)."""
     result = _meet(mannequin, extra, tolerance_cm, max_rounds)
     if not result[2]:
         return result

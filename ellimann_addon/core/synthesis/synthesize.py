@@ -48,11 +48,9 @@ from the RMs' mean Jacobian, Broyden updates):
 - Sh: the shoulder ellipsoids (those that depend on Sh) widen along x; the arms hanging from them
   (non-girth parts that depend on Sh) are carried sideways by the same amount, not thickened.
 
-The code: requests in ``core.synthesis.request``, the Reference Mannequins in ``core.synthesis.reference_set``, IDW
-in ``core.synthesis.idw``,
-the refinement in ``core.synthesis.refine``, the options in ``core.synthesis.options``; this module puts them
-together and keeps
-their names importable from here.
+The code: requests in ``core.synthesis.request``, the Reference Mannequins in ``core.synthesis.reference_set``, IDW in
+``core.synthesis.idw``, the refinement in ``core.synthesis.refine``, the options in ``core.synthesis.options``; this
+module puts them together and keeps their names importable from here.
 """
 
 from dataclasses import dataclass

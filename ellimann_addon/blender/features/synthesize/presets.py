@@ -1,11 +1,10 @@
 """Measurement presets of the Synthesize feature (Blender's preset system).
 
-The five female RMs, the ten mannequins of the paper's Table 2.5, the five male RMs and the user's own (each
-also sets the reference set it belongs to): the shipped ones are
-read from ``preset_files/`` beside this module, the user's are saved in Blender's user preset
-folder. A preset sets five fields but makes one live update (the menu's ``reset_cb`` / ``post_cb``
-hold it back), and the menu runs it through ``ELLIMANN_OT_apply_measurement_preset``, so that fields
-and mannequin change in one undo step (Blender's ``script.execute_preset`` makes none).
+The five female RMs, the ten mannequins of the paper's Table 2.5, the five male RMs and the user's own (each also sets
+the reference set it belongs to): the shipped ones are read from ``preset_files/`` beside this module, the user's are
+saved in Blender's user preset folder. A preset sets five fields but makes one live update (the menu's ``reset_cb`` /
+``post_cb`` hold it back), and the menu runs it through ``ELLIMANN_OT_apply_measurement_preset``, so that fields and
+mannequin change in one undo step (Blender's ``script.execute_preset`` makes none).
 """
 
 import os
