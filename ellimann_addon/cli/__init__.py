@@ -8,7 +8,7 @@ in a pose), ``measure`` (m_T of a file), ``demo`` (the paper's Table 2.5 mannequ
 picture), ``drape`` (a garment on a mannequin with Blender's cloth simulation), ``references`` (build or check
 a reference set) and ``population`` (rows sampled from a survey's statistics, for ``batch``); ``distributed`` runs
 ``batch --dask``; what they share is in ``output`` (printed lines, exit codes), ``arguments`` (parser pieces),
-``skinning`` (``--skin``: its options, checks and the skin made), ``writing`` (files, the output folder),
+``skin_options`` (``--skin``: its options and the settings they ask for), ``writing`` (files, the output folder),
 ``reporting`` (the report CSV) and ``provenance`` (what a batch row's files were made from, for ``--resume``).
 This package needs numpy only: Blender
 (the bpy module and ``ellimann_addon.blender``) is imported only when a .blend or .glb file, a drape or a picture

@@ -23,7 +23,7 @@ from ..core.measure.tailor import as_dict
 from ..core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ..core.synthesis.batch import by_reference_set, chunks, synthesize_chunk
 from ..core.synthesis.misses import missed_text
-from . import arguments, distributed, jobs, output, reporting, skinning, writing
+from . import arguments, distributed, jobs, output, reporting, skin_options, writing
 from .batch_csv import MeasurementsCsv
 from .output import PROG, UsageError
 from .provenance import SAID, Provenance
@@ -79,7 +79,7 @@ def add_parser(commands):
     )
     arguments.add_synthesis_options(batch)
     arguments.add_pose_option(batch)
-    skinning.add_skin_options(batch)
+    skin_options.add_skin_options(batch)
     batch.set_defaults(run=run, blender=lambda args: None)  # the batch's job checks its files
 
 
@@ -109,7 +109,7 @@ def run(args):
     formats, bundled = parse_formats(args.format)
     shard, shards = parse_shard(args.shard)
     options = arguments.synthesis_options(args)
-    skin = skinning.skin_settings(args)
+    skin = skin_options.skin_settings(args)
     sets = {"": arguments.references(args)}  # the command's set, read once, and each other set a row names
 
     def reference_of(chosen):
@@ -269,7 +269,7 @@ class Chunk:
         self.submitted = cluster.submit(self.work, options) if cluster is not None else None
 
     def outcomes(self):
-        """(row, (Synthesis, index) or (None, None) for a refused row), in the rows' order."""
+        """(row, (SynthesizedBatch, index) or (None, None) for a refused row), in the rows' order."""
         if self.cluster is not None:
             results = self.cluster.results(self.submitted)
         else:

@@ -4,7 +4,7 @@ command line's option (``--skin-voxel``, not the core's ``skin_voxel``)."""
 from ..core.errors import ElliMannError
 from ..core.job.request import NeedsBlenderError, check
 from .output import UsageError
-from .skinning import option_named
+from .skin_options import option_named
 from .writing import blender_available, no_blender
 
 

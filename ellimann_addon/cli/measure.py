@@ -14,7 +14,7 @@ from ..core.measure.extra import mannequin_extra_measurements
 from ..core.measurements import ALL_MEASUREMENTS, MEASUREMENT_LABELS, MEASUREMENTS, measurement_line
 from . import arguments, output, writing
 from .output import UsageError
-from .skinning import describe
+from .skin_options import describe
 
 LABELS = {**MEASUREMENT_LABELS, **MEASUREMENT_LABELS}
 KEY_WIDTH = max(map(len, ALL_MEASUREMENTS))  # the table's columns line up whatever the keys

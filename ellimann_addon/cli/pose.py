@@ -4,7 +4,7 @@ import sys
 
 from ..core.errors import MannequinError
 from ..core.formats.table import FORMATS, format_of
-from . import arguments, jobs, output, skinning, writing
+from . import arguments, jobs, output, skin_options, writing
 from .output import PROG, UsageError
 
 
@@ -29,7 +29,7 @@ def add_parser(commands):
     )
     arguments.add_verbose(pose)
     arguments.add_pose_option(pose)
-    skinning.add_skin_options(pose, rebuilt=True)
+    skin_options.add_skin_options(pose, rebuilt=True)
     pose.set_defaults(run=run, blender=lambda args: None)  # the job checks its file
 
 
@@ -46,7 +46,7 @@ def run(args):
         mannequin = Mannequin.load(args.input)
     except MannequinError as error:
         raise UsageError(f"{args.input}: {error}") from None
-    settings = skinning.skin_settings(args, mannequin.skin)
+    settings = skin_options.skin_settings(args, mannequin.skin)
     request = Request(
         skin=settings,
         pose=arguments.pose_ask(args),
@@ -63,8 +63,8 @@ def run(args):
         recorded = SkinSettings.from_dict(mannequin.skin)
     if recorded and recorded != settings:
         output.say(
-            f"{PROG} pose: {args.input} records its skin at {skinning.describe(recorded)}; made at "
-            f"{skinning.describe(settings)} as asked (another voxel or blend measures a little differently)"
+            f"{PROG} pose: {args.input} records its skin at {skin_options.describe(recorded)}; made at "
+            f"{skin_options.describe(settings)} as asked (another voxel or blend measures a little differently)"
         )
     result = make(job)  # the skin made again from the pieces, as the file records (the same pieces: the same skin)
     for warning in result.warnings:
@@ -74,6 +74,6 @@ def run(args):
     writing.write(result, job.formats, args.cushions)
     frames = result.frames
     count = f" ({len(frames)} frames)" if len(frames) > 1 else ""
-    made = f", with its {skinning.describe(settings)}" if settings is not None else ""
+    made = f", with its {skin_options.describe(settings)}" if settings is not None else ""
     output.say(f"wrote {args.output}: '{mannequin.name}' in pose {args.pose}{count}{made}", file=sys.stdout)
     return 0

@@ -14,7 +14,7 @@ from ..core.measurements import (
     measurement_line,
 )
 from ..core.synthesis.request import relative_error
-from . import arguments, jobs, output, skinning, writing
+from . import arguments, jobs, output, skin_options, writing
 from .output import PROG, UsageError
 
 
@@ -69,7 +69,7 @@ def add_parser(commands):
     )
     arguments.add_synthesis_options(synth)
     arguments.add_pose_option(synth)
-    skinning.add_skin_options(synth)
+    skin_options.add_skin_options(synth)
     synth.set_defaults(run=run, blender=lambda args: None)  # the job checks its files
 
 
@@ -111,7 +111,7 @@ def run(args):
         extra,
         arguments.synthesis_options(args, args.name),
         args.cushions,
-        skinning.skin_settings(args),
+        skin_options.skin_settings(args),
         arguments.pose_ask(args),
         (args.output,),
     )
@@ -148,7 +148,7 @@ def _line(args, result):
     skin = result.skin
     rounds = f"; {skin.rounds} round(s) of exact mode on the skin" if skin.exact else ""
     return (
-        f"wrote {args.output}: '{name}'{posed} ({args.mode}, {skinning.describe(skin.settings)}), "
+        f"wrote {args.output}: '{name}'{posed} ({args.mode}, {skin_options.describe(skin.settings)}), "
         f"skin {measurement_line(shown, MEASUREMENTS)} cm, max error {error:.3f}%{extra_line}; "
         f"pieces' m_T {measurement_line(result.five)} cm{rounds}"
     )

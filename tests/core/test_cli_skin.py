@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from devkit.cli_runs import assert_one_line_error, run
-from ellimann_addon.cli import build_parser, main, skinning
+from ellimann_addon.cli import build_parser, main, skin_options
 from ellimann_addon.core.geometry.mesh import euler_characteristic, is_closed_manifold
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.measurements import MEASUREMENTS
@@ -82,7 +82,7 @@ def test_the_skin_options_are_generated_from_the_skin_table(command):
 
 def settings_of(recorded=None, **given):
     args = argparse.Namespace(skin=True, **{name: given.get(name) for name in SKIN})
-    return skinning.skin_settings(args, recorded)
+    return skin_options.skin_settings(args, recorded)
 
 
 def test_a_skin_option_wins_over_the_file_s_record_which_wins_over_the_table():
@@ -91,7 +91,7 @@ def test_a_skin_option_wins_over_the_file_s_record_which_wins_over_the_table():
     assert settings_of(recorded) == SkinSettings(7.5, 0.9)
     assert settings_of(recorded, skin_level="preview") == SkinSettings(10.0, 0.9)
     assert settings_of(recorded, skin_level="preview", skin_voxel=6.0, skin_blend=0.3) == SkinSettings(6.0, 0.3)
-    assert skinning.skin_settings(argparse.Namespace(skin=False, **dict.fromkeys(SKIN)), recorded) is None
+    assert skin_options.skin_settings(argparse.Namespace(skin=False, **dict.fromkeys(SKIN)), recorded) is None
 
 
 # ------------------------------------------------------------------------------------------------ bad input

@@ -635,7 +635,8 @@ def test_mannequin_name_formats_the_request():
 
 
 def test_one_relative_error_formula_for_dicts_and_arrays():
-    """core.synthesis.synthesize.relative_error is what the operator, the CLI reports and Synthesis use (in %)."""
+    """core.synthesis.synthesize.relative_error is what the operator, the CLI reports and SynthesizedBatch use
+    (in %)."""
     request = dict(zip(MEASUREMENTS, (160.0, 40.0, 100.0, 80.0, 100.0)))
     measured = dict(zip(MEASUREMENTS, (160.0, 42.0, 99.0, 80.4, 100.0)))
     expected = [0.0, 5.0, 1.0, 0.5, 0.0]

@@ -14,5 +14,5 @@
 - request: a request checked, its name, the relative error of m_T
 - shipped: the shipped reference sets by name (female, male)
 - synthesize: ``synthesize`` / ``synthesize_batch`` / ``synthesize_extra``: request, set, IDW and refinement together;
-  ``Synthesis`` (a batch's arrays, per-row errors) and ``Synthesized`` (one mannequin, what it missed)
+  ``SynthesizedBatch`` (a batch's arrays, per-row errors) and ``Synthesized`` (one mannequin, what it missed)
 """

@@ -1,8 +1,8 @@
-"""A batch in chunks: a stream of rows cut into consecutive chunks (:func:`chunks`), each chunk's rows of one
-reference set (:func:`by_reference_set`) synthesized in one core batch, the rows a batch refuses synthesized alone,
-and each row's extra measurements met as ``synth`` meets them (:func:`synthesize_chunk`). The result is a
-``Synthesis`` with an error per row: what a Dask worker sends back. ``ellimann batch`` runs the chunks in the CSV's
-order, serially or on Dask, and streams what they give into its files."""
+"""A batch in chunks: a stream of rows cut into consecutive chunks (:func:`chunks`), each chunk's rows of one reference
+set (:func:`by_reference_set`) synthesized in one core batch, the rows a batch refuses synthesized alone, and each row's
+extra measurements met as ``synth`` meets them (:func:`synthesize_chunk`). The result is a ``SynthesizedBatch`` with an
+error per row: what a Dask worker sends back. ``ellimann batch`` runs the chunks in the CSV's order, serially or on
+Dask, and streams what they give into its files."""
 
 import math
 
@@ -11,7 +11,7 @@ import numpy as np
 from ..errors import ElliMannError, one_line
 from ..measure.tailor import as_dict
 from ..measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
-from .synthesize import Synthesis, meet_extra_request, synthesize_checked
+from .synthesize import SynthesizedBatch, meet_extra_request, synthesize_checked
 
 CHUNK = 256  # rows synthesized per core batch (and per Dask task)
 _FIELDS = ("rotation", "center", "semi_axes", "measured", "factors", "converged", "joints")
@@ -45,7 +45,7 @@ def synthesize_chunk(reference, requests, options, extras=None):
     per row the extra measurements it asks for ({key: cm}, checked by ``extra_request_problems``; empty: none),
     met as ``synth`` meets them (``meet_extra_request``), the rows' arrays then those of the mannequin that meets
     them. If the batch refuses a row (an implausible body), every row is synthesized alone, so only that row
-    fails: batched and one-at-a-time results are the same bits. Returns a Synthesis with ``errors`` per row
+    fails: batched and one-at-a-time results are the same bits. Returns a SynthesizedBatch with ``errors`` per row
     (and ``extra_measured`` when a row asked for extra measurements)."""
     requests = np.asarray(requests, dtype=float).reshape(-1, len(MEASUREMENTS))
     try:
@@ -79,7 +79,7 @@ def _one_at_a_time(reference, requests, options):
         arrays[key] = np.concatenate([getattr(part if part is not None else good, key) for part in parts])
         failed = [i for i, part in enumerate(parts) if part is None]
         arrays[key][failed] = False if key == "converged" else np.nan
-    return Synthesis(
+    return SynthesizedBatch(
         good.topology,
         requests,
         mode=good.mode,
@@ -91,9 +91,9 @@ def _one_at_a_time(reference, requests, options):
 
 
 def failed_chunk(reference, requests, errors, mode):
-    """A Synthesis of ``requests`` in which every row failed (``errors``: one line each), its arrays NaN."""
+    """A SynthesizedBatch of ``requests`` in which every row failed (``errors``: one line each), its arrays NaN."""
     count, parts = len(requests), len(reference.topology)
-    return Synthesis(
+    return SynthesizedBatch(
         reference.topology,
         np.asarray(requests, dtype=float).reshape(count, len(MEASUREMENTS)),
         np.full((count, parts, 3, 3), np.nan),

@@ -105,7 +105,7 @@ __all__ = [
     "REFERENCE_NAMES",
     "ReferenceSet",
     "Refinement",
-    "Synthesis",
+    "SynthesizedBatch",
     "SynthesisOptions",
     "Synthesized",
     "cached_reference_set",
@@ -131,7 +131,7 @@ __all__ = [
 
 
 @dataclass
-class Synthesis:
+class SynthesizedBatch:
     """A batch of synthesized mannequins sharing the reference set's topology (and its section heights)."""
 
     topology: object
@@ -219,7 +219,7 @@ def options_of(options=None, **fields):
 
 
 def synthesize_batch(reference, requests, options=None, *, measure=True, tolerance=EXACT_TOLERANCE, **fields):
-    """Synthesize many mannequins at once: requests (B, 5) cm -> Synthesis with (B, n, ...) arrays.
+    """Synthesize many mannequins at once: requests (B, 5) cm -> SynthesizedBatch with (B, n, ...) arrays.
 
     ``options``: a SynthesisOptions (default: exact mode, ``options.SYNTHESIS``); keywords mode=, metric=,
     power=, normalize= replace its fields. The paper's method is ``mode="idw", normalize="none"`` (with the
@@ -272,7 +272,7 @@ def synthesize_checked(reference, requests, options, *, measure=True, tolerance=
         center, semi_axes, measured = result.center, result.semi_axes, result.measured
         factors, converged = result.factors, result.converged
     check_plausible(reference.topology, requests, rotation, center, semi_axes)
-    return Synthesis(
+    return SynthesizedBatch(
         reference.topology,
         requests,
         rotation,
