@@ -85,8 +85,9 @@ class Cluster:
             )
         return groups, options, futures
 
-    def results(self, submitted): """The SynthesizedBatch of each group :meth:`submit` sent, waiting for them; a group
-        that failed every attempt comes back with every row's error set."""
+    def results(self, submitted):
+        """The SynthesizedBatch of each group :meth:`submit` sent, waiting for them; a group that failed every
+        attempt comes back with every row's error set."""
         from ..core.synthesis.batch import failed_chunk
 
         groups, options, futures = submitted
