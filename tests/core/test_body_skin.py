@@ -133,7 +133,7 @@ def test_a_request_beyond_the_bodies_is_refused_in_one_line_naming_the_measureme
     with pytest.raises(BodySkinError) as caught:
         maker.make(request)
     message = str(caught.value)
-    assert "\n" not in message and message.startswith("body skin: Wa ") and "cm" in message
+    assert "\n" not in message and message.startswith("body skin: ") and " Wa " in message and "cm" in message
 
 
 def test_posed_in_every_standard_pose_and_walk_frame_the_volume_is_kept(maker):

@@ -6,6 +6,8 @@ it measures the request (floor 5: everything below). The bodies themselves are t
 - deform: the smooth deformations the correction moves along (a displacement basis linear in its parameters)
 - tape: the measurements the correction aims at, by the body-mesh measurer's own code
 - correct: the correction, secant steps on the measurement residuals until the mesh measures the request
+- plausible: what a corrected body may become (proportions, folds, stretch, the arms clear of the trunk) and how far
+  a refused measurement reaches
 - mesh_checks: a body mesh stays closed, 2-manifold, of Euler characteristic 2 and unfolded
 - skin: the BodySkin (vertices, faces, bones, posing, measuring) and making one from a set's bodies
 """
