@@ -62,17 +62,18 @@ def closed_form_slopes(deformation, start):
     return np.array([slopes[key] for key in PARAMETERS])
 
 
-def correct(deformation, tape, request, neck_tilt=None, max_rounds=MAX_ROUNDS, aim=AIM_CM):
-    """The Correction of ``deformation``'s body to ``request`` ({key: cm} of PARAMETERS), read by ``tape``: not
-    ``converged`` with ``beyond`` naming the parameter when it would leave BOUNDS. BodySkinError when a
-    measurement cannot be taken on the corrected body."""
+def correct(deformation, read, request, max_rounds=MAX_ROUNDS, aim=AIM_CM, theta=None, start=None):
+    """The Correction of ``deformation``'s body to ``request`` ({key: cm} of PARAMETERS), ``read(vertices)`` giving
+    {key: cm}: not ``converged`` with ``beyond`` naming the parameter when it would leave BOUNDS. From ``theta``
+    (default none) and its reading ``start`` (default read). BodySkinError when a measurement cannot be taken on
+    the corrected body."""
     keys = [key for key in PARAMETERS if key in request]
     index = np.array([PARAMETERS.index(key) for key in keys])
     target = np.array([request[key] for key in keys])
     scales = np.array([SCALES[key] for key in keys])
     low, high = (np.array([BOUNDS[key][i] for key in keys]) for i in (0, 1))
-    theta = np.zeros(len(PARAMETERS))
-    start = tape.measure(deformation.rest, keys, neck_tilt)
+    theta = np.zeros(len(PARAMETERS)) if theta is None else np.array(theta, float)
+    start = start or read(deformation.apply(theta)[0])
     reading = np.array([start[key] for key in keys])
     closed = closed_form_slopes(deformation, start)[index]
     jacobian = np.diag(closed)
@@ -94,7 +95,7 @@ def correct(deformation, tape, request, neck_tilt=None, max_rounds=MAX_ROUNDS, a
             beyond = keys[k]
             break
         step = trial[index] - theta[index]
-        found = tape.measure(deformation.apply(trial)[0], keys, neck_tilt)
+        found = read(deformation.apply(trial)[0])
         new = np.array([found[key] for key in keys])
         if not np.all(np.isfinite(new)):
             missing = [key for key, value in zip(keys, new) if not np.isfinite(value)]

@@ -22,7 +22,7 @@ The joints move with the surface around them (each the mean displacement of the 
 
 import numpy as np
 
-from ..mannequin.skeleton import JOINT_COUNT, JOINT_INDEX
+from ..mannequin.skeleton import JOINT_INDEX
 
 PARAMETERS = ("He", "Sh", "Br", "Wa", "Hi", "neck", "upper_arm", "thigh", "calf", "crotch_height", "arm_length")
 TRUNK = ("Hi", "Wa", "Br")
@@ -238,12 +238,10 @@ class Deformation:
 
     def _joint_rings(self):
         """(24, V) each joint's share of each vertex's displacement: the vertices nearest to it."""
-        ring = np.zeros((JOINT_COUNT, len(self.rest)))
-        for j, joint in enumerate(self.joints):
-            distance = np.linalg.norm(self.rest - joint, axis=1)
-            near = distance <= JOINT_RING * distance.min() + 1e-3
-            ring[j, near] = 1.0 / near.sum()
-        return ring
+        offset = self.rest[None, :, :] - self.joints[:, None, :]
+        distance = np.sqrt(np.einsum("jvc,jvc->jv", offset, offset))
+        near = distance <= JOINT_RING * distance.min(axis=1, keepdims=True) + 1e-3
+        return near / near.sum(axis=1, keepdims=True)
 
     def displacement(self, theta):
         """(V, 3) displacement of the vertices for parameters ``theta`` (K,)."""

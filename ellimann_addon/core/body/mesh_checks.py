@@ -103,13 +103,20 @@ def arm_intrusion(vertices, faces, arms, fractions=INTRUSION_FRACTIONS):
     """(depth m, fraction of He) of the deepest point of an arm's horizontal section inside the trunk's (the
     triangles with no arm vertex) at heights ``fractions`` of He: 0 where the arms hang clear (the bodies')."""
     arm = arms["L"] | arms["R"]
-    trunk_faces, arm_faces = faces[~arm[faces].any(axis=1)], faces[arm[faces].all(axis=1)]
     bottom, height = float(vertices[:, 2].min()), float(np.ptp(vertices[:, 2]))
+    lowest, highest = bottom + min(fractions) * height, bottom + max(fractions) * height
+    face_z = vertices[faces, 2]
+    low, high = face_z.min(axis=1), face_z.max(axis=1)
+    band = (high >= lowest) & (low < highest)
+    trunk_faces, arm_faces = (faces[band & rows] for rows in (~arm[faces].any(axis=1), arm[faces].all(axis=1)))
+    ranges = [(vertices[chosen, 2].min(axis=1), vertices[chosen, 2].max(axis=1)) for chosen in (trunk_faces, arm_faces)]
     deepest, where = 0.0, float("nan")
     for fraction in fractions:
         z = bottom + fraction * height
-        trunk = section_segments(vertices, trunk_faces, z)[0]
-        limb = section_segments(vertices, arm_faces, z)[0]
+        trunk, limb = (
+            section_segments(vertices, chosen[(low < z) & (high >= z)], z)[0]
+            for chosen, (low, high) in zip((trunk_faces, arm_faces), ranges)
+        )
         if not len(trunk) or not len(limb):
             continue
         points = limb[:, 0]

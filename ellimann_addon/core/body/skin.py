@@ -16,10 +16,12 @@ from ..constants import MEASUREMENTS
 from ..geometry.mesh import volume
 from ..mannequin.skeleton import JOINT_INDEX
 from ..measure.extra import EXTRA_MEASUREMENTS
+from ..measure.neck import joint_tilt
 from ..pose.kinematics import bone_matrices
 from ..synthesis.bodies import load_set_bodies
-from .correct import PROMISE_CM, BodySkinError, correct
+from .correct import AIM_CM, PROMISE_CM, BodySkinError, correct
 from .deform import PARAMETERS, Deformation, abducted, smoothed
+from .extra_tape import ExtraTape, Marks, leg_masks
 from .mesh_checks import arm_intrusion
 from .model import IdwBodyModel
 from .plausible import (
@@ -75,8 +77,10 @@ class BodySkin:
 
     def measure(self, fractions=None, neck_tilt=None):
         """The skin measured as any body mesh (core.measure.body), its arms known from the labels: a
-        BodyMeasurement at ``fractions`` (default the set's)."""
-        return Tape(self.faces, self.arms, fractions or self.bodies.fractions).full(self.vertices, neck_tilt)
+        BodyMeasurement at ``fractions`` (default the set's), the neck square to ``neck_tilt`` (radians; default
+        the skin's own Neck -> Head axis, as today's skin is measured)."""
+        tilt = joint_tilt(self.joints) if neck_tilt is None else neck_tilt
+        return Tape(self.faces, self.arms, fractions or self.bodies.fractions).full(self.vertices, tilt)
 
     @property
     def volume(self):
@@ -89,6 +93,9 @@ class BodySkin:
             for key, value in self.request.items()
             if abs(self.measured[key] - value) > PROMISE_CM
         ]
+
+
+FINAL_PASSES = 3  # whole readings of a skin with extras (each but the last followed by a loop aimed anew)
 
 
 @dataclass
@@ -114,6 +121,8 @@ class BodySkinMaker:
         self.bodies = bodies
         self.model = model or IdwBodyModel(bodies, ranges)
         self.tape = Tape(bodies.faces, bodies.arms, bodies.fractions)
+        legs = leg_masks(bodies.region, bodies.region_names)
+        self.extra_tape = ExtraTape(bodies.faces, bodies.arms, legs, bodies.fractions)
         self.weights = smoothed(bodies.dense_weights, bodies.faces)
 
     def interpolated(self, request):
@@ -139,9 +148,6 @@ class BodySkinMaker:
             raise BodySkinError(self.refusal(asked, attempt))
         found = attempt.correction
         measured = found.measured
-        if any(key in EXTRA_MEASUREMENTS for key in asked):  # the whole measurer, the neck's tilt searched
-            full = self.tape.full(attempt.vertices).values
-            measured = {key: full.get(key, np.nan) for key in asked}
         weights = getattr(self.model, "weights", None)
         return BodySkin(
             attempt.vertices,
@@ -160,18 +166,11 @@ class BodySkinMaker:
         """An Attempt at ``asked`` ({key: cm}): the body model's body, its arms raised as far as they must be to
         clear the trunk, corrected; its first problem (core.body.plausible) when ``check``."""
         vertices, joints = self.model.body(asked)
-        tilt = crotch = None
-        if any(key in EXTRA_MEASUREMENTS for key in asked):
-            first = self.tape.full(vertices)
-            tilt = first.neck_tilt if np.isfinite(first.neck_tilt) else None
-            crotch = first.values.get("crotch_height")
-            crotch = None if crotch is None else crotch / 100.0
         faces, arms = self.bodies.faces, self.bodies.arms
         angle = 0.0
         while True:
             rest, rest_joints = abducted(vertices, joints, self.weights, angle) if angle else (vertices, joints)
-            deformation = Deformation(rest, rest_joints, self.weights, self.bodies.fractions, crotch)
-            found = correct(deformation, self.tape, asked, tilt)
+            found, deformation = self.corrected(asked, rest, rest_joints)
             corrected, moved = deformation.apply(found.theta)
             attempt = Attempt(corrected, moved, found, deformation, angle)
             keys = [key for key in PARAMETERS if key in asked]
@@ -198,6 +197,42 @@ class BodySkinMaker:
         if attempt.problem:
             attempt.blamed = blame(deformation, found.theta, keys, faces, bad)
         return attempt
+
+    def corrected(self, asked, rest, joints):
+        """(Correction, Deformation) of the body ``rest`` with ``joints`` to ``asked``: the five by the tape, the
+        extras by the extras' tape in windows about their last extremes (the neck square to the rest's own Neck ->
+        Head axis), then every band searched whole on the corrected body, its neck square to its own axis (the
+        final reading); when that differs from the loop's by more than the aim, the loop again from there, aimed
+        by the difference."""
+        keys = [key for key in PARAMETERS if key in asked]
+        extras = [key for key in keys if key in EXTRA_MEASUREMENTS]
+        marks = Marks()
+        tilt = joint_tilt(joints) if "neck" in extras else None
+
+        def read(vertices, whole=False, at_tilt=tilt, coarse=False):
+            values = self.tape.five(vertices)
+            if extras:
+                found, where = self.extra_tape.read(vertices, extras, at_tilt, None if whole else marks, coarse)
+                marks.neck, marks.calf = where.neck, where.calf
+                values.update(found)
+            return {key: values[key] for key in keys}
+
+        start = read(rest, whole=True, coarse=True)
+        crotch = start.get("crotch_height")
+        deformation = Deformation(rest, joints, self.weights, self.bodies.fractions, crotch and crotch / 100.0)
+        found = correct(deformation, read, asked, start=start)
+        for last in range(FINAL_PASSES - 1, -1, -1) if extras and found.converged else ():
+            corrected, moved = deformation.apply(found.theta)
+            final = read(corrected, whole=True, at_tilt=None if tilt is None else joint_tilt(moved))
+            offset = {key: final[key] - found.measured[key] for key in keys}
+            found.measured = final
+            if not last or all(abs(final[key] - asked[key]) <= AIM_CM for key in keys):
+                break
+            aimed = {key: asked[key] - offset[key] for key in keys}  # the loop's reading lacks the offset
+            again = correct(deformation, read, aimed, theta=found.theta)
+            found.theta, found.rounds, found.measured = again.theta, found.rounds + again.rounds, again.measured
+        found.converged = all(abs(found.measured[key] - asked[key]) <= PROMISE_CM for key in keys)
+        return found, deformation
 
     def refusal(self, asked, attempt):
         """The refusal's line: the blamed measurement, how far the body skin reaches, and why not further."""
