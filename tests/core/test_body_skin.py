@@ -19,7 +19,7 @@ from tools.reference_sets import SHARED
 
 SETS = ("female", "male")
 BANK = SHARED / "bodies"
-SIT_TOLERANCE = 0.06  # sitting bends both hips 90 degrees: the body model's own weights lose 5.5 % there
+VOLUME_TOLERANCE = 0.03  # every standard pose and walk frame (issue 42)
 
 
 @pytest.fixture(scope="module", params=SETS)
@@ -153,6 +153,6 @@ def test_posed_in_every_standard_pose_and_walk_frame_the_volume_is_kept(maker):
         frames = clamped_motion(name, skin.joints)[0]
         for pose in frames[:: max(1, len(frames) // 3)]:
             moved = skin.posed(pose)
-            assert abs(volume(moved, skin.faces) / rest - 1.0) <= (SIT_TOLERANCE if name == "sit" else 0.03), name
+            assert abs(volume(moved, skin.faces) / rest - 1.0) <= VOLUME_TOLERANCE, name
             points = forward_kinematics(skin.joints, pose.rotations, pose.translation)[2]
             assert np.linalg.norm(moved[arm] - points[elbow], axis=1).min() >= 0.8 * depth, name

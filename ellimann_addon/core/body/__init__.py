@@ -11,5 +11,6 @@ it measures the request (floor 5: everything below). The bodies themselves are t
 - plausible: what a corrected body may become (proportions, folds, stretch, the arms clear of the trunk) and how far
   a refused measurement reaches
 - mesh_checks: a body mesh stays closed, 2-manifold, of Euler characteristic 2 and unfolded
+- hips: the bone weights where the hips bend, re-drawn across tilted planes so that sitting keeps the volume
 - skin: the BodySkin (vertices, faces, bones, posing, measuring) and making one from a set's bodies
 """

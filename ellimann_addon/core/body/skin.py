@@ -9,6 +9,7 @@ skin over pieces), its ``joints`` are its own (the bodies' joints carried throug
 import pathlib
 import time
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -17,11 +18,11 @@ from ..geometry.mesh import volume
 from ..mannequin.skeleton import JOINT_INDEX
 from ..measure.extra import EXTRA_MEASUREMENTS
 from ..measure.neck import joint_tilt
-from ..pose.kinematics import bone_matrices
 from ..synthesis.bodies import load_set_bodies
 from .correct import AIM_CM, PROMISE_CM, BodySkinError, correct
 from .deform import PARAMETERS, Deformation, abducted, smoothed
 from .extra_tape import ExtraTape, Marks, leg_masks
+from .hips import balanced_bones, skinned
 from .mesh_checks import arm_intrusion
 from .model import IdwBodyModel
 from .plausible import (
@@ -58,18 +59,26 @@ class BodySkin:
     pieces_measured: dict = field(default_factory=dict)
     abduction: float = 0.0
 
+    @cached_property
+    def _balanced(self):
+        return balanced_bones(self.vertices, self.faces, self.joints, self.bodies.dense_weights)
+
     def bones(self):
-        """(joint indices (V, 4), weights (V, 4)) on the SMPL joints: the body model's own, summed per joint."""
-        return self.bodies.joint_index, self.bodies.joint_weight
+        """(joint indices (V, 4), weights (V, 4)) on the SMPL joints: the body model's own, summed per joint, with
+        the pelvis's and the thighs' shares re-drawn across the hips' tilted planes (core.body.hips): plain
+        linear-blend skinning that keeps the volume when sitting."""
+        return self._balanced[0]
+
+    @property
+    def hip_planes(self):
+        """(drop, half-width, tilt) of the hips' planes (core.body.hips) at which the skin keeps its volume in
+        sit: shares of the thigh's length, radians about world X."""
+        return self._balanced[1]
 
     def posed(self, pose):
         """The vertices (V, 3) in ``pose`` (core.pose.kinematics.Pose): linear-blend skinning on :meth:`bones`
         about this skin's own joints."""
-        matrices = bone_matrices(self.joints, pose)[:, :3, :]
-        index, weight = self.bones()
-        homogeneous = np.c_[self.vertices, np.ones(len(self.vertices))]
-        moved = np.einsum("vkij,vj->vki", matrices[index], homogeneous)
-        return np.einsum("vk,vki->vi", weight, moved)
+        return skinned(self.vertices, self.joints, *self.bones(), pose)
 
     @property
     def arms(self):
