@@ -14,6 +14,7 @@ reading of the five, and the time per request.
     python -m bench.bench_body_skin --bank-step 1 --sets female --no-pieces
     python -m bench.bench_body_skin --grid                # the 243 grid: met, refused by kind (a minute a set)
     python -m bench.bench_body_skin --gaps                # the cloth gap: each RM's pieces against its body skin
+    python -m bench.bench_body_skin --speed 5             # the speed alone, five and eleven, against today's skin
 """
 
 import argparse
@@ -273,6 +274,39 @@ def grid_counts(name):
     return counts, worst, lines, statistics.median(seconds)
 
 
+def timed(times, function, *args):
+    started = time.perf_counter()
+    function(*args)
+    times.append(time.perf_counter() - started)
+
+
+def speed(name, count=5, seed=7):
+    """Median seconds of an exact body skin (the five; the eleven) against today's skin over the pieces (preview,
+    final, exact with the five; exact with the eleven) in the same run, at ``count`` requests: the set's bodies'
+    own measurements each moved by up to 3 % (the first ``count`` of them, in turn)."""
+    from ellimann_addon.core.measure.extra import EXTRA_MEASUREMENTS
+
+    reference = named_reference_set(name)
+    bodies = load_set_bodies(reference_folder(name))
+    maker = BodySkinMaker(bodies, ranges=reference.ranges)
+    rng = np.random.default_rng(seed)
+    times = {key: [] for key in ("body five", "body eleven", "preview", "final", "exact five", "exact eleven")}
+    for i in range(count):
+        own = bodies.measurements(i % len(bodies))
+        request = {key: value * (1.0 + rng.uniform(-0.03, 0.03)) for key, value in own.items()}
+        five = {key: request[key] for key in MEASUREMENTS}
+        extra = {key: request[key] for key in EXTRA_MEASUREMENTS}
+        timed(times["body five"], maker.make, five)
+        timed(times["body eleven"], maker.make, five, extra)
+        mannequin = synthesize_batch(reference, [[five[key] for key in MEASUREMENTS]]).mannequin(0)
+        final = SkinSettings.at_level("final")
+        timed(times["preview"], build_skin, mannequin, SkinSettings.at_level("preview"))
+        timed(times["final"], build_skin, mannequin, final)
+        timed(times["exact five"], exact_skin, mannequin, final, five)
+        timed(times["exact eleven"], exact_skin, mannequin, final, five, extra)
+    return {key: statistics.median(values) for key, values in times.items()}
+
+
 def run(sets=("female", "male"), bank_step=8, with_pieces=True, held_out=True):
     for name in sets:
         if held_out:
@@ -297,7 +331,20 @@ def main(argv=None):
     parser.add_argument("--no-held-out", action="store_true")
     parser.add_argument("--grid", action="store_true", help="only the 243 grid's counts (met, refused by kind)")
     parser.add_argument("--gaps", action="store_true", help="only the RMs' cloth gap against their body skins")
+    parser.add_argument("--speed", type=int, metavar="N", help="only the speed, at N requests a set")
     args = parser.parse_args(argv)
+    if args.speed:
+        for name in args.sets.split(","):
+            found = speed(name, args.speed)
+            five, eleven = found["body five"], found["body eleven"]
+            print(
+                f"{name}: body skin {five * 1e3:.0f} ms (the five), {eleven * 1e3:.0f} ms (the eleven); today's skin "
+                f"preview {found['preview']:.2f} s ({found['preview'] / five:.0f}x), final {found['final']:.2f} s "
+                f"({found['final'] / five:.0f}x), exact {found['exact five']:.2f} s "
+                f"({found['exact five'] / five:.0f}x); exact with the eleven {found['exact eleven']:.2f} s "
+                f"({found['exact eleven'] / eleven:.0f}x)"
+            )
+        return
     if args.grid:
         for name in args.sets.split(","):
             counts, worst, lines, median = grid_counts(name)
