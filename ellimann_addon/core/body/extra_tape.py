@@ -111,7 +111,7 @@ class ExtraTape:
     def _calf(self, body, crotch, marks, search):
         """(mean of the two calves' largest girths over CALF_BAND of the crotch's height, {side: where})."""
         low, high = (body.bottom + f * crotch for f in CALF_BAND)
-        own = self._legs_apart(body, low, high)
+        own = self.legs_apart(body, low, high)
         out, where = [], {}
         for side in SIDES:
 
@@ -132,7 +132,7 @@ class ExtraTape:
             where[side] = (at - body.bottom) / crotch
         return float(np.mean(out)), where
 
-    def _legs_apart(self, body, low, high):
+    def legs_apart(self, body, low, high):
         """Whether between heights ``low`` and ``high`` the section of the measurer's leg triangles is each leg's
         own triangles only, each leg on its side of the mid-plane."""
         z = body.vertices[self.faces[self.other_rows], 2]

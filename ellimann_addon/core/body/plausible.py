@@ -75,19 +75,17 @@ def stretch_problem(before, after, faces):
     beyond STRETCH_RANGE (None, None otherwise)."""
     small, large = principal_stretches(before, after, faces)
     low, high = STRETCH_RANGE
-    for what, bad, value in (
-        ("squeezed below", small < low, small),
-        ("stretched beyond", large > high, large),
-    ):
-        if bad.sum() > STRETCH_ALLOWANCE * len(faces):
-            z = after[faces[bad]].mean(axis=1)[:, 2]
-            bottom, height = after[:, 2].min(), np.ptp(after[:, 2])
-            extreme = value[bad].min() if what.startswith("squeezed") else value[bad].max()
-            where = f"{(z.min() - bottom) / height:.2f}-{(z.max() - bottom) / height:.2f} He"
-            limit = low if what.startswith("squeezed") else high
-            line = f"{int(bad.sum())} triangles {what} {limit:g}x their size (to {extreme:.2f}x, at {where})"
-            return line, bad
-    return None, None
+    bad = (small < low) | (large > high)
+    if bad.sum() <= STRETCH_ALLOWANCE * len(faces):
+        return None, None
+    z = after[faces[bad]].mean(axis=1)[:, 2]
+    bottom, height = after[:, 2].min(), np.ptp(after[:, 2])
+    where = f"{(z.min() - bottom) / height:.2f}-{(z.max() - bottom) / height:.2f} He"
+    line = (
+        f"{int(bad.sum())} triangles would be stretched beyond {high:g}x or squeezed below {low:g}x their size "
+        f"(to {large[bad].max():.2f}x and {small[bad].min():.2f}x, at {where})"
+    )
+    return line, bad
 
 
 def surface_problem(before, after, faces, allowance=FOLD_ALLOWANCE):
