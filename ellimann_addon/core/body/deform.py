@@ -1,23 +1,27 @@
 """The correction's deformations: one smooth displacement field per measurement, each linear in its parameter,
 so that a corrected body is ``rest + sum(theta_k * basis_k)``: arithmetic on the vertices, no remeshing.
 
-Every field is a product of smooth functions (the body model's own bone weights, smoothstep profiles in height),
-so no field has a kink at a section height or a seam between regions:
+Every field is a product of smooth functions (bone weights smoothed over the mesh, smooth profiles in height), so
+no field has a kink at a section height or a seam between regions:
 
 - He: a vertical scale about the floor.
 - crotch_height: the legs stretched vertically and the trunk moved up by as much, He kept: a smoothstep ramp of
   the vertical scale across the crotch.
-- Sh: the arms and collars moved sideways (each side by the parameter, metres).
-- Br, Wa, Hi: horizontal scales of the trunk about its centre line, each by a profile in height that is 1 at its
-  section and 0 at the next ones (a smooth partition of unity between Hi and Br, fading below Hi and above Br),
-  the arms left out (their bone weights) and turned out about the shoulders by the angle that keeps them as far
-  from the trunk as they were.
+- Sh: the arms moved sideways (each side by the parameter, metres) and the shoulder girdle widened under them,
+  its side at the shoulders by GIRDLE of that (an x-scale of the trunk by a profile 0 at the waist, 1 from the
+  shoulder joints to the neck joint), the neck and head left out.
+- Br, Wa, Hi: horizontal scales of the trunk split between width and depth (SPLIT; the depth about a pivot that
+  gives the front FRONT_SHARE of it), each by a clamped cubic spline in height (:func:`cardinal`: 1 at its
+  section, 0 at the others', at HIP_FADE below the hips and at the neck joint), the arms left out (their bone
+  weights) and moved out rigidly by the trunk's mean widening beside them.
 - neck: a horizontal scale about the neck's centre line, by the neck's bone weight.
 - upper_arm, thigh, calf: scales across the limb's axis (shoulder-elbow, hip-knee, knee-ankle), by that
   bone's weight.
 - arm_length: a stretch along the arm's axis from the shoulder joint, by the arm's weight.
 
 The joints move with the surface around them (each the mean displacement of the vertices nearest to it).
+:func:`smoothed` spreads the bone weights the fields use over the mesh (once per set); :func:`abducted` raises
+the arms about the shoulders (a pose: core.body.plausible raises them to clear a wide trunk).
 """
 
 import numpy as np
@@ -35,7 +39,7 @@ SPLIT = {"Br": (0.9, 1.1), "Wa": (0.85, 1.25), "Hi": (0.9, 1.3)}
 FRONT_SHARE = {"Br": 0.55, "Wa": 0.6, "Hi": 0.4}
 GIRDLE = 0.75  # the trunk's side at the shoulders moves out by this much of the arms' move (the bank: 0.69-0.76)
 CROTCH_RAMP = 0.10  # He over which the legs' stretch turns into the trunk's lift
-CENTRE_BIN = 0.01  # m: the trunk's centre line from horizontal slices this thick ...
+CENTRE_BIN = 0.01  # m: the trunk's front and back from horizontal slices this thick ...
 CENTRE_SMOOTH = 5  # ... smoothed over this many slices
 JOINT_RING = 1.3  # a joint moves as the vertices within this many times its depth (distance to the surface)
 SIDES = ("L", "R")
@@ -122,8 +126,8 @@ def _unit(vector):
 
 class Deformation:
     """The basis (K, V, 3) of a body's correction (PARAMETERS order) at ``vertices`` (V, 3, on z = 0) with
-    ``joints`` (24, 3), ``weights`` (V, 24) its dense bone weights, ``fractions`` the section heights and
-    ``crotch`` the crotch's height (m, for its ramp; default 0.46 He)."""
+    ``joints`` (24, 3), ``weights`` (V, 24) its dense bone weights (smoothed: :func:`smoothed`), ``fractions`` the
+    section heights and ``crotch`` the crotch's height (m, for its ramp; default 0.46 He)."""
 
     def __init__(self, vertices, joints, weights, fractions, crotch=None):
         self.rest, self.joints = np.asarray(vertices, float), np.asarray(joints, float)

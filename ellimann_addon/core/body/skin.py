@@ -1,5 +1,7 @@
 """The body skin: the set's bodies interpolated for a request (core.body.model) and corrected on the mesh until
-it measures the request (core.body.correct), bound to the 24 joints with the bodies' own bone weights.
+it measures the request (core.body.correct), judged plausible or refused with how far it reaches
+(core.body.plausible), bound to the 24 joints with the bodies' own bone weights, the hips' re-drawn
+(core.body.hips).
 
 ``BodySkin`` answers as ``core.skin.surface.Skin`` does where a body can: ``vertices``, ``faces``, ``bones()``,
 ``posed(pose)``, ``measure()``, ``volume``; it has no pieces (``pieces``/``weights``/``following`` belong to a
