@@ -12,6 +12,9 @@ reading of the five, and the time per request.
 
     python -m bench.bench_body_skin                       # both sets, every 8th bank body, with today's skin
     python -m bench.bench_body_skin --bank-step 1 --sets female --no-pieces
+    python -m bench.bench_body_skin --grid                # the 243 grid: met, refused by kind (a minute a set)
+    python -m bench.bench_body_skin --gaps                # the cloth gap: each RM's pieces against its body skin
+    python -m bench.bench_body_skin --speed 5             # the speed alone, five and eleven, against today's skin
 """
 
 import argparse
@@ -22,7 +25,7 @@ import numpy as np
 
 from ellimann_addon.core.body.model import IdwBodyModel
 from ellimann_addon.core.body.skin import BodySkinMaker
-from ellimann_addon.core.geometry.volume import IOU_MARGIN, BodyVolume, mesh_voxel_iou
+from ellimann_addon.core.geometry.volume import IOU_MARGIN, IOU_SPACING, BodyVolume, mesh_voxel_iou
 from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.skin.exact import exact_skin
 from ellimann_addon.core.skin.settings import SkinSettings
@@ -96,7 +99,7 @@ def held_out_rows(name, with_pieces):
         row["best blend"] = iou(best_blend(others, body), faces, body, faces, _grid(body, faces))
         if rms is not None:
             reference = subset_set(rms, targets, [n for n in rms if n != six[held]])
-            row.update(_pieces(reference, body, faces, request))
+            row.update(_pieces(reference, body, faces, request, row["skin"], body))
         rows.append(row)
     return rows
 
@@ -119,13 +122,44 @@ def _twins(maker, body, faces, request):
         "blend error": vertex_error(blend, faces, body),
         "miss": max(abs(found[key] - request[key]) for key in MEASUREMENTS),
         "seconds": seconds,
+        "skin": skin,
     }
 
 
-def _pieces(reference, body, faces, request):
+def cloth_gap(mannequin, vertices, faces):
+    """tools.cloth_gap.surface_gap of a body skin against ``mannequin`` (its pieces), the mannequin stood in the
+    skin as tools/cloth_gap.py stands it in a body (floors alike, the volumes' centroids on one vertical line):
+    how far the skin lies outside the pieces a garment rests on."""
+    from tools.cloth_gap import surface_gap
+    from tools.overlap import standing_in
+
+    grid = BodyVolume(vertices, faces).grid(IOU_SPACING, margin=IOU_MARGIN)
+    lowest = float(
+        np.min(mannequin.center[:, 2] - np.linalg.norm(mannequin.rotation[:, 2, :] * mannequin.semi_axes, axis=1))
+    )
+    placed = mannequin.copy(center=mannequin.center + [0.0, 0.0, vertices[:, 2].min() - lowest])
+    return surface_gap(standing_in(grid, placed), vertices, faces)
+
+
+def rm_gaps(name):
+    """{stem: cloth_gap} of each RM of the shipped set against the body skin at its targets."""
+    reference = named_reference_set(name)
+    maker = BodySkinMaker(load_set_bodies(reference_folder(name)), ranges=reference.ranges)
+    out = {}
+    for i, stem in enumerate(reference.names):
+        skin = maker.make(reference.manifest.targets_cm[stem])
+        out[stem] = cloth_gap(reference.mannequins[i], skin.vertices, skin.faces)
+    return out
+
+
+def _pieces(reference, body, faces, request, skin=None, held_body=None):
     grid = _grid(body, faces)
     mannequin = synthesize_batch(reference, [[request[key] for key in MEASUREMENTS]]).mannequin(0)
     out = {}
+    if skin is not None:
+        out["gap"] = cloth_gap(mannequin, skin.vertices, skin.faces)
+    if held_body is not None:
+        out["body gap"] = cloth_gap(mannequin, held_body, faces)
     for level in ("preview", "final"):
         started = time.perf_counter()
         skin = build_skin(mannequin, SkinSettings.at_level(level))
@@ -179,9 +213,98 @@ def summary(label, rows):
             median = statistics.median(values)
             line += f"; today's {level[:-2]} {median:.2f} s ({median / body_s:.0f}x)"
     print(line)
+    gaps = [(row["gap"], row.get("body gap")) for row in made if "gap" in row]
+    if gaps:
+        print(f"  cloth gap, body skin outside the synthesized pieces: {gap_words([g for g, _ in gaps])}")
+        if all(b is not None for _, b in gaps):
+            print(f"  cloth gap, the held-out body itself outside them: {gap_words([b for _, b in gaps])}")
     for row in rows:
         if "refused" in row:
             print(f"  {row['body']}: {row['refused']}")
+
+
+def gap_words(gaps):
+    """Mean over the rows of each surface_gap figure, in words (mm, %)."""
+    mean = {key: float(np.mean([gap[key] for gap in gaps])) for key in gaps[0]}
+    return (
+        f"{mean['outside']:.0%} of the surface outside; area-weighted median {mean['median'] * 1e3:.1f} mm, "
+        f"p95 {mean['p95'] * 1e3:.1f} mm (over the part outside: median {mean['outside_median'] * 1e3:.1f} mm, "
+        f"p95 {mean['outside_p95'] * 1e3:.1f} mm)"
+    )
+
+
+def grid_counts(name):
+    """Over the 243 grid of the shipped set's ranges (3 levels each): {outcome: count} and the worst miss (cm) of
+    the five by the whole measurer, the refusals' lines by kind, the median seconds a skin."""
+    import itertools
+
+    from ellimann_addon.core.body.correct import BodySkinError
+
+    reference = named_reference_set(name)
+    maker = BodySkinMaker(load_set_bodies(reference_folder(name)), ranges=reference.ranges)
+    levels = {key: (low, 0.5 * (low + high), high) for key, (low, high) in reference.ranges.items()}
+    counts, worst, seconds, lines = {}, 0.0, [], []
+    for combo in itertools.product(range(3), repeat=len(MEASUREMENTS)):
+        request = {key: levels[key][i] for key, i in zip(MEASUREMENTS, combo)}
+        started = time.perf_counter()
+        try:
+            skin = maker.make(request)
+        except BodySkinError as error:
+            text = str(error)
+            kind = (
+                "beyond any body's proportions"
+                if "no body has" in text
+                else "arms through the trunk"
+                if "arms would" in text
+                else "folding"
+                if "fold" in text
+                else "stretched or squeezed"
+                if "triangles" in text
+                else "beyond the correction's bounds"
+            )
+            counts[kind] = counts.get(kind, 0) + 1
+            lines.append(f"{''.join(map(str, combo))} {text}")
+            continue
+        seconds.append(time.perf_counter() - started)
+        found = skin.measure().values
+        worst = max(worst, max(abs(found[key] - request[key]) for key in MEASUREMENTS))
+        counts["met"] = counts.get("met", 0) + 1
+        if skin.abduction > 0.0:
+            counts["met, arms raised"] = counts.get("met, arms raised", 0) + 1
+    return counts, worst, lines, statistics.median(seconds)
+
+
+def timed(times, function, *args):
+    started = time.perf_counter()
+    function(*args)
+    times.append(time.perf_counter() - started)
+
+
+def speed(name, count=5, seed=7):
+    """Median seconds of an exact body skin (the five; the eleven) against today's skin over the pieces (preview,
+    final, exact with the five; exact with the eleven) in the same run, at ``count`` requests: the set's bodies'
+    own measurements each moved by up to 3 % (the first ``count`` of them, in turn)."""
+    from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS
+
+    reference = named_reference_set(name)
+    bodies = load_set_bodies(reference_folder(name))
+    maker = BodySkinMaker(bodies, ranges=reference.ranges)
+    rng = np.random.default_rng(seed)
+    times = {key: [] for key in ("body five", "body eleven", "preview", "final", "exact five", "exact eleven")}
+    for i in range(count):
+        own = bodies.measurements(i % len(bodies))
+        request = {key: value * (1.0 + rng.uniform(-0.03, 0.03)) for key, value in own.items()}
+        five = {key: request[key] for key in MEASUREMENTS}
+        extra = {key: request[key] for key in EXTRA_MEASUREMENTS}
+        timed(times["body five"], maker.make, five)
+        timed(times["body eleven"], maker.make, five, extra)
+        mannequin = synthesize_batch(reference, [[five[key] for key in MEASUREMENTS]]).mannequin(0)
+        final = SkinSettings.at_level("final")
+        timed(times["preview"], build_skin, mannequin, SkinSettings.at_level("preview"))
+        timed(times["final"], build_skin, mannequin, final)
+        timed(times["exact five"], exact_skin, mannequin, final, five)
+        timed(times["exact eleven"], exact_skin, mannequin, final, five, extra)
+    return {key: statistics.median(values) for key, values in times.items()}
 
 
 def run(sets=("female", "male"), bank_step=8, with_pieces=True, held_out=True, quick=False):
@@ -209,7 +332,38 @@ def main(argv=None):
     parser.add_argument("--bank-step", type=int, default=8, help="every n-th bank body (0: none)")
     parser.add_argument("--no-pieces", action="store_true", help="without today's skin (fast)")
     parser.add_argument("--no-held-out", action="store_true")
+    parser.add_argument("--grid", action="store_true", help="only the 243 grid's counts (met, refused by kind)")
+    parser.add_argument("--gaps", action="store_true", help="only the RMs' cloth gap against their body skins")
+    parser.add_argument("--speed", type=int, metavar="N", help="only the speed, at N requests a set")
     args = parser.parse_args(argv)
+    if args.speed:
+        for name in args.sets.split(","):
+            found = speed(name, args.speed)
+            five, eleven = found["body five"], found["body eleven"]
+            print(
+                f"{name}: body skin {five * 1e3:.0f} ms (the five), {eleven * 1e3:.0f} ms (the eleven); today's skin "
+                f"preview {found['preview']:.2f} s ({found['preview'] / five:.0f}x), final {found['final']:.2f} s "
+                f"({found['final'] / five:.0f}x), exact {found['exact five']:.2f} s "
+                f"({found['exact five'] / five:.0f}x); exact with the eleven {found['exact eleven']:.2f} s "
+                f"({found['exact eleven'] / eleven:.0f}x)"
+            )
+        return
+    if args.grid:
+        for name in args.sets.split(","):
+            counts, worst, lines, median = grid_counts(name)
+            print(
+                f"{name} 243 grid: {counts}; worst miss of the five {worst * 10:.2f} mm; {median * 1e3:.0f} ms a skin"
+            )
+            for line in lines:
+                print(f"  {line}")
+        return
+    if args.gaps:
+        for name in args.sets.split(","):
+            gaps = rm_gaps(name)
+            for stem, gap in gaps.items():
+                print(f"{name} {stem}: {gap_words([gap])}")
+            print(f"{name} RMs: {gap_words(list(gaps.values()))}")
+        return
     run(args.sets.split(","), args.bank_step, not args.no_pieces, not args.no_held_out)
 
 

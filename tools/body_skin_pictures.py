@@ -6,7 +6,11 @@
 - ``body_skin_table_2_5.png``: the ten Table 2.5 requests (the paper's test requests), female set;
 - ``body_skin_twin_held_out.png``: the neutral reference body (not one of the shipped set's five) beside its body
   skin from the five measurements it measures, front and side;
-- ``body_skin_poses.png``: the Average's body skin in every still pose and three walk frames.
+- ``body_skin_poses.png``: the Average's body skin in every still pose and three walk frames;
+- ``body_skin_sit.png``: sitting, from the side, the female Average and Small Chubby and the male Average, each
+  with the body model's own weights and then with the hips' planes of core.body.hips;
+- ``body_skin_reach.png``: grid requests the correction reaches now (narrow shoulders with the arms raised, wide
+  shoulders over a slim trunk, the trunk's steepest allowed tapers), front and side.
 """
 
 import argparse
@@ -32,7 +36,14 @@ from tools.render import Slot, render
 IMAGES = Path(__file__).resolve().parent.parent / "docs" / "images"
 BODY_COLOR = (0.62, 0.64, 0.7, 1.0)
 WALK_FRAMES = (0, 6, 12)
-PICTURES = ("lineup", "lineup_male", "table_2_5", "twin", "poses")
+PICTURES = ("lineup", "lineup_male", "table_2_5", "twin", "poses", "sit", "reach")
+# (label, levels of He, Sh, Br, Wa, Hi in the female set's ranges: 0 low, 1 middle, 2 high)
+REACH = (
+    ("Sh 30, arms raised", (1, 0, 1, 1, 1)),
+    ("Sh 53 over a slim trunk", (1, 2, 0, 0, 1)),
+    ("Br 153 over Wa 102.5", (1, 1, 2, 1, 2)),
+    ("Wa 142 over Br 118.5", (1, 1, 1, 2, 1)),
+)
 
 
 def maker(set_name):
@@ -98,6 +109,37 @@ def poses(out):
     return render(out, slots, resolution=(3200, 1000))
 
 
+def sit(out):
+    from ellimann_addon.core.body.hips import largest, skinned
+    from ellimann_addon.core.geometry.mesh import volume
+
+    slots = []
+    for set_name, stem in (("female", "average"), ("female", "small_chubby"), ("male", "average")):
+        reference, made = maker(set_name)
+        skin = made.make(reference.manifest.targets_cm[stem])
+        pose = clamped_motion("sit", skin.joints)[0][0]
+        own = skinned(skin.vertices, skin.joints, *largest(made.bodies.dense_weights), pose)
+        for label, vertices in (("own weights", own), ("hips' planes", skin.posed(pose))):
+            change = volume(vertices, skin.faces) / skin.volume - 1.0
+            print(f"sit {set_name} {stem} {label}: volume {change:+.1%}")
+            obj = skin_object(f"{set_name} {stem} {label}", vertices, skin.faces)
+            slots.append(Slot(solid=[obj], turn=90.0))
+    return render(out, slots, resolution=(3000, 900))
+
+
+def reach(out):
+    reference, made = maker("female")
+    ranges = reference.ranges
+    slots = []
+    for label, levels in REACH:
+        request = {k: ranges[k][0] + 0.5 * i * (ranges[k][1] - ranges[k][0]) for k, i in zip(MEASUREMENTS, levels)}
+        skin = made.make(request)
+        print(f"{label}: {', '.join(f'{k} {v:.1f}' for k, v in request.items())}; arms raised {skin.abduction:.2f} rad")
+        obj = skin_object(label, skin.vertices, skin.faces)
+        slots += [Slot(solid=[obj]), Slot(solid=[obj], turn=90.0)]
+    return render(out, slots, resolution=(3600, 1000))
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m tools.body_skin_pictures", description=__doc__.splitlines()[0])
     parser.add_argument("--only", nargs="+", choices=PICTURES, default=list(PICTURES))
@@ -111,6 +153,8 @@ def main(argv=None):
             "table_2_5": lambda: table_2_5(args.out / "body_skin_table_2_5.png"),
             "twin": lambda: twin(args.out / "body_skin_twin_held_out.png"),
             "poses": lambda: poses(args.out / "body_skin_poses.png"),
+            "sit": lambda: sit(args.out / "body_skin_sit.png"),
+            "reach": lambda: reach(args.out / "body_skin_reach.png"),
         }
         for name in args.only:
             bpy.ops.wm.read_homefile(use_empty=True)

@@ -18,7 +18,7 @@ from tools.reference_sets import SHARED
 
 SETS = ("female", "male")
 BANK = SHARED / "bodies"
-SIT_TOLERANCE = 0.06  # sitting bends both hips 90 degrees: the body model's own weights lose 5.5 % there
+VOLUME_TOLERANCE = 0.03  # every standard pose and walk frame (issue 42)
 
 
 @pytest.fixture(scope="module", params=SETS)
@@ -132,7 +132,7 @@ def test_a_request_beyond_the_bodies_is_refused_in_one_line_naming_the_measureme
     with pytest.raises(BodySkinError) as caught:
         maker.make(request)
     message = str(caught.value)
-    assert "\n" not in message and message.startswith("body skin: Wa ") and "cm" in message
+    assert "\n" not in message and message.startswith("body skin: ") and " Wa " in message and "cm" in message
 
 
 def test_posed_in_every_standard_pose_and_walk_frame_the_volume_is_kept(maker):
@@ -152,6 +152,6 @@ def test_posed_in_every_standard_pose_and_walk_frame_the_volume_is_kept(maker):
         frames = clamped_motion(name, skin.joints)[0]
         for pose in frames[:: max(1, len(frames) // 3)]:
             moved = skin.posed(pose)
-            assert abs(volume(moved, skin.faces) / rest - 1.0) <= (SIT_TOLERANCE if name == "sit" else 0.03), name
+            assert abs(volume(moved, skin.faces) / rest - 1.0) <= VOLUME_TOLERANCE, name
             points = forward_kinematics(skin.joints, pose.rotations, pose.translation)[2]
             assert np.linalg.norm(moved[arm] - points[elbow], axis=1).min() >= 0.8 * depth, name

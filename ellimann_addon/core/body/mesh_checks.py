@@ -6,12 +6,13 @@ bodies' are. A full self-intersection test (every pair of triangles) is the test
 import numpy as np
 
 from ..constants import GIRTHS
-from ..geometry.mesh import convex_hull_2d, euler_characteristic, face_normals, is_closed_manifold
+from ..geometry.mesh import convex_hull_2d, euler_characteristic, face_normals, is_closed_manifold, section_segments
 
 MIN_AREA_SHARE = 0.05  # a triangle crushed below this share of its area before the correction is a fold
 # turned triangles a correction may leave in a crease (the armpits' hold a few nearly upright ones that turn over
 # when the arms come in by a centimetre or two) before the mesh counts as folded: 0.1 % of them
 FOLD_ALLOWANCE = 0.001
+INTRUSION_FRACTIONS = tuple(np.round(np.arange(0.42, 0.781, 0.015), 3))  # He: hands to armpits, every 2.5 cm
 CLEARANCE_BAND = 0.004  # m: the vertices this near a girth's height stand for its section
 
 
@@ -62,3 +63,66 @@ def arm_clearance(vertices, arms, fractions):
         inside = np.all(np.einsum("pkj,kj->pk", limb[:, None, :] - hull[None], normal) <= 0.0, axis=1)
         out[key] = not inside.any()
     return out
+
+
+def principal_stretches(before, after, faces):
+    """(smallest, largest) (F,) of each triangle's two principal stretches from ``before`` to ``after``: the
+    square roots of the eigenvalues of G0^-1 G1 (the triangle's edge metrics), 1 for a rigid motion."""
+    a, b = (
+        np.stack([v[faces[:, 1]] - v[faces[:, 0]], v[faces[:, 2]] - v[faces[:, 0]]], axis=2) for v in (before, after)
+    )
+    g0, g1 = np.einsum("fki,fkj->fij", a, a), np.einsum("fki,fkj->fij", b, b)
+    det0 = g0[:, 0, 0] * g0[:, 1, 1] - g0[:, 0, 1] * g0[:, 1, 0]
+    # tr(G0^-1 G1) and det(G0^-1 G1) in closed form
+    trace = (g0[:, 1, 1] * g1[:, 0, 0] - 2.0 * g0[:, 0, 1] * g1[:, 0, 1] + g0[:, 0, 0] * g1[:, 1, 1]) / det0
+    det = (g1[:, 0, 0] * g1[:, 1, 1] - g1[:, 0, 1] * g1[:, 1, 0]) / det0
+    spread = np.sqrt(np.maximum(0.25 * trace * trace - det, 0.0))
+    return np.sqrt(np.maximum(0.5 * trace - spread, 0.0)), np.sqrt(0.5 * trace + spread)
+
+
+def inside_loops(points, segments):
+    """Whether each 2-D point lies inside the closed loops made of ``segments`` (k, 2, 2) (crossing number)."""
+    y0, y1 = segments[None, :, 0, 1], segments[None, :, 1, 1]
+    x0, x1 = segments[None, :, 0, 0], segments[None, :, 1, 0]
+    py, px = points[:, None, 1], points[:, None, 0]
+    straddle = (y0 > py) != (y1 > py)
+    x_at = x0 + (py - y0) * (x1 - x0) / np.where(straddle, y1 - y0, 1.0)
+    return (np.sum(straddle & (x_at > px), axis=1) % 2) == 1
+
+
+def _segment_distance(points, segments):
+    """(P,) the distance of each 2-D point to the nearest of ``segments`` (k, 2, 2)."""
+    a, b = segments[None, :, 0], segments[None, :, 1]
+    edge = b - a
+    t = np.clip(np.einsum("pkj,pkj->pk", points[:, None] - a, edge) / np.maximum((edge * edge).sum(-1), 1e-30), 0, 1)
+    nearest = a + t[..., None] * edge
+    return np.sqrt(((points[:, None] - nearest) ** 2).sum(-1)).min(axis=1)
+
+
+def arm_intrusion(vertices, faces, arms, fractions=INTRUSION_FRACTIONS):
+    """(depth m, fraction of He) of the deepest point of an arm's horizontal section inside the trunk's (the
+    triangles with no arm vertex) at heights ``fractions`` of He: 0 where the arms hang clear (the bodies')."""
+    arm = arms["L"] | arms["R"]
+    bottom, height = float(vertices[:, 2].min()), float(np.ptp(vertices[:, 2]))
+    lowest, highest = bottom + min(fractions) * height, bottom + max(fractions) * height
+    face_z = vertices[faces, 2]
+    low, high = face_z.min(axis=1), face_z.max(axis=1)
+    band = (high >= lowest) & (low < highest)
+    trunk_faces, arm_faces = (faces[band & rows] for rows in (~arm[faces].any(axis=1), arm[faces].all(axis=1)))
+    ranges = [(vertices[chosen, 2].min(axis=1), vertices[chosen, 2].max(axis=1)) for chosen in (trunk_faces, arm_faces)]
+    deepest, where = 0.0, float("nan")
+    for fraction in fractions:
+        z = bottom + fraction * height
+        trunk, limb = (
+            section_segments(vertices, chosen[(low < z) & (high >= z)], z)[0]
+            for chosen, (low, high) in zip((trunk_faces, arm_faces), ranges)
+        )
+        if not len(trunk) or not len(limb):
+            continue
+        points = limb[:, 0]
+        inside = inside_loops(points, trunk)
+        if inside.any():
+            depth = float(_segment_distance(points[inside], trunk).max())
+            if depth > deepest:
+                deepest, where = depth, float(fraction)
+    return deepest, where

@@ -1,5 +1,7 @@
 """The body skin: the set's bodies interpolated for a request (core.body.model) and corrected on the mesh until
-it measures the request (core.body.correct), bound to the 24 joints with the bodies' own bone weights.
+it measures the request (core.body.correct), judged plausible or refused with how far it reaches
+(core.body.plausible), bound to the 24 joints with the bodies' own bone weights, the hips' re-drawn
+(core.body.hips).
 
 ``BodySkin`` answers as ``core.skin.surface.Skin`` does where a body can: ``vertices``, ``faces``, ``bones()``,
 ``posed(pose)``, ``measure()``, ``volume``; it has no pieces (``pieces``/``weights``/``following`` belong to a
@@ -9,17 +11,32 @@ skin over pieces), its ``joints`` are its own (the bodies' joints carried throug
 import pathlib
 import time
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
 from ..geometry.mesh import volume
+from ..mannequin.skeleton import JOINT_INDEX
+from ..measure.neck import joint_tilt
 from ..measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
-from ..pose.kinematics import bone_matrices
 from ..synthesis.bodies import load_set_bodies
-from .correct import LIMITS, PROMISE_CM, BodySkinError, correct
-from .deform import PARAMETERS, Deformation
-from .mesh_checks import FOLD_ALLOWANCE, fold_problems
+from .correct import AIM_CM, PROMISE_CM, BodySkinError, correct
+from .deform import PARAMETERS, Deformation, abducted, smoothed
+from .extra_tape import ExtraTape, Marks, leg_masks
+from .hips import balanced_bones, skinned
+from .mesh_checks import arm_intrusion
 from .model import IdwBodyModel
+from .plausible import (
+    INTRUSION_TOLERANCE,
+    MAX_ABDUCTION,
+    abduction_for,
+    bisect_reach,
+    blame,
+    describe_reach,
+    intrusion_blame,
+    proportion_problem,
+    surface_problem,
+)
 from .tape import Tape
 
 
@@ -28,7 +45,8 @@ class BodySkin:
     """A body skin: ``vertices`` (V, 3) m and ``faces`` (F, 3) of the set's topology, its ``joints`` (24, 3),
     bone weights (``bones()``), the ``request`` ({key: cm}) and what the skin measures (``measured``, by the
     body-mesh measurer), the body model's ``weights`` of the set's bodies, the correction's ``rounds`` and
-    ``seconds``; ``pieces_measured``: the pieces' own m_T beside it, when the caller has pieces."""
+    ``seconds``; ``pieces_measured``: the pieces' own m_T beside it, when the caller has pieces; ``abduction``:
+    how far (radians) its arms were raised sideways from the bodies' A-pose to clear its trunk."""
 
     vertices: np.ndarray
     faces: np.ndarray
@@ -40,19 +58,28 @@ class BodySkin:
     rounds: int = 0
     seconds: float = 0.0
     pieces_measured: dict = field(default_factory=dict)
+    abduction: float = 0.0
+
+    @cached_property
+    def _balanced(self):
+        return balanced_bones(self.vertices, self.faces, self.joints, self.bodies.dense_weights)
 
     def bones(self):
-        """(joint indices (V, 4), weights (V, 4)) on the SMPL joints: the body model's own, summed per joint."""
-        return self.bodies.joint_index, self.bodies.joint_weight
+        """(joint indices (V, 4), weights (V, 4)) on the SMPL joints: the body model's own, summed per joint, with
+        the pelvis's and the thighs' shares re-drawn across the hips' tilted planes (core.body.hips): plain
+        linear-blend skinning that keeps the volume when sitting."""
+        return self._balanced[0]
+
+    @property
+    def hip_planes(self):
+        """(drop, half-width, tilt) of the hips' planes (core.body.hips) at which the skin keeps its volume in
+        sit: shares of the thigh's length, radians about world X."""
+        return self._balanced[1]
 
     def posed(self, pose):
         """The vertices (V, 3) in ``pose`` (core.pose.kinematics.Pose): linear-blend skinning on :meth:`bones`
         about this skin's own joints."""
-        matrices = bone_matrices(self.joints, pose)[:, :3, :]
-        index, weight = self.bones()
-        homogeneous = np.c_[self.vertices, np.ones(len(self.vertices))]
-        moved = np.einsum("vkij,vj->vki", matrices[index], homogeneous)
-        return np.einsum("vk,vki->vi", weight, moved)
+        return skinned(self.vertices, self.joints, *self.bones(), pose)
 
     @property
     def arms(self):
@@ -60,8 +87,10 @@ class BodySkin:
 
     def measure(self, fractions=None, neck_tilt=None):
         """The skin measured as any body mesh (core.measure.body), its arms known from the labels: a
-        BodyMeasurement at ``fractions`` (default the set's)."""
-        return Tape(self.faces, self.arms, fractions or self.bodies.fractions).full(self.vertices, neck_tilt)
+        BodyMeasurement at ``fractions`` (default the set's), the neck square to ``neck_tilt`` (radians; default
+        the skin's own Neck -> Head axis, as today's skin is measured)."""
+        tilt = joint_tilt(self.joints) if neck_tilt is None else neck_tilt
+        return Tape(self.faces, self.arms, fractions or self.bodies.fractions).full(self.vertices, tilt)
 
     @property
     def volume(self):
@@ -76,16 +105,22 @@ class BodySkin:
         ]
 
 
-def largest_change(found, request):
-    """What the correction changed most (relative to its limit), in words: "scaling the Wa section by 0.82 for
-    Wa 63.0 cm (the bodies give 76.8 cm)"."""
-    keys = [key for key in PARAMETERS if key in request]
-    share = [abs(found.theta[PARAMETERS.index(key)]) / LIMITS[key] for key in keys]
-    key = keys[int(np.argmax(share))]
-    theta = found.theta[PARAMETERS.index(key)]
-    how = f"moving each arm {abs(theta) * 100:.1f} cm" if key == "Sh" else f"scaling by {1.0 + theta:.2f}"
-    start = found.start[key]
-    return f"{key} {request[key]:.1f} cm is {request[key] - start:+.1f} cm from the bodies' {start:.1f} cm: {how}"
+FINAL_PASSES = 3  # whole readings of a skin with extras (each but the last followed by a loop aimed anew)
+
+
+@dataclass
+class Attempt:
+    """One try at a request: the corrected ``vertices`` and ``joints``, the ``correction`` (core.body.correct)
+    on ``deformation``, the arms' ``abduction`` (radians), and the first ``problem`` (a line) with the measurement
+    it is blamed on (``blamed``), None for a plausible body skin."""
+
+    vertices: np.ndarray
+    joints: np.ndarray
+    correction: object
+    deformation: object
+    abduction: float = 0.0
+    problem: str = None
+    blamed: str = None
 
 
 class BodySkinMaker:
@@ -96,6 +131,9 @@ class BodySkinMaker:
         self.bodies = bodies
         self.model = model or IdwBodyModel(bodies, ranges)
         self.tape = Tape(bodies.faces, bodies.arms, bodies.fractions)
+        legs = leg_masks(bodies.region, bodies.region_names)
+        self.extra_tape = ExtraTape(bodies.faces, bodies.arms, legs, bodies.fractions)
+        self.weights = smoothed(bodies.dense_weights, bodies.faces)
 
     def interpolated(self, request):
         """(vertices, joints) of the body model alone (no correction)."""
@@ -103,48 +141,117 @@ class BodySkinMaker:
 
     def make(self, request, extra=None, check=True):
         """The BodySkin of ``request`` ({He..Hi: cm}) and ``extra`` ({key: cm} of any of the six extras).
-        BodySkinError (one line) for a request beyond the bodies or a mesh that would fold."""
+        BodySkinError (one line) for a request no plausible body skin meets (core.body.plausible), naming the
+        measurement, how far the body skin reaches and why not further; ``check=False``: no plausibility checks."""
         started = time.perf_counter()
         asked = {key: float(request[key]) for key in MEASUREMENTS}
         asked |= {key: float(value) for key, value in (extra or {}).items()}
         unknown = [key for key in asked if key not in MEASUREMENTS + EXTRA_MEASUREMENTS]
         if unknown:
             raise BodySkinError(f"body skin: {', '.join(unknown)} is no measurement ElliMann takes")
-        vertices, joints = self.model.body(asked)
-        crotch = None
-        extras = [key for key in asked if key in EXTRA_MEASUREMENTS]
-        tilt = None
-        if extras:
-            first = self.tape.full(vertices)
-            tilt = first.neck_tilt if np.isfinite(first.neck_tilt) else None
-            crotch = first.values.get("crotch_height")
-            crotch = None if crotch is None else crotch / 100.0
-        deformation = Deformation(vertices, joints, self.bodies.dense_weights, self.bodies.fractions, crotch)
-        found = correct(deformation, self.tape, asked, tilt)
-        corrected, moved_joints = deformation.apply(found.theta)
-        measured = found.measured
-        if extras:  # the whole measurer, the neck's tilt searched as on any scan
-            full = self.tape.full(corrected).values
-            measured = {key: full.get(key, np.nan) for key in asked}
-            if any(abs(measured[key] - asked[key]) > PROMISE_CM for key in asked):
-                found = correct(deformation, self.tape, asked, None)
-                corrected, moved_joints = deformation.apply(found.theta)
-                measured = found.measured
         if check:
-            problems = fold_problems(vertices, corrected, self.bodies.faces, FOLD_ALLOWANCE)
-            if problems:
-                raise BodySkinError(f"body skin: {largest_change(found, asked)} would fold the mesh ({problems[0]})")
+            problem, _ = proportion_problem(asked, self.bodies.fractions)
+            if problem:
+                raise BodySkinError(f"body skin: {problem}; no body has these proportions")
+        attempt = self.attempt(asked, check)
+        if attempt.problem:
+            raise BodySkinError(self.refusal(asked, attempt))
+        found = attempt.correction
+        measured = found.measured
         weights = getattr(self.model, "weights", None)
         return BodySkin(
-            corrected,
+            attempt.vertices,
             self.bodies.faces,
-            moved_joints,
+            attempt.joints,
             self.bodies,
             asked,
             measured,
             weights(asked) if weights else None,
             found.rounds,
             time.perf_counter() - started,
+            abduction=attempt.abduction,
+        )
+
+    def attempt(self, asked, check=True):
+        """An Attempt at ``asked`` ({key: cm}): the body model's body, its arms raised as far as they must be to
+        clear the trunk, corrected; its first problem (core.body.plausible) when ``check``."""
+        vertices, joints = self.model.body(asked)
+        faces, arms = self.bodies.faces, self.bodies.arms
+        angle = 0.0
+        while True:
+            rest, rest_joints = abducted(vertices, joints, self.weights, angle) if angle else (vertices, joints)
+            found, deformation = self.corrected(asked, rest, rest_joints)
+            corrected, moved = deformation.apply(found.theta)
+            attempt = Attempt(corrected, moved, found, deformation, angle)
+            keys = [key for key in PARAMETERS if key in asked]
+            if found.beyond or not found.converged:
+                worst = found.beyond or max(keys, key=lambda k: abs(found.measured[k] - asked[k]))
+                attempt.problem, attempt.blamed = "the correction would leave any body's proportions", worst
+                return attempt
+            if not check:
+                return attempt
+            depth, where = arm_intrusion(corrected, faces, arms)
+            if depth <= INTRUSION_TOLERANCE:
+                break
+            shoulder = float(np.mean(rest_joints[[JOINT_INDEX["L_Shoulder"], JOINT_INDEX["R_Shoulder"]], 2]))
+            more = abduction_for(depth, where, np.ptp(rest[:, 2]), shoulder - rest[:, 2].min())
+            if angle >= MAX_ABDUCTION:
+                attempt.problem = (
+                    f"the arms would cut {depth * 100:.1f} cm into the trunk at {where:.2f} He, raised by "
+                    f"{np.degrees(angle):.0f} degrees (at most)"
+                )
+                attempt.blamed = intrusion_blame(found, keys, where, self.bodies.fractions)
+                return attempt
+            angle = min(angle + more, MAX_ABDUCTION)
+        attempt.problem, bad = surface_problem(rest, corrected, faces)
+        if attempt.problem:
+            attempt.blamed = blame(deformation, found.theta, keys, faces, bad)
+        return attempt
+
+    def corrected(self, asked, rest, joints):
+        """(Correction, Deformation) of the body ``rest`` with ``joints`` to ``asked``: the five by the tape, the
+        extras by the extras' tape in windows about their last extremes (the neck square to the rest's own Neck ->
+        Head axis), then every band searched whole on the corrected body, its neck square to its own axis (the
+        final reading); when that differs from the loop's by more than the aim, the loop again from there, aimed
+        by the difference."""
+        keys = [key for key in PARAMETERS if key in asked]
+        extras = [key for key in keys if key in EXTRA_MEASUREMENTS]
+        marks = Marks()
+        tilt = joint_tilt(joints) if "neck" in extras else None
+
+        def read(vertices, whole=False, at_tilt=tilt, coarse=False):
+            values = self.tape.five(vertices)
+            if extras:
+                found, where = self.extra_tape.read(vertices, extras, at_tilt, None if whole else marks, coarse)
+                marks.neck, marks.calf = where.neck, where.calf
+                values.update(found)
+            return {key: values[key] for key in keys}
+
+        start = read(rest, whole=True, coarse=True)
+        crotch = start.get("crotch_height")
+        deformation = Deformation(rest, joints, self.weights, self.bodies.fractions, crotch and crotch / 100.0)
+        found = correct(deformation, read, asked, start=start)
+        for last in range(FINAL_PASSES - 1, -1, -1) if extras and found.converged else ():
+            corrected, moved = deformation.apply(found.theta)
+            final = read(corrected, whole=True, at_tilt=None if tilt is None else joint_tilt(moved))
+            offset = {key: final[key] - found.measured[key] for key in keys}
+            found.measured = final
+            if not last or all(abs(final[key] - asked[key]) <= AIM_CM for key in keys):
+                break
+            aimed = {key: asked[key] - offset[key] for key in keys}  # the loop's reading lacks the offset
+            again = correct(deformation, read, aimed, theta=found.theta)
+            found.theta, found.rounds, found.measured = again.theta, found.rounds + again.rounds, again.measured
+        found.converged = all(abs(found.measured[key] - asked[key]) <= PROMISE_CM for key in keys)
+        return found, deformation
+
+    def refusal(self, asked, attempt):
+        """The refusal's line: the blamed measurement, how far the body skin reaches, and why not further."""
+        key = attempt.blamed
+        start = attempt.correction.start[key]
+        reach = bisect_reach(lambda trial: self.attempt(trial).problem is None, key, asked, start)
+        return (
+            f"body skin: {describe_reach(key, asked[key], start, reach)}: {attempt.problem}; "
+            "ask nearer the set's bodies or use the pieces' skin"
         )
 
 

@@ -3,10 +3,9 @@
 
 The five (He, Sh, Br, Wa, Hi) are taken with ``measure_body_mesh``'s own steps (its StandingBody sections, its
 crossing rule, the same hull), only without the extra measurements' searches: :func:`five` equals
-``measure_body_mesh(...).values`` for the five, to the last bit (tests/core/test_body_tape.py). The six extras
-come from ``measure_body_mesh`` itself, with the neck square to a given tilt inside the loop (the tilt a tape
-settles at is searched once before and once after: a tilt that jumps between nearby bodies would make the loop
-chase it).
+``measure_body_mesh(...).values`` for the five, to the last bit (tests/core/test_body_data.py). The correction
+reads the six extras with core.body.extra_tape (the measurer's own steps, fast on the fixed topology);
+:meth:`full` is the whole measurer (a BodySkin's ``measure()``).
 """
 
 import numpy as np

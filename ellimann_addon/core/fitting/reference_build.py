@@ -477,21 +477,17 @@ def build_reference_set(
 
 
 def keep_bodies(bodies, labels, fractions):
-    """SetBodies of the BodyMesh list ``bodies`` with ``labels`` (BodyLabels); ReferenceBuildError (one line) for
-    bodies without joints or that cannot make a body skin (another topology, wrong axes or units)."""
-    missing = [body.name for body in bodies if body.joints is None]
+    """SetBodies of the BodyMesh list ``bodies`` with ``labels`` (BodyLabels); a body without joints takes the
+    labels' regressed ones (JointRegressor) when they have one. ReferenceBuildError (one line) for bodies without
+    joints or that cannot make a body skin (another topology, wrong axes or units)."""
+    regress = labels.regressor
+    joints = [b.joints if b.joints is not None or regress is None else regress(b.vertices) for b in bodies]
+    missing = [body.name for body, found in zip(bodies, joints) if found is None]
     if missing:
         raise ReferenceBuildError(f"bodies: {', '.join(missing)} have no joints (a body skin is posed on them)")
+    names, vertices = [body.name for body in bodies], np.stack([body.vertices for body in bodies])
     try:
-        return from_meshes(
-            [body.name for body in bodies],
-            np.stack([body.vertices for body in bodies]),
-            bodies[0].faces,
-            labels.region,
-            list(labels.region_names),
-            labels.bones,
-            np.stack([body.joints for body in bodies]),
-            fractions,
-        )
+        found = (labels.region, list(labels.region_names), labels.bones, np.stack(joints), fractions)
+        return from_meshes(names, vertices, bodies[0].faces, *found)
     except BodiesError as error:
         raise ReferenceBuildError(str(error)) from None

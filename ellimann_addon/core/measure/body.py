@@ -349,7 +349,7 @@ def measure_body_mesh(vertices, faces, fractions=None, neck_tilt=None, arms=None
     if arms_found:
         lengths, girths = [], []
         for side in SIDES:
-            start, tip, length, girth, loop = _arm(body, side, z_sh, arm_vertex[side], arm_faces[side])
+            start, tip, length, girth, loop = arm_reading(body, side, z_sh, arm_vertex[side], arm_faces[side])
             lengths.append(length)
             girths.append(girth)
             if side == "L":
@@ -385,7 +385,7 @@ def _shoulder_point(body, z_sh, side):
     return np.array([points[i, 0], points[i, 1], z_sh])
 
 
-def _arm(body, side, z_sh, arm_vertex, arm_faces):
+def arm_reading(body, side, z_sh, arm_vertex, arm_faces):
     """(shoulder point, fingertip, shoulder-to-fingertip length m, upper-arm girth m, its loop (k, 3)) of an arm."""
     start = _shoulder_point(body, z_sh, side)
     points = body.vertices[arm_vertex]
