@@ -26,9 +26,9 @@ import numpy as np
 from ellimann_addon.core.body.model import IdwBodyModel
 from ellimann_addon.core.body.skin import BodySkinMaker
 from ellimann_addon.core.geometry.volume import IOU_MARGIN, IOU_SPACING, BodyVolume, mesh_voxel_iou
+from ellimann_addon.core.mannequin.skin_record import SkinSettings
 from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.skin.exact import exact_skin
-from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.synthesis.bodies import load_set_bodies
 from ellimann_addon.core.synthesis.shipped import named_reference_set, reference_folder

@@ -28,7 +28,7 @@ LEVELS = {"preview": 10.0, "final": 5.0}
 # Run inside a tree: every RM's skin at each level, its CPU time and size, one JSON line.
 TREE_SCRIPT = """
 import json, time
-from ellimann_addon.core.skin.settings import SkinSettings
+from ellimann_addon.core.mannequin.skin_record import SkinSettings
 from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 figures = {}
@@ -57,8 +57,8 @@ def exact_seconds(levels=LEVELS):
     import time
 
     from ellimann_addon.core.constants import TABLE_2_5
+    from ellimann_addon.core.mannequin.skin_record import SkinSettings
     from ellimann_addon.core.skin.exact import exact_skin
-    from ellimann_addon.core.skin.settings import SkinSettings
     from ellimann_addon.core.synthesis.shipped import named_reference_set
     from ellimann_addon.core.synthesis.synthesize import synthesize
 

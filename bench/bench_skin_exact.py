@@ -15,11 +15,11 @@ import time
 import numpy as np
 
 from ellimann_addon.core.constants import TABLE_2_5
+from ellimann_addon.core.mannequin.skin_record import SkinSettings
 from ellimann_addon.core.measure.extra import mannequin_extra_measurements
 from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ellimann_addon.core.settings import LEVELS
 from ellimann_addon.core.skin.exact import exact_skin
-from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize
 from tools.bodies import body_requests, load_labels

@@ -15,9 +15,9 @@ import numpy as np
 
 from devkit.skin_weights_before import bone_weights_before
 from ellimann_addon.core.geometry.mesh import directed_edges, volume
+from ellimann_addon.core.mannequin.skin_record import SkinSettings
 from ellimann_addon.core.pose.kinematics import bone_matrices
 from ellimann_addon.core.pose.motion import clamped_motion
-from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.skinning import skinning_weights
 from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.skin.weights import follow_pieces

@@ -18,9 +18,9 @@ from ellimann_addon.blender.bridge.convert import world_triangles
 from ellimann_addon.blender.services.fbx import PROXY_NAME, SKIN_NAME, write_fbx
 from ellimann_addon.blender.services.render import render_view
 from ellimann_addon.blender.services.scene import empty_scene
+from ellimann_addon.core.mannequin.skin_record import SkinSettings
 from ellimann_addon.core.sizing.readers import read_measurement_file
 from ellimann_addon.core.skin.exact import exact_skin
-from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize_extra
 

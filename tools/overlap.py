@@ -18,10 +18,10 @@ import numpy as np
 
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.geometry import volume
+from ellimann_addon.core.mannequin.skin_record import SkinSettings
 from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.settings import LEVELS
 from ellimann_addon.core.skin.exact import exact_skin
-from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.synthesis.reference_set import load_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize_batch

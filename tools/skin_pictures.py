@@ -31,12 +31,12 @@ from ellimann_addon.core.files import atomic_output
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.geometry.mesh import euler_characteristic, section_segments
 from ellimann_addon.core.geometry.volume import IOU_MARGIN, BodyVolume
+from ellimann_addon.core.mannequin.skin_record import SkinSettings
 from ellimann_addon.core.measure.body import measure_body_mesh
 from ellimann_addon.core.measure.extra import split_measurements
 from ellimann_addon.core.pose.motion import clamped_motion
 from ellimann_addon.core.pose.standard import STILL_POSES
 from ellimann_addon.core.skin.field import skin_pieces
-from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import build_skin, outer_mesh
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize, synthesize_extra

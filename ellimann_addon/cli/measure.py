@@ -121,8 +121,8 @@ def skin_values(mannequin, path):
     """(SkinSettings, {key: cm}) of the skin a .json records (its ``skin`` section): made again from the pieces (the
     same pieces give the same skin), measured on its mesh as ``synth --skin`` reports it (the five by m_T's
     definitions, the extra ones by the body-mesh measurer; one not taken is left out)."""
+    from ..core.mannequin.skin_record import SkinSettings
     from ..core.skin.measure import body_measurements, mesh_measurements
-    from ..core.skin.settings import SkinSettings
     from ..core.skin.surface import SkinError, build_skin
 
     settings = SkinSettings.from_dict(mannequin.skin)

@@ -58,7 +58,7 @@ def run(args):
     arguments.say_clip(args, job.pose)
     recorded = None
     if settings is not None and mannequin.skin:
-        from ..core.skin.settings import SkinSettings  # the skin's code, loaded only when a skin is asked
+        from ..core.mannequin.skin_record import SkinSettings  # the skin's code, loaded only when a skin is asked
 
         recorded = SkinSettings.from_dict(mannequin.skin)
     if recorded and recorded != settings:

@@ -15,22 +15,22 @@ def flag(name):
 
 
 def add_skin_options(parser, rebuilt=False):
-    """--skin, and --skin-level, --skin-voxel, --skin-blend from the SKIN table (``rebuilt``: the command reads a
-    mannequin file, whose skin section, if any, says how its skin was made)."""
+    """--skin, and --skin-kind, --skin-level, --skin-voxel, --skin-blend from the SKIN table (``rebuilt``: the
+    command reads a mannequin file, whose skin section, if any, says how its skin was made)."""
     how = (
-        "as IN.json's skin section records (--skin-level, --skin-voxel, --skin-blend override it), or at the final "
-        "level if it records none"
+        "as IN.json's skin section records (the options override it), or, if it records none, as the options say"
         if rebuilt
-        else "at --skin-level (default final), --skin-voxel, --skin-blend"
+        else "by --skin-kind (default: the body skin where the set has bodies, the shipped sets have), or over the "
+        "pieces at --skin-level (default final), --skin-voxel, --skin-blend"
     )
     parser.add_argument(
         "--skin",
         action="store_true",
-        help="make the mannequin's skin, one closed smooth surface over its pieces (docs/skin.md), "
+        help="make the mannequin's skin, one closed surface (docs/body_skin.md, docs/skin.md), "
         f"{how}: .obj holds the skin alone, .json records how it was made, MJCF draws it over the pieces, "
-        ".blend/.glb hold it beside them; in exact mode the pieces are refined until the skin measures the "
-        "request (He, Sh, Br, Wa, Hi within 1 mm on its mesh), and the skin's measurements are reported beside "
-        "the pieces' m_T",
+        ".blend/.glb hold it beside them, bound to the armature; the skin measures the request (the five and "
+        "any extra ones asked, within 1 mm on its mesh: the body skin always, the pieces' in exact mode), and its "
+        "measurements are reported beside the pieces' m_T",
     )
     low, high = SKIN["skin_voxel"].limits
     for name, option in SKIN.items():
@@ -50,9 +50,10 @@ def skin_settings(args, recorded=None):
         if given:
             raise UsageError(f"{flag(given[0])} is a setting of the skin: add --skin (or drop {flag(given[0])})")
         return None
-    from ..core.skin.settings import SkinSettings  # the skin's code, loaded only when a skin is asked
+    from ..core.mannequin.skin_record import SkinSettings  # the skin's code, loaded only when a skin is asked
 
     base = SkinSettings.from_dict(recorded) if recorded else None
+    kind = args.skin_kind or (base.kind if base is not None else SKIN["skin_kind"].default)
     if args.skin_voxel is not None:
         voxel = args.skin_voxel
     elif args.skin_level is not None:
@@ -61,7 +62,7 @@ def skin_settings(args, recorded=None):
         voxel = base.voxel_mm if base is not None else LEVELS[SKIN["skin_level"].default]
     blend = args.skin_blend if args.skin_blend is not None else (base.blend if base else SKIN["skin_blend"].default)
     try:
-        return SkinSettings(voxel, blend)
+        return SkinSettings(voxel, blend, kind)
     except ElliMannError as error:
         raise UsageError(option_named(error)) from None
 
@@ -76,6 +77,5 @@ def option_named(error):
 
 
 def describe(settings):
-    """ "skin 5 mm" (and its blend when it is not the default)."""
-    blend = "" if settings.blend == SKIN["skin_blend"].default else f", blend {settings.blend:g}"
-    return f"skin {settings.voxel_mm:g} mm{blend}"
+    """ "body skin", "skin 5 mm" (and its blend when it is not the default): ``SkinSettings.describe``."""
+    return settings.describe()

@@ -16,6 +16,19 @@ BLEND_RANGE = (0.0, 3.0)  # how far neighbours blend, times the thinner piece's 
 DEFAULT_BLEND = 0.6  # times the thinner piece's smallest semi-axis (core.skin.field.blend_widths)
 
 SKIN = {
+    "skin_kind": Option(
+        "Skin",
+        "auto",
+        "What the skin is made from: the reference set's own bodies (a body with a face, hands and a navel, corrected "
+        "until the tape reads the request) or a smooth surface over the convex pieces",
+        "the skin's kind: body (the set's own bodies, corrected until the tape reads the request), pieces (a smooth "
+        "surface over the convex pieces, at --skin-level) or auto (default: body where the set has bodies)",
+        choices=(
+            Choice("auto", "Auto", "The body skin where the reference set has bodies, else the skin over the pieces"),
+            Choice("body", "Body", "The reference set's own bodies, interpolated and corrected to the request"),
+            Choice("pieces", "Pieces", "A smooth surface over the convex pieces, at the skin level"),
+        ),
+    ),
     "skin_level": Option(
         "Skin Level",
         "final",

@@ -11,8 +11,8 @@ from ellimann_addon.blender.services.scene import empty_scene
 from ellimann_addon.core.errors import ElliMannError
 from ellimann_addon.core.formats.avatar import bone_names, misses, posed_avatar, remeasure
 from ellimann_addon.core.mannequin.skeleton import JOINT_INDEX, JOINT_NAMES
+from ellimann_addon.core.mannequin.skin_record import SkinSettings
 from ellimann_addon.core.skin.measure import body_measurements, mesh_measurements
-from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 

@@ -19,11 +19,11 @@ from ellimann_addon.blender.services.rig import MODIFIER_NAME, apply_pose, build
 from ellimann_addon.blender.services.skin import COLLIDER_NAME
 from ellimann_addon.core.geometry.mesh import is_closed_manifold
 from ellimann_addon.core.mannequin.skeleton import JOINT_NAMES
+from ellimann_addon.core.mannequin.skin_record import SkinSettings
 from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.pose.motion import clamped_motion
 from ellimann_addon.core.skin.exact import MESH_TOLERANCE_CM
 from ellimann_addon.core.skin.measure import mesh_measurements
-from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 

@@ -21,12 +21,12 @@ from devkit.cli_runs import assert_one_line_error, run
 from ellimann_addon.cli import build_parser, main, skin_options
 from ellimann_addon.core.geometry.mesh import euler_characteristic, is_closed_manifold
 from ellimann_addon.core.mannequin.model import Mannequin
+from ellimann_addon.core.mannequin.skin_record import SkinSettings
 from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.pose.standard import standard_pose
 from ellimann_addon.core.settings import LEVELS, SKIN
 from ellimann_addon.core.skin.exact import MESH_TOLERANCE_CM
 from ellimann_addon.core.skin.measure import mesh_measurements
-from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import build_skin
 
 REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]

@@ -15,6 +15,7 @@ from ellimann_addon.core.drape.fit_metrics import mesh_distance
 from ellimann_addon.core.errors import ElliMannError
 from ellimann_addon.core.geometry.ellipsoid import sample_surface
 from ellimann_addon.core.geometry.mesh import euler_characteristic, is_closed_manifold, section_segments, volume
+from ellimann_addon.core.mannequin.skin_record import SkinSettings
 from ellimann_addon.core.measure.body import measure_body_mesh
 from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.skin import field
@@ -23,7 +24,6 @@ from ellimann_addon.core.skin.contour import marching_cubes
 from ellimann_addon.core.skin.exact import MESH_TOLERANCE_CM, exact_skin
 from ellimann_addon.core.skin.field import PieceField, apart_pairs, blend_pairs, blend_widths, sample_field, skin_pieces
 from ellimann_addon.core.skin.measure import field_measurements, mesh_measurements
-from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import SkinError, build_skin, gapped_mesh, outer_mesh, outer_surface
 from ellimann_addon.core.synthesis.shipped import SHIPPED_SETS, named_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize

@@ -9,12 +9,12 @@ import pytest
 
 from bench.bench_skin_exact import GRID, grid_request
 from ellimann_addon.core.constants import TABLE_2_5
+from ellimann_addon.core.mannequin.skin_record import SkinSettings
 from ellimann_addon.core.measure.extra import mannequin_extra_measurements
 from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.skin import exact
 from ellimann_addon.core.skin.exact import MESH_TOLERANCE_CM, exact_skin
 from ellimann_addon.core.skin.measure import body_measurements, mesh_measurements, skin_arms
-from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.synthesis.extra_refine import ExtraRequestError
 from ellimann_addon.core.synthesis.shipped import named_reference_set

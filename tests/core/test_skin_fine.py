@@ -5,7 +5,7 @@ every shipped set, the fine ones too, to one closed oriented sphere holding ever
 import pytest
 
 from ellimann_addon.core.geometry.mesh import volume
-from ellimann_addon.core.skin.settings import SkinSettings
+from ellimann_addon.core.mannequin.skin_record import SkinSettings
 from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.synthesis.shipped import FEMALE_FINE_SET, MALE_FINE_SET, named_reference_set
 from tests.core.test_skinning import VOLUME_TOLERANCE, every_frame, posed

@@ -8,10 +8,10 @@ import pytest
 from ellimann_addon.core.errors import ElliMannError
 from ellimann_addon.core.geometry.mesh import directed_edges, icosphere, volume
 from ellimann_addon.core.mannequin.skeleton import JOINT_INDEX
+from ellimann_addon.core.mannequin.skin_record import SkinSettings
 from ellimann_addon.core.pose.kinematics import Pose, axis_angle, bone_matrices, forward_kinematics
 from ellimann_addon.core.pose.motion import clamped_motion
 from ellimann_addon.core.pose.standard import POSE_NAMES
-from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.skinning import skinning_weights
 from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.skin.weights import follow_pieces

@@ -16,7 +16,7 @@ import numpy as np
 
 from ...core.errors import ElliMannError
 from ...core.geometry.ellipsoid import matrix_world
-from ...core.skin.settings import SkinSettings
+from ...core.mannequin.skin_record import SkinSettings
 from ...core.skin.surface import Skin
 from ...core.skin.weights import INFLUENCES
 from .built import built_collection, built_objects, tag_built

@@ -19,8 +19,8 @@ from ..geometry.cushion import mannequin_cushions
 from ..geometry.ellipsoid import matrix_world
 from ..geometry.frames import rigid_matrix
 from ..geometry.mesh import check_subdivision_level, icosphere
+from ..mannequin.skin_record import SkinSettings
 from ..skin.measure import SkinField
-from ..skin.settings import SkinSettings
 from ..skin.surface import build_skin
 
 

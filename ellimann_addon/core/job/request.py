@@ -92,6 +92,8 @@ class Job:
     warnings: list
     pose: PoseSource | None
     formats: dict  # {path: Format}
+    skin: object = None  # the SkinSettings asked, its kind decided ("auto" -> "body" or "pieces")
+    skin_reference: object = None  # the set whose bodies a body skin is made from (a made mannequin's: by its name)
 
     @property
     def reference(self):
@@ -104,10 +106,6 @@ class Job:
     @property
     def five(self):
         return None if self.values is None else as_dict(self.values)
-
-    @property
-    def skin(self):
-        return self.request.skin
 
     def needs_blender(self):
         """The first output that needs Blender to be written (posed as asked), or None."""
@@ -146,10 +144,41 @@ def check(request, blender=True, pose=None):
                 "cannot be posed: synthesize from a set with joints (the shipped sets have them)"
             )
     if request.skin is not None:
+        job.skin, job.skin_reference = checked_skin(request)
+    return job
+
+
+def checked_skin(request):
+    """(the skin's settings, its kind decided, and the set a body skin is made from) of a request asking one; SkinError
+    or ElliMannError (one line) for a skin that would be refused: a body skin from a set without bodies, a voxel too
+    fine for memory or too coarse for a piece of the pieces' skin."""
+    settings, made = request.skin, request.mannequin
+    reference = request.references
+    if made is not None:  # its file's record says which (a body skin remade from its set, known by its name)
+        recorded = (made.skin or {}).get("kind", "pieces")
+        kind = recorded if settings.kind == "auto" else settings.kind
+        if kind == "body":
+            from ..synthesis.shipped import named_reference_set
+
+            reference = named_reference_set(made.reference_set)
+    else:
+        kind = settings.kind
+    bodies = reference is not None and reference.manifest is not None and reference.manifest.bodies is not None
+    if kind == "auto":
+        kind = "body" if bodies else "pieces"
+    if kind == "body" and not bodies:
+        whose = f"the {reference.name} set" if reference is not None else "its set"
+        raise ElliMannError(
+            f"skin_kind: {whose} has no bodies (a set from before sets kept their bodies, or a hand-traced one): "
+            "the skin over its pieces can be made (skin kind pieces)"
+        )
+    settings = settings.of_kind(kind)
+    if kind == "pieces":
         from ..skin.surface import check_skin  # the skin's code, loaded only when a skin is asked
 
-        for mannequin in [made] if made is not None else request.references.mannequins:
-            check_skin(mannequin, request.skin)
+        for mannequin in [made] if made is not None else reference.mannequins:
+            check_skin(mannequin, settings)
+    return settings, reference if kind == "body" else None
     return job
 
 
@@ -170,7 +199,8 @@ def row_job(command, measurements, references, extra, warnings, name, outputs):
     values = np.array([measurements[key] for key in MEASUREMENTS], dtype=float)
     extra = {key: float(extra[key]) for key in EXTRA_MEASUREMENTS if key in extra}
     formats = check_outputs(outputs, pose.name if pose is not None and pose.animated else None)
-    return Job(request, values, extra, list(warnings), pose, formats)
+    skin_reference = references if command.skin is not None and command.skin.kind == "body" else None
+    return Job(request, values, extra, list(warnings), pose, formats, command.skin, skin_reference)
 
 
 def checked_extra(five, extra):

@@ -19,11 +19,12 @@ import numpy as np
 
 from ..errors import ElliMannError
 from ..geometry.mesh import connected_labels, directed_edges, volume
+from ..mannequin.skin_record import SkinSettings
 from ..measure.body import measure_body_mesh
 from ..pose.kinematics import bone_matrices, require_joints
 from .contour import marching_cubes
 from .field import FADE, blend_pairs, blend_widths, sample_field, skin_pieces
-from .settings import SkinSettings, check_skin_size
+from .settings import check_skin_size
 from .skinning import skinning_weights
 from .weights import follow_pieces, piece_motions, piece_weights
 

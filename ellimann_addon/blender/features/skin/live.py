@@ -15,7 +15,7 @@ import uuid
 from ....core.errors import ElliMannError
 from ....core.job.make import make
 from ....core.job.request import Request, check
-from ....core.skin.settings import SkinSettings
+from ....core.mannequin.skin_record import SkinSettings
 from ...bridge.convert import collection_to_mannequin
 from ...bridge.skin import is_stale_skin, skin_object, write_skin_vertices
 from ...services.skin import add_skin

@@ -9,8 +9,8 @@ from bpy.props import EnumProperty, FloatProperty
 from ....core.errors import ElliMannError
 from ....core.job.make import make
 from ....core.job.request import Request, check
+from ....core.mannequin.skin_record import SkinSettings
 from ....core.settings import SKIN, VOXEL_RANGE_MM
-from ....core.skin.settings import SkinSettings
 from ... import ids
 from ...bridge.convert import rig_object
 from ...services.skin import add_skin
