@@ -20,9 +20,9 @@ setup:
 test:
 	$(PYTHON) -m tools.matrix --lanes "$(LANES)"
 
-# The fast lane for working: core and Blender tests not marked slow, on the working venv.
+# The fast lane for working: core, command-line and Blender tests not marked slow, on the working venv.
 check: setup
-	$(PY) -m pytest -p no:cacheprovider -q -m "not slow" tests/core tests/blender
+	$(PY) -m pytest -p no:cacheprovider -q -m "not slow" tests/core tests/cli tests/blender
 
 demo: setup
 	$(PY) -m ellimann_addon demo -o $(DEMO_OUT)

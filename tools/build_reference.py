@@ -6,7 +6,7 @@
 ``--check`` passes when every shipped number is within CHECK_TOLERANCE of the rebuild and the docs
 match it at their printed precision (a number may differ by one unit of its last printed digit,
 where rounding puts it on either side): other CPUs' BLAS differ from this one's in the last bits,
-which the build does not amplify (tests/tools/test_build_reference.py perturbs it to make sure).
+which the build does not amplify (tests/tools/shipped/test_build_reference.py perturbs it to make sure).
 
 Reads the body meshes of ``<repo>/../shared/refmodels`` (see its README) and writes
 ``reference_blends/base_mannequin.json`` and the five ``<name>.json`` Reference Mannequins, their
@@ -125,7 +125,7 @@ def build(refmodels=DEFAULT_REFMODELS, log=print, jitter=0.0):
     """Build BM and the five RMs. Returns (base, {name: rm}, report dict).
 
     ``jitter`` (m): every body vertex moved by a seeded uniform offset up to that much, to test that
-    the build does not amplify rounding (tests/tools/test_build_reference.py).
+    the build does not amplify rounding (tests/tools/shipped/test_build_reference.py).
     """
     started = time.perf_counter()
     labels = load_labels(refmodels)

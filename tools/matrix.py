@@ -8,8 +8,8 @@ A lane is a virtual environment ``.venv-bpy<version>`` (Blender 5.0's is ``.venv
 venv that ``make check``, ``demo``, ``bench`` and ``build`` use) made by that Blender's Python with the bpy
 wheel and the numpy that Blender bundles, plus ``requirements-dev.txt``'s tools; it is made on first
 use and kept (a stamp of its pins decides when to reinstall). pip's own cache is shared by every
-lane, so each wheel is downloaded once. The Blender-free core suite runs once per numpy major, the
-tools suite once (on numpy 2), the Blender suite on every lane. Two lanes run at once (the machines
+lane, so each wheel is downloaded once. The Blender-free core and command-line (cli) suites run once per
+numpy major, the tools suite once (on numpy 2), the Blender suite on every lane. Two lanes run at once (the machines
 have two cores); each lane's full pytest output goes to ``out/matrix/<lane>.log`` and is printed when
 the lane fails.
 The last line is the whole matrix's count, ``matrix: N passed, N failed``.
@@ -34,7 +34,7 @@ REPO = pathlib.Path(__file__).resolve().parents[1]
 REQUIREMENTS = REPO / "requirements-dev.txt"
 LOGS = REPO / "out" / "matrix"
 
-SUITES = {"core": "tests/core", "tools": "tests/tools", "blender": "tests/blender"}
+SUITES = {"core": "tests/core", "cli": "tests/cli", "tools": "tests/tools", "blender": "tests/blender"}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -52,23 +52,28 @@ class Lane:
         return REPO / (self.venv_name or f".venv-bpy{self.blender}")
 
 
-# Oldest LTS (the manifest's minimum), newest LTS, the last Python 3.11 release, the newest release.
-# numpy: Blender 4.2-5.0 bundle numpy 1.26; bpy 5.1+ wheels require numpy>=2.2,<3, of which pip takes
-# the newest. The core runs once per numpy major: on 5.0 (numpy 1) and on 5.3 (numpy 2); its tests marked
-# slow (half its time: the skin's exact grid, the falling balls, the golden-section grids) run once, on 5.0,
-# since 5.3 also carries the tools suite (the reference build, twice: some 4 minutes), which runs once, on
-# numpy 2: the shipped data are built on the working venv's numpy 1, so it also shows the build does not
-# depend on numpy's major. The Blender suite's slow tests run on the oldest and the newest Blender.
+# Oldest LTS (the manifest's minimum), newest LTS, the last Python 3.11 release, the newest release. numpy: Blender
+# 4.2-5.0 bundle numpy 1.26; bpy 5.1+ wheels require numpy>=2.2,<3, of which pip takes the newest. The core runs once
+# per numpy major: on 5.0 (numpy 1) and on 5.3 (numpy 2), and the command line's Blender-free suite (cli) beside it,
+# treated alike; the core's tests marked slow (half its time: the skin's exact grid, the falling balls, the
+# golden-section grids) run once, on 5.0, since 5.3 also carries the tools suite (the reference build, twice: some 4
+# minutes), which runs once, on numpy 2: the shipped data are built on the working venv's numpy 1, so it also shows
+# the build does not depend on numpy's major. The Blender suite's slow tests run on the oldest and the newest Blender.
 # The newest lane runs on OpenBLAS's kernel for the first x86-64 CPUs, the others on the one it picks for this CPU
-# (AVX-512's on many): every exactness test then runs under two kernels, whose last bits differ (issue 40; the
-# same requests under threads, kernels and numpy's SIMD compared in tests/core/test_same_answer.py).
+# (AVX-512's on many): every exactness test then runs under two kernels, whose last bits differ (issue 40; the same
+# requests under threads, kernels and numpy's SIMD compared in tests/core/test_same_answer.py).
 OLD_KERNEL = "Prescott"
 LANES = (
     Lane("4.2", "3.11", ("bpy==4.2.23", "numpy==1.26.4"), ("blender",)),
     Lane("4.5", "3.11", ("bpy==4.5.15", "numpy==1.26.4"), ("blender",), quick=("blender",)),
-    Lane("5.0", "3.11", ("bpy==5.0.1", "numpy==1.26.4"), ("core", "blender"), ".venv", quick=("blender",)),
+    Lane("5.0", "3.11", ("bpy==5.0.1", "numpy==1.26.4"), ("core", "cli", "blender"), ".venv", quick=("blender",)),
     Lane(
-        "5.3", "3.13", ("bpy==5.3.0", "numpy==2.5.5"), ("core", "tools", "blender"), quick=("core",), kernel=OLD_KERNEL
+        "5.3",
+        "3.13",
+        ("bpy==5.3.0", "numpy==2.5.5"),
+        ("core", "cli", "tools", "blender"),
+        quick=("core", "cli"),
+        kernel=OLD_KERNEL,
     ),
 )
 QUICK_VARIABLE = "ELLIMANN_QUICK_SUITES"  # read by tests/conftest.py

@@ -1,6 +1,6 @@
 """docs/formats/measurement_files.md's mapping tables, generated from core.sizing.names (the page holds them
 between ``BEGIN``/``END`` markers; ``python -m tools.measurement_files_doc`` rewrites them and
-tests/core/test_sizing_doc.py checks the page matches the code)."""
+tests/core/sizing/test_mapping_doc.py checks the page matches the code)."""
 
 from .names import CHART, FREESEWING, FREESEWING_OTHER, KEYS, PREDICTORS, SEAMLY, SEAMLY_OTHER
 

@@ -1,7 +1,8 @@
 """BVH clips read and retargeted with numpy alone (core.formats.bvh, core.pose.bone_match, retarget, clip): every
 rig's names placed where they belong (and their mirror images mirrored), the clip's own directions kept, rest poses
 that differ, clamps summarised per joint, the feet against the floor, units, resampling. The clips are written
-here (devkit.clips), not downloaded; the comparison with Blender's own importer is tests/blender/test_bvh.py."""
+here (devkit.clips), not downloaded; the comparison with Blender's own importer is
+tests/blender/features/test_bvh.py."""
 
 import numpy as np
 import pytest

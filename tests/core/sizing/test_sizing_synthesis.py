@@ -9,7 +9,7 @@ from ellimann_addon.core.sizing.readers import read_measurement_file
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize_extra
 
-DATA = pathlib.Path(__file__).resolve().parents[1] / "data" / "sizing"
+DATA = pathlib.Path(__file__).resolve().parents[2] / "data" / "sizing"
 
 
 @pytest.mark.parametrize("name", ["women_run.vst", "jane.vit"])

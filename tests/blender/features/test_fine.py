@@ -64,7 +64,7 @@ def test_the_panel_synthesizes_from_a_fine_set_with_its_cushions_and_exports(cho
     assert len(built) == len(reference.topology.cushion_pairs)
     for i, j in mannequin.topology.cushion_pairs:
         if mannequin.topology.names[i] in coarse.index and mannequin.topology.names[j] in coarse.index:
-            continue  # the 40's cushions: tests/blender/test_cushions_measure.py, test_rig.py
+            continue  # the 40's cushions: tests/blender/features/test_cushions_measure.py, services/test_rig.py
         first, second = ((mannequin.rotation[k], mannequin.center[k], mannequin.semi_axes[k]) for k in (i, j))
         obj = built[mannequin.topology.names[i]]
         vertices, faces = world_triangles(obj)

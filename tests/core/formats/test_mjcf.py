@@ -20,7 +20,7 @@ from ellimann_addon.core.synthesis.manifest import MANIFEST_FILE
 
 mujoco = pytest.importorskip("mujoco")  # a dev dependency (requirements-dev.txt); CI always has it
 
-REFERENCE_DIR = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"
+REFERENCE_DIR = pathlib.Path(__file__).resolve().parents[3] / "reference_blends"
 DENSITY = 1000.0  # MuJoCo's default geom density: body mass / DENSITY is the piece's volume
 
 

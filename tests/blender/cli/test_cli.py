@@ -26,7 +26,7 @@ from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ellimann_addon.core.synthesis.synthesize import relative_error
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
+ROOT = pathlib.Path(__file__).resolve().parents[3]
 REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]
 VALUES = dict(zip(MEASUREMENTS, (165.0, 41.5, 101.25, 82.75, 117.5)))
 

@@ -12,7 +12,7 @@ from ellimann_addon.core.errors import ElliMannError
 from ellimann_addon.core.formats import table
 from ellimann_addon.core.formats.table import BATCH_FILE, BLENDER_FORMATS, CORE_FORMATS, FORMATS
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
+ROOT = pathlib.Path(__file__).resolve().parents[3]
 PACKAGE = ROOT / "ellimann_addon"
 ROWS = [*FORMATS.values(), BATCH_FILE]
 
@@ -24,7 +24,7 @@ def test_each_row_has_its_whole_file_check_and_the_core_s_rows_their_writer(row)
         assert callable(row.write) and row.writer() is row.write
     elif row.name in BLENDER_FORMATS and "ellimann_addon.blender.services.writers" not in sys.modules:
         with pytest.raises(ElliMannError, match=f"writing a .{row.extension} file needs Blender"):
-            row.writer()  # the Blender layer binds it when loaded (tests/blender/test_export_gltf.py)
+            row.writer()  # the Blender layer binds it when loaded (tests/blender/services/test_export_gltf.py)
 
 
 def test_a_path_s_format_is_decided_by_its_extension_once_and_refused_in_one_line():

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from tests.tools.test_coverage import RADIUS, mannequin, sphere
+from tests.tools.shipped.test_coverage import RADIUS, mannequin, sphere
 from tools.coverage import BodyVolume, fill_metrics
 from tools.fill_bound import fill_curve
 

@@ -10,7 +10,7 @@ import pytest
 from ellimann_addon.blender.bridge import convert
 from ellimann_addon.core.mannequin.model import Mannequin
 
-FOLDER = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"
+FOLDER = pathlib.Path(__file__).resolve().parents[3] / "reference_blends"
 STEMS = ("base_mannequin", "small_slim", "tall_slim", "small_chubby", "tall_chubby", "average")
 
 

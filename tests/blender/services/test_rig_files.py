@@ -23,7 +23,7 @@ Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  #
 @pytest.fixture(scope="module", params=[FEMALE_SET])
 def average(request):
     """The Average RM of the paper's 40; of the fine topology too for the posed .obj and .blend (its glTF: the
-    rest pose with cushions, tests/blender/test_fine.py)."""
+    rest pose with cushions, tests/blender/features/test_fine.py)."""
     return Mannequin.load(SHIPPED_SETS[request.param] / "average.json")
 
 

@@ -15,7 +15,7 @@ from ellimann_addon.core.sizing.readers import read_measurement_file
 from ellimann_addon.core.sizing.rows import SizingError
 from ellimann_addon.core.synthesis.population import load_population
 
-DATA = pathlib.Path(__file__).resolve().parents[1] / "data" / "sizing"
+DATA = pathlib.Path(__file__).resolve().parents[2] / "data" / "sizing"
 
 
 def test_vit_values_used_unused_and_predicted():

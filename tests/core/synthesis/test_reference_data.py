@@ -14,8 +14,8 @@ from ellimann_addon.core.mannequin.topology import NAME_PATTERN
 from ellimann_addon.core.measure.tailor import section_heights
 from ellimann_addon.core.measurements import MEASUREMENTS
 
-FOLDER = pathlib.Path(__file__).resolve().parents[2] / "reference_blends"
-DOCS = pathlib.Path(__file__).resolve().parents[2] / "docs"
+FOLDER = pathlib.Path(__file__).resolve().parents[3] / "reference_blends"
+DOCS = pathlib.Path(__file__).resolve().parents[3] / "docs"
 RM_NAMES = tuple(REFERENCE_MEASUREMENTS)
 REFERENCE_RM = "average"  # the RM the others' axes were relabelled against
 TOLERANCE = 0.005  # the issue: m_T within 0.5% of Table 2.3

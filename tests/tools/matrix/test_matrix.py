@@ -12,7 +12,7 @@ import pytest
 from tools import matrix
 from tools.reference_blends import FOLDER, STEMS
 
-REPO = pathlib.Path(__file__).resolve().parents[2]
+REPO = pathlib.Path(__file__).resolve().parents[3]
 ZSTD_MAGIC = b"\x28\xb5\x2f\xfd"
 
 
@@ -44,6 +44,13 @@ def test_core_runs_on_each_numpy_major_tools_once_and_blender_on_every_lane():
     assert sum("tools" in lane.suites for lane in matrix.LANES) == 1
 
 
+def test_the_command_line_s_blender_free_suite_runs_where_the_core_runs_and_as_quick():
+    assert matrix.SUITES["cli"] == "tests/cli"
+    for lane in matrix.LANES:
+        assert ("cli" in lane.suites) == ("core" in lane.suites), lane.blender
+        assert ("cli" in lane.quick) == ("core" in lane.quick), lane.blender
+
+
 def test_every_suite_s_slow_tests_run_on_some_lane_and_the_blender_ones_on_the_oldest_and_newest():
     for suite in matrix.SUITES:
         assert any(suite in lane.suites and suite not in lane.quick for lane in matrix.LANES), suite
@@ -53,9 +60,9 @@ def test_every_suite_s_slow_tests_run_on_some_lane_and_the_blender_ones_on_the_o
 
 
 def test_a_quick_suite_leaves_out_its_slow_tests_only(tmp_path):
-    tests = pathlib.Path(__file__).resolve().parents[1]
+    tests = pathlib.Path(__file__).resolve().parents[2]
     command = [sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "--collect-only", "-q"]
-    paths = [str(tests / "core" / "test_skin.py"), str(tests / "tools" / "test_matrix.py")]
+    paths = [str(tests / "core" / "skin" / "test_skin.py"), str(tests / "tools" / "matrix" / "test_matrix.py")]
 
     def collected(quick, *options):
         env = {**os.environ, matrix.QUICK_VARIABLE: quick}
@@ -152,6 +159,6 @@ def test_one_lane_runs_on_an_old_blas_kernel_unless_one_is_set(monkeypatch):
 
 def test_no_two_test_files_share_a_name():
     """A lane runs tests/core and tests/blender in one pytest, which imports test files by their base name."""
-    tests = pathlib.Path(__file__).resolve().parents[1]
+    tests = pathlib.Path(__file__).resolve().parents[2]
     names = [path.name for path in tests.rglob("test_*.py")]
     assert sorted({name for name in names if names.count(name) > 1}) == []

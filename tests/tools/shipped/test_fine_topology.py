@@ -86,8 +86,8 @@ def test_a_fine_base_missing_one_recorded_selection_is_refused_in_one_line(tmp_p
 @pytest.mark.parametrize("build_set", [FEMALE, MALE], ids=["female-fine", "male-fine"])
 def test_exact_mode_meets_the_measurements_of_bodies_the_fine_sets_have_not_seen(build_set):
     """Each set's neutral body (none of its RMs') measured as a scan is measured: the fine set's exact mode meets its
-    measurements to 0.001 %, as it meets the mannequins' (the 243 grid: tests/core/test_fine_set.py). One body per
-    set: reading and measuring a body mesh is what takes the time."""
+    measurements to 0.001 %, as it meets the mannequins' (the 243 grid: tests/core/synthesis/test_fine_set.py). One
+    body per set: reading and measuring a body mesh is what takes the time."""
     _assert_exact_on_bodies(build_set, [build_set.reference_body])
 
 

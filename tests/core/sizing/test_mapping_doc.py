@@ -6,7 +6,7 @@ import pathlib
 from ellimann_addon.core.sizing.mapping_doc import BEGIN, END, mapping_markdown, replace_tables
 from ellimann_addon.core.sizing.names import CHART, FREESEWING, FREESEWING_KNOWN, KEYS, PREDICTORS, SEAMLY, SEAMLY_KNOWN
 
-PAGE = pathlib.Path(__file__).resolve().parents[2] / "docs" / "formats" / "measurement_files.md"
+PAGE = pathlib.Path(__file__).resolve().parents[3] / "docs" / "formats" / "measurement_files.md"
 
 
 def test_the_page_holds_the_tables_the_code_makes():

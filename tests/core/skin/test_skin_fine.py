@@ -1,6 +1,7 @@
-"""The skin on the fine topology (90 pieces) keeps its volume when posed, as on the 40 (tests/core/test_skinning.py),
-on the Average Reference Mannequin of each fine set; tests/core/test_skin.py holds every Reference Mannequin of
-every shipped set, the fine ones too, to one closed oriented sphere holding every piece."""
+"""The skin on the fine topology (90 pieces) keeps its volume when posed, as on the 40
+(tests/core/skin/test_skinning.py), on the Average Reference Mannequin of each fine set; tests/core/skin/test_skin.py
+holds every Reference Mannequin of every shipped set, the fine ones too, to one closed oriented sphere holding every
+piece."""
 
 import pytest
 
@@ -8,7 +9,7 @@ from ellimann_addon.core.geometry.mesh import volume
 from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.synthesis.shipped import FEMALE_FINE_SET, MALE_FINE_SET, named_reference_set
-from tests.core.test_skinning import VOLUME_TOLERANCE, every_frame, posed
+from tests.core.skin.test_skinning import VOLUME_TOLERANCE, every_frame, posed
 
 
 @pytest.fixture(scope="module", params=[FEMALE_FINE_SET, MALE_FINE_SET])
