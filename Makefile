@@ -1,6 +1,6 @@
 # Every target sets itself up. The working venv .venv is the matrix's Blender 5.0 lane (bpy 5.0.1,
 # Python 3.11); `make test` also makes the other lanes' venvs (.venv-bpy4.2, .venv-bpy4.5,
-# .venv-bpy5.3) on first use. tools/matrix.py says which Blender, Python and numpy each one holds.
+# .venv-bpy5.3) on first use. tools/matrix/lanes.py says which Blender, Python and numpy each one holds.
 PYTHON ?= python3.11
 VENV := .venv
 PY := $(VENV)/bin/python

@@ -13,7 +13,7 @@ from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.geometry.mesh import icosphere
 from ellimann_addon.core.measure.body import measure_body_mesh
 from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS
-from tools.reference_sets import TRACING_FOLDER
+from tools.shipped.reference_sets import TRACING_FOLDER
 
 
 def body_object(vertices, faces, name="scan"):

@@ -14,7 +14,7 @@ from ellimann_addon.core.body.skin import BodySkinMaker
 from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ellimann_addon.core.synthesis.bodies import load_set_bodies
 from ellimann_addon.core.synthesis.shipped import named_reference_set, reference_folder
-from tools.reference_sets import SHARED
+from tools.shipped.reference_sets import SHARED
 
 SETS = ("female", "male")
 BANK = SHARED / "bodies"

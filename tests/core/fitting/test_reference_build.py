@@ -232,7 +232,7 @@ def _y_up_copy(body, path):
 
 
 def test_a_body_exported_from_blender_reads_as_the_same_body_given_with_up_z(tmp_path):
-    from tools.build_reference import DEFAULT_REFMODELS
+    from tools.shipped.build_reference import DEFAULT_REFMODELS
 
     z_up = read_obj(DEFAULT_REFMODELS / "average.obj", up="z")
     y_up = read_obj(_y_up_copy(z_up, tmp_path / "average.obj"))
@@ -255,7 +255,7 @@ def test_a_body_exported_from_blender_reads_as_the_same_body_given_with_up_z(tmp
     ],
 )
 def test_a_body_in_the_wrong_axes_or_unit_is_refused_in_one_line_before_fitting(tmp_path, capsys, change, words):
-    from tools.build_reference import DEFAULT_REFMODELS
+    from tools.shipped.build_reference import DEFAULT_REFMODELS
 
     body = read_obj(DEFAULT_REFMODELS / "average.obj", up="z")
     vertices = {

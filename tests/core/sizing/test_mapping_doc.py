@@ -11,7 +11,7 @@ PAGE = pathlib.Path(__file__).resolve().parents[3] / "docs" / "formats" / "measu
 
 def test_the_page_holds_the_tables_the_code_makes():
     page = PAGE.read_text(encoding="utf-8")
-    assert replace_tables(page) == page, "run python -m tools.measurement_files_doc"
+    assert replace_tables(page) == page, "run python -m tools.figures.measurement_files_doc"
 
 
 def test_every_mapping_row_is_on_the_page_with_its_reason():

@@ -1,7 +1,7 @@
 """The skin's voxel IoU with a body (core.geometry.volume.mesh_voxel_iou): two overlapping balls' IoU is the
 lens's closed form, a mesh with itself is 1, the body's own grid is the mesh's cells; and on every reference body
 of both sets the skin of the mannequin synthesized for it (over its exact pieces, and exact on the skin) overlaps
-the body at least as well as its pieces do, the exact skin within 0.005 of them (tools/overlap.py; the table in
+the body at least as well as its pieces do, the exact skin within 0.005 of them (tools/figures/overlap.py; the table in
 docs/skin_drape.md)."""
 
 import math
@@ -11,8 +11,8 @@ import pytest
 
 from ellimann_addon.core.geometry import volume
 from ellimann_addon.core.skin.contour import marching_cubes
-from tools.overlap import set_overlaps
-from tools.reference_sets import BUILD_SETS
+from tools.figures.overlap import set_overlaps
+from tools.shipped.reference_sets import BUILD_SETS
 
 RADIUS = 0.1
 SPACING = 0.002

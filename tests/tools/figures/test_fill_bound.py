@@ -1,11 +1,11 @@
-"""The greedy fill bound (tools/fill_bound.py) on a sphere, whose answer is known."""
+"""The greedy fill bound (tools/figures/fill_bound.py) on a sphere, whose answer is known."""
 
 import numpy as np
 import pytest
 
 from tests.tools.shipped.test_coverage import RADIUS, mannequin, sphere
-from tools.coverage import BodyVolume, fill_metrics
-from tools.fill_bound import fill_curve
+from tools.figures.fill_bound import fill_curve
+from tools.shipped.coverage import BodyVolume, fill_metrics
 
 
 @pytest.fixture(scope="module")

@@ -1,6 +1,7 @@
-"""tools/measurement_files_doc.py: --check passes on the page as committed and fails on one whose tables differ."""
+"""tools/figures/measurement_files_doc.py: --check passes on the page as committed and fails on one whose tables
+differ."""
 
-from tools import measurement_files_doc
+from tools.figures import measurement_files_doc
 
 
 def test_check_passes_and_fails(tmp_path, monkeypatch, capsys):

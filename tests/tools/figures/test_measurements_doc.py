@@ -1,7 +1,7 @@
-"""tools/measurements_doc.py: the table of docs/measurements.md is core.measurements.TABLE's; --check fails on a page
-whose table differs."""
+"""tools/figures/measurements_doc.py: the table of docs/measurements.md is core.measurements.TABLE's; --check fails
+on a page whose table differs."""
 
-from tools import measurements_doc
+from tools.figures import measurements_doc
 
 
 def test_the_page_s_table_is_the_code_s_and_check_can_fail(tmp_path, monkeypatch, capsys):

@@ -1,5 +1,5 @@
-"""tools/overlap.py stands a mannequin where its body stands before core.geometry.volume.voxel_iou compares them: on a
-ball whose answer is known in closed form."""
+"""tools/figures/overlap.py stands a mannequin where its body stands before core.geometry.volume.voxel_iou compares
+them: on a ball whose answer is known in closed form."""
 
 import numpy as np
 import pytest
@@ -9,7 +9,7 @@ from ellimann_addon.core.geometry.mesh import icosphere
 from ellimann_addon.core.geometry.mesh import volume as mesh_volume
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.mannequin.topology import Part, Topology
-from tools.overlap import standing_in
+from tools.figures.overlap import standing_in
 
 RADIUS = 0.1
 SPACING = 0.004

@@ -9,8 +9,8 @@ import tomllib
 
 import pytest
 
-from tools import matrix
-from tools.reference_blends import FOLDER, STEMS
+from tools.matrix import lanes as matrix
+from tools.shipped.reference_blends import FOLDER, STEMS
 
 REPO = pathlib.Path(__file__).resolve().parents[3]
 ZSTD_MAGIC = b"\x28\xb5\x2f\xfd"
@@ -89,7 +89,7 @@ def blend_header_version(path):
 @pytest.mark.parametrize("stem", STEMS)
 def test_shipped_blends_are_saved_by_the_oldest_supported_blender(stem):
     # A file saved by a newer Blender does not open in an older one (5.0 files not at all in 4.x):
-    # tools/reference_blends.py writes them on the oldest lane.
+    # tools/shipped/reference_blends.py writes them on the oldest lane.
     major, minor = manifest_minimum()[:2]
     assert blend_header_version(FOLDER / f"{stem}.blend") == major * 100 + minor
 

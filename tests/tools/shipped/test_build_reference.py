@@ -1,7 +1,7 @@
 """The shipped reference data is what its build tool makes from ../shared/refmodels today, on any CPU.
 
 A change to fitting, cleaning or refinement that moves the reference mannequins fails here until
-``python -m tools.build_reference`` is run again and its output committed (JSON, .blend, docs).
+``python -m tools.shipped.build_reference`` is run again and its output committed (JSON, .blend, docs).
 Another CPU's BLAS rounds differently in the last bits; the build must not amplify that. So the one
 build here (about three minutes) is run with every body vertex moved by JITTER, a rounding-level change
 of the inputs, and must still pass ``--check``: land within CHECK_TOLERANCE of every shipped number and
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from ellimann_addon.core.mannequin.model import Mannequin
-from tools import build_reference
+from tools.shipped import build_reference
 
 JITTER = 1e-9  # m: a rounding-level change of the inputs
 SHIPPED = build_reference.REPO / "reference_blends"

@@ -1,4 +1,4 @@
-"""The fill metrics of the build tool (tools/coverage.py), on bodies and mannequins whose answer is known."""
+"""The fill metrics of the build tool (tools/shipped/coverage.py), on bodies and mannequins whose answer is known."""
 
 import numpy as np
 import pytest
@@ -8,7 +8,7 @@ from ellimann_addon.core.geometry.mesh import icosphere
 from ellimann_addon.core.geometry.mesh import volume as mesh_volume
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.mannequin.topology import Part, Topology
-from tools.coverage import BodyVolume, chain_gaps, fill_metrics, occupancy, report, separation
+from tools.shipped.coverage import BodyVolume, chain_gaps, fill_metrics, occupancy, report, separation
 
 RADIUS = 0.1
 

@@ -1,8 +1,9 @@
-"""The fine topology's definition (tools/reference_topology_fine.py) and tools: its parts are the 40 and more, each
-new part on a bone and traced from enough vertices; the cloth's gap (tools/cloth_gap.py) on shapes whose answer is
-known; a base missing one recorded selection is refused by ``references build`` in one line, nothing written; exact
-mode meets the measurements of bodies the set has not seen. That the shipped fine sets are what tools/build_fine.py
-builds is ``python -m tools.build_fine --check`` (two builds of several minutes: not in the test matrix's budget).
+"""The fine topology's definition (tools/shipped/reference_topology_fine.py) and tools: its parts are the 40 and
+more, each new part on a bone and traced from enough vertices; the cloth's gap (tools/figures/cloth_gap.py) on shapes
+whose answer is known; a base missing one recorded selection is refused by ``references build`` in one line, nothing
+written; exact mode meets the measurements of bodies the set has not seen. That the shipped fine sets are what
+tools/shipped/build_fine.py builds is ``python -m tools.shipped.build_fine --check`` (two builds of several minutes:
+not in the test matrix's budget).
 """
 
 import numpy as np
@@ -18,12 +19,12 @@ from ellimann_addon.core.measure.body import measure_body_mesh
 from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.shipped import FEMALE_FINE_SET, SHIPPED_SETS, named_reference_set
 from ellimann_addon.core.synthesis.synthesize import EXACT_TOLERANCE, synthesize_batch
-from tools import reference_topology as rt
-from tools.bodies import REFERENCE_BODY, RM_BODIES, load_labels
-from tools.build_reference import trace_reference
-from tools.cloth_gap import surface_gap, weighted_percentile
-from tools.reference_sets import FEMALE, MALE, TRACING_FOLDER
-from tools.reference_topology_fine import EXTRA_SPECS, FINE_CHAINS, FINE_SPECS
+from tools.figures.cloth_gap import surface_gap, weighted_percentile
+from tools.shipped import reference_topology as rt
+from tools.shipped.bodies import REFERENCE_BODY, RM_BODIES, load_labels
+from tools.shipped.build_reference import trace_reference
+from tools.shipped.reference_sets import FEMALE, MALE, TRACING_FOLDER
+from tools.shipped.reference_topology_fine import EXTRA_SPECS, FINE_CHAINS, FINE_SPECS
 
 
 def test_the_fine_topology_is_the_40_and_the_new_parts_each_on_a_bone():

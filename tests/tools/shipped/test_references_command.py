@@ -13,7 +13,7 @@ from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, load_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize_batch
-from tools.build_reference import CHECK_TOLERANCE, DEFAULT_REFMODELS
+from tools.shipped.build_reference import CHECK_TOLERANCE, DEFAULT_REFMODELS
 
 THREE = ("small_slim", "tall_chubby", "average")
 

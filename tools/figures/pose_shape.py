@@ -1,7 +1,7 @@
 """The posing shape check: real reference bodies re-posed to a T-pose by their own skeleton against the
 synthesized mannequin in ``t_pose``, by voxel IoU, beside the same IoU at rest.
 
-    .venv/bin/python -m tools.pose_shape [--refmodels DIR] [--spacing M]
+    .venv/bin/python -m tools.figures.pose_shape [--refmodels DIR] [--spacing M]
 
 Each body of ``refmodels/`` (the five the Reference Mannequins are built from) is re-posed with rigid
 per-vertex bones (each vertex rides on its dominant skinning bone of ``reference_female_regions.json``;
@@ -30,9 +30,9 @@ from ellimann_addon.core.pose.standard import a_pose, t_pose
 from ellimann_addon.core.synthesis.reference_set import load_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 
-from .bodies import RM_BODIES, load_labels
+from ..shipped.bodies import RM_BODIES, load_labels
 
-DEFAULT_REFMODELS = pathlib.Path(__file__).resolve().parents[2] / "shared" / "refmodels"
+DEFAULT_REFMODELS = pathlib.Path(__file__).resolve().parents[3] / "shared" / "refmodels"
 TORSO = ("Pelvis", "Spine1", "Spine2", "Spine3", "Neck")
 UPPER = ("upperarm",)
 LOWER = ("lowerarm", "wrist", "metacarpal", "finger")
@@ -94,7 +94,7 @@ def iou(body_vertices, faces, rig, pose, spacing):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m tools.pose_shape", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m tools.figures.pose_shape", description=__doc__.splitlines()[0])
     parser.add_argument("--refmodels", type=pathlib.Path, default=DEFAULT_REFMODELS)
     parser.add_argument("--spacing", type=float, default=0.006)
     args = parser.parse_args(argv)

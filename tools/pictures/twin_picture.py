@@ -1,7 +1,7 @@
 """Dev tool (not shipped): a body's twin synthesized from the five measurements and from all it measures,
 stood in the body as bench_scan stands it, the body a ghost over each (docs/images/twin_five_vs_all.png).
 
-    .venv/bin/python -m tools.twin_picture [--bodies small_chubby tall_slim] [--out PNG]
+    .venv/bin/python -m tools.pictures.twin_picture [--bodies small_chubby tall_slim] [--out PNG]
 """
 
 import argparse
@@ -14,9 +14,9 @@ from ellimann_addon.core.measure.body import measure_body_mesh
 from ellimann_addon.core.measure.extra import split_measurements
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize_extra
-from tools import render
-from tools.build_reference import DEFAULT_REFMODELS
-from tools.overlap import standing_in
+from tools.figures.overlap import standing_in
+from tools.pictures import render
+from tools.shipped.build_reference import DEFAULT_REFMODELS
 
 SPACING = 0.005  # m, bench_scan's grid
 
@@ -31,10 +31,10 @@ def twins(name, reference):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m tools.twin_picture", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m tools.pictures.twin_picture", description=__doc__.splitlines()[0])
     parser.add_argument("--bodies", nargs="+", default=["small_chubby", "tall_slim"])
     parser.add_argument(
-        "--out", type=Path, default=Path(__file__).resolve().parent.parent / "docs" / "images" / "twin_five_vs_all.png"
+        "--out", type=Path, default=Path(__file__).resolve().parents[2] / "docs" / "images" / "twin_five_vs_all.png"
     )
     args = parser.parse_args(argv)
     reference = named_reference_set("female")

@@ -1,5 +1,5 @@
 """Rewrite the table of docs/measurements.md from ``core.measurements.TABLE`` (the code is the source):
-``python -m tools.measurements_doc`` (``--check``: exit 1 when the page differs)."""
+``python -m tools.figures.measurements_doc`` (``--check``: exit 1 when the page differs)."""
 
 import argparse
 import pathlib
@@ -8,8 +8,8 @@ import sys
 from ellimann_addon.core.files import atomic_write_text
 from ellimann_addon.core.measurements import TABLE
 
-PAGE = pathlib.Path(__file__).resolve().parents[1] / "docs" / "measurements.md"
-START = "<!-- the table: python -m tools.measurements_doc -->"
+PAGE = pathlib.Path(__file__).resolve().parents[2] / "docs" / "measurements.md"
+START = "<!-- the table: python -m tools.figures.measurements_doc -->"
 END = "<!-- end of the table -->"
 
 
@@ -45,7 +45,7 @@ def main(argv=None):
     wanted = rewritten(page)
     if args.check:
         if wanted != page or START not in page:
-            print(f"{PAGE} differs from core.measurements.TABLE: run python -m tools.measurements_doc")
+            print(f"{PAGE} differs from core.measurements.TABLE: run python -m tools.figures.measurements_doc")
             return 1
         return 0
     if wanted != page:

@@ -1,6 +1,7 @@
 """Dev tool (not shipped): where each measurement is taken, drawn on a mannequin and on a body (docs/measurements.md).
 
-    python -m tools.render_measurements [--body NAME] [--mannequin NAME] --out PNG [--neck-out PNG [--bodies DIR]]
+    python -m tools.pictures.render_measurements [--body NAME] [--mannequin NAME] --out PNG
+        [--neck-out PNG [--bodies DIR]]
 
 The body (one of ../shared/refmodels) and the mannequin (a shipped female Reference Mannequin, measured through
 its pieces' mesh, the same code as a scan, at its own neck tilt) are drawn semi-transparent, front and side, with
@@ -29,7 +30,7 @@ from ellimann_addon.core.measure.extra import mannequin_tilt
 from ellimann_addon.core.measure.neck import NECK_BAND
 from ellimann_addon.core.synthesis.shipped import reference_folder
 
-from .reference_sets import TRACING_FOLDER
+from ..shipped.reference_sets import TRACING_FOLDER
 from .render import Slot, render
 
 COLORS = {
@@ -123,7 +124,9 @@ def neck_picture(folder, out):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m tools.render_measurements", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m tools.pictures.render_measurements", description=__doc__.split("\n")[0]
+    )
     parser.add_argument("--body", default="average")
     parser.add_argument("--mannequin", default="average")
     parser.add_argument("--out", required=True)

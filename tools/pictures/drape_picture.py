@@ -5,8 +5,8 @@ draped (Blender cloth, cushion colliders at the default resolution) on the manne
 it, on the dense body it stands for (``../shared/refmodels/average.obj``) or, with ``--versus skin``,
 on the mannequin's skin (the drape's skin collider at its default level). Front view, Workbench.
 
-    .venv/bin/python -m tools.drape_picture [--out docs/images/drape_average.png] [--frames 60]
-    .venv/bin/python -m tools.drape_picture --versus skin --out docs/images/drape_skin.png
+    .venv/bin/python -m tools.pictures.drape_picture [--out docs/images/drape_average.png] [--frames 60]
+    .venv/bin/python -m tools.pictures.drape_picture --versus skin --out docs/images/drape_skin.png
 """
 
 import argparse

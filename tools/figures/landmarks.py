@@ -1,8 +1,8 @@
 """Where a set's section heights fall on its bodies: the landmarks behind SECTION_FRACTIONS, measured.
 
-    .venv/bin/python -m tools.landmarks [--picture docs/images/landmarks.png]
+    .venv/bin/python -m tools.figures.landmarks [--picture docs/images/landmarks.png]
 
-For each body of the female and male sets (tools/reference_sets.py), as fractions of its height He: the
+For each body of the female and male sets (tools/shipped/reference_sets.py), as fractions of its height He: the
 natural waist (the narrowest torso girth between 0.55 and 0.72 He; girths over the torso-mask triangles,
 convex hull perimeters, as the bodies' READMEs measure), the crotch (the lowest pelvis vertex on the
 sagittal plane), the most posterior buttock point, the bust point (the most anterior chest vertex off the
@@ -21,8 +21,8 @@ from ellimann_addon.core.constants import CM_PER_M
 from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.geometry.mesh import convex_hull_2d, plane_section_points, polygon_perimeter
 
-from .bodies import RM_BODIES, load_labels
-from .reference_sets import BUILD_SETS, TRACING_FOLDER
+from ..shipped.bodies import RM_BODIES, load_labels
+from ..shipped.reference_sets import BUILD_SETS, TRACING_FOLDER
 
 PROFILE = np.arange(0.40, 0.8201, 0.0025)  # fractions of He the girth profile is sampled at
 WAIST_BAND = (0.55, 0.72)
@@ -99,7 +99,7 @@ def picture(results, path):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m tools.landmarks", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m tools.figures.landmarks", description=__doc__.split("\n")[0])
     parser.add_argument("--picture", help="also draw the girth profiles to this PNG (needs matplotlib)")
     args = parser.parse_args(argv)
     results = {name: set_landmarks(BUILD_SETS[name]) for name in ("female", "male")}

@@ -1,6 +1,6 @@
 """Dev tool (not shipped): the skin's pictures for docs/skin.md, Workbench renders of skins made at the final level.
 
-    .venv/bin/python -m tools.skin_pictures [--only NAME ...] [--voxel MM] [--out DIR]
+    .venv/bin/python -m tools.pictures.skin_pictures [--only NAME ...] [--voxel MM] [--out DIR]
 
 - ``skin_reference_lineup.png``, ``skin_reference_lineup_male.png``: the five Reference Mannequins of each shipped
   set with their skins, front;
@@ -40,11 +40,11 @@ from ellimann_addon.core.skin.settings import SkinSettings
 from ellimann_addon.core.skin.surface import build_skin, outer_mesh
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize, synthesize_extra
-from tools.build_reference import DEFAULT_REFMODELS
-from tools.overlap import standing_in
-from tools.render import Slot, render
+from tools.figures.overlap import standing_in
+from tools.pictures.render import Slot, render
+from tools.shipped.build_reference import DEFAULT_REFMODELS
 
-IMAGES = Path(__file__).resolve().parent.parent / "docs" / "images"
+IMAGES = Path(__file__).resolve().parents[2] / "docs" / "images"
 BODY_COLOR = (0.62, 0.64, 0.7, 1.0)
 WALK_FRAMES = (0, 6, 12)
 PICTURES = ("lineup", "lineup_male", "table_2_5", "twin", "poses", "gap")
@@ -142,7 +142,7 @@ def gap_sections(settings, out):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m tools.skin_pictures", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m tools.pictures.skin_pictures", description=__doc__.splitlines()[0])
     parser.add_argument("--only", nargs="+", choices=PICTURES, default=list(PICTURES))
     parser.add_argument("--voxel", type=float, default=None, help="the skin's voxel in mm (default: the final level)")
     parser.add_argument("--out", type=Path, default=IMAGES)

@@ -2,7 +2,7 @@
 side by side (Workbench): the A-pose avatar (decimated to the garment tools' budget) front and side, and the
 T-pose one with Mixamo's names and its collision proxy beside it.
 
-    python -m tools.fbx_picture tests/data/sizing/jane.vit --out docs/images/fbx_avatar.png
+    python -m tools.pictures.fbx_picture tests/data/sizing/jane.vit --out docs/images/fbx_avatar.png
 """
 
 import argparse

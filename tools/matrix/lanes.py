@@ -9,12 +9,13 @@ venv that ``make check``, ``demo``, ``bench`` and ``build`` use) made by that Bl
 wheel and the numpy that Blender bundles, plus ``requirements-dev.txt``'s tools; it is made on first
 use and kept (a stamp of its pins decides when to reinstall). pip's own cache is shared by every
 lane, so each wheel is downloaded once. The Blender-free core and command-line (cli) suites run once per
-numpy major, the tools suite once (on numpy 2), the Blender suite on every lane. Two lanes run at once (the machines
-have two cores); each lane's full pytest output goes to ``out/matrix/<lane>.log`` and is printed when
+numpy major, the tools suite once (on numpy 2), the Blender suite on every lane. Two lanes run at once (the
+machines have two cores); each lane's full pytest output goes to ``out/matrix/<lane>.log`` and is printed when
 the lane fails.
 The last line is the whole matrix's count, ``matrix: N passed, N failed``.
 
-Runs on the Python standard library only: it must work before any venv exists.
+Runs on the Python standard library only: it must work before any venv exists (``python3 -m tools.matrix`` runs
+this module's ``main`` through the package's ``__main__.py``).
 """
 
 import argparse
@@ -30,7 +31,7 @@ import sys
 import time
 import xml.etree.ElementTree as ET
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
+REPO = pathlib.Path(__file__).resolve().parents[2]
 REQUIREMENTS = REPO / "requirements-dev.txt"
 LOGS = REPO / "out" / "matrix"
 
@@ -298,7 +299,3 @@ def _tail(path, lines=60):
     start = next((i for i, line in enumerate(text) if re.match(r"=+ (FAILURES|ERRORS) =+", line)), None)
     chosen = text[start:] if start is not None else text[-lines:]
     return "\n".join(chosen[-400:])
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,8 +1,8 @@
 """How well a mannequin synthesized from a body's measurements overlaps that body: voxel IoU.
 
-    .venv/bin/python -m tools.overlap [--set female|male|both] [--spacing M] [--skin-voxel MM]
+    .venv/bin/python -m tools.figures.overlap [--set female|male|both] [--spacing M] [--skin-voxel MM]
 
-For each of a set's six bodies (tools/reference_sets.py): measure the body as its README does (at the
+For each of a set's six bodies (tools/shipped/reference_sets.py): measure the body as its README does (at the
 set's section heights), synthesize a mannequin from those five numbers with the set's shipped Reference
 Mannequins (exact mode), stand it where the body stands (the floors at z = 0 and the volumes' centroids
 on one vertical line, since a synthesized mannequin is registered on its own landmark) and compare the
@@ -26,8 +26,8 @@ from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.synthesis.reference_set import load_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 
-from .bodies import RM_BODIES, body_measurements, load_labels
-from .reference_sets import BUILD_SETS, TRACING_FOLDER
+from ..shipped.bodies import RM_BODIES, body_measurements, load_labels
+from ..shipped.reference_sets import BUILD_SETS, TRACING_FOLDER
 
 
 def standing_in(grid, mannequin):
@@ -75,7 +75,7 @@ def set_overlaps(build_set, spacing=volume.IOU_SPACING, skin_voxel_mm=None, bodi
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m tools.overlap", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m tools.figures.overlap", description=__doc__.split("\n")[0])
     parser.add_argument("--set", choices=[*sorted(BUILD_SETS), "both"], default="both")
     parser.add_argument("--spacing", type=float, default=volume.IOU_SPACING, help="grid spacing (m)")
     parser.add_argument(

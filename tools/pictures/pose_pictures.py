@@ -1,8 +1,8 @@
 """Dev tool (not shipped): Workbench pictures of posing, for docs/posing.md.
 
-    python -m tools.pose_pictures poses OUT.png [--mannequin RM.json]   # the five standard poses side by side
-    python -m tools.pose_pictures walk-drape OUT.png [--frames N]        # a frame of the tube dress on the walk
-    python -m tools.pose_pictures clip OUT.png                           # a BVH clip, beside Blender's import of it
+    python -m tools.pictures.pose_pictures poses OUT.png [--mannequin RM.json]  # the five standard poses side by side
+    python -m tools.pictures.pose_pictures walk-drape OUT.png [--frames N]      # a frame of the tube dress on the walk
+    python -m tools.pictures.pose_pictures clip OUT.png               # a BVH clip, beside Blender's import of it
 
 Each mannequin is rigged and posed the way the Pose panel does it (``services.rig``; the walk shown at its
 frame 7, mid-stride); the walking drape is ``services.drape`` with the walk as its motion, three of its
@@ -150,7 +150,7 @@ def side_by_side(paths, out):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m tools.pose_pictures", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m tools.pictures.pose_pictures", description=__doc__.splitlines()[0])
     parser.add_argument("what", choices=("poses", "walk-drape", "clip"))
     parser.add_argument("out", metavar="OUT.png")
     parser.add_argument("--mannequin", default=str(REFERENCE_FOLDER / "average.json"))

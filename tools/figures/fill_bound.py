@@ -1,10 +1,10 @@
 """How many more convex pieces would bring a shipped Reference Mannequin's coverage of its body to a target: a
 greedy bound with balls (docs/topology_fine_tried.md, "Filling what is left").
 
-    .venv/bin/python -m tools.fill_bound [--set female-fine] [--target 0.94] [--outset MM] [--most N]
+    .venv/bin/python -m tools.figures.fill_bound [--set female-fine] [--target 0.94] [--outset MM] [--most N]
 
-Each RM stands in its body as tools/overlap.py stands it (5 mm grid). Balls are added one at a time, each the one
-that adds the most body cells no piece fills less the outside cells it adds (a cell outside costs what a cell inside
+Each RM stands in its body as tools/figures/overlap.py stands it (5 mm grid). Balls are added one at a time, each the
+one that adds the most body cells no piece fills less the outside cells it adds (a cell outside costs what a cell inside
 is worth, as the fine topology's fit weighs them). A ball is centred inside the body and reaches ``outset`` past the
 nearest point of the body's surface, and it crosses no section band (the set's section heights, ``clearance`` of
 the height either side): a part that crosses a section follows its measurement. Placed freely on each body, a
@@ -23,18 +23,18 @@ from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.geometry.volume import IOU_MARGIN, IOU_SPACING, occupancy
 from ellimann_addon.core.mannequin.model import Mannequin
 
-from .bodies import RM_BODIES
-from .coverage import BodyVolume
+from ..shipped.bodies import RM_BODIES
+from ..shipped.coverage import BodyVolume
+from ..shipped.reference_sets import BUILD_SETS
 from .overlap import standing_in
-from .reference_sets import BUILD_SETS
 
 REACH = 0.04  # m: the deepest a ball's centre lies (radius up to REACH + outset)
 CLEARANCE = 0.0125  # of the height, either side of a section: the fine topology's
 
 
 def fill_curve(body, grid, mannequin, outset=0.002, clearance=CLEARANCE, reach=REACH, most=120, target=None):
-    """[(coverage, excess)] of ``mannequin`` (standing in ``body``, a tools.coverage.BodyVolume, on its ``grid``)
-    with 0, 1, 2, ... greedy balls added, up to ``most`` or until coverage reaches ``target``; and the balls
+    """[(coverage, excess)] of ``mannequin`` (standing in ``body``, a tools.shipped.coverage.BodyVolume, on its
+    ``grid``) with 0, 1, 2, ... greedy balls added, up to ``most`` or until coverage reaches ``target``; and the balls
     [(centre, radius)]. A ball's centre lies at most ``reach`` deep."""
     inside, filled = grid.inside.ravel(), occupancy(grid, mannequin).ravel()
     points = grid.origin + grid.spacing * np.argwhere(np.ones(grid.inside.shape, dtype=bool))
@@ -89,7 +89,7 @@ def fill_curve(body, grid, mannequin, outset=0.002, clearance=CLEARANCE, reach=R
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m tools.fill_bound", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m tools.figures.fill_bound", description=__doc__.split("\n")[0])
     parser.add_argument("--set", choices=sorted(BUILD_SETS), default="female-fine")
     parser.add_argument("--target", type=float, default=0.94, help="the coverage to reach (share)")
     parser.add_argument("--outset", type=float, default=2.0, help="mm a ball reaches past the body's surface")
@@ -102,7 +102,7 @@ def main(argv=None):
         mannequin = Mannequin.load(build_set.out / f"{name}.json")
         mesh = read_obj(build_set.refmodels / f"{name}.obj", up="z")
         body = BodyVolume(mesh.vertices, mesh.faces)
-        grid = body.grid(IOU_SPACING, margin=IOU_MARGIN)  # tools/overlap.py's
+        grid = body.grid(IOU_SPACING, margin=IOU_MARGIN)  # tools/figures/overlap.py's
         curve, balls = fill_curve(
             body, grid, standing_in(grid, mannequin), args.outset / 1000, most=args.most, target=args.target
         )

@@ -1,6 +1,6 @@
-"""Dev tool (not shipped): the body skin's pictures for docs/body_skin.md, Workbench renders (tools/render.py).
+"""Dev tool (not shipped): the body skin's pictures for docs/body_skin.md, Workbench renders (tools/pictures/render.py).
 
-    .venv/bin/python -m tools.body_skin_pictures [--only NAME ...] [--out DIR]
+    .venv/bin/python -m tools.pictures.body_skin_pictures [--only NAME ...] [--out DIR]
 
 - ``body_skin_lineup.png``, ``body_skin_lineup_male.png``: the body skin at each RM's targets, both shipped sets;
 - ``body_skin_table_2_5.png``: the ten Table 2.5 requests (the paper's test requests), female set;
@@ -26,10 +26,10 @@ from ellimann_addon.core.pose.motion import clamped_motion
 from ellimann_addon.core.pose.standard import STILL_POSES
 from ellimann_addon.core.synthesis.bodies import load_set_bodies
 from ellimann_addon.core.synthesis.shipped import named_reference_set, reference_folder
-from tools.build_reference import DEFAULT_REFMODELS
-from tools.render import Slot, render
+from tools.pictures.render import Slot, render
+from tools.shipped.build_reference import DEFAULT_REFMODELS
 
-IMAGES = Path(__file__).resolve().parent.parent / "docs" / "images"
+IMAGES = Path(__file__).resolve().parents[2] / "docs" / "images"
 BODY_COLOR = (0.62, 0.64, 0.7, 1.0)
 WALK_FRAMES = (0, 6, 12)
 PICTURES = ("lineup", "lineup_male", "table_2_5", "twin", "poses")
@@ -99,7 +99,9 @@ def poses(out):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m tools.body_skin_pictures", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m tools.pictures.body_skin_pictures", description=__doc__.splitlines()[0]
+    )
     parser.add_argument("--only", nargs="+", choices=PICTURES, default=list(PICTURES))
     parser.add_argument("--out", type=Path, default=IMAGES)
     args = parser.parse_args(argv)

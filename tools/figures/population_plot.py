@@ -4,7 +4,7 @@ Per measurement: the histogram of the requested (sampled) values, the measured m
 mannequins over it, the survey's normal; below, the relative error of m_T against the request (full
 precision from the batch's mannequins.npz when there is one, else the report's four decimals).
 
-    python -m tools.population_plot PEOPLE.csv BATCH_DIR -o PNG [--stats ansur2_female]
+    python -m tools.figures.population_plot PEOPLE.csv BATCH_DIR -o PNG [--stats ansur2_female]
 """
 
 import argparse

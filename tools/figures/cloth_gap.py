@@ -7,7 +7,7 @@ a piece), weighted by the vertex's share of the surface area (core.fitting.body_
 surface outside the mannequin and the area-weighted median and 95th percentile of the distance over the whole
 surface and over the part outside.
 
-    python -m tools.cloth_gap [--sets female,male,female-fine,male-fine] [--cushions]
+    python -m tools.figures.cloth_gap [--sets female,male,female-fine,male-fine] [--cushions]
 """
 
 import numpy as np
@@ -43,12 +43,12 @@ def surface_gap(mannequin, vertices, faces, cushions=False):
 
 def set_gaps(build_set, cushions=False):
     """{mannequin stem: surface_gap} of a shipped set's Base Mannequin and RMs, each stood in the body it was fitted
-    to as tools/overlap.py stands a twin (floors at z = 0, the volumes' centroids on one vertical line)."""
+    to as tools/figures/overlap.py stands a twin (floors at z = 0, the volumes' centroids on one vertical line)."""
     from ellimann_addon.core.fitting.body_mesh import read_obj
     from ellimann_addon.core.geometry.volume import IOU_MARGIN, IOU_SPACING, BodyVolume
     from ellimann_addon.core.mannequin.model import Mannequin
 
-    from .bodies import RM_BODIES
+    from ..shipped.bodies import RM_BODIES
     from .overlap import standing_in
 
     out = {}
@@ -63,9 +63,9 @@ def set_gaps(build_set, cushions=False):
 def main(argv=None):
     import argparse
 
-    from .reference_sets import BUILD_SETS
+    from ..shipped.reference_sets import BUILD_SETS
 
-    parser = argparse.ArgumentParser(prog="python -m tools.cloth_gap", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m tools.figures.cloth_gap", description=__doc__.split("\n")[0])
     parser.add_argument("--sets", default=",".join(BUILD_SETS), help=f"comma-separated, of {', '.join(BUILD_SETS)}")
     parser.add_argument("--cushions", action="store_true", help="the cushion mannequins (slower)")
     args = parser.parse_args(argv)

@@ -1,4 +1,4 @@
-"""ElliMann's fine topology: the shipped 40 parts (tools/reference_topology.py) and the pieces that fill where
+"""ElliMann's fine topology: the shipped 40 parts (tools/shipped/reference_topology.py) and the pieces that fill where
 they miss.
 
 Where the 40 miss was measured on the Base Mannequin over its body: the body's volume outside every piece, each
@@ -408,7 +408,7 @@ FINE_SPECS = tuple(
     for spec in SPECS + EXTRA_SPECS
 )
 
-# tools/coverage.py's chains on the fine topology: the 40's links, each with the new parts that join it.
+# tools/shipped/coverage.py's chains on the fine topology: the 40's links, each with the new parts that join it.
 FINE_CHAINS = {
     "leg": [
         ("Pelvis", "Gluteus", "Hip", "Outer Hip", "Upper Gluteus"),

@@ -1,6 +1,6 @@
 """Write the .blend twins of ``reference_blends/*.json`` with the oldest Blender the manifest promises.
 
-    python3 -m tools.reference_blends [--folder DIR] [STEM ...]
+    python3 -m tools.shipped.reference_blends [--folder DIR] [STEM ...]
 
 Blender reads files saved by older versions, never those of newer ones, and Blender 5.0 changed the
 file format itself (4.x cannot open a 5.0 file at all). So the shipped twins are saved by the
@@ -14,7 +14,7 @@ import pathlib
 import subprocess
 import sys
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
+REPO = pathlib.Path(__file__).resolve().parents[2]
 FOLDER = REPO / "reference_blends"
 STEMS = ("base_mannequin", "small_slim", "tall_slim", "small_chubby", "tall_chubby", "average")
 
@@ -42,7 +42,7 @@ def write_blends(mannequins, folder):
 
 
 def oldest_lane_python():
-    from .matrix import LANES, ensure_venv
+    from ..matrix.lanes import LANES, ensure_venv
 
     lane = LANES[0]
     with open(os.devnull, "w") as quiet:
@@ -50,7 +50,9 @@ def oldest_lane_python():
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python3 -m tools.reference_blends", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="python3 -m tools.shipped.reference_blends", description=__doc__.split("\n")[0]
+    )
     parser.add_argument(
         "--folder",
         type=pathlib.Path,
@@ -65,7 +67,7 @@ def main(argv=None):
 
     lane, python = oldest_lane_python()
     if pathlib.Path(sys.prefix).resolve() != lane.venv.resolve():
-        command = [str(python), "-m", "tools.reference_blends", "--folder", str(args.folder), *args.stems]
+        command = [str(python), "-m", "tools.shipped.reference_blends", "--folder", str(args.folder), *args.stems]
         return subprocess.run(command, cwd=REPO).returncode
 
     from ellimann_addon.core.mannequin.model import Mannequin

@@ -1,6 +1,6 @@
-"""The reference sets the tools build (tools/build_reference.py the female, tools/build_male.py the male) and
-measure (tools/overlap.py, tools/landmarks.py): which bodies, which reference body, which targets and which
-section heights (the landmarks that travel with a set: core.synthesis.reference_set).
+"""The reference sets the tools build (tools/shipped/build_reference.py the female, tools/shipped/build_male.py the
+male) and measure (tools/figures/overlap.py, tools/figures/landmarks.py): which bodies, which reference body, which
+targets and which section heights (the landmarks that travel with a set: core.synthesis.reference_set).
 
 Every set is traced with the same selections, made once on the neutral female body: all bodies share one mesh
 topology and vertex order (../shared/refmodels_male/README.md), so the same vertices trace the same part on a
@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 from ellimann_addon.core.constants import REFERENCE_MEASUREMENTS, SECTION_FRACTIONS
 from ellimann_addon.core.fitting.reference_build import read_targets
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
+REPO = pathlib.Path(__file__).resolve().parents[2]
 SHARED = REPO.parent / "shared"
 TRACING_FOLDER = SHARED / "refmodels"  # the neutral female body and the region labels the selections use
 
@@ -61,7 +61,8 @@ MALE = BuildSet(
     "reference_lineup_male.png",
 )
 
-# The same bodies, targets and heights on the fine topology (tools/reference_topology_fine.py, tools/build_fine.py).
+# The same bodies, targets and heights on the fine topology (tools/shipped/reference_topology_fine.py,
+# tools/shipped/build_fine.py).
 FEMALE_FINE = replace(
     FEMALE,
     name="female-fine",

@@ -1,5 +1,5 @@
 """Rewrite docs/formats/measurement_files.md's mapping tables from core.sizing.names (the code is the source):
-``python -m tools.measurement_files_doc`` (``--check``: exit 1 when the page differs)."""
+``python -m tools.figures.measurement_files_doc`` (``--check``: exit 1 when the page differs)."""
 
 import argparse
 import pathlib
@@ -8,7 +8,7 @@ import sys
 from ellimann_addon.core.files import atomic_write_text
 from ellimann_addon.core.sizing.mapping_doc import replace_tables
 
-PAGE = pathlib.Path(__file__).resolve().parents[1] / "docs" / "formats" / "measurement_files.md"
+PAGE = pathlib.Path(__file__).resolve().parents[2] / "docs" / "formats" / "measurement_files.md"
 
 
 def main(argv=None):
@@ -19,7 +19,7 @@ def main(argv=None):
     wanted = replace_tables(page)
     if args.check:
         if wanted != page:
-            print(f"{PAGE} differs from core.sizing.names: run python -m tools.measurement_files_doc")
+            print(f"{PAGE} differs from core.sizing.names: run python -m tools.figures.measurement_files_doc")
             return 1
         return 0
     if wanted != page:

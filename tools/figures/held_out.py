@@ -1,6 +1,6 @@
 """What more Reference Mannequins buy: the overlap of a synthesized mannequin with a body not in its set.
 
-    .venv/bin/python -m tools.held_out [--refmodels DIR] [--workers N] [--out FILE.md]
+    .venv/bin/python -m tools.figures.held_out [--refmodels DIR] [--workers N] [--out FILE.md]
 
 The six female bodies of ../shared/refmodels are built into RMs once, by the product's builder (an RM depends
 only on its own body: fitted, refined and cleaned alone; only its axis labels follow the set's reference RM,
@@ -31,9 +31,9 @@ from ellimann_addon.core.synthesis.manifest import Manifest, targets_range
 from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, ReferenceSet
 from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 
-from .bodies import REFERENCE_BODY, body_measurements, load_labels, read_bodies
-from .build_reference import DEFAULT_REFMODELS, REFERENCE_RM
-from .reference_sets import TRACING_FOLDER
+from ..shipped.bodies import REFERENCE_BODY, body_measurements, load_labels, read_bodies
+from ..shipped.build_reference import DEFAULT_REFMODELS, REFERENCE_RM
+from ..shipped.reference_sets import TRACING_FOLDER
 
 SIZES = (3, 4, 5)
 
@@ -41,7 +41,7 @@ SIZES = (3, 4, 5)
 def six_rms(refmodels, workers, build_set=None):
     """({stem: RM} of the six bodies, {stem: targets}, {stem: body -> RM shift}, {stem: BodyMesh}).
 
-    ``build_set`` (tools/reference_sets.py, default the female set of the 40): whose base, bodies (its six, from
+    ``build_set`` (tools/shipped/reference_sets.py, default the female set of the 40): whose base, bodies (its six, from
     ``refmodels``), targets and section heights."""
     from ellimann_addon.core.fitting.reference_build import build_reference_set
 
@@ -129,7 +129,7 @@ def markdown(rows):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m tools.held_out", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m tools.figures.held_out", description=__doc__.split("\n")[0])
     parser.add_argument("--refmodels", type=pathlib.Path, default=DEFAULT_REFMODELS)
     parser.add_argument("--workers", type=int, default=2, help="processes building the six RMs")
     parser.add_argument("--out", type=pathlib.Path, help="also write the table to this markdown file")

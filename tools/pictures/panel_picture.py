@@ -3,7 +3,7 @@
 Blender's default dark theme (fields, buttons and labels where ``draw`` puts them, the values the scene
 holds), not captured from a window.
 
-    .venv/bin/python -m tools.panel_picture references --out docs/images/reference_set_panel.png
+    .venv/bin/python -m tools.pictures.panel_picture references --out docs/images/reference_set_panel.png
 
 ``references``: the Reference Set panel with the shipped Base Mannequin and the five reference bodies
 of ../shared/refmodels typed with their Table 2.3 targets. ``pose``: the Pose panel of the Average RM after
@@ -18,7 +18,7 @@ import tempfile
 
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="ellimann-panel-"))
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
+REPO = pathlib.Path(__file__).resolve().parents[2]
 WIDTH, LINE, PAD = 560, 34, 14
 THEME = {
     "back": (48, 48, 48),
@@ -195,7 +195,7 @@ def pose_scene():
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m tools.panel_picture", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m tools.pictures.panel_picture", description=__doc__.splitlines()[0])
     parser.add_argument("panel", choices=("references", "pose"))
     parser.add_argument("--out", type=pathlib.Path, required=True)
     parser.add_argument("--refmodels", type=pathlib.Path, default=REPO.parent / "shared" / "refmodels")

@@ -1,11 +1,11 @@
-"""Give the shipped reference sets their bodies: each set's five RM bodies (tools/reference_sets.py knows which
+"""Give the shipped reference sets their bodies: each set's five RM bodies (tools/shipped/reference_sets.py knows which
 folder of ../shared holds them), their region labels and the body model's bone weights
 (../shared/refmodels/reference_female_regions.json and skin_weights.npz, one topology for the female and the male
 bodies), written as the set's ``bodies.npz`` (core.body.bodies) and named in its manifest; nothing else in the
 set changes.
 
-    .venv/bin/python -m tools.add_bodies            # write bodies.npz into the four shipped sets
-    .venv/bin/python -m tools.add_bodies --check    # compare the shipped files with what it would write
+    .venv/bin/python -m tools.shipped.add_bodies            # write bodies.npz into the four shipped sets
+    .venv/bin/python -m tools.shipped.add_bodies --check    # compare the shipped files with what it would write
 """
 
 import argparse
@@ -85,14 +85,14 @@ def check(build_set):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m tools.add_bodies", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m tools.shipped.add_bodies", description=__doc__.split("\n")[0])
     parser.add_argument("--sets", default=",".join(BUILD_SETS), help=f"comma-separated, of {', '.join(BUILD_SETS)}")
     parser.add_argument("--check", action="store_true", help="compare with the shipped files; write nothing")
     args = parser.parse_args(argv)
     sets = [BUILD_SETS[name] for name in args.sets.split(",")]
     if args.check:
         problems = [line for build_set in sets for line in check(build_set)]
-        print("\n".join(problems) or "the shipped bodies are what tools.add_bodies writes")
+        print("\n".join(problems) or "the shipped bodies are what tools.shipped.add_bodies writes")
         return 1 if problems else 0
     for build_set in sets:
         add_bodies(build_set)

@@ -1,7 +1,7 @@
 """Build ElliMann's reference data: the Base Mannequin and the five Reference Mannequins.
 
-    .venv/bin/python -m tools.build_reference [--refmodels DIR] [--out DIR] [--docs DIR] [--no-blend]
-    .venv/bin/python -m tools.build_reference --check     # rebuild in memory, compare with the shipped files and docs
+    .venv/bin/python -m tools.shipped.build_reference [--refmodels DIR] [--out DIR] [--docs DIR] [--no-blend]
+    .venv/bin/python -m tools.shipped.build_reference --check  # rebuild in memory, compare with the shipped files, docs
 
 ``--check`` passes when every shipped number is within CHECK_TOLERANCE of the rebuild and the docs
 match it at their printed precision (a number may differ by one unit of its last printed digit,
@@ -12,10 +12,10 @@ Reads the body meshes of ``<repo>/../shared/refmodels`` (see its README) and wri
 ``reference_blends/base_mannequin.json`` and the five ``<name>.json`` Reference Mannequins, their
 .blend twins, a Workbench line-up ``docs/images/reference_lineup.png`` and the Base Mannequin over
 its body ``docs/images/base_mannequin_trace.png`` (with the bpy module), ``docs/topology.md`` and
-``docs/reference_mannequins.md`` (with how much of its body each mannequin fills, tools/coverage.py).
+``docs/reference_mannequins.md`` (with how much of its body each mannequin fills, tools/shipped/coverage.py).
 
 Steps (paper, Sections 2.3.2-2.3.4):
-1. Trace: every part of tools/reference_topology.py selects its vertices on the neutral reference body
+1. Trace: every part of tools/shipped/reference_topology.py selects its vertices on the neutral reference body
    (regions and bones of its labels); the selections and fit settings are recorded on the Base
    Mannequin's parts (core/mannequin/traces.py), as Fit Ellipsoid records them in Blender.
 2. Base Mannequin: the parts fitted over ``reference_female.obj`` (core/fitting/mannequin_fit.py), registered and
@@ -67,7 +67,7 @@ from . import coverage
 from . import reference_topology as rt
 from .bodies import REFERENCE_BODY, RM_BODIES, body_measurements, load_labels, load_skeletons
 
-REPO = pathlib.Path(__file__).resolve().parents[1]
+REPO = pathlib.Path(__file__).resolve().parents[2]
 DEFAULT_REFMODELS = REPO.parent / "shared" / "refmodels"
 BASE_FILE = "base_mannequin"
 REFERENCE_RM = "average"  # the RM whose axes the others are relabelled against
@@ -79,8 +79,8 @@ FILL_SPACING = FitConstants().fill_spacing
 
 def trace_reference(reference_body, labels, specs=rt.SPECS):
     """{part name: PartTrace}: the vertices of every part of ``specs`` (default: the shipped 40,
-    tools/reference_topology.py) on the reference body and its fit settings; the cavity walls (open mouth and eye
-    sockets, bodies.hidden_vertices) are looked for in the head only: elsewhere every vertex is skin. Also returns
+    tools/shipped/reference_topology.py) on the reference body and its fit settings; the cavity walls (open mouth and
+    eye sockets, bodies.hidden_vertices) are looked for in the head only: elsewhere every vertex is skin. Also returns
     the cavity mask (bool per vertex)."""
     vertices = reference_body.vertices
     height = vertices[:, 2].max() - vertices[:, 2].min()
@@ -106,7 +106,7 @@ def trace_base(reference_body, traces, constants=None, joints=None, topology=Non
     """The Base Mannequin fitted over the reference body: symmetric, registered, each part's trace
     recording the axis its frame took from the points, ``joints`` (the body's, or None) moved with it.
     ``constants``: the fit's (core.fitting.mannequin_fit.FitConstants; default the female set's section heights);
-    ``topology``: its parts (default: the shipped 40 of tools/reference_topology.py).
+    ``topology``: its parts (default: the shipped 40 of tools/shipped/reference_topology.py).
     Returns (base, body -> base translation)."""
     topology = topology or rt.topology()
     base, kept = fit_mannequin(
@@ -202,9 +202,9 @@ def shipped_manifest(refmodels):
     }
     manifest = legacy_manifest()
     manifest.base = BASE_FILE
-    manifest.bodies = BODIES_FILE  # the RMs' bodies, for the body skin (tools/add_bodies.py)
+    manifest.bodies = BODIES_FILE  # the RMs' bodies, for the body skin (tools/shipped/add_bodies.py)
     manifest.provenance = {
-        "built_by": "python -m tools.build_reference",
+        "built_by": "python -m tools.shipped.build_reference",
         "bodies": "../shared/refmodels (Anny 0.6.2)",
         "traced_on": REFERENCE_BODY,
         "labelled_against": REFERENCE_RM,
@@ -235,7 +235,7 @@ def save_all(mannequins, out, manifest):
 
 def write_blends(stems, folder):
     """The .blend twins of ``folder``'s ``<stem>.json`` files, saved by the oldest supported Blender
-    (tools/reference_blends.py: no Blender opens a newer one's file)."""
+    (tools/shipped/reference_blends.py: no Blender opens a newer one's file)."""
     from . import reference_blends
 
     if reference_blends.main(["--folder", str(folder), *stems]):
@@ -243,8 +243,8 @@ def write_blends(stems, folder):
 
 
 def write_lineup(files, path):
-    """Workbench render of mannequin JSON files side by side (tools/render.py). Needs the bpy module."""
-    from . import render
+    """Workbench render of mannequin JSON files side by side (tools/pictures/render.py). Needs the bpy module."""
+    from ..pictures import render
 
     path.parent.mkdir(parents=True, exist_ok=True)
     render.main(["mannequins", *map(str, files), "--out", str(path)])
@@ -253,7 +253,7 @@ def write_lineup(files, path):
 def write_trace(mannequin_file, body_file, shift, path):
     """Workbench render of a mannequin over the semi-transparent body it was traced from (moved by
     ``shift``, the mannequin's registration), front and side. Needs the bpy module."""
-    from . import render
+    from ..pictures import render
 
     path.parent.mkdir(parents=True, exist_ok=True)
     render.main(
@@ -345,7 +345,8 @@ def topology_doc(base):
     lines = [
         "# ElliMann's reference topology",
         "",
-        "<!-- generated by `python -m tools.build_reference`; edit tools/reference_topology.py, not this file -->",
+        "<!-- generated by `python -m tools.shipped.build_reference`; "
+        "edit tools/shipped/reference_topology.py, not this file -->",
         "",
         f"{len(base.topology)} ellipsoids, head to feet, arms and hands included. Names follow the paper "
         "(`<number>.<letter> <Label>[.L|.R]`); the numbers of the two parts the paper names keep the "
@@ -458,7 +459,7 @@ def measurements_doc(base, rms, report):
     lines = [
         "# Reference Mannequins: Table 2.3 vs m_T",
         "",
-        "<!-- generated by `python -m tools.build_reference`; do not edit -->",
+        "<!-- generated by `python -m tools.shipped.build_reference`; do not edit -->",
         "",
         "m_T is `Mannequin.measure()` (closed form) of the shipped JSON files in `reference_blends/`. "
         "Each RM is the topology of `docs/topology.md` fitted inside its body from `refmodels/`, "
@@ -534,13 +535,13 @@ def fit_rows(rms, report):
 
 
 def fill_doc(fill, links=coverage.CHAINS, depth=rt.Spec.depth, topology_doc="topology.md"):
-    """Markdown lines: how each mannequin fills its body (tools/coverage.py), the gaps along the chains ``links``;
-    ``depth`` (m): how far the topology's parts (``topology_doc``) may reach outside the skin."""
+    """Markdown lines: how each mannequin fills its body (tools/shipped/coverage.py), the gaps along the chains
+    ``links``; ``depth`` (m): how far the topology's parts (``topology_doc``) may reach outside the skin."""
     spacing = coverage.GRID_SPACING * 1e3
     lines = [
         "## How much of its body each mannequin fills",
         "",
-        "Measured by `tools/coverage.py` against the body each mannequin was traced from (moved by the same "
+        "Measured by `tools/shipped/coverage.py` against the body each mannequin was traced from (moved by the same "
         f"registration), on a regular {spacing:g} mm grid: **coverage** is the share of the body's volume "
         "inside the union of the pieces, **excess** the share of the pieces' volume outside the body, "
         "**depth** how far (mm) a piece reaches outside the body surface at most, and which. *Ellipsoids*: "
@@ -597,7 +598,7 @@ def summary(base, rms):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m tools.build_reference", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m tools.shipped.build_reference", description=__doc__.split("\n")[0])
     parser.add_argument(
         "--refmodels",
         type=pathlib.Path,

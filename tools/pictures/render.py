@@ -5,10 +5,10 @@ so the file being rendered is left as it was. Each *slot* is one group of solid 
 collections or objects) with optional semi-transparent *ghosts* (e.g. the reference body it was
 traced over); several slots stand side by side along X for a line-up.
 
-    python -m tools.render mannequins A.json [B.json ...] [--ghost A.obj ...] --out PNG [--view SIDE]
+    python -m tools.pictures.render mannequins A.json [B.json ...] [--ghost A.obj ...] --out PNG [--view SIDE]
         [--ghost-shift X Y Z] [--side-too]
-    python -m tools.render poses A.json --out PNG [--view THREE_QUARTER] [--pose NAME ...] [--walk-frame K]
-    python -m tools.render objs A.obj [B.obj ...] --out PNG [--side K ...]
+    python -m tools.pictures.render poses A.json --out PNG [--view THREE_QUARTER] [--pose NAME ...] [--walk-frame K]
+    python -m tools.pictures.render objs A.obj [B.obj ...] --out PNG [--side K ...]
 """
 
 import argparse
@@ -210,7 +210,7 @@ def objs(files, out, sides=(), color=(0.87, 0.72, 0.62, 1.0)):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m tools.render", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m tools.pictures.render", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
     lineup = sub.add_parser("mannequins", help="mannequin JSON files side by side")
     lineup.add_argument("files", nargs="+", type=Path)
