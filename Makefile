@@ -1,6 +1,6 @@
 # Every target sets itself up. The working venv .venv is the matrix's Blender 5.0 lane (bpy 5.0.1,
 # Python 3.11); `make test` also makes the other lanes' venvs (.venv-bpy4.2, .venv-bpy4.5,
-# .venv-bpy5.3) on first use. tools/matrix.py says which Blender, Python and numpy each one holds.
+# .venv-bpy5.3) on first use. tools/matrix/lanes.py says which Blender, Python and numpy each one holds.
 PYTHON ?= python3.11
 VENV := .venv
 PY := $(VENV)/bin/python
@@ -20,9 +20,9 @@ setup:
 test:
 	$(PYTHON) -m tools.matrix --lanes "$(LANES)"
 
-# The fast lane for working: core and Blender tests not marked slow, on the working venv.
+# The fast lane for working: core, command-line and Blender tests not marked slow, on the working venv.
 check: setup
-	$(PY) -m pytest -p no:cacheprovider -q -m "not slow" tests/core tests/blender
+	$(PY) -m pytest -p no:cacheprovider -q -m "not slow" tests/core tests/cli tests/blender
 
 demo: setup
 	$(PY) -m ellimann_addon demo -o $(DEMO_OUT)

@@ -3,7 +3,7 @@
 What Blender prints is captured, so only the benchmarks' own lines show; ``-v`` / ``--verbose``
 shows Blender's output too (on stderr). ``--quick``: each benchmark's quick mode (a few requests, one repetition,
 no older commit checked out): it checks that every benchmark still runs (the tests run each one's quick mode:
-tests/core/test_bench_quick.py, tests/blender/test_bench_quick.py); its figures mean nothing.
+tests/core/test_bench_quick.py, tests/blender/test_bench_quick_blender.py); its figures mean nothing.
 """
 
 import importlib
@@ -34,7 +34,7 @@ BENCHES = (
 )
 
 # The benchmarks that need the bpy module (Blender's cloth, the panel, its importer): their quick modes run in
-# tests/blender/test_bench_quick.py, the others' in tests/core/test_bench_quick.py.
+# tests/blender/test_bench_quick_blender.py, the others' in tests/core/test_bench_quick.py.
 NEEDS_BLENDER = (
     "bench_synthesis",
     "bench_live",

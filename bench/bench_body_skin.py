@@ -5,7 +5,7 @@ reading of the five, and the time per request.
 
 - Leave-one-out over the six bodies of ../shared/refmodels (female) and ../shared/refmodels_male: the held-out
   body's twin from the other five bodies (the body skin) and from the other five's RMs (today's exact skin over
-  the pieces; the six RMs built once by tools.held_out.six_rms, a few minutes per set); beside them the bodies'
+  the pieces; the six RMs built once by tools.figures.held_out.six_rms, a few minutes per set); beside them the bodies'
   blend alone and the least-squares best blend of the five (fitted to the answer: what five bodies can give).
 - The 80 bodies of ../shared/bodies (never seen by the shipped sets): their twins from the shipped set.
 - Speed: an exact body skin per request against today's skin at the preview and final levels and exact mode.
@@ -33,8 +33,8 @@ from ellimann_addon.core.skin.surface import build_skin
 from ellimann_addon.core.synthesis.bodies import load_set_bodies
 from ellimann_addon.core.synthesis.shipped import named_reference_set, reference_folder
 from ellimann_addon.core.synthesis.synthesize import synthesize_batch
-from tools.add_bodies import set_bodies
-from tools.reference_sets import BUILD_SETS, SHARED
+from tools.shipped.add_bodies import set_bodies
+from tools.shipped.reference_sets import BUILD_SETS, SHARED
 
 SPACING = 0.008  # m: the issue's voxels
 TODAY = "today's skin"
@@ -85,7 +85,7 @@ def held_out_rows(name, with_pieces):
     bodies = set_bodies(build_set, six)
     rms = None
     if with_pieces:
-        from tools.held_out import six_rms, subset_set
+        from tools.figures.held_out import six_rms, subset_set
 
         rms, targets, _, _ = six_rms(build_set.refmodels, 2, build_set)
     rows = []

@@ -29,7 +29,7 @@ from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ellimann_addon.core.synthesis import extra_refine as refine_extra
 from ellimann_addon.core.synthesis import synthesize as synthesis
 from ellimann_addon.core.synthesis.shipped import FEMALE_SET, MALE_SET, named_reference_set
-from tools.reference_sets import TRACING_FOLDER
+from tools.shipped.reference_sets import TRACING_FOLDER
 
 GRID_STEP = 27  # every 27th of the 243 inner-quartile requests: 9 per set
 MEET_PER_SET = 2

@@ -1,7 +1,6 @@
 """Scan to mannequin: the time to measure a body mesh, and how much the extra measurements make a synthesized
-twin overlap its body (core.geometry.volume.voxel_iou of its ellipsoids, the twin stood as tools/overlap.py stands
-it), on
-the six female reference bodies of ../shared/refmodels.
+twin overlap its body (core.geometry.volume.voxel_iou of its ellipsoids, the twin stood as tools/figures/overlap.py
+stands it), on the six female reference bodies of ../shared/refmodels.
 
 Per body: measure the mesh (core.measure.body, no labels), synthesize in exact mode with the five it found, with
 the five and each extra measurement alone, and with all it found (core.synthesis.extra_refine), and count the IoU of
@@ -21,9 +20,9 @@ from ellimann_addon.core.measure.extra import split_measurements
 from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize_extra
-from tools.bodies import body_measurements, load_labels
-from tools.overlap import standing_in
-from tools.reference_sets import TRACING_FOLDER
+from tools.figures.overlap import standing_in
+from tools.shipped.bodies import body_measurements, load_labels
+from tools.shipped.reference_sets import TRACING_FOLDER
 
 BODIES = ("reference_female", "small_slim", "tall_slim", "small_chubby", "tall_chubby", "average")
 SPACING = 0.005

@@ -2,11 +2,11 @@
 twin synthesized (exact mode) from the other five bodies' Reference Mannequins with the five measurements its mesh
 gives and with all eleven, and the IoU of each twin with the body (bench_scan's overlap: 5 mm voxels, the twin
 stood in the body); with ``--gap``, also how far the body's surface lies outside the twin from its five (the cloth's
-gap, tools/cloth_gap.py).
+gap, tools/figures/cloth_gap.py).
 
 bench_scan's bodies are, but for the neutral one, the bodies of the shipped RMs, whose five-measurement twin
 is nearly their own RM: this is the fair test of what the extra measurements add. The six RMs are built once
-by the product's builder (tools.held_out.six_rms: an RM depends only on its own body), a few minutes per set.
+by the product's builder (tools.figures.held_out.six_rms: an RM depends only on its own body), a few minutes per set.
 
     python -m bench bench_scan_held_out                        # the female set (the paper's 40)
     python -m bench.bench_scan_held_out --sets female,female-fine,male,male-fine --gap
@@ -22,12 +22,12 @@ from ellimann_addon.core.geometry.volume import IOU_MARGIN, BodyVolume
 from ellimann_addon.core.measure.body import measure_body_mesh
 from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.shipped import named_reference_set
-from tools.bodies import read_bodies
-from tools.build_reference import DEFAULT_REFMODELS
-from tools.cloth_gap import surface_gap
-from tools.held_out import six_rms, subset_set
-from tools.overlap import standing_in
-from tools.reference_sets import BUILD_SETS, FEMALE
+from tools.figures.cloth_gap import surface_gap
+from tools.figures.held_out import six_rms, subset_set
+from tools.figures.overlap import standing_in
+from tools.shipped.bodies import read_bodies
+from tools.shipped.build_reference import DEFAULT_REFMODELS
+from tools.shipped.reference_sets import BUILD_SETS, FEMALE
 
 
 def held_out(build_set=FEMALE, workers=2, gap=False, quick=False):

@@ -2,7 +2,7 @@
 the request on its own mesh, the rounds and the time.
 
 The grid (GRID): reference bodies' own measurements (the five as their README measures them, the six as the
-body-mesh measurer takes them: tools.bodies.body_requests), with and without the six, on both sets; and Table
+body-mesh measurer takes them: tools.shipped.bodies.body_requests), with and without the six, on both sets; and Table
 2.5 requests with the set's own extra measurements 6 % up or down. Each request: a mannequin synthesized from
 the five (exact mode), then ``core.skin.exact.exact_skin`` at the preview and the final level. Printed per
 request and level: the rounds, the seconds (wall clock, this process; the machine is shared: read them as a
@@ -22,8 +22,8 @@ from ellimann_addon.core.settings import LEVELS
 from ellimann_addon.core.skin.exact import exact_skin
 from ellimann_addon.core.synthesis.shipped import named_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize
-from tools.bodies import body_requests, load_labels
-from tools.reference_sets import BUILD_SETS, TRACING_FOLDER
+from tools.shipped.bodies import body_requests, load_labels
+from tools.shipped.reference_sets import BUILD_SETS, TRACING_FOLDER
 
 # (set, body or Table 2.5 row, extra measurements: "none", "own" (the body's) or a ratio to what the set gives)
 GRID = (

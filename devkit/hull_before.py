@@ -2,7 +2,7 @@
 speed-up (main at b43ba1d, verbatim but for the name): a 128-direction grid, every cell where the outermost
 ellipse changes or a hidden one seemed possible sampled 16 times finer, 12 Gauss-Legendre nodes per piece. Its
 bound on a hidden ellipse used that ellipse's curvature, not the outermost one's, so it can miss a small ellipse
-rising through a flat side between grid directions (tests/core/test_measure.py). Tests check the two agree on
+rising through a flat side between grid directions (tests/core/measure/test_tailor.py). Tests check the two agree on
 random bodies; the bench measures both in one run."""
 
 import numpy as np

@@ -23,7 +23,7 @@ import sys
 BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 OLD_KERNEL = "Prescott"  # OpenBLAS's kernel for the first x86-64 CPUs: every x86-64 CPU runs it
 # The extra measurements of three of ../shared/refmodels' bodies as measured on their meshes (tests/core/
-# test_refine_extra.py): the tall one's thigh and calf once hung on the last bits of the neck's band search.
+# test_extra_refine.py): the tall one's thigh and calf once hung on the last bits of the neck's band search.
 BODIES = {
     "slim": ((148.0, 31.11, 84.97, 63.0, 83.0), (27.59, 19.95, 43.85, 32.30, 67.17, 57.02)),
     "tall": ((170.99, 30.22, 83.98, 62.99, 84.01), (29.03, 19.50, 43.55, 35.17, 80.07, 64.09)),

@@ -15,7 +15,7 @@ def toy():
 
 def pytest_collection_modifyitems(config, items):
     """Leave out the tests marked slow of the suites (tests/<suite>) named in ELLIMANN_QUICK_SUITES: the matrix
-    (tools/matrix.py) runs them on another lane."""
+    (tools/matrix/lanes.py) runs them on another lane."""
     quick = {name for name in os.environ.get("ELLIMANN_QUICK_SUITES", "").split(",") if name}
     if not quick:
         return

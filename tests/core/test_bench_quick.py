@@ -1,7 +1,7 @@
 """Every benchmark runs (``make bench`` is run by hand, rarely: a function it calls that moved or changed must fail
 a test, not the benchmark a user tries): each numpy-only one's quick mode here (a few requests, one repetition, no
-older commit checked out), those that need the bpy module in tests/blender/test_bench_quick.py. Their figures are
-not checked: speed is measured by ``make bench``, never asserted."""
+older commit checked out), those that need the bpy module in tests/blender/test_bench_quick_blender.py. Their figures
+are not checked: speed is measured by ``make bench``, never asserted."""
 
 import importlib
 import inspect

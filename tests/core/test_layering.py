@@ -205,15 +205,22 @@ def test_no_private_name_is_imported_across_modules():
     assert offenders == []
 
 
-def module_graph(sources=None):
-    """Each module of the package -> the modules of the package it imports, at its top or inside a function (a lazy
-    import is an edge too). ``sources``: {dotted name: source text} read instead of those modules' files."""
+def dotted_modules(folders):
+    """{dotted name: path} of every module under ``folders`` (packages by their ``__init__``)."""
+    modules = {}
+    for folder in folders:
+        for path in folder.rglob("*.py"):
+            parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+            modules[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = path
+    return modules
+
+
+def module_graph(sources=None, folders=(PACKAGE,)):
+    """Each module of the package (or of ``folders``) -> the modules among them it imports, at its top or inside a
+    function (a lazy import is an edge too). ``sources``: {dotted name: source text} read instead of those modules'
+    files."""
     sources = sources or {}
-    graph = {}
-    for path in PACKAGE.rglob("*.py"):
-        parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
-        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
-        graph[name] = set(resolved_imports(path, sources.get(name)))
+    graph = {name: set(resolved_imports(path, sources.get(name))) for name, path in dotted_modules(folders).items()}
 
     def edges(name, deps):
         # A module's own packages are loaded before it: importing a submodule of one (``from .. import ids``) adds
@@ -249,6 +256,30 @@ def test_no_import_cycle_in_the_package():
     assert find_cycle(module_graph()) == []
 
 
+REPOSITORY = PACKAGE.parent
+DEV_FOLDERS = tuple(REPOSITORY / name for name in ("tools", "bench", "devkit"))
+
+
+def test_no_import_cycle_anywhere_tools_bench_and_devkit_included():
+    assert find_cycle(module_graph(folders=(PACKAGE, *DEV_FOLDERS))) == []
+
+
+def test_every_import_of_tools_bench_or_devkit_names_one_of_their_modules():
+    """tools/, bench/ and devkit/ are imported by path from the repository root (tests, benchmarks, ``python -m``): a
+    module moved without its importers following fails here, lazy imports included, not when that code first runs."""
+    modules = dotted_modules(DEV_FOLDERS)
+    importers = [*modules.values(), *(REPOSITORY / "tests").rglob("*.py")]
+    unknown = [
+        f"{path.relative_to(REPOSITORY)}: {name}"
+        for path in importers
+        for name in resolved_imports(path)
+        if name.split(".")[0] in {"tools", "bench", "devkit"}
+        and name not in modules
+        and name.rsplit(".", 1)[0] not in modules  # ``from tools.x import name``: a name of a module
+    ]
+    assert unknown == []
+
+
 def test_the_cycle_check_sees_a_lazy_import_of_a_parent_package_s_code():
     """The command line once registered the whole add-on to write a .glb (``from .. import register`` inside a
     function), which registered the Blender command, which imports the command line: a cycle through the parent
@@ -269,6 +300,21 @@ def test_every_folder_of_the_package_has_a_one_line_readme():
     missing = [str(f.relative_to(PACKAGE.parent)) for f in folders if not (f / "README.md").is_file()]
     assert missing == []
     long = [str(f.relative_to(PACKAGE.parent)) for f in folders if len((f / "README.md").read_text().splitlines()) != 1]
+    assert long == []
+
+
+def test_every_folder_of_tools_devkit_tests_and_bench_has_a_one_line_readme():
+    """The package's rule (above) for the folders around it: each README.md is one line saying what the folder holds."""
+    folders = [
+        folder
+        for root in ("tools", "devkit", "tests", "bench")
+        for folder in [REPOSITORY / root, *(REPOSITORY / root).rglob("*")]
+        if folder.is_dir()
+        and not any(p == "__pycache__" or p.startswith(".") for p in folder.relative_to(REPOSITORY).parts)
+    ]
+    missing = [str(f.relative_to(REPOSITORY)) for f in folders if not (f / "README.md").is_file()]
+    assert missing == []
+    long = [str(f.relative_to(REPOSITORY)) for f in folders if len((f / "README.md").read_text().splitlines()) != 1]
     assert long == []
 
 

@@ -6,7 +6,7 @@ collide; the skin is what a viewer shows over them.
 - In the articulated MJCF (``core.formats.mjcf_articulated``) its bones are the 24 SMPL bodies, each bound at its
   rest joint centre with the world's axes (how those bodies stand at rest) and weighted as ``Skin.bones`` gives
   (the weights glTF and Blender's Armature modifier use), so that MuJoCo moves the skin with the body in every
-  keyframe and in simulation exactly as ``Skin.posed`` does (``tests/core/test_cli_skin.py`` compares them).
+  keyframe and in simulation exactly as ``Skin.posed`` does (``tests/cli/test_cli_skin.py`` compares them).
 
 Coordinates are written to 7 significant digits (MuJoCo keeps them in single precision: about a micrometre).
 """

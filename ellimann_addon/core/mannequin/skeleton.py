@@ -122,7 +122,7 @@ PART_BONES = {
     "Ankle": "Knee",
     "Foot": "Ankle",
     "Toes": "Foot",
-    # the fine topology's (tools/reference_topology_fine.py)
+    # the fine topology's (tools/shipped/reference_topology_fine.py)
     "Occiput": "Head",
     "Forehead": "Head",
     "Jaw": "Head",

@@ -12,7 +12,7 @@ A file's name maps onto one of them only where the file's definition measures th
 a similar name is not enough (each mapping says why). Two survey measurements are used only to predict a missing
 one (``PREDICTORS``): the neck's girth at its base and the breadth between the acromia (the shoulder tips), which
 the shipped survey holds beside the five. Every mapping is one ``Mapping`` row; docs/formats/measurement_files.md
-is generated from these tables (``mapping_markdown``; tests/core/test_sizing_doc.py checks the page).
+is generated from these tables (``mapping_markdown``; tests/core/sizing/test_mapping_doc.py checks the page).
 """
 
 from dataclasses import dataclass

@@ -3,7 +3,7 @@ FreeSewing measurements set (.json), a size chart's row (.csv). Each measurement
 where the format has one that is the same measurement (core.sizing.names, the same tables the readers use); the
 others go where the format keeps what it has no name for: Seamly2D's custom measurements (``@ellimann_Sh``), the
 set's ``ellimann`` section; a chart takes ElliMann's keys. Read back with core.sizing.readers, every value
-returns as written (tests/core/test_sizing_roundtrip.py). Files are written atomically.
+returns as written (tests/core/sizing/test_writers.py). Files are written atomically.
 """
 
 import csv

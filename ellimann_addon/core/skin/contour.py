@@ -7,7 +7,7 @@ same from both sides: inside corners join only along the cube's edges (6-connect
 always separates them. On each face the crossing points are then joined in segments; every crossing point lies
 on two faces, so the segments close into cycles, each a fan whose diagonals cross the cube. Two cubes sharing a
 face make the same segments on it, and around a crossing point the four cubes' patches close into one disk: the
-result is a closed 2-manifold whatever the field (``tests/core/test_skin.py`` checks it on random fields).
+result is a closed 2-manifold whatever the field (``tests/core/skin/test_skin.py`` checks it on random fields).
 
 Corners are numbered by their offset bits (x 1, y 2, z 4); a corner is inside where the field is negative.
 """

@@ -21,7 +21,7 @@ Volume. Bending one joint by theta about an axis a through it changes the skinne
     dV = -(1 - cos theta) * integral of w (1 - w) (r_perp . N) dS  +  sin theta * integral of w (a x r) . N dS
 
 over the skin (w the bent side's weight, r = x - joint, r_perp its part across a, N the outward normal: the
-divergence theorem on the blended map; ``tests/core/test_skinning.py`` checks it). The first term always loses,
+divergence theorem on the blended map; ``tests/core/skin/test_skinning.py`` checks it). The first term always loses,
 the more the wider the blend; the second depends only on where the blend runs round the limb. The hips lose most:
 the thigh's flesh lies in front of the hip joint, so a blend at the joint's level folds the thigh into the belly
 when it flexes. So the hips bend lower, their planes HIP_DROP of the way from the joint down to the lowest point of

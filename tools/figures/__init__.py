@@ -1,0 +1,1 @@
+"""Numbers, tables and plots for the docs, numpy only (README.md)."""

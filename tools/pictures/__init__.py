@@ -1,0 +1,1 @@
+"""Pictures for the docs drawn through Blender (README.md)."""

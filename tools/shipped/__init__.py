@@ -1,0 +1,1 @@
+"""Building the shipped reference sets and their data (README.md)."""
