@@ -127,11 +127,11 @@ def _twins(maker, body, faces, request):
 
 
 def cloth_gap(mannequin, vertices, faces):
-    """tools.cloth_gap.surface_gap of a body skin against ``mannequin`` (its pieces), the mannequin stood in the
-    skin as tools/cloth_gap.py stands it in a body (floors alike, the volumes' centroids on one vertical line):
+    """tools.figures.cloth_gap.surface_gap of a body skin against ``mannequin`` (its pieces), the mannequin stood in the
+    skin as tools/figures/cloth_gap.py stands it in a body (floors alike, the volumes' centroids on one vertical line):
     how far the skin lies outside the pieces a garment rests on."""
-    from tools.cloth_gap import surface_gap
-    from tools.overlap import standing_in
+    from tools.figures.cloth_gap import surface_gap
+    from tools.figures.overlap import standing_in
 
     grid = BodyVolume(vertices, faces).grid(IOU_SPACING, margin=IOU_MARGIN)
     lowest = float(

@@ -10,11 +10,11 @@ own steps (its StandingBody, crotch, leg girths, neck slices, arm readings), wit
 - the neck square to a given tilt (the skin's own Neck -> Head axis, as today's skin is measured: a tilt
   searched on the mesh jumps between nearby bodies).
 
-``read(..., marks=None)`` searches every band as the measurer does (its samples, its golden steps): the same
-numbers as ``measure_body_mesh(vertices, faces, fractions, neck_tilt, arms)`` (tests/core/test_body_tape.py, on
-the bank's bodies). With ``marks`` (where the last reading found the calf's and the neck's extremes) it searches
-only a window about them (WINDOW_SAMPLES and WINDOW_STEPS): the correction's loop, whose bodies move by
-millimetres between readings; an extreme's value is insensitive to where exactly it is found.
+``read(..., marks=None)`` searches every band as the measurer does (its samples, its golden steps): the same numbers as
+``measure_body_mesh(vertices, faces, fractions, neck_tilt, arms)`` (tests/core/body/test_body_extra_tape.py, on the
+bank's bodies). With ``marks`` (where the last reading found the calf's and the neck's extremes) it searches only a
+window about them (WINDOW_SAMPLES and WINDOW_STEPS): the correction's loop, whose bodies move by millimetres between
+readings; an extreme's value is insensitive to where exactly it is found.
 """
 
 from dataclasses import dataclass, field

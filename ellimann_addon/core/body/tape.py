@@ -3,7 +3,7 @@
 
 The five (He, Sh, Br, Wa, Hi) are taken with ``measure_body_mesh``'s own steps (its StandingBody sections, its
 crossing rule, the same hull), only without the extra measurements' searches: :func:`five` equals
-``measure_body_mesh(...).values`` for the five, to the last bit (tests/core/test_body_data.py). The correction
+``measure_body_mesh(...).values`` for the five, to the last bit (tests/core/synthesis/test_bodies.py). The correction
 reads the six extras with core.body.extra_tape (the measurer's own steps, fast on the fixed topology);
 :meth:`full` is the whole measurer (a BodySkin's ``measure()``).
 """

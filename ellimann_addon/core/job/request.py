@@ -179,7 +179,6 @@ def checked_skin(request):
         for mannequin in [made] if made is not None else reference.mannequins:
             check_skin(mannequin, settings)
     return settings, reference if kind == "body" else None
-    return job
 
 
 def row_job(command, measurements, references, extra, warnings, name, outputs):

@@ -149,7 +149,7 @@ def test_bodies_without_joints_are_kept_with_regressed_ones_or_refused_in_one_li
 
 
 def test_a_skeleton_file_gives_each_body_its_joints(tmp_path, female):
-    from tools.reference_sets import SHARED
+    from tools.shipped.reference_sets import SHARED
 
     found = skeleton_joints(SHARED / "refmodels" / "skeleton.json")
     for i, name in enumerate(female.names):

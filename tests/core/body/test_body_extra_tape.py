@@ -11,7 +11,7 @@ from ellimann_addon.core.measure.body import StandingBody, measure_body_mesh
 from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS
 from ellimann_addon.core.synthesis.bodies import load_set_bodies
 from ellimann_addon.core.synthesis.shipped import reference_folder
-from tools.reference_sets import SHARED
+from tools.shipped.reference_sets import SHARED
 
 TILT = 0.35  # radians forward: a neck axis's tilt as the bodies' joints give (0.3-0.45)
 
