@@ -107,29 +107,35 @@ def run(args):
     settings, skin_measured = skin
     if args.json:
         shown = _shown(values)
-        shown["skin"] = {"voxel_mm": settings.voxel_mm, "blend": settings.blend, **_shown(skin_measured)}
+        how = {"kind": "body"} if settings.kind == "body" else {"voxel_mm": settings.voxel_mm, "blend": settings.blend}
+        shown["skin"] = {**how, **_shown(skin_measured)}
         print(json.dumps(shown))
         return 0
     _print(values, False, path, f"{mannequin.name or path}: its pieces (m_T and more)")
     how = describe(settings).removeprefix("skin ")
-    title = f"{mannequin.name or path}: its skin ({how}, made again from the pieces as the file records it; its mesh)"
+    title = f"{mannequin.name or path}: its skin ({how}, made again as the file records it; its mesh)"
     _print(skin_measured, False, path, title)
     return 0
 
 
 def skin_values(mannequin, path):
-    """(SkinSettings, {key: cm}) of the skin a .json records (its ``skin`` section): made again from the pieces (the
-    same pieces give the same skin), measured on its mesh as ``synth --skin`` reports it (the five by m_T's
-    definitions, the extra ones by the body-mesh measurer; one not taken is left out)."""
+    """(SkinSettings, {key: cm}) of the skin a .json records (its ``skin`` section): made again as the file records
+    it (a job of the mannequin already made: the body skin from its set's bodies and the request it records, the skin
+    over the pieces from the pieces), measured on its mesh as ``synth --skin`` reports it (one not taken is left
+    out)."""
+    from ..core.errors import ElliMannError
+    from ..core.job.make import make
+    from ..core.job.request import Request, check
     from ..core.mannequin.skin_record import SkinSettings
     from ..core.skin.measure import body_measurements, mesh_measurements
-    from ..core.skin.surface import SkinError, build_skin
 
     settings = SkinSettings.from_dict(mannequin.skin)
     try:
-        skin = build_skin(mannequin, settings)
-    except SkinError as error:
+        skin = make(check(Request(mannequin=mannequin, skin=settings))).skin.skin
+    except ElliMannError as error:
         raise UsageError(f"{path}: its skin cannot be made again: {output.one_line(error)}") from None
+    if settings.kind == "body":
+        return settings, dict(skin.measure().values)
     values = mesh_measurements(skin)
     values.update(body_measurements(skin).values)
     return settings, values

@@ -177,7 +177,7 @@ def _result(args, result):
     if result.skin is not None:
         skin = result.skin
         out["skin"] = {
-            **skin.settings.to_dict(),
+            **skin.skin.record(),
             "measured": skin.measured,
             "error_pct": errors(skin.measured),
             "exact": skin.exact,

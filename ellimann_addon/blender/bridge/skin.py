@@ -22,7 +22,7 @@ from ...core.skin.weights import INFLUENCES
 from .built import built_collection, built_objects, tag_built
 from .convert import fill_mesh, mesh_vertices, write_mesh_vertices
 
-SETTINGS_KEY = "ellimann_skin"  # how the skin was made: SkinSettings.to_dict() as JSON
+SETTINGS_KEY = "ellimann_skin"  # how the skin was made: its record (Skin.record(), BodySkin.record()) as JSON
 SOURCE_KEY = "ellimann_skin_source"  # the pieces' matrices (n x 12) it was made from, for staleness
 PIECE_ATTRIBUTES = tuple(f"ellimann_piece_{k}" for k in range(INFLUENCES))
 WEIGHT_ATTRIBUTES = tuple(f"ellimann_piece_weight_{k}" for k in range(INFLUENCES))
@@ -64,13 +64,15 @@ def write_skin_object(collection, skin, name=None):
     inverse = np.linalg.inv(np.array(obj.matrix_world))
     fill_mesh(mesh, skin.vertices @ inverse[:3, :3].T + inverse[:3, 3], skin.faces)
     mesh.shade_smooth()
-    for names, kind, values in (
-        (PIECE_ATTRIBUTES, "INT", skin.pieces.astype(np.int32)),
-        (WEIGHT_ATTRIBUTES, "FLOAT", skin.weights.astype(np.float32)),
-    ):
-        for k, name_k in enumerate(names):
-            mesh.attributes.new(name_k, kind, "POINT").data.foreach_set("value", np.ascontiguousarray(values[:, k]))
-    obj[SETTINGS_KEY] = json.dumps(skin.settings.to_dict())
+    if skin.settings.kind != "body":  # the pieces each vertex follows (a live step moves it with them)
+        for names, kind, values in (
+            (PIECE_ATTRIBUTES, "INT", skin.pieces.astype(np.int32)),
+            (WEIGHT_ATTRIBUTES, "FLOAT", skin.weights.astype(np.float32)),
+        ):
+            for k, name_k in enumerate(names):
+                attribute = mesh.attributes.new(name_k, kind, "POINT")
+                attribute.data.foreach_set("value", np.ascontiguousarray(values[:, k]))
+    obj[SETTINGS_KEY] = json.dumps(skin.record())
     obj[SOURCE_KEY] = piece_matrices(skin.mannequin).ravel().tolist()
     return obj
 
@@ -115,10 +117,20 @@ def read_skin(obj, mannequin):
 
 def skin_settings_of(obj):
     """How a skin object was made (SkinSettings), or None if it does not say."""
+    record = skin_record_of(obj)
     try:
-        return SkinSettings.from_dict(json.loads(obj[SETTINGS_KEY]))
-    except (KeyError, ValueError, TypeError, ElliMannError):
+        return None if record is None else SkinSettings.from_dict(record)
+    except ElliMannError:
         return None
+
+
+def skin_record_of(obj):
+    """A skin object's ``skin`` section (how to make it again, core.mannequin.skin_record), or None."""
+    try:
+        record = json.loads(obj[SETTINGS_KEY])
+    except (KeyError, ValueError, TypeError):
+        return None
+    return record if isinstance(record, dict) else None
 
 
 def is_stale_skin(obj, mannequin):

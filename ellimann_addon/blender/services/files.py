@@ -55,7 +55,7 @@ from ...core.measurements import MEASUREMENTS
 from ..bridge.built import built_objects, is_stale
 from ..bridge.convert import collection_to_mannequin, objects_recursive
 from ..bridge.selection import part_lookup
-from ..bridge.skin import is_stale_skin, skin_object, skin_settings_of
+from ..bridge.skin import is_stale_skin, skin_object, skin_record_of
 from .chatter import blender_output
 from .rig import build_rig
 from .scene import add_mannequin, empty_scene
@@ -77,8 +77,7 @@ def part_extras(obj):
         "partner": props.partner,
     }
     if props.kind == "SKIN":
-        settings = skin_settings_of(obj)
-        return {"kind": "SKIN", "skin": settings.to_dict() if settings is not None else None}
+        return {"kind": "SKIN", "skin": skin_record_of(obj)}
     if props.kind == "ELLIPSOID":
         matrix = np.array(obj.matrix_world)
         semi = np.linalg.norm(matrix[:3, :3], axis=0)

@@ -59,6 +59,12 @@ class BodySkin:
     seconds: float = 0.0
     pieces_measured: dict = field(default_factory=dict)
     abduction: float = 0.0
+    mannequin: object = None  # the pieces it goes with (a job's: core.job.make), their joints this skin's
+    settings: object = None  # how it was asked (core.mannequin.skin_record.SkinSettings, kind "body")
+
+    def record(self):
+        """The ``skin`` section of the file of the pieces it goes with: how to make it again (the request)."""
+        return self.settings.to_dict(self.request)
 
     @cached_property
     def _balanced(self):

@@ -74,4 +74,4 @@ def with_skin_record(mannequin, skin):
         for field in ("rotation", "center", "semi_axes")
     ):
         raise ElliMannError(f"skin: made from other pieces than those of '{mannequin.name}'")
-    return mannequin.copy(skin=skin.settings.to_dict())
+    return mannequin.copy(skin=skin.record())

@@ -73,6 +73,8 @@ def add_skin(root, skin, bone_bodies=None, joints=None):
 def skin_comment(skin):
     """The MJCF comment's line about the skin."""
     settings = skin.settings
+    if settings.kind == "body":
+        return f" Skin: the body skin ({len(skin.vertices)} vertices), drawn only: the pieces collide.\n"
     return (
         f" Skin: one closed mesh over the pieces ({len(skin.vertices)} vertices, {settings.voxel_mm:g} mm voxels, "
         f"blend {settings.blend:g}), drawn only: the pieces collide.\n"

@@ -69,6 +69,8 @@ def skin_title(skin, pose=None):
     name = skin.mannequin.name
     where = f" in pose '{pose.name}'" if pose is not None else ""
     settings = skin.settings
+    if settings.kind == "body":
+        return f"ElliMann body skin of '{name}'{where}; measurements are the rest pose's"
     return (
         f"ElliMann skin of '{name}'{where}: {settings.voxel_mm:g} mm voxels, blend {settings.blend:g}; "
         "measurements are the rest pose's"

@@ -6,7 +6,7 @@ batch synthesizes its rows together (``core.synthesis.batch.synthesize_chunk``, 
 with :func:`finish`."""
 
 from ..measure.tailor import as_dict
-from ..measurements import EXTRA_MEASUREMENTS
+from ..measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ..synthesis.misses import request_misses, skin_misses
 from ..synthesis.synthesize import IDW_EXTRA_NOTE, meet_extra_request, synthesize_checked
 from .result import Result, SkinMade
@@ -43,7 +43,7 @@ def finish(job, mannequin, measured, progress=None, bones=False):
         warnings.append(IDW_EXTRA_NOTE)
     skin = None
     if job.skin is not None:
-        mannequin, measured, skin = _skin(job, mannequin, measured, report)
+        mannequin, measured, skin = _skin(job, mannequin, measured, report, warnings)
         if bones and mannequin.joints is not None:
             report(0.8, "weighting it to the bones")
             skin.skin.bones()
@@ -69,14 +69,62 @@ def synthesized_misses(job, measured):
     return request_misses(measured, job.values, job.extra, job.options.mode)
 
 
-def _skin(job, mannequin, measured, report):
-    """(pieces, their measurements, SkinMade): in exact mode the pieces refined until their skin measures the
-    request (``core.skin.exact``), else the skin of the pieces as they are, measured on its mesh."""
+def _skin(job, mannequin, measured, report, warnings):
+    """(pieces, their measurements, SkinMade) of a job's skin. The body skin (``core.body``): the set's bodies
+    interpolated for the request and corrected until they measure it, the pieces kept as they are (their joints the
+    skin's, where its body bends); asked as "auto", a request no body skin meets gets the skin over the pieces, and a
+    warning saying why. The skin over the pieces: in exact mode the pieces refined until it measures the request
+    (``core.skin.exact``), else the skin of the pieces as they are, measured on its mesh."""
+    settings = job.skin
+    if settings.kind == "body":
+        from ..body.correct import BodySkinError  # the body skin's code, loaded only when one is asked
+
+        try:
+            return _body_skin(job, mannequin, measured, report)
+        except BodySkinError as error:
+            if job.request.skin.kind != "auto":
+                raise
+            settings = settings.of_kind("pieces")
+            warnings.append(f"{error}; the skin is made over the pieces instead")
+    return _pieces_skin(job, settings, mannequin, measured, report)
+
+
+_MAKERS = {}  # id of a reference set -> (the set, its BodySkinMaker): a set's bodies read and prepared once
+
+
+def body_skin_maker(reference):
+    """The ``core.body.skin.BodySkinMaker`` of a reference set with bodies, made once per set."""
+    from ..body.skin import body_skin_maker as make_maker
+
+    kept = _MAKERS.get(id(reference))
+    if kept is None or kept[0] is not reference:
+        kept = _MAKERS[id(reference)] = (reference, make_maker(reference))
+        while len(_MAKERS) > 4:
+            del _MAKERS[next(iter(_MAKERS))]
+    return kept[1]
+
+
+def _body_skin(job, mannequin, measured, report):
+    """:func:`_skin`'s body skin: for a synthesized mannequin its request, for one already made the request its
+    file's skin section records."""
+    asked = {**job.five, **job.extra} if job.values is not None else dict((mannequin.skin or {}).get("request", {}))
+    five = {key: asked[key] for key in MEASUREMENTS if key in asked}
+    if len(five) < len(MEASUREMENTS):
+        five = {**dict(mannequin.measurements or {}), **five}
+    extra = {key: value for key, value in asked.items() if key in EXTRA_MEASUREMENTS}
+    report(0.0, "making the body skin from the set's bodies")
+    body = body_skin_maker(job.skin_reference).make(five, extra or None)
+    mannequin = mannequin.copy(joints=body.joints)  # the pieces bend where the skin's body does
+    body.mannequin, body.settings = mannequin, job.skin
+    return mannequin, measured, SkinMade(body, dict(body.measured), True, body.rounds, not body.misses())
+
+
+def _pieces_skin(job, settings, mannequin, measured, report):
+    """:func:`_skin`'s skin over the pieces."""
     from ..skin.exact import exact_skin  # the skin's code, loaded only when a skin is asked
     from ..skin.measure import body_measurements, mesh_measurements
     from ..skin.surface import build_skin
 
-    settings = job.skin
     if measured is None:  # a mannequin already made: its skin made again, as its file records
         report(0.0, f"making the skin ({settings.voxel_mm:g} mm voxels)")
         return mannequin, measured, SkinMade(build_skin(mannequin, settings), {}, False)

@@ -45,6 +45,10 @@ class Skin:
     weights: np.ndarray
     settings: SkinSettings
 
+    def record(self):
+        """The ``skin`` section of its pieces' file: how to make it again."""
+        return self.settings.to_dict()
+
     def bones(self):
         """(bones (V, 4), weights (V, 4)): linear-blend skinning weights on the SMPL joints, smooth across every
         joint and keeping the volume where the legs bend (``core.skin.skinning``; made once, on first use).
