@@ -53,7 +53,12 @@ def skin_settings(args, recorded=None):
     from ..core.mannequin.skin_record import SkinSettings  # the skin's code, loaded only when a skin is asked
 
     base = SkinSettings.from_dict(recorded) if recorded else None
+    pieces_only = [name for name in ("skin_level", "skin_voxel", "skin_blend") if getattr(args, name) is not None]
     kind = args.skin_kind or (base.kind if base is not None else SKIN["skin_kind"].default)
+    if pieces_only and kind == "body":
+        raise UsageError(f"{flag(pieces_only[0])} is a setting of the skin over the pieces: the body skin has none")
+    if pieces_only and args.skin_kind is None:
+        kind = "pieces"  # a voxel, a level or a blend asks for the skin over the pieces
     if args.skin_voxel is not None:
         voxel = args.skin_voxel
     elif args.skin_level is not None:

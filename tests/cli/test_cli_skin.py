@@ -87,7 +87,9 @@ def settings_of(recorded=None, **given):
 
 def test_a_skin_option_wins_over_the_file_s_record_which_wins_over_the_table():
     recorded = SkinSettings(7.5, 0.9).to_dict()
-    assert settings_of() == SkinSettings(LEVELS[SKIN["skin_level"].default], SKIN["skin_blend"].default)
+    default = SkinSettings(LEVELS[SKIN["skin_level"].default], SKIN["skin_blend"].default, SKIN["skin_kind"].default)
+    assert settings_of() == default and default.kind == "auto"  # the body skin where the set has bodies
+    assert settings_of(skin_level="preview").kind == "pieces"  # a setting of the pieces' skin asks for it
     assert settings_of(recorded) == SkinSettings(7.5, 0.9)
     assert settings_of(recorded, skin_level="preview") == SkinSettings(10.0, 0.9)
     assert settings_of(recorded, skin_level="preview", skin_voxel=6.0, skin_blend=0.3) == SkinSettings(6.0, 0.3)
@@ -300,7 +302,7 @@ def test_exact_mode_meets_the_request_on_the_skin_and_measure_of_its_obj_agrees(
     """Final level (5 mm): the skin's mesh within 1 mm of each of the five, the pieces' m_T beside it (less: the blend
     adds what the pieces lack), and the body-mesh measurer on the .obj agreeing."""
     out = tmp_path / "e.obj"
-    code, stdout, stderr = run(["synth", *REQUEST, "--skin", "-o", str(out), "--json"], capsys)
+    code, stdout, stderr = run(["synth", *REQUEST, "--skin", "--skin-kind", "pieces", "-o", str(out), "--json"], capsys)
     assert code == 0, stderr
     result = json.loads(stdout)
     skin = result["skin"]

@@ -406,7 +406,10 @@ WITH_SKIN = {**GOOD, "skin": SKIN_RECORD}
     "skin, words",
     [
         ([], ["skin: must be an object (version, voxel_mm, blend, method) or absent, got a list"]),
-        ({**SKIN_RECORD, "version": 2}, ["skin.version: is 2; this ElliMann reads skin version 1"]),
+        ({**SKIN_RECORD, "version": 3}, ["skin.version: is 3; this ElliMann reads skin versions 1 and 2"]),
+        ({**SKIN_RECORD, "version": 2}, ['skin.kind: must be "body" in version 2, got None']),
+        ({"version": 2, "kind": "body", "method": "m", "request": {"He": "tall"}}, ["skin.request: must be an object"]),
+        ({"version": 2, "kind": "body", "method": "m", "request": {"waist": 70}}, ["skin.request: must be an object"]),
         ({**SKIN_RECORD, "version": True}, ["skin.version"]),
         ({k: v for k, v in SKIN_RECORD.items() if k != "version"}, ["skin.version: is None"]),
         ({**SKIN_RECORD, "voxel_mm": "5"}, ["skin.voxel_mm: must be a number from 1 to 40, got '5'"]),

@@ -13,13 +13,14 @@ import sys
 import uuid
 
 from ....core.errors import ElliMannError
-from ....core.job.make import make
+from ....core.job.make import body_skin_maker, make
 from ....core.job.request import Request, check
 from ....core.mannequin.skin_record import SkinSettings
 from ...bridge.convert import collection_to_mannequin
 from ...bridge.skin import is_stale_skin, skin_object, write_skin_vertices
 from ...services.skin import add_skin
 from ..synthesize.live import Debounced, add_follower, remove_follower
+from ..synthesize.request import job_of, reference_of, request_of
 
 STAMP_KEY = "ellimann_skin_stamp"  # on a skin object: which core Skin it holds (_made)
 KEPT = 8  # core Skins kept in memory (each a few MB at the preview level)
@@ -45,22 +46,28 @@ def remembered(obj):
 
 
 def follow(scene, target, mannequin, seconds_left):
-    """A live step's follower: the target's skin moved with its pieces to ``mannequin``, and a new one made once the
-    fields are still. Moving it costs a few milliseconds (bench_live_skin), so it is done even when the step has
-    used its budget already (``seconds_left`` <= 0: a slow machine): a skin left behind would look broken."""
+    """A live step's follower: the target's skin moved to ``mannequin``, and made again once the fields are still.
+    A skin over the pieces moves with them (each vertex by its pieces' motion); a body skin takes the body model's
+    blend of the set's bodies for the new request (the correction waits for the fields to be still). Either costs a
+    few milliseconds (bench_live_skin), so it is done even when the step has used its budget already
+    (``seconds_left`` <= 0: a slow machine): a skin left behind would look broken."""
     props = scene.ellimann_synthesis
     if not props.skin:
         return
     obj = skin_object(target)
     skin = remembered(obj) if obj is not None else None
-    if skin is not None and skin.mannequin.topology.names == mannequin.topology.names:
+    if skin is not None and skin.settings.kind == "body":
+        vertices, _ = body_skin_maker(reference_of(props)).interpolated(request_of(props))
+        write_skin_vertices(obj, vertices)
+    elif skin is not None and skin.mannequin.topology.names == mannequin.topology.names:
         write_skin_vertices(obj, skin.following(mannequin).vertices)
     _settle_later(scene)
 
 
 def settle_skin(scene):
-    """Make the live target's skin again from its pieces at the preview level, unless it holds them already.
-    Returns the skin object, or None (nothing to do, or it could not be made: the panel's status says why)."""
+    """Make the live target's skin again, unless it holds it already: the panel's kind (a body skin for the request,
+    or the skin over the target's pieces at the preview level). Returns the skin object, or None (nothing to do, or
+    it could not be made: the panel's status says why)."""
     props = scene.ellimann_synthesis
     target = props.target
     if not props.skin or target is None or not target.ellimann.is_mannequin:
@@ -73,7 +80,13 @@ def settle_skin(scene):
             return None
         if obj is not None and remembered(obj) is not None and not is_stale_skin(obj, mannequin):
             return None
-        skin = make(check(Request(mannequin=mannequin, skin=SkinSettings.at_level(LIVE_LEVEL))), bones=True).skin.skin
+        settings = SkinSettings.at_level(LIVE_LEVEL, kind=props.skin_kind.lower())
+        job = job_of(props, skin=settings)
+        if job.skin.kind == "body":  # the request's body skin, over the pieces the target holds
+            skin = make(job, bones=True).skin.skin
+            skin.mannequin = mannequin.copy(joints=skin.joints)
+        else:
+            skin = make(check(Request(mannequin=mannequin, skin=job.skin)), bones=True).skin.skin
         obj = add_skin(target, skin)
     except (ElliMannError, RuntimeError) as error:
         message = " ".join(str(error).split())

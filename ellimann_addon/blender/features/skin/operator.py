@@ -18,6 +18,17 @@ from ..base import MannequinOperator, OperatorError, mannequin_or_cancel
 from . import live
 
 
+def kind_property(update=None):
+    option = SKIN["skin_kind"]
+    return EnumProperty(
+        name=option.label,
+        items=option.enum_items(),
+        default=option.enum_default,
+        description=option.description,
+        **({"update": update} if update else {}),
+    )
+
+
 def level_property(update=None):
     option = SKIN["skin_level"]
     return EnumProperty(
@@ -51,19 +62,21 @@ def blend_property():
     )
 
 
-def settings_of(level, voxel_mm=0.0, blend=SKIN["skin_blend"].default):
-    """SkinSettings of a panel's level (an enum item), voxel (0: the level's) and blend; ElliMannError names a bad
-    one. Blender's float properties are single precision: their values are rounded to what was typed."""
-    return SkinSettings.at_level(level.lower(), round(voxel_mm, 4) or None, round(blend, 6))
+def settings_of(level, voxel_mm=0.0, blend=SKIN["skin_blend"].default, kind="PIECES"):
+    """SkinSettings of a panel's kind and level (enum items), voxel (0: the level's) and blend; ElliMannError names a
+    bad one. Blender's float properties are single precision: their values are rounded to what was typed."""
+    return SkinSettings.at_level(level.lower(), round(voxel_mm, 4) or None, round(blend, 6), kind.lower())
 
 
 class ELLIMANN_OT_build_skin(MannequinOperator, bpy.types.Operator):
-    """Build a smooth closed skin over the active mannequin's pieces, bound to its armature if it has one"""
+    """Build the active mannequin's skin (from its set's bodies where it has them, or a smooth surface over its
+    pieces), bound to its armature if it has one"""
 
     bl_idname = ids.BUILD_SKIN
     bl_label = "Build Skin"
     bl_options = {"REGISTER", "UNDO"}
 
+    kind: kind_property()
     level: level_property()
     voxel: voxel_property()
     blend: blend_property()
@@ -74,7 +87,7 @@ class ELLIMANN_OT_build_skin(MannequinOperator, bpy.types.Operator):
         started = time.perf_counter()
         window_manager.progress_begin(0.0, 1.0)
         try:
-            settings = settings_of(self.level, self.voxel, self.blend)
+            settings = settings_of(self.level, self.voxel, self.blend, self.kind)
             job = check(Request(mannequin=mannequin, skin=settings))
             result = make(job, lambda fraction, _message: window_manager.progress_update(fraction), bones=True)
             skin = result.skin.skin
@@ -92,7 +105,7 @@ class ELLIMANN_OT_build_skin(MannequinOperator, bpy.types.Operator):
             bound = "bound to the armature"
         self.report(
             {"INFO"},
-            f"Built the skin of '{collection.name}': {len(skin.vertices):,} vertices at {settings.voxel_mm:g} mm, "
+            f"Built the {skin.settings.describe()} of '{collection.name}': {len(skin.vertices):,} vertices, "
             f"{bound} ({time.perf_counter() - started:.1f} s)",
         )
         return {"FINISHED"}

@@ -11,7 +11,7 @@ from ..base import SubPanel
 
 
 class ELLIMANN_PT_skin(SubPanel, bpy.types.Panel):
-    """A smooth skin over the pieces"""
+    """The mannequin's skin: from its set's bodies, or a smooth surface over its pieces"""
 
     bl_idname = ids.PANEL_SKIN
     bl_label = "Skin"
@@ -25,7 +25,7 @@ class ELLIMANN_PT_skin(SubPanel, bpy.types.Panel):
         if obj is None:
             return
         settings = skin_settings_of(obj)
-        made = f", {settings.voxel_mm:g} mm voxels" if settings is not None else ""
+        made = f", {settings.describe()}" if settings is not None else ""
         layout.label(text=f"{len(obj.data.vertices):,} vertices{made}")
         try:
             stale = is_stale_skin(obj, collection_to_mannequin(collection, check=False))

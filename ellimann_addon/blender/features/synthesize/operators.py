@@ -34,7 +34,7 @@ class ELLIMANN_OT_synthesize_mannequin(bpy.types.Operator):
         window_manager = context.window_manager
         window_manager.progress_begin(0.0, 1.0)
         try:
-            job = job_of(props, skin=settings_of(props.skin_level) if props.skin else None)
+            job = job_of(props, skin=settings_of(props.skin_level, kind=props.skin_kind) if props.skin else None)
             result = make(job, lambda fraction, _message: window_manager.progress_update(fraction), bones=True)
             if result.mannequin.joints is not None:
                 check_rig(result.mannequin)  # before the scene changes

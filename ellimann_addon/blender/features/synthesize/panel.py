@@ -53,8 +53,11 @@ class ELLIMANN_PT_synthesize(SubPanel, bpy.types.Panel):
         layout.row().prop(props, "output", expand=True)
         row = layout.row()
         row.prop(props, "skin")
+        kind = row.row()
+        kind.active = props.skin
+        kind.prop(props, "skin_kind", text="")
         level = row.row()
-        level.active = props.skin
+        level.active = props.skin and props.skin_kind != "BODY"
         level.prop(props, "skin_level", text="")
         options = layout.column(align=True)
         options.prop(props, "normalize")

@@ -13,7 +13,7 @@ from ....core.measurements import (
     MEASUREMENT_LABELS,
 )
 from ....core.synthesis.options import SYNTHESIS
-from ..skin.operator import level_property
+from ..skin.operator import kind_property, level_property
 from .live import on_request_change
 from .request import REFERENCE_SET_ITEMS
 
@@ -84,9 +84,11 @@ class ELLIMANN_PG_synthesis(bpy.types.PropertyGroup):
         name="Skin",
         default=False,
         update=on_request_change,
-        description="Give the mannequin a smooth skin over its pieces, bound to its armature. Live, the skin follows "
-        "the pieces at each step and is made again at the preview level once the fields are still",
+        description="Give the mannequin a skin (from the set's own bodies where it has them, or a smooth surface over "
+        "its pieces), bound to its armature. Live, the skin follows each step (the bodies' blend, or the pieces) and "
+        "is made again once the fields are still",
     )
+    skin_kind: kind_property()
     skin_level: level_property()
     normalize: _option("normalize")
     metric: _option("metric")
