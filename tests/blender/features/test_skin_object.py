@@ -11,7 +11,7 @@ from devkit import gltf_skin, gltf_validator
 from devkit.blender_scene import parts, state
 from ellimann_addon.blender.bridge.built import built_objects
 from ellimann_addon.blender.bridge.convert import collection_to_mannequin, mannequin_to_collection, rig_object
-from ellimann_addon.blender.bridge.skin import is_stale_skin, read_skin, skin_object
+from ellimann_addon.blender.bridge.skin import is_stale_skin, read_skin, skin_object, skin_vertices
 from ellimann_addon.blender.features.skin import live as skin_live
 from ellimann_addon.blender.services.files import write_mannequin
 from ellimann_addon.blender.services.posing import write_posed
@@ -204,7 +204,7 @@ def test_a_blend_with_a_skin_keeps_the_pieces_hidden_as_colliders(average, previ
 def props():
     props = bpy.context.scene.ellimann_synthesis
     props.reference_set, props.mode, props.live, props.skin = "FEMALE", "EXACT", False, True
-    props.skin_level = "PREVIEW"
+    props.skin_kind, props.skin_level = "PIECES", "PREVIEW"
     for key, value in zip(MEASUREMENTS, (159.0, 43.0, 117.0, 104.0, 117.0)):
         setattr(props, key.lower(), value)
     return props
@@ -233,6 +233,34 @@ def test_synthesize_with_skin_and_live_the_skin_follows_the_pieces_then_is_made_
     fire_skin_settle()  # the fields are still: a new skin from the settled pieces, at the preview level
     assert skin_object(target) == obj and not is_stale_skin(obj, collection_to_mannequin(target))
     assert skin_live.remembered(obj) is not made and len(built_objects(target, "SKIN")) == 1
+    props.live = False
+
+
+def test_the_body_skin_is_the_panel_s_default_follows_a_live_step_by_the_bodies_blend_and_is_made_exact_once_still(
+    props,
+):
+    """Skin kind Auto on a set with bodies: the body skin (the set's bodies' own topology), bound to the armature;
+    a live step gives it the body model's blend for the new request at once, and the exact body skin once the fields
+    are still."""
+    from ellimann_addon.core.job.make import body_skin_maker
+    from ellimann_addon.core.synthesis.shipped import named_reference_set
+
+    props.skin_kind = "AUTO"
+    assert bpy.ops.ellimann.synthesize_mannequin() == {"FINISHED"}
+    target = props.target
+    obj = skin_object(target)
+    made = skin_live.remembered(obj)
+    assert made.settings.kind == "body" and len(obj.data.vertices) == len(made.vertices) == 13348
+    assert obj.modifiers[0].object == rig_object(target)
+    asked = dict(zip(MEASUREMENTS, (159.0, 43.0, 117.0, 104.0, 117.0)))
+    assert all(abs(made.measured[key] - wanted) <= MESH_TOLERANCE_CM for key, wanted in asked.items())
+    props.live = True
+    props.he = 165.0  # a live step: the bodies' blend for the new request, no correction yet
+    blend, _ = body_skin_maker(named_reference_set("female")).interpolated({**asked, "He": 165.0})
+    assert np.abs(skin_vertices(obj) - blend).max() < 1e-5
+    fire_skin_settle()
+    settled = skin_live.remembered(obj)
+    assert settled is not made and settled.settings.kind == "body" and abs(settled.measured["He"] - 165.0) <= 0.1
     props.live = False
 
 
