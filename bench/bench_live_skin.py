@@ -1,11 +1,13 @@
-"""The Synthesize panel's Live step with the preview skin on, against the same step without it, in one process.
+"""The Synthesize panel's Live step with each kind of skin on, against the same step without one, in one process.
 
-Both runs synthesize the Average request (exact mode, cushions, the armature Synthesize builds), turn Live on and
-drag He over 15 steps (150-170 cm); with Skin on the skin (preview level, 10 mm) is made by Synthesize and every
-step moves it with its pieces (``features.skin.live.follow``: ``Skin.following`` and the mesh written in place). The
-two runs alternate over ROUNDS rounds, so that the machine's load falls on both alike. Printed: each run's median
-step (wall and this process's CPU), their ratio, the follower's own median time (inside the step), the step's budget
-(``LIVE_STEP_BUDGET``), and what the settle costs (the skin made again at the preview level, bound again).
+Every run synthesizes the Average request (exact mode, cushions, the armature Synthesize builds), turns Live on and
+drags He over 15 steps (150-170 cm). With the skin over the pieces (preview level, 10 mm) every step moves it with
+its pieces (``features.skin.live.follow``: ``Skin.following`` and the mesh written in place); with the body skin (the
+set's bodies, the panel's default) every step writes the body model's blend for the new request (no correction
+until the fields are still). The runs alternate over ROUNDS rounds, so that the machine's load falls on all alike.
+Printed: each run's median step (wall and this process's CPU), its ratio to the run without a skin, the follower's
+own median time (inside the step), the step's budget (``LIVE_STEP_BUDGET``), and what each settle costs (the skin
+made again: the pieces' at the preview level, the exact body skin; weighted and bound again).
 
 ``python -m bench.bench_live_skin``
 """
@@ -26,10 +28,14 @@ def timed(function):
     return (time.perf_counter() - wall) * 1e3, (time.process_time() - cpu) * 1e3
 
 
-def steps(bpy, props, skin, values=STEPS):
-    """[wall, CPU] ms of each slider step of one run (Skin on or off) over He ``values``."""
-    props.live, props.skin = False, skin
+KINDS = (None, "PIECES", "BODY")  # no skin, the skin over the pieces, the body skin
+
+
+def steps(bpy, props, kind, values=STEPS):
+    """[wall, CPU] ms of each slider step of one run (``kind``: None for no skin) over He ``values``."""
+    props.live, props.skin = False, kind is not None
     props.mode, props.output, props.skin_level = "EXACT", "CUSHIONS", "PREVIEW"
+    props.skin_kind = kind or "AUTO"
     for key, value in AVERAGE.items():
         setattr(props, key, value)
     bpy.ops.ellimann.synthesize_mannequin()
@@ -48,14 +54,15 @@ def run(rounds=ROUNDS, quick=False):
     from ellimann_addon.blender.features.synthesize.live import LIVE_STEP_BUDGET
 
     ellimann_addon.register()
-    follower_times = []
+    follower_times = {kind: [] for kind in KINDS[1:]}
     original = skin_live.follow
 
     def measured(scene, target, mannequin, seconds_left):
         start = time.perf_counter()
         original(scene, target, mannequin, seconds_left)
-        if scene.ellimann_synthesis.skin:
-            follower_times.append((time.perf_counter() - start) * 1e3)
+        props = scene.ellimann_synthesis
+        if props.skin:
+            follower_times[props.skin_kind].append((time.perf_counter() - start) * 1e3)
 
     from ellimann_addon.blender.features.synthesize import live
 
@@ -65,19 +72,18 @@ def run(rounds=ROUNDS, quick=False):
         bpy.ops.wm.read_homefile(use_empty=True)
         props = bpy.context.scene.ellimann_synthesis
         props.reference_set = "FEMALE"
-        runs = {False: [], True: []}
+        runs = {kind: [] for kind in KINDS}
         rounds, values = (1, STEPS[::7]) if quick else (rounds, STEPS)
-        settle = []
+        settle = {kind: [] for kind in KINDS[1:]}
         for _ in range(rounds):
-            for skin in (False, True):
-                runs[skin] += steps(bpy, props, skin, values)
+            for kind in KINDS:
+                runs[kind] += steps(bpy, props, kind, values)
                 if bpy.app.timers.is_registered(skin_live._settle_timer):
                     bpy.app.timers.unregister(skin_live._settle_timer)
                 if bpy.app.timers.is_registered(live._settle_timer):
                     bpy.app.timers.unregister(live._settle_timer)
-                if skin:
-                    props.skin = True
-                    settle.append(timed(lambda: skin_live.settle_skin(bpy.context.scene)))
+                if kind is not None:
+                    settle[kind].append(timed(lambda: skin_live.settle_skin(bpy.context.scene)))
             bpy.ops.wm.read_homefile(use_empty=True)
             props = bpy.context.scene.ellimann_synthesis
             props.reference_set = "FEMALE"
@@ -92,19 +98,22 @@ def report(runs, follower_times, settle, rounds, budget, count=None):
     print(
         f"Live step with cushions and the armature, {count or len(STEPS)} He steps x {rounds} rounds, runs alternating"
     )
+    names = {"PIECES": "the pieces' skin (preview)", "BODY": "the body skin"}
     for column, title in ((0, "wall"), (1, "CPU (this process)")):
-        without = statistics.median(pair[column] for pair in runs[False])
-        with_skin = statistics.median(pair[column] for pair in runs[True])
+        without = statistics.median(pair[column] for pair in runs[None])
+        line = f"  median {title:<20} without a skin {without:7.2f} ms"
+        for kind in KINDS[1:]:
+            on = statistics.median(pair[column] for pair in runs[kind])
+            line += f"   {names[kind]} {on:7.2f} ms ({on / without:4.2f}x)"
+        print(line)
+    for kind in KINDS[1:]:
+        follower = statistics.median(follower_times[kind])
+        wall, cpu = (statistics.median(s[i] for s in settle[kind]) for i in (0, 1))
         print(
-            f"  median {title:<20} without skin {without:8.2f} ms   preview skin on {with_skin:8.2f} ms   "
-            f"ratio {with_skin / without:5.2f}x"
+            f"  {names[kind]}: its follower inside a step (median wall) {follower:.2f} ms; the settle (made again, "
+            f"weighted, bound; median wall / CPU) {wall:.0f} / {cpu:.0f} ms"
         )
-    print(f"  the skin's follower inside a step (median wall): {statistics.median(follower_times):.2f} ms")
     print(f"  the step's budget (LIVE_STEP_BUDGET): {budget * 1e3:.0f} ms")
-    print(
-        f"  the settle (skin made again at 10 mm, weighted, bound; median wall / CPU): "
-        f"{statistics.median(s[0] for s in settle):.0f} / {statistics.median(s[1] for s in settle):.0f} ms"
-    )
 
 
 if __name__ == "__main__":
