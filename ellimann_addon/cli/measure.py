@@ -169,6 +169,7 @@ def measure_glb(path, args):
 def measure_mesh_file(path, args):
     """({key: cm} of what could be measured, [problem lines]) of a body mesh file."""
     from ..core.fitting.body_mesh import BodyMeshError, read_body_mesh  # a mesh's reader, loaded when one is read
+    from ..core.synthesis.bodies import labelled_arms
 
     try:
         vertices, faces = read_body_mesh(path, args.up, args.unit)
@@ -176,7 +177,8 @@ def measure_mesh_file(path, args):
         raise UsageError(output.one_line(error)) from None
     fractions = arguments.references(args).section_fractions if args.references else None
     tilt = getattr(args, "neck_tilt", None)  # measure's own option (synth --from has none)
-    result = measure_body_mesh(vertices, faces, fractions, None if tilt is None else math.radians(tilt))
+    arms = labelled_arms(faces)  # a body of the sets' own topology (a scan's twin): its arms by the labels
+    result = measure_body_mesh(vertices, faces, fractions, None if tilt is None else math.radians(tilt), arms)
     return result.values, result.problems
 
 

@@ -23,6 +23,7 @@ REPORT_COLUMNS = (
     + ["skin_voxel_mm", "skin_blend"]
     + [f"{k}_skin" for k in ALL_MEASUREMENTS]
     + [f"{k}_skin_error_pct" for k in ALL_MEASUREMENTS]
+    + ["skin_kind"]  # appended last (issue 42): a reader of the older columns finds them where they were
 )
 
 # the result columns, empty until a row has them
@@ -74,7 +75,10 @@ def report_row(
         got = [values[key] for key in both]
         for key, value, error in zip(both, got, relative_error(got, [asked[key] for key in both])):
             row[f"{key}_{suffix}"], row[f"{key}_{errors}"] = f"{value:.4f}", f"{error:.4f}"
-    if skin_settings is not None:
+    if skin_settings is not None and skin_settings.kind == "body":
+        row["skin_kind"] = "body"
+    elif skin_settings is not None:
+        row["skin_kind"] = "pieces"
         row["skin_voxel_mm"], row["skin_blend"] = f"{skin_settings.voxel_mm:g}", f"{skin_settings.blend:g}"
     return row
 

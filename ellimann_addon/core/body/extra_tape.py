@@ -40,10 +40,11 @@ COARSE_SAMPLES, COARSE_STEPS = 12, 8  # a first reading's whole band, coarser th
 
 @dataclass
 class Marks:
-    """Where a reading found the extremes: the neck's offset along its axis (fraction of He) and each calf's
-    height (fraction of the crotch's height)."""
+    """Where a reading found the extremes: the neck's offset along its axis (fraction of He) and the tilt it was
+    square to (radians), and each calf's height (fraction of the crotch's height)."""
 
     neck: float = float("nan")
+    tilt: float = float("nan")
     calf: dict = field(default_factory=dict)
 
 
@@ -92,7 +93,7 @@ class ExtraTape:
                 if "calf" in wanted:
                     values["calf"], found.calf = self._calf(body, crotch, marks, search)
         if "neck" in wanted:
-            values["neck"], found.neck = self._neck(body, tilt, marks, search)
+            values["neck"], found.neck, found.tilt = self._neck(body, tilt, marks, search)
         if {"upper_arm", "arm_length"} & set(wanted):
             z_sh = body.at(body.fractions["Sh"])
             readings = [arm_reading(body, s, z_sh, self.arms[s], self.arm_faces[s]) for s in SIDES]
@@ -151,7 +152,8 @@ class ExtraTape:
         return hull_girth(section_segments(body.vertices, self.faces[crossed], z)[0].reshape(-1, 2))[0]
 
     def _neck(self, body, tilt, marks, search):
-        """(smallest girth square to the axis at ``tilt``, its offset / He): body_neck's search, or a window."""
+        """(smallest girth square to the axis at ``tilt``, its offset / He, the tilt): body_neck's search, or a
+        window."""
         if tilt is None:
             tilt = body_neck(body)[1]
         slices = NeckSlices(body, tilt, neck_origin(body))
@@ -160,4 +162,4 @@ class ExtraTape:
             girth, offset = slices.smallest(low, high, WINDOW_SAMPLES, WINDOW_STEPS)
         else:
             girth, offset = slices.smallest(**search)
-        return girth, offset / body.height
+        return girth, offset / body.height, float(tilt)

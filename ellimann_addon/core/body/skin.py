@@ -17,7 +17,6 @@ import numpy as np
 
 from ..geometry.mesh import volume
 from ..mannequin.skeleton import JOINT_INDEX
-from ..measure.neck import joint_tilt
 from ..measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ..synthesis.bodies import load_set_bodies
 from .correct import AIM_CM, PROMISE_CM, BodySkinError, correct
@@ -92,11 +91,10 @@ class BodySkin:
         return self.bodies.arms
 
     def measure(self, fractions=None, neck_tilt=None):
-        """The skin measured as any body mesh (core.measure.body), its arms known from the labels: a
-        BodyMeasurement at ``fractions`` (default the set's), the neck square to ``neck_tilt`` (radians; default
-        the skin's own Neck -> Head axis, as today's skin is measured)."""
-        tilt = joint_tilt(self.joints) if neck_tilt is None else neck_tilt
-        return Tape(self.faces, self.arms, fractions or self.bodies.fractions).full(self.vertices, tilt)
+        """The skin measured as ``measure`` reads any body mesh (core.measure.body), its arms known from the
+        labels: a BodyMeasurement at ``fractions`` (default the set's), the neck square to ``neck_tilt`` (radians;
+        default the tilt a tape settles at, as on the scan a twin is made for)."""
+        return Tape(self.faces, self.arms, fractions or self.bodies.fractions).full(self.vertices, neck_tilt)
 
     @property
     def volume(self):
@@ -216,20 +214,21 @@ class BodySkinMaker:
 
     def corrected(self, asked, rest, joints):
         """(Correction, Deformation) of the body ``rest`` with ``joints`` to ``asked``: the five by the tape, the
-        extras by the extras' tape in windows about their last extremes (the neck square to the rest's own Neck ->
-        Head axis), then every band searched whole on the corrected body, its neck square to its own axis (the
-        final reading); when that differs from the loop's by more than the aim, the loop again from there, aimed
-        by the difference."""
+        extras by the extras' tape in windows about their last extremes, the neck square to the tilt the last whole
+        reading settled at (held through a loop: a tilt searched anew each round jumps between nearby bodies); then
+        every band searched whole on the corrected body, its neck at the tilt a tape settles at, as ``measure``
+        reads any body mesh (the final reading); when that differs from the loop's by more than the aim, the loop
+        again from there, aimed by the difference."""
         keys = [key for key in PARAMETERS if key in asked]
         extras = [key for key in keys if key in EXTRA_MEASUREMENTS]
         marks = Marks()
-        tilt = joint_tilt(joints) if "neck" in extras else None
 
-        def read(vertices, whole=False, at_tilt=tilt, coarse=False):
+        def read(vertices, whole=False, coarse=False):
             values = self.tape.five(vertices)
             if extras:
-                found, where = self.extra_tape.read(vertices, extras, at_tilt, None if whole else marks, coarse)
-                marks.neck, marks.calf = where.neck, where.calf
+                tilt = None if whole else marks.tilt
+                found, where = self.extra_tape.read(vertices, extras, tilt, None if whole else marks, coarse)
+                marks.neck, marks.calf, marks.tilt = where.neck, where.calf, where.tilt
                 values.update(found)
             return {key: values[key] for key in keys}
 
@@ -238,8 +237,8 @@ class BodySkinMaker:
         deformation = Deformation(rest, joints, self.weights, self.bodies.fractions, crotch and crotch / 100.0)
         found = correct(deformation, read, asked, start=start)
         for last in range(FINAL_PASSES - 1, -1, -1) if extras and found.converged else ():
-            corrected, moved = deformation.apply(found.theta)
-            final = read(corrected, whole=True, at_tilt=None if tilt is None else joint_tilt(moved))
+            corrected, _ = deformation.apply(found.theta)
+            final = read(corrected, whole=True)
             offset = {key: final[key] - found.measured[key] for key in keys}
             found.measured = final
             if not last or all(abs(final[key] - asked[key]) <= AIM_CM for key in keys):

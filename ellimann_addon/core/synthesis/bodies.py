@@ -387,6 +387,17 @@ def read_bodies(path):
     )
 
 
+def labelled_arms(faces):
+    """{"L", "R": (V,) bool} the arms' vertices of a mesh whose triangles are the shipped bodies' own (a body of
+    the body model, a body skin, a scan's twin), from their labels; None for any other mesh, whose arms the
+    measurer finds by their geometry."""
+    faces = np.asarray(faces)
+    known = shipped_bodies()
+    if not known or known[0].faces.shape != faces.shape or not np.array_equal(known[0].faces, faces):
+        return None
+    return known[0].arms
+
+
 def load_set_bodies(folder):
     """The SetBodies of a reference-set folder, or None for a set without bodies (an old folder, a hand-traced
     set); BodiesError for a manifest that names a bodies file that cannot be read."""

@@ -7,6 +7,7 @@ import bpy
 
 from ....core.measure.body import measure_body_mesh
 from ....core.measurements import measurement_line
+from ....core.synthesis.bodies import labelled_arms
 from ... import ids
 from ...bridge.convert import world_triangles
 from ...bridge.selection import owning_mannequin
@@ -23,7 +24,7 @@ def is_body_mesh(obj):
 def measure_object(obj, fractions=None):
     """(values {key: cm}, problems [lines]) of a mesh object in world space (Blender: Z up, metres)."""
     vertices, faces = world_triangles(obj)
-    result = measure_body_mesh(vertices, faces, fractions)
+    result = measure_body_mesh(vertices, faces, fractions, arms=labelled_arms(faces))
     return result.values, result.problems
 
 
