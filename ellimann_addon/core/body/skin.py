@@ -15,13 +15,18 @@ import numpy as np
 from ..constants import MEASUREMENTS
 from ..geometry.mesh import volume
 from ..measure.extra import EXTRA_MEASUREMENTS
+from ..measure.further import FURTHER_MEASUREMENTS
 from ..pose.kinematics import bone_matrices
 from ..synthesis.bodies import load_set_bodies
+from ..synthesis.body_space import load_set_body_space
 from .correct import LIMITS, PROMISE_CM, BodySkinError, correct
 from .deform import PARAMETERS, Deformation
 from .mesh_checks import FOLD_ALLOWANCE, fold_problems
 from .model import IdwBodyModel
+from .ridge import RidgeBodyModel
 from .tape import Tape
+
+BODY_MODELS = (None, "ridge", "idw")  # body_skin_maker's choices (None: the best the set has)
 
 
 @dataclass
@@ -41,6 +46,7 @@ class BodySkin:
     rounds: int = 0
     seconds: float = 0.0
     pieces_measured: dict = field(default_factory=dict)
+    informed: dict = field(default_factory=dict)  # measurements the body model took that the correction did not meet
 
     def bones(self):
         """(joint indices (V, 4), weights (V, 4)) on the SMPL joints: the body model's own, summed per joint."""
@@ -91,7 +97,8 @@ def largest_change(found, request):
 
 class BodySkinMaker:
     """Makes body skins from a set's ``bodies`` (SetBodies) with a body ``model`` (default IDW over them, the
-    set's ``ranges`` for its metric). The tape and the topology's checks are made once."""
+    set's ``ranges`` for its metric; core.body.ridge.RidgeBodyModel over a set's body space). The tape and the
+    topology's checks are made once."""
 
     def __init__(self, bodies, model=None, ranges=None):
         self.bodies = bodies
@@ -102,16 +109,25 @@ class BodySkinMaker:
         """(vertices, joints) of the body model alone (no correction)."""
         return self.model.body(request)
 
-    def make(self, request, extra=None, check=True):
-        """The BodySkin of ``request`` ({He..Hi: cm}) and ``extra`` ({key: cm} of any of the six extras).
-        BodySkinError (one line) for a request beyond the bodies or a mesh that would fold."""
+    def make(self, request, extra=None, check=True, shape=None, tolerances=None):
+        """The BodySkin of ``request`` ({He..Hi: cm}) and ``extra`` ({key: cm} of any of the six extras), both met
+        by the correction; ``shape`` ({key: cm} of any measurement the model takes, core.measure.further's too):
+        inputs of the body model only (its ``informed``); ``tolerances`` ({key: cm} or "exact"): the tape's error
+        the model weighs each input by (a model that takes them: core.body.ridge). BodySkinError (one line) for a
+        request beyond the bodies or a mesh that would fold."""
         started = time.perf_counter()
         asked = {key: float(request[key]) for key in MEASUREMENTS}
         asked |= {key: float(value) for key, value in (extra or {}).items()}
+        informed = {key: float(value) for key, value in (shape or {}).items() if key not in asked}
         unknown = [key for key in asked if key not in MEASUREMENTS + EXTRA_MEASUREMENTS]
+        unknown += [key for key in informed if key not in MEASUREMENTS + EXTRA_MEASUREMENTS + FURTHER_MEASUREMENTS]
         if unknown:
             raise BodySkinError(f"body skin: {', '.join(unknown)} is no measurement ElliMann takes")
-        vertices, joints = self.model.body(asked)
+        inputs = asked | informed
+        if tolerances is None:
+            vertices, joints = self.model.body(inputs)
+        else:
+            vertices, joints = self.model.body(inputs, tolerances)
         crotch = None
         extras = [key for key in asked if key in EXTRA_MEASUREMENTS]
         tilt = None
@@ -143,16 +159,29 @@ class BodySkinMaker:
             self.bodies,
             asked,
             measured,
-            weights(asked) if weights else None,
+            weights(inputs) if weights else None,
             found.rounds,
             time.perf_counter() - started,
+            informed=informed,
         )
 
 
-def body_skin_maker(reference):
-    """A BodySkinMaker for a loaded ReferenceSet whose folder holds bodies (None without): the set's ranges
-    for the model. ``reference.sources`` locate the folder."""
+def body_skin_maker(reference, model=None, tolerances=None):
+    """A BodySkinMaker for a loaded ReferenceSet whose folder holds bodies (None without). ``model``: None (the
+    best the set has: ridge regression over its body space when it has one, else IDW over its bodies), "ridge" or
+    "idw" (the set's ranges for its metric); ``tolerances``: the ridge's default (core.body.ridge). BodySkinError
+    for "ridge" on a set without a body space. ``reference.sources`` locate the folder."""
+    if model not in BODY_MODELS:
+        raise BodySkinError(f"body model: {model!r} is not one of {', '.join(str(m) for m in BODY_MODELS)}")
     if not getattr(reference, "sources", None):
         return None
-    bodies = load_set_bodies(pathlib.Path(reference.sources[0]).parent)
-    return None if bodies is None else BodySkinMaker(bodies, ranges=reference.ranges)
+    folder = pathlib.Path(reference.sources[0]).parent
+    bodies = load_set_bodies(folder)
+    if bodies is None:
+        return None
+    space = None if model == "idw" else load_set_body_space(folder)
+    if space is None and model == "ridge":
+        raise BodySkinError(f"body model: the set in {folder} has no body space (body_space.npz): use 'idw'")
+    if space is None:
+        return BodySkinMaker(bodies, ranges=reference.ranges)
+    return BodySkinMaker(bodies, RidgeBodyModel(space, tolerances))
