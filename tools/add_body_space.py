@@ -25,8 +25,9 @@ from .add_bodies import body_labels, meshes
 from .reference_sets import BUILD_SETS, SHARED
 
 BANKS = SHARED / "bodies"
-# what --check lets a fresh file differ by: float16 directions (m), float32 mean, measurements (cm)
-TOLERANCES = {"mean": 1e-5, "directions": 2e-4, "measured": 2e-2, "gram": 1e-6}
+# what --check lets a fresh file differ by: float16 directions (up to 0.66 m: a float16 step there is 4.9e-4, and
+# rounding may land a step either side), float32 mean, measurements (cm), the Gram matrix (m^2)
+TOLERANCES = {"mean": 1e-5, "directions": 1e-3, "measured": 2e-2, "gram": 1e-6}
 
 
 def bank(sex, folder=BANKS):
