@@ -31,6 +31,7 @@ BENCHES = (
     "bench_batch",
     "bench_fine",
     "bench_body_skin",
+    "bench_body_space",
 )
 
 # The benchmarks that need the bpy module (Blender's cloth, the panel, its importer): their quick modes run in

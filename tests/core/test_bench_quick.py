@@ -27,6 +27,7 @@ NUMPY_ONLY = {  # name: slow (more than a few seconds in quick mode)
     "bench_extra": True,
     "bench_skin_exact": True,
     "bench_body_skin": False,
+    "bench_body_space": True,
 }
 
 

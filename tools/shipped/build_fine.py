@@ -32,6 +32,7 @@ from ellimann_addon.core.fitting.mannequin_fit import FitConstants
 from ellimann_addon.core.fitting.reference_build import BuildSettings, build_reference_set, relative_errors
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.measurements import MEASUREMENTS
+from ellimann_addon.core.synthesis.body_space import SPACE_FILE
 from ellimann_addon.core.synthesis.manifest import MANIFEST_FILE, read_manifest
 
 from . import build_reference as br
@@ -110,6 +111,7 @@ def build(build_set, traced=None, log=print, workers=2):
         body_labels=shipped_body_labels(),  # the bodies kept with the set (bodies.npz, tools/shipped/add_bodies.py)
         provenance=_provenance(build_set),
     )
+    built.manifest.body_space = SPACE_FILE  # the set's bank, made by tools.add_body_space
     shifts = {br.BASE_FILE: base_shift, **built.report.shifts}
     fill = {}
     for name, m in [(br.BASE_FILE, built.base), *built.mannequins.items()]:

@@ -27,6 +27,7 @@ from ellimann_addon.core.fitting.mannequin_fit import FitConstants
 from ellimann_addon.core.fitting.reference_build import BuildSettings, build_reference_set, relative_errors
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.measurements import MEASUREMENTS
+from ellimann_addon.core.synthesis.body_space import SPACE_FILE
 
 from . import build_reference as br
 from . import coverage
@@ -73,6 +74,7 @@ def build(log=print):
         body_labels=shipped_body_labels(),  # the bodies kept with the set (bodies.npz, tools/shipped/add_bodies.py)
         provenance=PROVENANCE,
     )
+    built_set.manifest.body_space = SPACE_FILE  # the set's bank, made by tools.add_body_space
     built, base, rms = built_set.report, built_set.base, built_set.mannequins
     cavity = np.zeros(len(reference_body.vertices), dtype=bool)  # the open mouth and eye sockets, as traced
     for trace in traced.traces.values():

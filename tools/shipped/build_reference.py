@@ -61,6 +61,7 @@ from ellimann_addon.core.mannequin.traces import PartTrace
 from ellimann_addon.core.measure.tailor import section_heights
 from ellimann_addon.core.measurements import MEASUREMENTS
 from ellimann_addon.core.synthesis.bodies import BODIES_FILE
+from ellimann_addon.core.synthesis.body_space import SPACE_FILE
 from ellimann_addon.core.synthesis.manifest import MANIFEST_FILE, legacy_manifest, read_manifest
 
 from . import coverage
@@ -203,6 +204,9 @@ def shipped_manifest(refmodels):
     manifest = legacy_manifest()
     manifest.base = BASE_FILE
     manifest.bodies = BODIES_FILE  # the RMs' bodies, for the body skin (tools/shipped/add_bodies.py)
+    manifest.body_space = (
+        SPACE_FILE  # its bank and its six bodies, for the ridge body model (tools/shipped/add_body_space.py)
+    )
     manifest.provenance = {
         "built_by": "python -m tools.shipped.build_reference",
         "bodies": "../shared/refmodels (Anny 0.6.2)",

@@ -3,6 +3,7 @@ it measures the request (floor 5: everything below). The bodies themselves are t
 (core.synthesis.bodies).
 
 - model: the body model, a request's measurements -> vertices and joints (IDW over the bodies; replaceable)
+- ridge: the ridge body model over a set's body space (any measurements in, their tolerances weighed)
 - deform: the smooth deformations the correction moves along (a displacement basis linear in its parameters)
 - tape: the measurements the correction aims at, by the body-mesh measurer's own code
 - extra_tape: the six extras by the body-mesh measurer's own steps, fast on the fixed topology (the legs from the

@@ -17,8 +17,10 @@ import numpy as np
 
 from ..geometry.mesh import volume
 from ..mannequin.skeleton import JOINT_INDEX
+from ..measure.further import FURTHER_MEASUREMENTS
 from ..measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ..synthesis.bodies import load_set_bodies
+from ..synthesis.body_space import load_set_body_space
 from .correct import AIM_CM, PROMISE_CM, BodySkinError, correct
 from .deform import PARAMETERS, Deformation, abducted, smoothed
 from .extra_tape import ExtraTape, Marks, leg_masks
@@ -36,7 +38,10 @@ from .plausible import (
     proportion_problem,
     surface_problem,
 )
+from .ridge import RidgeBodyModel
 from .tape import Tape
+
+BODY_MODELS = (None, "ridge", "idw")  # body_skin_maker's choices (None: the best the set has)
 
 
 @dataclass
@@ -60,6 +65,7 @@ class BodySkin:
     abduction: float = 0.0
     mannequin: object = None  # the pieces it goes with (a job's: core.job.make), their joints this skin's
     settings: object = None  # how it was asked (core.mannequin.skin_record.SkinSettings, kind "body")
+    informed: dict = field(default_factory=dict)  # measurements the body model took that the correction did not meet
 
     def record(self):
         """The ``skin`` section of the file of the pieces it goes with: how to make it again (the request)."""
@@ -129,7 +135,8 @@ class Attempt:
 
 class BodySkinMaker:
     """Makes body skins from a set's ``bodies`` (SetBodies) with a body ``model`` (default IDW over them, the
-    set's ``ranges`` for its metric). The tape and the topology's checks are made once."""
+    set's ``ranges`` for its metric; core.body.ridge.RidgeBodyModel over a set's body space). The tape and the
+    topology's checks are made once."""
 
     def __init__(self, bodies, model=None, ranges=None):
         self.bodies = bodies
@@ -139,27 +146,34 @@ class BodySkinMaker:
         self.extra_tape = ExtraTape(bodies.faces, bodies.arms, legs, bodies.fractions)
         self.weights = smoothed(bodies.dense_weights, bodies.faces)
 
-    def interpolated(self, request):
-        """(vertices, joints) of the body model alone (no correction)."""
-        return self.model.body(request)
+    def interpolated(self, request, tolerances=None):
+        """(vertices, joints) of the body model alone (no correction) for ``request`` ({key: cm}: any inputs the
+        model takes), its inputs weighed by ``tolerances`` (a model that takes them: core.body.ridge)."""
+        return self.model.body(request) if tolerances is None else self.model.body(request, tolerances)
 
-    def make(self, request, extra=None, check=True):
-        """The BodySkin of ``request`` ({He..Hi: cm}) and ``extra`` ({key: cm} of any of the six extras).
-        BodySkinError (one line) for a request no plausible body skin meets (core.body.plausible), naming the
-        measurement, how far the body skin reaches and why not further; ``check=False``: no plausibility checks."""
+    def make(self, request, extra=None, check=True, shape=None, tolerances=None):
+        """The BodySkin of ``request`` ({He..Hi: cm}) and ``extra`` ({key: cm} of any of the six extras), both met
+        by the correction; ``shape`` ({key: cm} of any measurement the model takes, core.measure.further's too):
+        inputs of the body model only (its ``informed``); ``tolerances`` ({key: cm} or "exact"): the tape's error
+        the model weighs each input by (a model that takes them: core.body.ridge). BodySkinError (one line) for a
+        request no plausible body skin meets (core.body.plausible), naming the measurement, how far the body skin
+        reaches and why not further; ``check=False``: no plausibility checks."""
         started = time.perf_counter()
         asked = {key: float(request[key]) for key in MEASUREMENTS}
         asked |= {key: float(value) for key, value in (extra or {}).items()}
+        informed = {key: float(value) for key, value in (shape or {}).items() if key not in asked}
         unknown = [key for key in asked if key not in MEASUREMENTS + EXTRA_MEASUREMENTS]
+        unknown += [key for key in informed if key not in MEASUREMENTS + EXTRA_MEASUREMENTS + FURTHER_MEASUREMENTS]
         if unknown:
             raise BodySkinError(f"body skin: {', '.join(unknown)} is no measurement ElliMann takes")
         if check:
             problem, _ = proportion_problem(asked, self.bodies.fractions)
             if problem:
                 raise BodySkinError(f"body skin: {problem}; no body has these proportions")
-        attempt = self.attempt(asked, check)
+        inputs = asked | informed
+        attempt = self.attempt(asked, check, informed, tolerances)
         if attempt.problem:
-            raise BodySkinError(self.refusal(asked, attempt))
+            raise BodySkinError(self.refusal(asked, attempt, informed, tolerances))
         found = attempt.correction
         measured = found.measured
         weights = getattr(self.model, "weights", None)
@@ -170,16 +184,18 @@ class BodySkinMaker:
             self.bodies,
             asked,
             measured,
-            weights(asked) if weights else None,
+            weights(inputs) if weights else None,
             found.rounds,
             time.perf_counter() - started,
             abduction=attempt.abduction,
+            informed=informed,
         )
 
-    def attempt(self, asked, check=True):
-        """An Attempt at ``asked`` ({key: cm}): the body model's body, its arms raised as far as they must be to
-        clear the trunk, corrected; its first problem (core.body.plausible) when ``check``."""
-        vertices, joints = self.model.body(asked)
+    def attempt(self, asked, check=True, informed=None, tolerances=None):
+        """An Attempt at ``asked`` ({key: cm}): the body model's body (``informed`` its inputs too, weighed by
+        ``tolerances``), its arms raised as far as they must be to clear the trunk, corrected; its first problem
+        (core.body.plausible) when ``check``."""
+        vertices, joints = self.interpolated(asked | (informed or {}), tolerances)
         faces, arms = self.bodies.faces, self.bodies.arms
         angle = 0.0
         while True:
@@ -249,21 +265,35 @@ class BodySkinMaker:
         found.converged = all(abs(found.measured[key] - asked[key]) <= PROMISE_CM for key in keys)
         return found, deformation
 
-    def refusal(self, asked, attempt):
+    def refusal(self, asked, attempt, informed=None, tolerances=None):
         """The refusal's line: the blamed measurement, how far the body skin reaches, and why not further."""
         key = attempt.blamed
         start = attempt.correction.start[key]
-        reach = bisect_reach(lambda trial: self.attempt(trial).problem is None, key, asked, start)
+        reach = bisect_reach(
+            lambda trial: self.attempt(trial, True, informed, tolerances).problem is None, key, asked, start
+        )
         return (
             f"body skin: {describe_reach(key, asked[key], start, reach)}: {attempt.problem}; "
             "ask nearer the set's bodies or use the pieces' skin"
         )
 
 
-def body_skin_maker(reference):
-    """A BodySkinMaker for a loaded ReferenceSet whose folder holds bodies (None without): the set's ranges
-    for the model. ``reference.sources`` locate the folder."""
+def body_skin_maker(reference, model=None, tolerances=None):
+    """A BodySkinMaker for a loaded ReferenceSet whose folder holds bodies (None without). ``model``: None (the
+    best the set has: ridge regression over its body space when it has one, else IDW over its bodies), "ridge" or
+    "idw" (the set's ranges for its metric); ``tolerances``: the ridge's default (core.body.ridge). BodySkinError
+    for "ridge" on a set without a body space. ``reference.sources`` locate the folder."""
+    if model not in BODY_MODELS:
+        raise BodySkinError(f"body model: {model!r} is not one of {', '.join(str(m) for m in BODY_MODELS)}")
     if not getattr(reference, "sources", None):
         return None
-    bodies = load_set_bodies(pathlib.Path(reference.sources[0]).parent)
-    return None if bodies is None else BodySkinMaker(bodies, ranges=reference.ranges)
+    folder = pathlib.Path(reference.sources[0]).parent
+    bodies = load_set_bodies(folder)
+    if bodies is None:
+        return None
+    space = None if model == "idw" else load_set_body_space(folder)
+    if space is None and model == "ridge":
+        raise BodySkinError(f"body model: the set in {folder} has no body space (body_space.npz): use 'idw'")
+    if space is None:
+        return BodySkinMaker(bodies, ranges=reference.ranges)
+    return BodySkinMaker(bodies, RidgeBodyModel(space, tolerances))

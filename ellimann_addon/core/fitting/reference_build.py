@@ -42,11 +42,13 @@ from ..mannequin.clean import (
 from ..mannequin.joints import anchor_indices, follow_pieces
 from ..measure.tailor import as_dict, section_heights
 from ..measurements import ABSURD_LIMITS, MEASUREMENTS
-from ..synthesis.bodies import BODIES_FILE, BodiesError, from_meshes
+from ..synthesis.bodies import BODIES_FILE, BodiesError
+from ..synthesis.body_space import SPACE_FILE
 from ..synthesis.manifest import STEM, Manifest, targets_range, write_reference_set
 from ..synthesis.refine import FACTOR_LIMITS, refine
 from .body_mesh import mesh_problem
 from .mannequin_fit import BuildCancelledError, FitConstants, fit_mannequin
+from .reference_bodies import keep_bodies, keep_space
 
 __all__ = [
     "BASE_STEM",
@@ -111,12 +113,15 @@ class BuiltReferenceSet:
     manifest: Manifest
     report: BuildReport
     bodies: object = None  # the bodies it was built from (core.synthesis.bodies.SetBodies), when given their labels
+    space: object = None  # their body space (core.synthesis.body_space.BodySpace), from MIN_SPACE_BODIES bodies
 
     @classmethod
-    def assemble(cls, rms, report, targets, name, sex=None, base_stem=BASE_STEM, provenance=None, bodies=None):
+    def assemble(
+        cls, rms, report, targets, name, sex=None, base_stem=BASE_STEM, provenance=None, bodies=None, space=None
+    ):
         """The set of the cleaned ``rms`` ({stem: RM}) and ``report`` (its base relabelled): each made the set's
         (``reference_set`` = ``name``), and their manifest, its ranges the targets' min-max; ``bodies`` (SetBodies)
-        kept as the set's bodies file."""
+        and ``space`` (BodySpace) kept as the set's bodies and body-space files."""
         stems = list(rms)
         manifest = Manifest(
             name=name,
@@ -128,9 +133,10 @@ class BuiltReferenceSet:
             targets_cm={stem: dict(targets[stem]) for stem in stems},
             provenance={**(provenance or {}), "labelled_against": report.reference},
             bodies=BODIES_FILE if bodies is not None else None,
+            body_space=SPACE_FILE if space is not None else None,
         )
         mannequins = {stem: rm.copy(reference_set=name) for stem, rm in rms.items()}
-        return cls(mannequins, report.base.copy(reference_set=name), manifest, report, bodies)
+        return cls(mannequins, report.base.copy(reference_set=name), manifest, report, bodies, space)
 
     def write(self, folder):
         """Write the set into ``folder`` (each file atomically, its bodies before the manifest, the manifest last);
@@ -138,6 +144,8 @@ class BuiltReferenceSet:
         written = []
         if self.bodies is not None:
             written.append(self.bodies.save(pathlib.Path(folder) / self.manifest.bodies))
+        if self.space is not None:
+            written.append(self.space.save(pathlib.Path(folder) / self.manifest.body_space))
         return written + write_reference_set(folder, self.mannequins, self.manifest, base=self.base)
 
 
@@ -196,11 +204,11 @@ def _is_number(text):
         return False
 
 
-def validate_inputs(base, bodies, targets):
+def validate_inputs(base, bodies, targets, minimum=MIN_BODIES):
     """Raise ReferenceBuildError (one line) for anything a build cannot start from; returns the traced mesh's
-    (name, vertex count). ``bodies``: BodyMesh list; ``targets``: {body name: {measurement: cm}}."""
-    if len(bodies) < MIN_BODIES:
-        raise ReferenceBuildError(f"bodies: a reference set needs at least {MIN_BODIES} bodies, got {len(bodies)}")
+    (name, vertex count). ``bodies``: BodyMesh list (``minimum`` of them); ``targets``: {name: {measurement: cm}}."""
+    if len(bodies) < minimum:
+        raise ReferenceBuildError(f"bodies: a reference set needs at least {minimum} bodies, got {len(bodies)}")
     names = [body.name for body in bodies]
     twice = sorted({name for name in names if names.count(name) > 1})
     if twice:
@@ -346,7 +354,7 @@ def relative_errors(measured, targets):
     return {key: measured[key] / targets[key] - 1.0 for key in MEASUREMENTS}
 
 
-def _fit_body(base, body, targets, settings, cancel=None):
+def fit_body(base, body, targets, settings, cancel=None):
     """One body's RM before the set is cleaned: (name, body -> RM shift, m_T as fitted, RM, refinement factors)."""
     fitted, _ = fit_mannequin(
         body,
@@ -397,7 +405,8 @@ def build_reference_set(
     bodies). ``name`` (default: the base's set's), ``sex``, ``base_stem`` (the base's file) and ``provenance``
     (where the base and bodies came from; the build adds the RM it labelled against) go into the manifest.
     ``body_labels`` (core.synthesis.bodies.BodyLabels of the bodies' topology): the bodies are kept with the set
-    (``bodies.npz``, for the body skin: core.body), each with its joints; without, the set has no bodies.
+    (``bodies.npz``, for the body skin: core.body), each with its joints, and from MIN_SPACE_BODIES bodies their
+    body space (``body_space.npz``: core.synthesis.body_space, each body measured); without, the set has no bodies.
     Returns a BuiltReferenceSet. Raises ReferenceBuildError (one line) before any work for bad input, or when an
     RM cannot meet its targets.
     """
@@ -425,7 +434,7 @@ def build_reference_set(
     if workers > 1 and len(bodies) > 1:
         pool = ProcessPoolExecutor(min(workers, len(bodies)))
         try:
-            futures = [pool.submit(_fit_body, *job) for job in jobs]
+            futures = [pool.submit(fit_body, *job) for job in jobs]
             for k, future in enumerate(as_completed(futures)):
                 if cancel is not None and cancel():
                     raise BuildCancelledError()
@@ -437,7 +446,7 @@ def build_reference_set(
     else:
         for k, job in enumerate(jobs):
             tell(k, f"fitting {job[1].name} ({k + 1} of {len(bodies)})")
-            stem, *result = _fit_body(*job, cancel=cancel)
+            stem, *result = fit_body(*job, cancel=cancel)
             fitted[stem] = result
     adjusted = []
     for stem in names:
@@ -472,22 +481,9 @@ def build_reference_set(
             report.fill[body.name] = fill_shares(volume.grid(settings.check_spacing), rms[body.name])
         report.seconds["coverage check"] = time.perf_counter() - started
     tell(steps, "built")
-    kept = None if body_labels is None else keep_bodies(bodies, body_labels, base.section_fractions)
-    return BuiltReferenceSet.assemble(rms, report, targets, name, sex, base_stem, provenance, kept)
-
-
-def keep_bodies(bodies, labels, fractions):
-    """SetBodies of the BodyMesh list ``bodies`` with ``labels`` (BodyLabels); a body without joints takes the
-    labels' regressed ones (JointRegressor) when they have one. ReferenceBuildError (one line) for bodies without
-    joints or that cannot make a body skin (another topology, wrong axes or units)."""
-    regress = labels.regressor
-    joints = [b.joints if b.joints is not None or regress is None else regress(b.vertices) for b in bodies]
-    missing = [body.name for body, found in zip(bodies, joints) if found is None]
-    if missing:
-        raise ReferenceBuildError(f"bodies: {', '.join(missing)} have no joints (a body skin is posed on them)")
-    names, vertices = [body.name for body in bodies], np.stack([body.vertices for body in bodies])
     try:
-        found = (labels.region, list(labels.region_names), labels.bones, np.stack(joints), fractions)
-        return from_meshes(names, vertices, bodies[0].faces, *found)
+        kept = None if body_labels is None else keep_bodies(bodies, body_labels, base.section_fractions)
+        space = None if kept is None else keep_space(bodies, body_labels, base.section_fractions, progress)
     except BodiesError as error:
         raise ReferenceBuildError(str(error)) from None
+    return BuiltReferenceSet.assemble(rms, report, targets, name, sex, base_stem, provenance, kept, space)

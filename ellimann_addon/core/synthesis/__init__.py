@@ -2,6 +2,8 @@
 
 - bodies: a set's bodies (one topology) stored compactly beside its RMs (``bodies.npz``): mean, offsets, labels,
   bone weights on the 24 joints, each body's joints and measurements; reading, writing and their checks
+- body_space: many bodies as a ridge body model's statistics (``body_space.npz``): building one from a bank (its
+  bad bodies refused), reading, writing
 - batch: a batch in chunks (one core batch each, refused rows alone, extra measurements met) with per-row errors
 - extra_refine: exact mode for the six extra measurements, alternated with the five's refinement
 - idw: segmented and proportional IDW: the weights, the interpolated pieces and joints

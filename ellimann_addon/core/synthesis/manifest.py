@@ -5,7 +5,8 @@
      "base": stem or null, "mannequins": [stems] (N >= 3), "measurements": ["He", "Sh", "Br", "Wa", "Hi"],
      "section_fractions": {"Sh", "Br", "Wa", "Hi": fraction of He}, "ranges_cm": {key: [lo, hi]},
      "absurd_limits_cm": {key: [lo, hi]}, "targets_cm": {stem: {key: cm}}, "provenance": {...},
-     "bodies": file name (optional: the body meshes the RMs were traced from, core.body.bodies)}
+     "bodies": file name (optional: the body meshes the RMs were traced from, core.body.bodies),
+     "body_space": file name (optional: many bodies as a ridge body model's statistics, core.synthesis.body_space)}
 
 A folder without a manifest is the legacy layout: the five female RMs of Table 2.3 and the constants of
 core/constants.py (:func:`legacy_manifest`).
@@ -48,6 +49,7 @@ class Manifest:
     targets_cm: dict = field(default_factory=dict)
     provenance: dict = field(default_factory=dict)
     bodies: str = None  # the set's bodies file in the folder (core.body.bodies), or None: a set without bodies
+    body_space: str = None  # the set's body-space file (core.synthesis.body_space), or None: a set without one
 
     def to_dict(self):
         data = {
@@ -66,6 +68,8 @@ class Manifest:
         }
         if self.bodies is not None:  # a set without bodies writes the manifest it always wrote
             data["bodies"] = self.bodies
+        if self.body_space is not None:
+            data["body_space"] = self.body_space
         return data
 
     @classmethod
@@ -121,6 +125,9 @@ class Manifest:
         bodies = data.get("bodies")
         if bodies is not None and (not isinstance(bodies, str) or not BODIES_NAME.match(bodies)):
             raise bad("bodies", f"{bodies!r:.40} is not a file name in the folder (letters, digits, _ . -; .npz)")
+        space = data.get("body_space")
+        if space is not None and (not isinstance(space, str) or not BODIES_NAME.match(space)):
+            raise bad("body_space", f"{space!r:.40} is not a file name in the folder (letters, digits, _ . -; .npz)")
         return cls(
             name,
             list(stems),
@@ -132,6 +139,7 @@ class Manifest:
             targets,
             provenance,
             bodies,
+            space,
         )
 
 

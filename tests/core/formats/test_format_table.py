@@ -45,6 +45,7 @@ PAGES = {  # a page per format ElliMann defines, and code each must name
     "reference_set.md": ["write_reference_set", "read_manifest", "load_reference_set", "references check"],
     "batch_npz.md": ["BatchFileWriter", "write_batch_file", "read_batch_file", "load_batch_file"],
     "batch_csv.md": ["MeasurementsCsv", "Report"],
+    "body_space.md": ["BodySpace.save", "read_body_space", "space_from_meshes", "tools.shipped.add_body_space"],
 }
 
 
