@@ -57,8 +57,7 @@ def status_line(read, row):
 
 
 class ELLIMANN_OT_open_measurement_file(ElliMannOperator, bpy.types.Operator):
-    """Fill the measurements from a measurement file: a Seamly2D/Valentina .vit or .vst, a FreeSewing set (.json) or
-    a size chart (.csv); a missing one of the five is predicted from the survey"""
+    """Fill the measurements from a .vit, .vst, FreeSewing set or size chart; a missing one of the five is predicted"""
 
     bl_idname = ids.OPEN_MEASUREMENT_FILE
     bl_label = "Open Measurement File"
