@@ -94,3 +94,22 @@ def test_synth_writes_an_avatar_with_its_proxy(tmp_path, capsys):
     bpy.ops.import_scene.fbx(filepath=str(path))
     meshes = sorted(o.name for o in bpy.data.objects if o.type == "MESH")
     assert meshes == ["ElliMann Avatar", "ElliMann Collision Proxy"]
+
+
+def test_pose_and_batch_write_avatars_in_the_pose_asked(tmp_path, capsys):
+    """``pose IN.json --pose t_pose --skin -o x.fbx`` stands the avatar in the T-pose; a ``batch --skin`` row writes
+    one too (every job's avatar options reach the writer)."""
+    source = tmp_path / "m.json"
+    assert run(["synth", *REQUEST, "--skin", "-o", str(source)], capsys)[0] == 0
+    code, _, stderr = run(["pose", str(source), "--pose", "t_pose", "--skin", "-o", str(tmp_path / "t.fbx")], capsys)
+    assert code == 0, stderr
+    bpy.ops.wm.read_homefile(use_empty=True)
+    bpy.ops.import_scene.fbx(filepath=str(tmp_path / "t.fbx"), automatic_bone_orientation=False)
+    (rig,) = [o for o in bpy.data.objects if o.type == "ARMATURE"]
+    shoulder, wrist = (rig.matrix_world @ rig.data.bones[name].head_local for name in ("L_Shoulder", "L_Wrist"))
+    assert abs(wrist.z - shoulder.z) < 0.01  # the T-pose
+    table = tmp_path / "rows.csv"
+    table.write_text("name,He,Sh,Br,Wa,Hi\nana,165,41.5,101.25,82.75,117.5\n")
+    code, _, stderr = run(["batch", str(table), "-o", str(tmp_path / "b"), "--format", "fbx", "--skin", "-q"], capsys)
+    assert code == 0, stderr
+    assert incomplete(tmp_path / "b" / "ana.fbx") is None
