@@ -7,9 +7,11 @@ skin on (auto: the body skin where the set has bodies), written in every ``--for
 a size outside the set's range, increments that make a girth negative) is said in one line and reported, and the run
 goes on. numpy alone writes .json, .obj and .xml; .fbx and .glb need Blender, refused before any work without it."""
 
+import contextlib
 import os
 import re
 import sys
+import time
 
 from ..core.errors import ElliMannError
 from ..core.formats.table import format_named, listing
@@ -209,10 +211,12 @@ def run(args):
                 outputs=outputs(name),
                 avatar=None if avatar is None else avatar_replace(avatar, told.append),
             )
+            started = time.time()
             try:
                 make_row(request, made, told)
             except (ElliMannError, OSError) as error:
                 made.fail(f"{read.path} size {row.label!r}: {output.one_line(error)}")
+                remove_written(request.outputs, started)
         for line in made.lines():
             output.say(f"{PROG} sizes: {line}")
         progress.step(row.label)
@@ -241,6 +245,15 @@ def avatar_replace(avatar, told):
     return dataclasses.replace(avatar, told=told)
 
 
+def remove_written(paths, since):
+    """Remove the files of ``paths`` written since ``since`` (a row that failed halfway: its .json written, its .fbx
+    refused): nothing is left of a failed row."""
+    for path in paths:
+        with contextlib.suppress(OSError):
+            if os.path.getmtime(path) >= since - 1.0:
+                os.remove(path)
+
+
 def make_row(request, made, told):
     """Make one row's job and write its files; ``made`` (sizes_report.Made) keeps what came of it."""
     from ..core.job.make import make
@@ -260,16 +273,20 @@ def lineup(args, out, done):
     if not writing.blender_available():
         output.say(f"{PROG} sizes: no line-up picture: it needs Blender (the bpy module); files and report are written")
         return None
-    writing.blender_module("the line-up picture")
-    from ..blender.services.render import render_lineup
-
     path = os.path.join(out, "lineup.png")
-    with writing.writing(path):
-        render_lineup(
-            [m.result.mannequin for m in made],
-            path,
-            labels=[m.row.label for m in made],
-            skins=[m.result.skin.skin if m.result.skin is not None else None for m in made],
-            width=max(800, 260 * len(made)),
-        )
+    try:  # the avatars and the report matter more than their picture: a picture that fails is said, not fatal
+        writing.blender_module("the line-up picture")
+        from ..blender.services.render import render_lineup
+
+        with writing.writing(path):
+            render_lineup(
+                [m.result.mannequin for m in made],
+                path,
+                labels=[m.row.label for m in made],
+                skins=[m.result.skin.skin if m.result.skin is not None else None for m in made],
+                width=max(800, 260 * len(made)),
+            )
+    except (ElliMannError, RuntimeError) as error:
+        output.say(f"{PROG} sizes: warning: no line-up picture: {output.one_line(error)}")
+        return None
     return path

@@ -5,6 +5,7 @@ or in a pose that is no rest pose is refused in one line before any work."""
 
 import csv
 import pathlib
+import re
 
 import bpy
 import numpy as np
@@ -113,3 +114,16 @@ def test_pose_and_batch_write_avatars_in_the_pose_asked(tmp_path, capsys):
     code, _, stderr = run(["batch", str(table), "-o", str(tmp_path / "b"), "--format", "fbx", "--skin", "-q"], capsys)
     assert code == 0, stderr
     assert incomplete(tmp_path / "b" / "ana.fbx") is None
+
+
+def test_a_size_whose_avatar_cannot_be_decimated_within_2_mm_fails_and_leaves_nothing(tmp_path, capsys):
+    folder = tmp_path / "out"
+    argv = ["sizes", str(DATA / "jane.vit"), "-o", str(folder), "--format", "json,fbx", "--max-triangles", "5000"]
+    code, stdout, stderr = run([*argv, "--no-picture", "-q"], capsys)
+    assert code == 1 and "0 of 1 avatars written" in stdout
+    (failed,) = [line for line in stderr.splitlines() if "failed:" in line]
+    assert re.search(
+        r"size 'Jane Doe': fbx: the avatar \([\d,]+ triangles\) misses the request by [+-]0\.\d\d cm", failed
+    )
+    assert failed.endswith("raise the triangle budget (--max-triangles)")
+    assert sorted(p.name for p in folder.iterdir()) == ["report.csv", "report.md"]  # its .json removed too
