@@ -3,17 +3,19 @@
 - ``ellimann …`` (``pip install .``: :func:`main_exit`) and ``python -m ellimann_addon …``
 - ``blender --background --command ellimann …`` (registered by ``blender/cli_command.py``)
 
-Subcommands, a module each: ``synth`` (one mannequin), ``batch`` (a CSV of measurements), ``pose`` (a mannequin
-in a pose), ``measure`` (m_T of a file), ``demo`` (the paper's Table 2.5 mannequins with a report and a line-up
-picture), ``drape`` (a garment on a mannequin with Blender's cloth simulation), ``references`` (build or check
-a reference set) and ``population`` (rows sampled from a survey's statistics, for ``batch``); ``distributed`` runs
-``batch --dask``; what they share is in ``output`` (printed lines, exit codes), ``arguments`` (parser pieces),
-``skin_options`` (``--skin``: its options and the settings they ask for), ``writing`` (files, the output folder),
-``reporting`` (the report CSV) and ``provenance`` (what a batch row's files were made from, for ``--resume``).
-This package needs numpy only: Blender
-(the bpy module and ``ellimann_addon.blender``) is imported only when a .blend or .glb file, a drape or a picture
-is involved, and a command that needs it without it is refused in one line. What Blender prints is captured
-(``chatter``) and shown only with ``--verbose``. User mistakes end with a one-line reason and a non-zero exit code:
+Subcommands, a module each: ``synth`` (one mannequin), ``batch`` (a CSV of measurements), ``sizes`` (an avatar per
+person or size of a measurement file: .vit, .vst, a FreeSewing set, a size chart; its report: ``sizes_report``),
+``pose`` (a mannequin in a pose), ``measure`` (m_T of a file; ``measurement_files``: written back as a .vit,
+FreeSewing set or chart row), ``demo`` (the paper's Table 2.5 mannequins with a report and a line-up picture),
+``drape`` (a garment on a mannequin with Blender's cloth simulation), ``references`` (build or check a reference
+set) and ``population`` (rows sampled from a survey's statistics, for ``batch``); ``distributed`` runs ``batch
+--dask``; what they share is in ``output`` (printed lines, exit codes), ``arguments`` (parser pieces),
+``skin_options`` (``--skin``: its options and the settings they ask for), ``avatar_options`` (an FBX avatar's),
+``writing`` (files, the output folder), ``reporting`` (the report CSV) and ``provenance`` (what a batch row's files
+were made from, for ``--resume``). This package needs numpy only: Blender (the bpy module and
+``ellimann_addon.blender``) is imported only when a .blend, .glb or .fbx file, a drape or a picture is involved,
+and a command that needs it without it is refused in one line. What Blender prints is captured (``chatter``) and
+shown only with ``--verbose``. User mistakes end with a one-line reason and a non-zero exit code:
 1 for bad input or a failed row, 2 for a malformed command line, 3 when exact mode missed a request (the files are
 written), 130 when interrupted (Ctrl-C).
 """
@@ -24,12 +26,12 @@ import sys
 
 from ..core.constants import VERSION
 from ..core.errors import ElliMannError
-from . import batch, demo, drape, measure, output, population, pose, references, synth
+from . import batch, demo, drape, measure, output, population, pose, references, sizes, synth
 from .output import INTERRUPTED, MISSED, PROG, UsageError, one_line, say
 from .writing import blender_available, no_blender
 
 __all__ = ["INTERRUPTED", "MISSED", "PROG", "UsageError", "build_parser", "main", "main_exit"]
-SUBCOMMANDS = (synth, batch, pose, measure, demo, drape, references, population)
+SUBCOMMANDS = (synth, batch, sizes, pose, measure, demo, drape, references, population)
 
 
 def build_parser():

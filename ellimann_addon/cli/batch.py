@@ -329,7 +329,7 @@ def _row(args, command, formats, result, i, row, bundles=None, made=None):
                 made.forget(name)  # no record while its files are being written again
             made_now = finish(job, mannequin, measured)
             if paths:
-                writing.write(made_now, job.formats, args.cushions)
+                writing.write(made_now, job.formats, args.cushions, job.avatar)
             if paths and made is not None:
                 made.write(row)
         except (ElliMannError, OSError, RuntimeError) as error:

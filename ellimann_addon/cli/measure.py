@@ -1,6 +1,7 @@
 """``ellimann measure``: m_T and the extra measurements of a .json mannequin (no Blender; one that records a skin:
 its pieces' and, labelled apart, its skin's, made again as the file records it), of a .blend (Blender), of a .glb
-(what its extras record, no Blender) or of a body mesh (.obj / .ply / .stl, no Blender)."""
+(what its extras record, no Blender) or of a body mesh (.obj / .ply / .stl, no Blender); with
+``--write-measurements``, written back as a .vit, a FreeSewing set or a chart row (``measurement_files``)."""
 
 import json
 import math
@@ -12,7 +13,7 @@ from ..core.mannequin.model import Mannequin
 from ..core.measure.body import MESH_EXTENSIONS, measure_body_mesh
 from ..core.measure.extra import mannequin_extra_measurements
 from ..core.measurements import ALL_MEASUREMENTS, MEASUREMENT_LABELS, MEASUREMENTS, measurement_line
-from . import arguments, output, writing
+from . import arguments, measurement_files, output, writing
 from .output import UsageError
 from .skin_options import describe
 
@@ -56,6 +57,7 @@ def add_parser(commands):
         "mannequin records (its own set's; female for files that record none)",
         shipped="female, male, female-fine or male-fine (of the mannequin's own topology)",
     )
+    measurement_files.add_write_options(measure)
     arguments.add_verbose(measure)
     measure.set_defaults(run=run, blender=needs_blender)
 
@@ -76,6 +78,8 @@ def run(args):
             raise UsageError(f"--neck-tilt is for a body mesh: a mannequin's neck leans as its joints do ({path})")
         if not (math.isfinite(args.neck_tilt) and low <= args.neck_tilt <= high):
             raise UsageError(f"--neck-tilt must be {low:g} to {high:g} degrees, got {args.neck_tilt:g}")
+    measurement_files.check_write(args)
+    stem = os.path.splitext(os.path.basename(path))[0]
     if kind in MESH_EXTENSIONS:
         values, problems = measure_mesh_file(path, args)
         if not values:
@@ -83,6 +87,7 @@ def run(args):
         for problem in problems:
             output.say(f"{output.PROG} measure: warning: {path}: {problem}")
         _print(values, args.json, path, f"{path}: body mesh")
+        measurement_files.write_measurements(args, values, stem)
         return 0
     if kind == ".glb":
         return measure_glb(path, args)
@@ -101,10 +106,13 @@ def run(args):
     values = dict(mannequin.measure())
     values.update(mannequin_extra_measurements(mannequin))
     skin = skin_values(mannequin, path) if kind == ".json" and mannequin.skin is not None else None
+    sex = measurement_files.sex_of(mannequin)
     if skin is None:
         _print(values, args.json, path, f"{mannequin.name or path}: m_T and more")
+        measurement_files.write_measurements(args, values, mannequin.name or stem, sex)
         return 0
     settings, skin_measured = skin
+    measurement_files.write_measurements(args, skin_measured, mannequin.name or stem, sex)  # the body's surface
     if args.json:
         shown = _shown(values)
         how = {"kind": "body"} if settings.kind == "body" else {"voxel_mm": settings.voxel_mm, "blend": settings.blend}
@@ -155,6 +163,8 @@ def measure_glb(path, args):
     values = {key: float(recorded[key]) for key in MEASUREMENTS}
     name = extras.get("name") or path
     _print(values, args.json, path, f"{name}: m_T of its pieces as the file's extras record it")
+    stem = os.path.splitext(os.path.basename(path))[0]
+    measurement_files.write_measurements(args, values, extras.get("name") or stem)
     skins = skin_nodes(doc)
     if skins and not args.json:
         voxel = skins[0].get("voxel_mm")

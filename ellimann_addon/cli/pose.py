@@ -71,7 +71,7 @@ def run(args):
         output.say(f"{PROG} pose: warning: {warning}")
     for note in result.notes:
         output.say(f"{PROG} pose: {note}")
-    writing.write(result, job.formats, args.cushions)
+    writing.write(result, job.formats, args.cushions, job.avatar)
     frames = result.frames
     count = f" ({len(frames)} frames)" if len(frames) > 1 else ""
     made = f", with its {skin_options.describe(settings)}" if settings is not None else ""

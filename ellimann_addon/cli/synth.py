@@ -14,7 +14,7 @@ from ..core.measurements import (
     measurement_line,
 )
 from ..core.synthesis.request import relative_error
-from . import arguments, jobs, output, skin_options, writing
+from . import arguments, avatar_options, jobs, output, skin_options, writing
 from .output import PROG, UsageError
 
 
@@ -70,6 +70,7 @@ def add_parser(commands):
     arguments.add_synthesis_options(synth)
     arguments.add_pose_option(synth)
     skin_options.add_skin_options(synth)
+    avatar_options.add_avatar_options(synth)
     synth.set_defaults(run=run, blender=lambda args: None)  # the job checks its files
 
 
@@ -114,6 +115,7 @@ def run(args):
         skin_options.skin_settings(args),
         arguments.pose_ask(args),
         (args.output,),
+        avatar=avatar_options.avatar_settings(args, (args.output,)),
     )
     job = jobs.checked(request)  # everything that could refuse it, before any work
     arguments.say_clip(args, job.pose)
@@ -122,7 +124,7 @@ def run(args):
         output.say(f"{PROG} synth: warning: {warning}")
     for note in result.notes:
         output.say(f"{PROG} synth: {note}")
-    writing.write(result, job.formats, args.cushions)
+    writing.write(result, job.formats, args.cushions, job.avatar)
     if args.json:
         print(json.dumps(_result(args, result)))
     else:

@@ -3,6 +3,7 @@ Blender's (.blend, .glb) through ``blender.services.writers`` only when asked (b
 functions that need it); one-line errors naming the file; the output folder."""
 
 import contextlib
+import dataclasses
 import importlib.util
 import os
 import sys
@@ -63,10 +64,11 @@ def blender_writers(what="this"):
     return bpy
 
 
-def write(result, formats, cushions=False):
+def write(result, formats, cushions=False, avatar=None):
     """Write a job's ``result`` (``core.job.result.Result``: the mannequin, its skin, its poses) to every path of
     ``formats`` ({path: Format}, decided once by the job), each by its row's writer (``core.formats.table``);
-    Blender is loaded only for .blend and .glb. A path that cannot be written raises UsageError naming it (not the
+    Blender is loaded only for .blend, .glb and .fbx. ``avatar``: the job's AvatarOptions for an .fbx (what it must
+    measure: ``Result.avatar_request``). A path that cannot be written raises UsageError naming it (not the
     temporary file behind it)."""
     posed = result.frames is not None
     blender = [path for path, kind in formats.items() if kind.needs_blender_for(posed)]
@@ -79,6 +81,8 @@ def write(result, formats, cushions=False):
         frames=result.frames,
         fps=result.fps,
     )
+    if avatar is not None:
+        settings["avatar"] = dataclasses.replace(avatar, request=result.avatar_request())
     for path, kind in formats.items():  # the core's files one at a time: an error names its file
         if not kind.needs_blender_for(posed):
             with writing(path):

@@ -85,8 +85,8 @@ def incomplete(path, kind=None):
     block chain from the header to the ENDB block (Blender 4.x and 5.x layouts; zstd files: the
     frames listed in the seek table Blender appends; gzip: the decompressed blocks); .glb: the
     length in the header is the file's and the chunks fill it; .json/.xml: it parses; .png: it
-    ends with IEND; .obj: it ends with a complete line; .npz: its zip directory reads; .fbx (binary): its signature
-    and its footer. Any other kind: it is not empty.
+    ends with IEND; .obj and .csv: it ends with a complete line; .npz: its zip directory reads; .fbx (binary): its
+    signature and its footer; .vit: it parses as XML. Any other kind: it is not empty.
     """
     kind = extension_of(path) if kind is None else kind
     try:
@@ -244,6 +244,8 @@ def _fbx(stream, size):
 
 _CHECKS = {"blend": _blend, "glb": _glb, "json": _json, "xml": _xml, "png": _png, "obj": _obj, "npz": _npz}
 _CHECKS["fbx"] = _fbx
+_CHECKS["vit"] = _xml  # a Seamly2D / Valentina measurements file (core.sizing.writers) is XML
+_CHECKS["csv"] = _obj  # a size chart's row (core.sizing.writers): it ends with a complete line, as an .obj
 CHECKED_KINDS = tuple(_CHECKS)  # the extensions :func:`incomplete` checks beyond "not empty"
 
 

@@ -1,4 +1,4 @@
-"""The option tables of the skin and the drape: an ``option_table.Option`` per setting (default, label,
+"""The option tables of the skin, the avatar and the drape: an ``option_table.Option`` per setting (default, label,
 descriptions, choices, limits), from which the command line's options and the panels' properties are generated, and
 the few numbers they are made of. On the core's ground floor, as ``synthesis.options.SYNTHESIS`` on its package's:
 building the command line's parser loads no skin or drape code (their settings' classes,
@@ -52,6 +52,41 @@ SKIN = {
         "How far neighbouring pieces blend, in units of the thinner piece's smallest semi-axis (0: a plain union)",
         "how far neighbouring pieces blend, times the thinner one's smallest semi-axis (default {default:g})",
         limits=BLEND_RANGE,
+    ),
+}
+
+# The avatar's (``core.formats.avatar``: the FBX row's, for garment tools): its rest pose, the bones' names, the
+# pieces beside it, the skin's triangle budget.
+AVATAR_POSES = ("a_pose", "t_pose")
+BONE_NAMINGS = ("smpl", "mixamo")
+AVATAR_TRIANGLES = 70_000  # CLO's import guidance for an avatar: at most about 70k triangles
+AVATAR_MIN_TRIANGLES = 5_000  # a smaller budget leaves no body to measure
+
+AVATAR = {
+    "bones": Option(
+        "Bone Names",
+        "smpl",
+        "The avatar's bone names: SMPL's (L_Hip, ...) or Mixamo's (mixamorig:LeftUpLeg, ...)",
+        "an FBX avatar's bone names: smpl (L_Hip, ...; default) or mixamo (mixamorig:LeftUpLeg, ..., as Mixamo's "
+        "own files name them)",
+        choices=(
+            Choice("smpl", "SMPL", "SMPL's joint names"),
+            Choice("mixamo", "Mixamo", "Mixamo's bone names, prefixed mixamorig:"),
+        ),
+    ),
+    "proxy": Option(
+        "Collision Proxy",
+        False,
+        "Write the pieces beside the avatar as a collision proxy (each rigid on its bone)",
+        "an FBX avatar: write the pieces beside the skin as a collision proxy (each rigid on its bone)",
+    ),
+    "max_triangles": Option(
+        "Triangle Budget",
+        AVATAR_TRIANGLES,
+        "The most triangles the avatar's skin may have: a finer one is decimated and measured again",
+        "an FBX avatar: the most triangles its skin may have (default {default:,}; at least {low:,}): a finer one is "
+        "decimated and measured again, and must still meet the request within 2 mm",
+        limits=(AVATAR_MIN_TRIANGLES, 10_000_000),
     ),
 }
 

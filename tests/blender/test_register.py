@@ -41,8 +41,8 @@ def leftovers():
 
 def test_disable_leaves_nothing_and_enable_works_again():
     # property groups, operators, panels, menus (the Synthesize, Reference Set and Pose features' among them)
-    # + Measure Body Mesh, Synthesize from Mesh; Build Skin and its panel
-    assert len(all_classes()) == 2 + 14 + 6 + 1 + 2 + 6 + 6 + 6 + 2 + 2
+    # + Measure Body Mesh, Synthesize from Mesh; Build Skin and its panel; Open Measurement File
+    assert len(all_classes()) == 2 + 14 + 6 + 1 + 2 + 6 + 6 + 6 + 2 + 2 + 1
     assert len(all_classes()) == len(set(all_classes()))
     assert not [c.__name__ for c in all_classes() if not c.is_registered]
     live._settle_later(bpy.context.scene)  # a live update's timers, still waiting

@@ -124,6 +124,16 @@ def test_json_xml_png_and_obj_checks(tmp_path):
     (tmp_path / "m.obj").write_bytes(b"o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2")
     assert "complete line" in incomplete(tmp_path / "m.obj")
     assert "No such file" in incomplete(tmp_path / "missing.json")
+    # The measurement files core.sizing.writers writes: a .vit is XML, a chart's .csv ends with a complete line
+    every_truncation_is_caught(
+        tmp_path,
+        b'<smis><unit>cm</unit><body-measurements><m name="height" value="165"/></body-measurements></smis>',
+        "m.vit",
+    )
+    (tmp_path / "m.csv").write_bytes(b"size,He\nunit,cm\nM,165\n")
+    assert incomplete(tmp_path / "m.csv") is None
+    (tmp_path / "m.csv").write_bytes(b"size,He\nunit,cm\nM,16")
+    assert "complete line" in incomplete(tmp_path / "m.csv")
 
 
 # ------------------------------------------------------------------------------------------------ atomic writes

@@ -31,6 +31,7 @@ class ELLIMANN_MT_object(bpy.types.Menu):
         layout.operator(ids.BUILD_REFERENCE_SET)
         layout.operator(ids.SYNTHESIZE_MANNEQUIN)
         layout.operator(ids.SYNTHESIZE_FROM_MESH)
+        layout.operator(ids.OPEN_MEASUREMENT_FILE)
         layout.operator(ids.DRAPE_GARMENT)
         layout.separator()
         layout.operator(ids.ADD_ARMATURE, icon="ARMATURE_DATA")

@@ -115,7 +115,7 @@ def write_fbx(
         what = "could not be measured" if not np.isfinite(off) else f"misses the request by {off:+.2f} cm"
         raise ElliMannError(
             f"fbx: the avatar ({len(faces):,} triangles) {what} for {key} (tolerance {tolerance_cm:g} cm); "
-            "raise the triangle budget"
+            "raise the triangle budget (--max-triangles)"
         )
     avatar = posed_avatar(mannequin, vertices, weights, pose)
     with blender_output():

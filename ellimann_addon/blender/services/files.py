@@ -50,7 +50,7 @@ import numpy as np
 from ...core.errors import ElliMannError
 from ...core.files import atomic_output
 from ...core.formats.glb import EXTRAS_FORMAT, EXTRAS_KEY, EXTRAS_VERSION
-from ...core.formats.table import BLENDER_FORMATS, extension_of
+from ...core.formats.table import SCENE_FORMATS, extension_of
 from ...core.measurements import MEASUREMENTS
 from ..bridge.built import built_objects, is_stale
 from ..bridge.convert import collection_to_mannequin, objects_recursive
@@ -229,7 +229,7 @@ def write_with_skin(paths, collection, mannequin, measured=None, skin=None):
 def checked_paths(paths):
     """``paths`` as strings; ElliMannError naming the first that is not a .blend or .glb file."""
     paths = [os.fspath(p) for p in paths]
-    other = [p for p in paths if extension_of(p) not in BLENDER_FORMATS]
+    other = [p for p in paths if extension_of(p) not in SCENE_FORMATS]
     if other:
         raise ElliMannError(f"path: {other[0]!r} is not a .blend or .glb file (the core writes .obj, .json, .xml)")
     return paths

@@ -1,4 +1,5 @@
-"""Headless Workbench pictures of mannequins: a front line-up with a label under each body."""
+"""Headless Workbench pictures of mannequins: a front line-up with a label under each body (their pieces, or their
+skins)."""
 
 import math
 import os
@@ -7,6 +8,8 @@ import bpy
 import numpy as np
 
 from ...core.geometry.ellipsoid import bounds
+from ..bridge.convert import mesh_from_arrays
+from ..bridge.skin import SKIN_COLOR
 from .chatter import blender_output
 from .files import atomic_output
 from .scene import add_mannequin, empty_scene
@@ -16,23 +19,32 @@ LABEL_COLOR = (0.15, 0.15, 0.15, 1.0)
 GAP = 0.12  # m between neighbouring bodies
 
 
-def render_lineup(mannequins, filepath, labels=None, cushions=False, width=2000):
+def render_lineup(mannequins, filepath, labels=None, cushions=False, width=2000, skins=None):
     """Render ``mannequins`` side by side, seen from the front, into a PNG ``width`` pixels wide.
 
     Replaces the current file with an empty scene. Labels (default: the mannequins' names) are text
-    objects under the feet. The picture is written atomically; its height follows the line-up.
+    objects under the feet. ``skins``: for each mannequin its skin (anything with ``vertices`` and ``faces``, in
+    metres) drawn in its place, or None for its pieces. The picture is written atomically; its height follows
+    the line-up.
     """
     empty_scene()
     scene = bpy.context.scene
     labels = list(labels) if labels is not None else [m.name for m in mannequins]
+    skins = list(skins) if skins is not None else [None] * len(mannequins)
     x = 0.0
     low = np.array([np.inf, np.inf, np.inf])
     high = -low
-    for mannequin, label in zip(mannequins, labels):
-        lo, hi = bounds(mannequin.rotation, mannequin.center, mannequin.semi_axes)
-        lo, hi = lo.min(axis=0), hi.max(axis=0)
+    for mannequin, label, skin in zip(mannequins, labels, skins):
+        if skin is not None:
+            lo, hi = np.min(skin.vertices, axis=0), np.max(skin.vertices, axis=0)
+        else:
+            lo, hi = bounds(mannequin.rotation, mannequin.center, mannequin.semi_axes)
+            lo, hi = lo.min(axis=0), hi.max(axis=0)
         offset = np.array([x - lo[0], 0.0, 0.0])
-        add_mannequin(mannequin.translated(offset), cushions=cushions)
+        if skin is not None:
+            _add_skin(label, np.asarray(skin.vertices) + offset, skin.faces)
+        else:
+            add_mannequin(mannequin.translated(offset), cushions=cushions)
         _add_label(label, (x + 0.5 * (hi[0] - lo[0]), lo[1] - 0.2, -0.05))
         low, high = np.minimum(low, lo + offset), np.maximum(high, hi + offset)
         x += hi[0] - lo[0] + GAP
@@ -40,6 +52,15 @@ def render_lineup(mannequins, filepath, labels=None, cushions=False, width=2000)
     _frame_front(scene, low, high, width)
     workbench(scene)
     return write_png(scene, filepath)
+
+
+def _add_skin(name, vertices, faces):
+    mesh = mesh_from_arrays(f"Skin {name}", vertices, faces)
+    mesh.shade_smooth()
+    obj = bpy.data.objects.new(f"Skin {name}", mesh)
+    obj.color = SKIN_COLOR
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
 
 
 def _add_label(text, location, size=0.07):

@@ -9,9 +9,14 @@ exporter writes them (``blender.services.fbx``).
 - the pose: a T-pose moves the skin by linear-blend skinning (``Skin.posed``'s formula on the dense table) and the
   mannequin's pieces and joints rigidly with their bones (``pose_mannequin``), so the written rest pose is the
   T-pose and the skeleton's bones start at the posed joints;
-- the measurements: a decimated skin is measured again as its own mesh (``core.skin.measure``: each vertex takes
-  the pieces of the nearest vertex of the skin it was decimated from) in the A-pose, where they are defined; it
-  must still meet the request within ``DECIMATED_TOLERANCE_CM`` of each measurement.
+- the measurements: a decimated skin is measured again as its own mesh in the A-pose, where they are defined: a
+  skin over the pieces by ``core.skin.measure`` (each vertex takes the pieces of the nearest vertex of the skin it
+  was decimated from), the body skin (``core.body.skin.BodySkin``) by the body-mesh measurer
+  (``core.measure.body.measure_body_mesh``) with its arms carried over the same way from the labels; it must still
+  meet the request within ``DECIMATED_TOLERANCE_CM`` of each measurement.
+
+How a job asks for an avatar (``core.job.request.Request.avatar``, the format table's ``fbx`` row): an
+:class:`AvatarOptions` (the pose, the bones' names, the proxy, the triangle budget).
 """
 
 from dataclasses import dataclass
@@ -22,19 +27,20 @@ from ..errors import ElliMannError
 from ..geometry.ellipsoid import matrix_world
 from ..geometry.mesh import icosphere
 from ..mannequin.skeleton import JOINT_COUNT, JOINT_NAMES, part_bones
+from ..measure.body import measure_body_mesh
+from ..measure.neck import joint_tilt
 from ..pose.kinematics import bone_matrices, pose_mannequin
 from ..pose.motion import clamped_motion
 from ..pose.rig_names import RIG_NAME_MAPS
+from ..settings import AVATAR_MIN_TRIANGLES, AVATAR_POSES, AVATAR_TRIANGLES, BONE_NAMINGS
 from ..skin.measure import body_measurements, mesh_measurements
 from ..skin.surface import Skin
 
-GARMENT_TOOL_TRIANGLES = 70_000  # CLO's import guidance for an avatar: at most about 70k triangles
+GARMENT_TOOL_TRIANGLES = AVATAR_TRIANGLES  # CLO's import guidance for an avatar: at most about 70k triangles
 DECIMATED_TOLERANCE_CM = 0.2  # a decimated avatar meets every requested measurement within 2 mm
-AVATAR_POSES = ("a_pose", "t_pose")
-BONE_NAMINGS = ("smpl", "mixamo")
 MIXAMO_PREFIX = "mixamorig:"
 PROXY_LEVEL = 2  # icosphere level of a piece in the collision proxy (320 triangles each)
-MIN_TRIANGLES = 5_000  # a smaller budget leaves no body to measure
+MIN_TRIANGLES = AVATAR_MIN_TRIANGLES  # a smaller budget leaves no body to measure
 
 
 def bone_names(naming="smpl"):
@@ -70,6 +76,27 @@ def check_avatar_options(pose, naming, max_triangles):
         isinstance(max_triangles, bool) or not isinstance(max_triangles, int) or max_triangles < MIN_TRIANGLES
     ):
         raise ElliMannError(f"triangles: the budget must be a whole number of at least {MIN_TRIANGLES:,}")
+
+
+@dataclass(frozen=True)
+class AvatarOptions:
+    """How an avatar is written (the format table's ``fbx`` row): its rest ``pose`` (a_pose, t_pose), the bones'
+    names (``naming``: smpl, mixamo), the pieces beside it as a collision ``proxy``, the skin's triangle budget
+    (``max_triangles``; None: as it is). ``request`` {key: cm}: what it must still measure once decimated (a job
+    fills it from its result: ``core.job.result.Result.avatar_request``); ``told(FbxAvatar)``: called with what
+    each file holds (a caller's report), if given."""
+
+    pose: str = "a_pose"
+    naming: str = "smpl"
+    proxy: bool = False
+    max_triangles: int | None = GARMENT_TOOL_TRIANGLES
+    request: dict | None = None
+    told: object = None
+
+    def checked(self):
+        """Itself, or ElliMannError (one line) for an option ElliMann does not write."""
+        check_avatar_options(self.pose, self.naming, self.max_triangles)
+        return self
 
 
 def blend(vertices, weights, matrices):
@@ -112,10 +139,18 @@ def proxy_mesh(mannequin, level=PROXY_LEVEL):
 
 
 def remeasure(skin, vertices, faces, nearest):
-    """{key: cm} of a decimated skin's mesh (``vertices``, ``faces``), each vertex taking the pieces of the vertex
-    ``nearest`` (V,) of ``skin`` it lies closest to: the five (core.skin.measure.mesh_measurements) and the
-    six extra ones (body_measurements)."""
+    """({key: cm}, problems) of a decimated skin's mesh (``vertices``, ``faces``), each vertex taking what it needs
+    from the vertex ``nearest`` (V,) of ``skin`` it lies closest to. A skin over the pieces
+    (``core.skin.surface.Skin``): its pieces, measured as that skin (core.skin.measure: the five by
+    mesh_measurements, the six extra ones by body_measurements). The body skin (``core.body.skin.BodySkin``, which
+    has no pieces): its arms from the labels, measured as the body skin measures itself (``measure_body_mesh`` at its
+    set's heights, the neck square to its own Neck -> Head axis)."""
     nearest = np.asarray(nearest, dtype=np.int64)
+    if not hasattr(skin, "pieces"):
+        arms = {side: np.asarray(skin.arms[side], bool)[nearest] for side in ("L", "R")}
+        vertices, faces = np.asarray(vertices, float), np.asarray(faces, np.int64)
+        found = measure_body_mesh(vertices, faces, skin.bodies.fractions, joint_tilt(skin.joints), arms)
+        return dict(found.values), list(found.problems)
     decimated = Skin(
         skin.mannequin,
         np.asarray(vertices, float),

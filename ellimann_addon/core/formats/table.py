@@ -5,13 +5,15 @@ whole, so a write cut short never replaces a file) and the function that writes 
 
 A path's format is decided here once (:func:`format_of`, :func:`check_outputs`), and every list of formats in a help
 or an error text is made from the table (:func:`listing`). The core writes .obj, .json and MJCF
-(``core.formats.core_writers``); Blender writes .blend and .glb, and the Blender layer binds its writer to those rows
-when it is loaded (:func:`bind_writer`): the core never imports it. The formats ElliMann defines have a page each in
-docs/formats/.
+(``core.formats.core_writers``); Blender writes .blend, .glb and the FBX avatar, and the Blender layer binds its
+writers to those rows when it is loaded (:func:`bind_writer`): the core never imports it. A row that ``needs_skin``
+(the FBX avatar: the skin on its bones, for garment tools) is refused by a job that asks for no skin. The formats
+ElliMann defines have a page each in docs/formats/.
 
 Every row's ``write(mannequin, paths, *, cushions, skin, measured, frames, fps)`` writes one mannequin (its
 ``skin``, if any; in ``frames``, a list of ``core.pose.kinematics.Pose``, if posed) to each of ``paths``, all of
-that row's format, and returns them.
+that row's format, and returns them; it takes any other setting by keyword and ignores those it has no use for (the
+avatar's ``avatar``: ``core.formats.avatar.AvatarOptions``).
 """
 
 import os
@@ -31,6 +33,7 @@ class Format:
     blender_posed: bool  # writing it posed needs the bpy module
     whole_file: str  # what core.files.incomplete checks of it before it replaces anything
     write: object = None  # its writer (see the module's docstring); Blender's rows: bound by the Blender layer
+    needs_skin: bool = False  # it holds the mannequin's skin alone (an avatar): a job without a skin is refused
 
     @property
     def aliases(self):
@@ -104,6 +107,16 @@ FORMATS = {
             _json_files,
         ),
         Format("mjcf", "xml", "MJCF, for MuJoCo", True, False, False, "it parses as XML", _mjcf_files),
+        Format(
+            "fbx",
+            "fbx",
+            "FBX avatar for garment tools (the skin on 24 bones, Y up)",
+            False,
+            True,
+            True,
+            "it starts with the binary FBX signature and ends with its footer",
+            needs_skin=True,
+        ),
     )
 }
 # The batch's own one-file format (``batch --format npz``): every mannequin of a batch, not one per file, so not a
@@ -118,7 +131,9 @@ BATCH_FILE = Format(
     "its zip directory reads (reading it, read_batch_file checks every array's shape)",
 )
 CORE_FORMATS = tuple(name for name, f in FORMATS.items() if not f.blender)  # obj, json, mjcf
-BLENDER_FORMATS = tuple(name for name, f in FORMATS.items() if f.blender)  # blend, glb
+BLENDER_FORMATS = tuple(name for name, f in FORMATS.items() if f.blender)  # blend, glb, fbx
+AVATAR_FORMATS = tuple(name for name, f in FORMATS.items() if f.needs_skin)  # fbx
+SCENE_FORMATS = tuple(name for name in BLENDER_FORMATS if name not in AVATAR_FORMATS)  # blend, glb: one scene
 
 
 def format_of(path):

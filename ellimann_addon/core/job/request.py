@@ -5,9 +5,10 @@ synthesis options, cushions, the skin and its settings, a pose (a standard pose,
 files to write; or, instead of measurements, a mannequin already made (``pose IN.json``). :func:`check` turns it
 into a :class:`Job` or refuses it in one line (ElliMannError): a request out of its limits, extra measurements that
 contradict the five, a path whose format is unknown or needs Blender where there is none, an animation for a format
-that holds none, a pose without joints, a skin voxel too fine for memory or too coarse for a piece. Nothing is
-made, let alone written, for a request that would be refused halfway. ``synth``, ``pose``, every row of ``batch``
-and the Synthesize operator build their jobs here; ``core.job.make`` makes them.
+that holds none, a pose without joints, a skin voxel too fine for memory or too coarse for a piece, an avatar (the
+format table's FBX row) without a skin, joints or a rest pose it can stand in. Nothing is made, let alone written,
+for a request that would be refused halfway. ``synth``, ``pose``, ``sizes``, every row of ``batch`` and the
+Synthesize operator build their jobs here; ``core.job.make`` makes them.
 """
 
 from dataclasses import dataclass, field, replace
@@ -18,6 +19,7 @@ from ..errors import ElliMannError
 from ..formats.table import check_outputs
 from ..measure.tailor import as_dict
 from ..measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
+from ..settings import AVATAR_POSES
 from ..synthesis.extra_refine import ExtraRequestError, extra_request_problems
 from ..synthesis.options import SynthesisOptions
 from ..synthesis.request import checked_request
@@ -51,7 +53,9 @@ class Request:
     the extra measurements {key: cm}; ``references``: a loaded ``core.synthesis.reference_set.ReferenceSet``;
     ``skin``: a ``core.skin.settings.SkinSettings`` (None: no skin); ``outputs``: the paths to write (formats by
     their extensions, ``core.formats.table``). ``mannequin``: one already made, posed (and skinned) as it is,
-    instead of one synthesized from measurements."""
+    instead of one synthesized from measurements. ``avatar``: how an avatar output (.fbx) is written
+    (``core.formats.avatar.AvatarOptions``; None: its defaults), its rest pose the request's ``pose`` when one is
+    asked."""
 
     measurements: dict | None = None
     references: object = None
@@ -62,6 +66,7 @@ class Request:
     pose: PoseAsk | None = None
     outputs: tuple = ()
     mannequin: object = None
+    avatar: object = None
 
 
 @dataclass(frozen=True)
@@ -94,6 +99,7 @@ class Job:
     formats: dict  # {path: Format}
     skin: object = None  # the SkinSettings asked, its kind decided ("auto" -> "body" or "pieces")
     skin_reference: object = None  # the set whose bodies a body skin is made from (a made mannequin's: by its name)
+    avatar: object = None  # an avatar output's AvatarOptions, its pose decided (None: the job writes no avatar)
 
     @property
     def reference(self):
@@ -145,7 +151,35 @@ def check(request, blender=True, pose=None):
             )
     if request.skin is not None:
         job.skin, job.skin_reference = checked_skin(request)
+    job.avatar = checked_avatar(request, formats, pose)
     return job
+
+
+def checked_avatar(request, formats, pose):
+    """The AvatarOptions of a request writing an avatar (a row of the format table that ``needs_skin``: .fbx), its
+    rest pose the request's pose when one is asked; None when it writes none. ElliMannError (one line) naming the
+    file for an avatar without a skin, without joints, or asked to stand in a pose that is not a rest pose."""
+    path = next((path for path, kind in formats.items() if kind.needs_skin), None)
+    if path is None:
+        return None
+    from ..formats.avatar import AvatarOptions  # the avatar's code, loaded only when one is written
+
+    if request.skin is None:
+        raise ElliMannError(f"{path}: an FBX avatar is the mannequin's skin on its bones: ask for a skin (--skin)")
+    made = request.mannequin
+    joints = made.joints if made is not None else request.references.joints
+    if joints is None:
+        raise ElliMannError(f"{path}: an FBX avatar needs a skeleton, and this mannequin has no joints")
+    avatar = request.avatar or AvatarOptions()
+    if pose is not None:
+        if pose.clip is not None or pose.frames is not None or pose.name not in AVATAR_POSES:
+            poses = " or ".join(AVATAR_POSES)
+            raise ElliMannError(
+                f"{path}: an FBX avatar stands in its rest pose, {poses}, not {pose.name!r}; write that pose to "
+                "another format"
+            )
+        avatar = replace(avatar, pose=pose.name)
+    return avatar.checked()
 
 
 def checked_skin(request):
@@ -199,7 +233,7 @@ def row_job(command, measurements, references, extra, warnings, name, outputs):
     extra = {key: float(extra[key]) for key in EXTRA_MEASUREMENTS if key in extra}
     formats = check_outputs(outputs, pose.name if pose is not None and pose.animated else None)
     skin_reference = references if command.skin is not None and command.skin.kind == "body" else None
-    return Job(request, values, extra, list(warnings), pose, formats, command.skin, skin_reference)
+    return Job(request, values, extra, list(warnings), pose, formats, command.skin, skin_reference, command.avatar)
 
 
 def checked_extra(five, extra):

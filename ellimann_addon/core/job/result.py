@@ -2,6 +2,7 @@
 its poses, what exact mode missed, and the lines to tell the user. Callers write the files and word their reports
 from it."""
 
+import math
 from dataclasses import dataclass, field
 
 from ..measurements import MEASUREMENTS
@@ -55,6 +56,21 @@ class Result:
     def shown(self):
         """What a user is shown as measured: the skin's measurements with a skin, else the pieces'."""
         return self.skin.measured if self.skin is not None else self.measured
+
+    def avatar_request(self):
+        """{key: cm} an avatar of this result's skin must still measure once decimated (``core.formats.avatar``):
+        the request where the skin meets it (exact mode on the skin, within its tolerance), else what the skin
+        itself measures (a skin of IDW's pieces, a measurement exact mode missed); None without a skin or a
+        request."""
+        if self.skin is None or self.request is None:
+            return None
+        found = {}
+        for key, asked in self.request.items():
+            got = self.skin.measured.get(key)
+            if got is None or not math.isfinite(got):
+                continue
+            found[key] = asked if self.skin.exact and abs(got - asked) <= SKIN_MISS_CM else float(got)
+        return found
 
     def missed_text(self):
         """One line for what was missed ("" if nothing), the pieces' or the skin's."""

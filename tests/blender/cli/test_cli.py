@@ -146,7 +146,7 @@ def test_synth_refuses_bad_measurements(tmp_path, capsys, references, args, word
 
 def test_synth_refuses_unknown_outputs_and_missing_references(tmp_path, capsys, references):
     code, _, err = run(["synth", *REQUEST, "-o", str(tmp_path / "m.stl"), "--references", references], capsys)
-    assert_one_line_error(code, err, ".blend, .glb, .obj, .json or .xml (MJCF)")
+    assert_one_line_error(code, err, ".blend, .glb, .obj, .json, .xml (MJCF) or .fbx")
     code, _, err = run(
         ["synth", *REQUEST, "-o", str(tmp_path / "m.json"), "--references", str(tmp_path / "no")], capsys
     )

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from ellimann_addon.blender.services.fbx import PROXY_NAME, SKIN_NAME, nearest_vertices, write_fbx
+from ellimann_addon.blender.services.rig import WEIGHT_STEPS
 from ellimann_addon.blender.services.scene import empty_scene
 from ellimann_addon.core.errors import ElliMannError
 from ellimann_addon.core.formats.avatar import bone_names, misses, posed_avatar, remeasure
@@ -150,3 +151,69 @@ def test_a_cut_short_fbx_is_not_whole(tmp_path, avatar):
     assert incomplete(tmp_path / "cut.fbx") == "it does not end with the FBX footer"
     (tmp_path / "text.fbx").write_bytes(b"; FBX 7.4.0 project file\n")
     assert incomplete(tmp_path / "text.fbx") == "it does not start with the binary FBX signature"
+
+
+# The body skin (core.body: the default skin where the set has bodies), as a job makes it and the format table's
+# fbx row writes it (its writer bound by blender.services.writers).
+BODY_BUDGET = 10_000  # under the body skin's 26,692 triangles: decimated, and within 2 mm (about 0.7 mm here)
+BODY_REQUEST = dict(zip(("He", "Sh", "Br", "Wa", "Hi"), (165.0, 41.5, 101.25, 82.75, 117.5)))
+
+
+@pytest.fixture(scope="module")
+def body_avatar():
+    from ellimann_addon.core.job.make import make
+    from ellimann_addon.core.job.request import Request, check
+
+    reference = named_reference_set("female")
+    asked = {"neck": 34.0, "thigh": 60.0}
+    return make(check(Request(BODY_REQUEST, reference, asked, skin=SkinSettings(kind="body"))))
+
+
+def test_a_decimated_body_skin_avatar_through_the_format_table_still_meets_its_request(tmp_path, body_avatar):
+    from ellimann_addon.blender.services import writers  # noqa: F401  (binds the fbx row's writer)
+    from ellimann_addon.core.formats.avatar import AvatarOptions
+    from ellimann_addon.core.formats.table import write_file
+
+    result = body_avatar
+    skin = result.skin.skin
+    assert skin.settings.kind == "body" and not hasattr(skin, "pieces")
+    request = result.avatar_request()
+    assert request == {**BODY_REQUEST, "neck": 34.0, "thigh": 60.0}
+    told = []
+    path = tmp_path / "body.fbx"
+    options = AvatarOptions(max_triangles=BODY_BUDGET, request=request, told=told.append)
+    assert write_file(result.mannequin, path, skin=skin, avatar=options) == str(path)
+    (out,) = told
+    assert out.decimated == len(skin.faces) > BODY_BUDGET >= out.triangles > 0.9 * BODY_BUDGET
+    assert misses(out.measured, request) == []  # 2 mm
+    written, heads = _written({SKIN_NAME})
+    _reimport(path)
+    back, back_heads = _written({SKIN_NAME})
+    _same_body(written[SKIN_NAME], back[SKIN_NAME])
+    assert sorted(back_heads) == sorted(JOINT_NAMES)
+    for name in JOINT_NAMES:  # the skeleton is the body skin's own
+        assert np.abs(back_heads[name] - skin.joints[JOINT_INDEX[name]]).max() < 1e-5
+    weights = back[SKIN_NAME][2]
+    total = sum(weights.values())  # each vertex follows its bones, its weights kept to 1/WEIGHT_STEPS each
+    assert np.all(np.abs(total - 1.0) <= 4 / WEIGHT_STEPS)
+    # The body as it came back, measured again here as a body skin measures itself: still within 2 mm
+    vertices, faces, _ = back[SKIN_NAME]
+    measured, problems = remeasure(skin, vertices, faces, nearest_vertices(skin.vertices, vertices))
+    assert problems == [] and misses(measured, request) == []
+    assert measured == pytest.approx(out.measured, abs=1e-3)
+
+
+def test_a_body_skin_avatar_decimated_too_far_is_refused_and_nothing_written(tmp_path, body_avatar):
+    result = body_avatar
+    with pytest.raises(ElliMannError, match=r"fbx: the avatar \(6,000 triangles\) misses the request by .* for thigh"):
+        write_fbx(tmp_path / "x.fbx", result.mannequin, result.skin.skin, result.avatar_request(), max_triangles=6_000)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_fbx_row_refuses_a_mannequin_without_a_skin(tmp_path, avatar):
+    from ellimann_addon.blender.services import writers  # noqa: F401
+    from ellimann_addon.core.formats.table import write_file
+
+    with pytest.raises(ElliMannError, match=r"x\.fbx: an FBX avatar is the mannequin's skin: ask for one"):
+        write_file(avatar[0], tmp_path / "x.fbx")
+    assert list(tmp_path.iterdir()) == []

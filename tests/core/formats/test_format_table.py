@@ -30,13 +30,14 @@ def test_each_row_has_its_whole_file_check_and_the_core_s_rows_their_writer(row)
 def test_a_path_s_format_is_decided_by_its_extension_once_and_refused_in_one_line():
     formats = table.check_outputs(["a.JSON", "b.xml", "c.glb"])
     assert [kind.name for kind in formats.values()] == ["json", "mjcf", "glb"]
-    with pytest.raises(ElliMannError, match=r"'d\.stl': an output file must end in \.blend, \.glb, \.obj, \.json or "):
+    with pytest.raises(ElliMannError, match=r"'d\.stl': an output file must end in \.blend, \.glb, \.obj, \.json, "):
         table.check_outputs(["d.stl"])
     with pytest.raises(ElliMannError, match="--pose walk is an animation and a .obj file holds none; write .blend"):
         table.check_outputs(["e.obj"], "walk")
     assert table.format_named("XML") is FORMATS["mjcf"] and table.format_named("npz") is None
     assert table.format_named("npz", batch=True) is BATCH_FILE
-    assert table.listing(what="name") == "blend, glb, obj, json, mjcf (xml)"
+    assert table.listing(what="name") == "blend, glb, obj, json, mjcf (xml), fbx"
+    assert table.listing().endswith(".json, .xml (MJCF) or .fbx")
 
 
 PAGES = {  # a page per format ElliMann defines, and code each must name
@@ -46,6 +47,8 @@ PAGES = {  # a page per format ElliMann defines, and code each must name
     "batch_npz.md": ["BatchFileWriter", "write_batch_file", "read_batch_file", "load_batch_file"],
     "batch_csv.md": ["MeasurementsCsv", "Report"],
     "body_space.md": ["BodySpace.save", "read_body_space", "space_from_meshes", "tools.shipped.add_body_space"],
+    "fbx_avatar.md": ["write_fbx", "write_avatar_files", "remeasure", "core.files.incomplete", "ellimann sizes"],
+    "measurement_files.md": ["read_measurement_file", "write_vit", "ellimann sizes", "--write-measurements"],
 }
 
 

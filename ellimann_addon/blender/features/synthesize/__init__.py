@@ -1,10 +1,12 @@
-"""Synthesize: five measurements (and any of the extra ones) in, a mannequin out; presets, Live updates of the last
-one, and Synthesize from Mesh (a body mesh's twin)."""
+"""Synthesize: five measurements (and any of the extra ones) in, a mannequin out; presets, a measurement file
+opened as one, Live updates of the last one, and Synthesize from Mesh (a body mesh's twin)."""
 
-from . import from_mesh, live, operators, panel, presets, props
+from . import from_mesh, live, measurement_file, operators, panel, presets, props
 
 # Registered in this order (the property group before the pointer to it), unregistered in reverse.
-classes = props.classes + operators.classes + from_mesh.classes + presets.classes + panel.classes
+classes = (
+    props.classes + operators.classes + from_mesh.classes + presets.classes + measurement_file.classes + panel.classes
+)
 
 
 def register_hooks():

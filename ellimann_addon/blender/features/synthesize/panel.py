@@ -1,4 +1,5 @@
-"""The Synthesize sub-panel of the ElliMann sidebar tab: presets, the request and its m_T, options, Live."""
+"""The Synthesize sub-panel of the ElliMann sidebar tab: presets and a measurement file, the request and its m_T,
+options, Live."""
 
 import bpy
 
@@ -30,6 +31,7 @@ class ELLIMANN_PT_synthesize(SubPanel, bpy.types.Panel):
         row.menu(ids.MENU_MEASUREMENT_PRESETS, text=ELLIMANN_MT_measurement_presets.bl_label)
         row.operator(ids.ADD_MEASUREMENT_PRESET, text="", icon="ADD")
         row.operator(ids.ADD_MEASUREMENT_PRESET, text="", icon="REMOVE").remove_active = True
+        layout.operator(ids.OPEN_MEASUREMENT_FILE, icon="FILEBROWSER")
 
         header = layout.row()
         header.label(text="Request (cm)")
