@@ -69,8 +69,7 @@ def settings_of(level, voxel_mm=0.0, blend=SKIN["skin_blend"].default, kind="PIE
 
 
 class ELLIMANN_OT_build_skin(MannequinOperator, bpy.types.Operator):
-    """Build the active mannequin's skin (from its set's bodies where it has them, or a smooth surface over its
-    pieces), bound to its armature if it has one"""
+    """Build the active mannequin's skin (its set's bodies, or a smooth surface over its pieces), bound to its armature"""  # noqa: E501
 
     bl_idname = ids.BUILD_SKIN
     bl_label = "Build Skin"
