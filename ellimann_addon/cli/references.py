@@ -2,6 +2,7 @@
 (``build``), or check a reference-set folder (``check``). numpy only."""
 
 import argparse
+import dataclasses
 import hashlib
 import os
 import pathlib
@@ -97,6 +98,7 @@ def run_build(args):
         traced_mesh,
         validate_inputs,
     )
+    from ..core.synthesis.bodies import SKELETON_FILE, BodiesError, shipped_topology_labels, skeleton_joints
 
     out = pathlib.Path(args.output)
     base = load_base(args.base)
@@ -114,9 +116,12 @@ def run_build(args):
         raise UsageError(f"--bodies: a reference set needs at least {MIN_BODIES} bodies, got {len(args.bodies)}")
     try:
         bodies = [read_obj(path, args.up, args.unit) for path in args.bodies]
-    except BodyMeshError as error:
+        skeletons = skeleton_joints(pathlib.Path(args.bodies[0]).parent / SKELETON_FILE)
+    except (BodyMeshError, BodiesError) as error:
         raise UsageError(output.one_line(error)) from None
+    bodies = [dataclasses.replace(body, joints=skeletons.get(body.name, body.joints)) for body in bodies]
     validate_inputs(base, bodies, targets)  # before the folder is made: bad input writes nothing
+    labels = shipped_topology_labels(bodies[0].faces)  # bodies of the body model's topology: kept for the body skin
     writing.output_folder(str(out), "references build")
 
     def progress(fraction, text):
@@ -132,6 +137,7 @@ def run_build(args):
         name=args.name or out.resolve().name,
         sex=args.sex,
         base_stem=base_stem,
+        body_labels=labels,
         provenance={
             "built_by": f"{PROG} references build",
             "base": {"file": pathlib.Path(args.base).name, **traced_mesh(base)},
@@ -150,6 +156,12 @@ def run_build(args):
         filled = f", fills {fill['coverage']:.1%} of its body (excess {fill['excess']:.1%})" if fill else ""
         print(f"{stem}: worst m_T error {error:+z.4%} ({key}){filled}")
     print(f"wrote {len(stems)} Reference Mannequins, {base_stem}.json and reference_set.json to {out}")
+    if built.bodies is None:
+        print("the bodies are not the body model's topology: the set's skin is the smooth skin over its pieces")
+    else:
+        joints = "their skeleton file's" if skeletons else "regressed from the labels"
+        space = ", their body space (body_space.npz)" if built.space is not None else ""
+        print(f"kept the bodies for the body skin (bodies.npz{space}; the joints {joints})")
     return 0
 
 

@@ -37,6 +37,7 @@ from ..measurements import ALL_MEASUREMENTS
 from .manifest import read_manifest
 
 BODIES_FILE = "bodies.npz"
+SKELETON_FILE = "skeleton.json"  # a body model's joints, beside its bodies (skeleton_joints)
 BODIES_FORMAT = "ellimann-bodies"
 BODIES_VERSION = 1
 WEIGHTS_PER_VERTEX = 4

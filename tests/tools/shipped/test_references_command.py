@@ -1,6 +1,9 @@
 """``ellimann references build`` on three of the reference bodies, exported as Blender writes OBJ (Y up): its
 RMs are the shipped ones (an RM depends only on its body, and the Average, nearest the three's mean, labels them
-as it labels the shipped five), ``references check`` passes, and the set synthesizes and measures exactly."""
+as it labels the shipped five), ``references check`` passes, the set synthesizes and measures exactly, and it keeps
+the bodies for their body skin."""
+
+import json
 
 import numpy as np
 import pytest
@@ -11,6 +14,8 @@ from ellimann_addon.core.fitting.body_mesh import read_obj
 from ellimann_addon.core.geometry.mesh import from_scene_axes
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.measurements import MEASUREMENTS
+from ellimann_addon.core.synthesis.bodies import load_set_bodies
+from ellimann_addon.core.synthesis.manifest import read_manifest
 from ellimann_addon.core.synthesis.reference_set import REFERENCE_FOLDER, load_reference_set
 from ellimann_addon.core.synthesis.synthesize import synthesize_batch
 from tools.shipped.build_reference import CHECK_TOLERANCE, DEFAULT_REFMODELS
@@ -93,6 +98,25 @@ def test_check_passes_and_the_set_synthesizes_exactly(built, capsys):
     batch = synthesize_batch(reference, requests, mode="exact")
     assert batch.converged.all()
     assert np.allclose(batch.measured, requests, rtol=1e-5)
+
+
+@pytest.mark.slow
+def test_the_set_keeps_its_bodies_and_makes_their_body_skin(built, tmp_path, capsys):
+    """The bodies are the body model's: kept (bodies.npz), their joints regressed from the labels (no skeleton
+    file beside them), and the set's --skin is their body skin, exact on the tape."""
+    bodies, shipped = load_set_bodies(built), load_set_bodies(REFERENCE_FOLDER)
+    assert bodies.names == list(THREE) and read_manifest(built).body_space is None  # a space from ten bodies on
+    for i, name in enumerate(THREE):
+        j = shipped.names.index(name)
+        assert np.abs(bodies.vertices(i) - shipped.vertices(j)).max() < 1e-3
+        assert np.abs(bodies.joints[i] - shipped.joints[j]).max() < 0.03
+    asked = ["--he", "160", "--sh", "40", "--br", "100", "--wa", "85", "--hi", "105"]
+    out = tmp_path / "x.json"
+    code, stdout, err = run(["synth", "--references", str(built), *asked, "--skin", "-o", str(out), "--json"], capsys)
+    skin = json.loads(stdout)["skin"]
+    assert code == 0 and skin["kind"] == "body", err
+    for key, value in zip(MEASUREMENTS, map(float, asked[1::2])):
+        assert abs(skin["measured"][key] - value) <= 0.1, key
 
 
 def test_a_body_with_shuffled_vertex_order_is_refused(tmp_path, capsys):

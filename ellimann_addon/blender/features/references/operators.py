@@ -22,6 +22,7 @@ from ....core.fitting.reference_build import (
     validate_inputs,
 )
 from ....core.measurements import MEASUREMENTS
+from ....core.synthesis.bodies import shipped_topology_labels
 from ....core.synthesis.manifest import MANIFEST_FILE
 from ... import ids
 from ...bridge.bodies import body_mesh
@@ -81,6 +82,7 @@ class Request:
             name=self.name,
             sex=self.sex,
             base_stem=BASE_STEM,
+            body_labels=shipped_topology_labels(self.bodies[0].faces),  # the body model's bodies: kept for its skin
             provenance={
                 "built_by": "Blender: ElliMann > Build Reference Set",
                 "base": {"collection": self.base.name, **traced_mesh(self.base)},
@@ -106,6 +108,9 @@ def finish(operator, context, request, built):
     props.status = f"{len(rms)} RMs in {request.folder}; worst m_T error {worst[0]:.3%} ({worst[1]})" + (
         f"; each fills at least {filled:.0%} of its body" if filled is not None else ""
     )
+    if built.bodies is not None:
+        props.status += "; the bodies kept for the body skin"
+
     props.progress = 1.0
     operator.report({"INFO"}, f"Built '{manifest.name}': {props.status}; use it in Synthesize > Reference Set > Folder")
     return {"FINISHED"}
