@@ -41,7 +41,7 @@ def assert_one_line_error(code, err, *words):
 
 # Runs the CLI as ``python -m ellimann_addon`` does (its __main__) with Blender's modules blocked, and reports on
 # stderr's last line which ElliMann modules of the bpy layer were imported (tests/cli/test_cli_without_blender.py
-# has its own, with a test that the blocker blocks).
+# tests that the blocker blocks).
 WITHOUT_BLENDER = """
 import atexit, runpy, sys
 class NoBlender:

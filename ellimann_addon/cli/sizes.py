@@ -11,7 +11,6 @@ import contextlib
 import os
 import re
 import sys
-import time
 
 from ..core.errors import ElliMannError
 from ..core.formats.table import format_named, listing
@@ -211,12 +210,11 @@ def run(args):
                 outputs=outputs(name),
                 avatar=None if avatar is None else avatar_replace(avatar, told.append),
             )
-            started = time.time()
             try:
                 make_row(request, made, told)
-            except (ElliMannError, OSError) as error:
+            except (ElliMannError, OSError, RuntimeError) as error:  # RuntimeError: a Blender writer's
                 made.fail(f"{read.path} size {row.label!r}: {output.one_line(error)}")
-                remove_written(request.outputs, started)
+                remove_outputs(request.outputs)
         for line in made.lines():
             output.say(f"{PROG} sizes: {line}")
         progress.step(row.label)
@@ -245,13 +243,12 @@ def avatar_replace(avatar, told):
     return dataclasses.replace(avatar, told=told)
 
 
-def remove_written(paths, since):
-    """Remove the files of ``paths`` written since ``since`` (a row that failed halfway: its .json written, its .fbx
-    refused): nothing is left of a failed row."""
+def remove_outputs(paths):
+    """Remove the files of a row that failed, halfway or not (its .json written, its .fbx refused; or an earlier
+    run's, which this run was to replace): a report's failed row has no files."""
     for path in paths:
         with contextlib.suppress(OSError):
-            if os.path.getmtime(path) >= since - 1.0:
-                os.remove(path)
+            os.remove(path)
 
 
 def make_row(request, made, told):

@@ -76,17 +76,24 @@ import os, sys
 os.environ["BLENDER_USER_RESOURCES"] = sys.argv[2]
 import bpy
 from bl_pkg import bl_extension_cli
-sys.exit(bl_extension_cli.cli_extension_handler(["install-file", "-r", "user_default", "-e", sys.argv[1]]))
+code = bl_extension_cli.cli_extension_handler(["install-file", "-r", "user_default", "-e", sys.argv[1]])
+from bl_ext.user_default.ellimann.ellimann_addon.blender.services import teardown
+teardown.exit_with(code)
 """
 FRESH_SESSION = """
 import json, os, sys
 os.environ["BLENDER_USER_RESOURCES"] = sys.argv[1]
 import bpy
-bpy.ops.wm.read_userpref()  # Blender reads them at start; a script on the bpy module must ask (README)
+if bpy.app.version >= (4, 5, 0):
+    bpy.ops.wm.read_userpref()  # Blender reads them at start; a script on the bpy module must ask (README)
+else:
+    bpy.ops.preferences.addon_enable(module="bl_ext.user_default.ellimann")  # 4.2's read_userpref crashes (README)
 print(json.dumps([
     "bl_ext.user_default.ellimann" in bpy.context.preferences.addons,
     sorted(bpy.ops.ellimann.new_mannequin(name="Fresh")),
 ]))
+from bl_ext.user_default.ellimann.ellimann_addon.blender.services import teardown
+teardown.exit_with(0)
 """
 
 

@@ -14,28 +14,11 @@ import numpy as np
 import pytest
 
 from devkit import synthetic
+from devkit.cli_runs import WITHOUT_BLENDER
 from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 REQUEST = ["--he", "165", "--sh", "41.5", "--br", "101.25", "--wa", "82.75", "--hi", "117.5"]
-
-# Runs the CLI as ``python -m ellimann_addon`` does (its __main__), with Blender's modules blocked, and
-# reports on stderr's last line which ElliMann modules of the bpy layer were imported.
-WITHOUT_BLENDER = """
-import atexit, runpy, sys
-class NoBlender:
-    def find_spec(self, name, path=None, target=None):
-        if name.split(".")[0] in ("bpy", "bmesh", "mathutils", "bpy_extras", "gpu"):
-            raise ImportError(f"No module named {name!r} (blocked by the test)")
-        return None
-sys.meta_path.insert(0, NoBlender())
-def report():
-    loaded = sorted(m for m in sys.modules if m == "bpy" or m.startswith("ellimann_addon.blender"))
-    print("LOADED", loaded, file=sys.stderr)
-atexit.register(report)
-sys.argv = ["ellimann", *sys.argv[1:]]
-runpy.run_module("ellimann_addon", run_name="__main__", alter_sys=True)
-"""
 
 
 @pytest.fixture(scope="module")

@@ -19,7 +19,6 @@ from devkit.cli_runs import assert_one_line_error, without_blender
 from ellimann_addon.cli import main
 from ellimann_addon.core.mannequin.model import Mannequin
 from ellimann_addon.core.measure.body import measure_body_mesh
-from ellimann_addon.core.measure.neck import joint_tilt
 from ellimann_addon.core.measurements import EXTRA_MEASUREMENTS, MEASUREMENTS
 from ellimann_addon.core.sizing.readers import read_measurement_file
 from ellimann_addon.core.sizing.rows import UNITS
@@ -59,11 +58,10 @@ def female_bodies():
 
 
 def measured_as_written(folder, name, bodies):
-    """{key: cm} of a size's skin as its .obj holds it: measured as any body mesh (the set's section heights, its
-    arms from the set's labels, the neck square to the skeleton its .json records)."""
+    """{key: cm} of a size's skin as its .obj holds it: measured as ``ellimann measure`` reads any body mesh (the
+    set's section heights, its arms from the set's labels, the neck where a tape drawn tight settles)."""
     vertices, faces = skin_from_obj(folder / f"{name}.obj")
-    joints = Mannequin.load(folder / f"{name}.json").joints
-    return measure_body_mesh(vertices, faces, bodies.fractions, joint_tilt(joints), bodies.arms).values
+    return measure_body_mesh(vertices, faces, bodies.fractions, None, bodies.arms).values
 
 
 def check_every_avatar_meets_its_row(folder, path, bodies, **reading):

@@ -1,6 +1,6 @@
 """Leaving a Python process that imported Blender as the ``bpy`` module.
 
-Blender 4.2-4.5 as a module crash (SIGSEGV) in their own teardown at interpreter exit once any
+Blender 4.2-4.5 as a module crash (SIGSEGV) or hang in their own teardown at interpreter exit once any
 property with a Python callback (``update=``, ``poll=``) has been registered, unregistered or not:
 the work is done and the files are written, but the exit code is 139. 5.0 and later exit cleanly.
 On those versions the process leaves through :func:`exit_without_teardown` instead: scripts end

@@ -7,8 +7,9 @@ own steps (its StandingBody, crotch, leg girths, neck slices, arm readings), wit
   same ones, in the same order (checked per reading: any other triangle in the calf's band, or a leg across the
   mid-plane, and the measurer's own leg girth is used);
 - the crotch from the triangles that cross the mid-plane only (the same segments);
-- the neck square to a given tilt (the skin's own Neck -> Head axis, as today's skin is measured: a tilt
-  searched on the mesh jumps between nearby bodies).
+- the neck square to a given tilt, or at the tilt a tape drawn tight settles at (``measure``'s search) when none
+  is given; the correction's loop holds the last whole reading's tilt (``Marks.tilt``), since a tilt searched
+  anew each round jumps between nearby bodies.
 
 ``read(..., marks=None)`` searches every band as the measurer does (its samples, its golden steps): the same numbers as
 ``measure_body_mesh(vertices, faces, fractions, neck_tilt, arms)`` (tests/core/body/test_body_extra_tape.py, on the

@@ -38,7 +38,7 @@ from .plausible import (
     proportion_problem,
     surface_problem,
 )
-from .ridge import RidgeBodyModel
+from .ridge import RidgeBodyModel, resolve_tolerances
 from .tape import Tape
 
 BODY_MODELS = (None, "ridge", "idw")  # body_skin_maker's choices (None: the best the set has)
@@ -166,6 +166,7 @@ class BodySkinMaker:
         unknown += [key for key in informed if key not in MEASUREMENTS + EXTRA_MEASUREMENTS + FURTHER_MEASUREMENTS]
         if unknown:
             raise BodySkinError(f"body skin: {', '.join(unknown)} is no measurement ElliMann takes")
+        self._check_model_asks(informed, tolerances)
         if check:
             problem, _ = proportion_problem(asked, self.bodies.fractions)
             if problem:
@@ -176,7 +177,6 @@ class BodySkinMaker:
             raise BodySkinError(self.refusal(asked, attempt, informed, tolerances))
         found = attempt.correction
         measured = found.measured
-        weights = getattr(self.model, "weights", None)
         return BodySkin(
             attempt.vertices,
             self.bodies.faces,
@@ -184,12 +184,29 @@ class BodySkinMaker:
             self.bodies,
             asked,
             measured,
-            weights(inputs) if weights else None,
+            self.model.weights(inputs, tolerances) if tolerances is not None else self.model.weights(inputs),
             found.rounds,
             time.perf_counter() - started,
             abduction=attempt.abduction,
             informed=informed,
         )
+
+    def _check_model_asks(self, informed, tolerances):
+        """BodySkinError (one line) for what the body model would not use: a shape or tolerances without a body
+        space (the five bodies' IDW reads the five alone), a tolerance that names no measurement or is no cm."""
+        if not isinstance(self.model, RidgeBodyModel):
+            if informed or tolerances is not None:
+                what = "shape measurements" if informed else "tolerances"
+                raise BodySkinError(f"body skin: {what} need the set's body space (body_space.npz); this set has none")
+            return
+        if isinstance(tolerances, dict):
+            unknown = [key for key in tolerances if key not in MEASUREMENTS + EXTRA_MEASUREMENTS + FURTHER_MEASUREMENTS]
+            if unknown:
+                raise BodySkinError(f"body skin: tolerances: {', '.join(unknown)} is no measurement ElliMann takes")
+        try:
+            resolve_tolerances(tolerances, ())
+        except ValueError as error:
+            raise BodySkinError(f"body skin: {error}") from None
 
     def attempt(self, asked, check=True, informed=None, tolerances=None):
         """An Attempt at ``asked`` ({key: cm}): the body model's body (``informed`` its inputs too, weighed by

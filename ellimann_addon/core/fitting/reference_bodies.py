@@ -13,14 +13,20 @@ def keep_bodies(bodies, labels, fractions):
     """SetBodies of the BodyMesh list ``bodies`` with ``labels`` (BodyLabels); a body without joints takes the
     labels' regressed ones (JointRegressor) when they have one. BodiesError (one line) for bodies without joints or
     that cannot make a body skin (another topology, wrong axes or units)."""
+    names, vertices = [body.name for body in bodies], np.stack([body.vertices for body in bodies])
+    found = (labels.region, list(labels.region_names), labels.bones, body_joints(bodies, labels), fractions)
+    return from_meshes(names, vertices, bodies[0].faces, *found)
+
+
+def body_joints(bodies, labels):
+    """(N, 24, 3) the bodies' joints: each body's own, or the labels' regressed ones (JointRegressor) where it has
+    none. BodiesError (one line) naming the bodies with neither."""
     regress = labels.regressor
     joints = [b.joints if b.joints is not None or regress is None else regress(b.vertices) for b in bodies]
     missing = [body.name for body, found in zip(bodies, joints) if found is None]
     if missing:
         raise BodiesError(f"bodies: {', '.join(missing)} have no joints (a body skin is posed on them)")
-    names, vertices = [body.name for body in bodies], np.stack([body.vertices for body in bodies])
-    found = (labels.region, list(labels.region_names), labels.bones, np.stack(joints), fractions)
-    return from_meshes(names, vertices, bodies[0].faces, *found)
+    return np.stack(joints)
 
 
 def keep_space(bodies, labels, fractions, progress=None):
@@ -39,7 +45,7 @@ def keep_space(bodies, labels, fractions, progress=None):
         bodies[0].faces,
         labels.region,
         list(labels.region_names),
-        np.stack([body.joints for body in bodies]),
+        body_joints(bodies, labels),
         fractions,
         tell,
     )

@@ -354,6 +354,21 @@ def relative_errors(measured, targets):
     return {key: measured[key] / targets[key] - 1.0 for key in MEASUREMENTS}
 
 
+def accept_cleaned(name, rm, targets, report, settings):
+    """Record a cleaned RM's m_T errors in ``report``; ReferenceBuildError when it is off its targets by more than
+    the accepted tolerance or is not clean."""
+    report.errors[name] = relative_errors(rm.measure(), targets)
+    key, error = report.worst(name)
+    if abs(error) > settings.accept_tolerance:
+        raise ReferenceBuildError(
+            f"{name}: after cleaning m_T {key} is off its target by {error:.3%} (accepted "
+            f"{settings.accept_tolerance:.1%})"
+        )
+    problems = cleanliness_problems(rm.check())
+    if problems:
+        raise ReferenceBuildError(f"{name}: {'; '.join(problems)}")
+
+
 def fit_body(base, body, targets, settings, cancel=None):
     """One body's RM before the set is cleaned: (name, body -> RM shift, m_T as fitted, RM, refinement factors)."""
     fitted, _ = fit_mannequin(
@@ -461,16 +476,7 @@ def build_reference_set(
         report.shifts[stem] = report.shifts[stem] + (rms[stem].center - before.center).mean(axis=0)
     report.base = relabel(base, rms[reference])
     for stem, rm in rms.items():
-        report.errors[stem] = relative_errors(rm.measure(), targets[stem])
-        key, error = report.worst(stem)
-        if abs(error) > settings.accept_tolerance:
-            raise ReferenceBuildError(
-                f"{stem}: after cleaning m_T {key} is off its target by {error:.3%} (accepted "
-                f"{settings.accept_tolerance:.1%})"
-            )
-        problems = cleanliness_problems(rm.check())
-        if problems:
-            raise ReferenceBuildError(f"{stem}: {'; '.join(problems)}")
+        accept_cleaned(stem, rm, targets[stem], report, settings)
     if settings.check_spacing:
         tell(len(bodies), "checking how each RM fills its body")
         started = time.perf_counter()

@@ -34,10 +34,9 @@ from .reference_build import (
     BuiltReferenceSet,
     FitConstants,
     ReferenceBuildError,
+    accept_cleaned,
     central_body,
-    cleanliness_problems,
     fit_body,
-    relative_errors,
     validate_inputs,
 )
 
@@ -91,16 +90,7 @@ def extend_reference_set(folder, bodies, targets, progress=None, cancel=None, se
     rms = {}
     for body, before, rm in zip(bodies, adjusted, cleaned):
         report.shifts[body.name] = report.shifts[body.name] + (rm.center - before.center).mean(axis=0)
-        report.errors[body.name] = relative_errors(rm.measure(), targets[body.name])
-        key, error = report.worst(body.name)
-        if abs(error) > settings.accept_tolerance:
-            raise ReferenceBuildError(
-                f"{body.name}: after cleaning m_T {key} is off its target by {error:.3%} (accepted "
-                f"{settings.accept_tolerance:.1%})"
-            )
-        problems = cleanliness_problems(rm.check())
-        if problems:
-            raise ReferenceBuildError(f"{body.name}: {'; '.join(problems)}")
+        accept_cleaned(body.name, rm, targets[body.name], report, settings)
         rms[body.name] = rm.copy(reference_set=manifest.name)
 
     manifest.mannequins = stems + list(rms)

@@ -28,7 +28,6 @@ from ..geometry.ellipsoid import matrix_world
 from ..geometry.mesh import icosphere
 from ..mannequin.skeleton import JOINT_COUNT, JOINT_NAMES, part_bones
 from ..measure.body import measure_body_mesh
-from ..measure.neck import joint_tilt
 from ..pose.kinematics import bone_matrices, pose_mannequin
 from ..pose.motion import clamped_motion
 from ..pose.rig_names import RIG_NAME_MAPS
@@ -144,12 +143,12 @@ def remeasure(skin, vertices, faces, nearest):
     (``core.skin.surface.Skin``): its pieces, measured as that skin (core.skin.measure: the five by
     mesh_measurements, the six extra ones by body_measurements). The body skin (``core.body.skin.BodySkin``, which
     has no pieces): its arms from the labels, measured as the body skin measures itself (``measure_body_mesh`` at its
-    set's heights, the neck square to its own Neck -> Head axis)."""
+    set's heights, the neck where a tape settles, as ``measure`` reads a scan)."""
     nearest = np.asarray(nearest, dtype=np.int64)
     if not hasattr(skin, "pieces"):
         arms = {side: np.asarray(skin.arms[side], bool)[nearest] for side in ("L", "R")}
         vertices, faces = np.asarray(vertices, float), np.asarray(faces, np.int64)
-        found = measure_body_mesh(vertices, faces, skin.bodies.fractions, joint_tilt(skin.joints), arms)
+        found = measure_body_mesh(vertices, faces, skin.bodies.fractions, None, arms)
         return dict(found.values), list(found.problems)
     decimated = Skin(
         skin.mannequin,

@@ -272,9 +272,13 @@ def skeleton_joints(path):
         return {}
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
-        return {name: joints_from_makehuman(bones) for name, bones in data["bodies"].items()}
-    except (OSError, ValueError, KeyError, TypeError) as error:
+        found = {name: joints_from_makehuman(bones) for name, bones in data["bodies"].items()}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as error:
         raise BodiesError(f"{path}: cannot be read as a skeleton file ({error})") from None
+    for name, joints in found.items():
+        if joints.shape != (JOINT_COUNT, 3) or not np.all(np.isfinite(joints)):
+            raise BodiesError(f"{path}: body {name}: its joints are not 24 finite points")
+    return found
 
 
 def from_meshes(names, vertices, faces, region, region_names, weights, joints, fractions=None):
@@ -334,19 +338,26 @@ def check_bodies(names, vertices, faces, region, region_names, joints):
             raise BodiesError(f"body {name}: its toes point to +Y (ElliMann's bodies face -Y)")
 
 
-def read_bodies(path):
-    """SetBodies from a ``bodies.npz`` file; BodiesError naming the file and what is wrong."""
-    path = pathlib.Path(path)
+def read_versioned_npz(path, what, format_name, newest):
+    """{name: array} of an .npz file whose ``format`` is ``format_name`` and ``version`` 1 to ``newest``;
+    BodiesError naming the file and what is wrong (``what``: "a bodies file")."""
     try:
         with np.load(path, allow_pickle=False) as data:
             arrays = {key: data[key] for key in data.files}
     except (OSError, ValueError, zipfile.BadZipFile, EOFError) as error:
-        raise BodiesError(f"{path}: cannot be read as a bodies file ({error})") from None
-    if str(arrays.get("format", "")) != BODIES_FORMAT:
-        raise BodiesError(f"{path}: format is not '{BODIES_FORMAT}'")
+        raise BodiesError(f"{path}: cannot be read as {what} ({error})") from None
+    if str(arrays.get("format", "")) != format_name:
+        raise BodiesError(f"{path}: format is not '{format_name}'")
     version = int(arrays.get("version", -1))
-    if not 1 <= version <= BODIES_VERSION:
-        raise BodiesError(f"{path}: version {version}; this ElliMann reads versions 1 to {BODIES_VERSION}")
+    if not 1 <= version <= newest:
+        raise BodiesError(f"{path}: version {version}; this ElliMann reads versions 1 to {newest}")
+    return arrays
+
+
+def read_bodies(path):
+    """SetBodies from a ``bodies.npz`` file; BodiesError naming the file and what is wrong."""
+    path = pathlib.Path(path)
+    arrays = read_versioned_npz(path, "a bodies file", BODIES_FORMAT, BODIES_VERSION)
     try:
         names = [str(n) for n in arrays["names"]]
         mean = arrays["mean"].astype(float)

@@ -24,7 +24,6 @@ their leave-one-out errors (cross-validation) in closed form. The bodies themsel
 
 import io
 import pathlib
-import zipfile
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,7 +34,7 @@ from ..mannequin.skeleton import JOINT_COUNT
 from ..measure.body import check_mesh, measure_body_mesh, section_blobs
 from ..measure.further import FURTHER_MEASUREMENTS, measure_further
 from ..measurements import ALL_MEASUREMENTS
-from .bodies import FRACTION_KEYS, BodiesError, check_bodies
+from .bodies import FRACTION_KEYS, BodiesError, check_bodies, read_versioned_npz
 from .manifest import read_manifest
 
 SPACE_FILE = "body_space.npz"
@@ -224,16 +223,7 @@ def duplicate_bodies(names, vertices, within=DUPLICATE_M):
 def read_body_space(path):
     """BodySpace from a ``body_space.npz`` file; BodiesError naming the file and what is wrong."""
     path = pathlib.Path(path)
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            arrays = {key: data[key] for key in data.files}
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as error:
-        raise BodiesError(f"{path}: cannot be read as a body-space file ({error})") from None
-    if str(arrays.get("format", "")) != SPACE_FORMAT:
-        raise BodiesError(f"{path}: format is not '{SPACE_FORMAT}'")
-    version = int(arrays.get("version", -1))
-    if not 1 <= version <= SPACE_VERSION:
-        raise BodiesError(f"{path}: version {version}; this ElliMann reads versions 1 to {SPACE_VERSION}")
+    arrays = read_versioned_npz(path, "a body-space file", SPACE_FORMAT, SPACE_VERSION)
     try:
         names, keys = [str(n) for n in arrays["names"]], tuple(str(k) for k in arrays["keys"])
         count = int(arrays["vertex_count"])

@@ -101,8 +101,9 @@ def test_a_build_is_written_as_a_set_and_loaded_into_a_new_collection(tmp_path, 
     names = [row.body.name for row in props.bodies]
     base = Mannequin.load(REFERENCE_FOLDER / "base_mannequin.json")
 
-    def build(base_, bodies, targets, progress=None, cancel=None, **manifest):
-        """The core's build without the fitting: the shipped RMs, assembled into a set as the core does."""
+    def build(base_, bodies, targets, progress=None, cancel=None, body_labels=None, **manifest):
+        """The core's build without the fitting: the shipped RMs, assembled into a set as the core does (no bodies
+        kept: the shipped RMs are not these bodies')."""
         from ellimann_addon.core.fitting.reference_build import BuildReport, BuiltReferenceSet
 
         rms = {name: rm.copy(name=name) for name, rm in zip(names, shipped.mannequins)}

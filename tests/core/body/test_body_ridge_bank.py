@@ -64,6 +64,13 @@ def test_the_shipped_sets_make_ridge_body_skins_and_old_folders_idw(tmp_path):
         body_skin_maker(old_set, "ridge")
     with pytest.raises(BodySkinError, match="body model"):
         body_skin_maker(old_set, "nearest")
+    # What IDW over the five bodies would not use is refused, not ignored
+    idw = body_skin_maker(old_set)
+    five = {key: float(idw.bodies.measured[0][i]) for i, key in enumerate(MEASUREMENTS)}
+    refused = (({"tolerances": EXACT}, "tolerances need"), ({"shape": {"knee": 38.0}}, "shape measurements need"))
+    for asks, said in refused:
+        with pytest.raises(BodySkinError, match=said):
+            idw.make(five, **asks)
 
 
 def test_a_body_skin_meets_the_five_and_says_what_only_informed_it(bank):
@@ -78,6 +85,9 @@ def test_a_body_skin_meets_the_five_and_says_what_only_informed_it(bank):
     assert abs(skin.weights.sum() - 1.0) < 1e-9 and len(skin.weights) == len(space)
     with pytest.raises(BodySkinError, match="shoe"):
         maker.make(five, shape={"shoe": 40.0})
+    for tolerances, said in (({"Hii": 1.0}, "Hii is no measurement"), ({"Hi": -1.0}, "0 or more"), ("loose", "loose")):
+        with pytest.raises(BodySkinError, match=said):
+            maker.make(five, tolerances=tolerances)
 
 
 @pytest.mark.slow

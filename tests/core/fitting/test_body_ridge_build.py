@@ -11,7 +11,7 @@ from ellimann_addon.core.fitting.body_mesh import BodyMesh, read_obj
 from ellimann_addon.core.fitting.reference_bodies import keep_space
 from ellimann_addon.core.fitting.reference_build import ReferenceBuildError
 from ellimann_addon.core.fitting.reference_extend import extend_reference_set
-from ellimann_addon.core.synthesis.bodies import BodiesError, load_set_bodies
+from ellimann_addon.core.synthesis.bodies import BodiesError, load_set_bodies, shipped_topology_labels
 from ellimann_addon.core.synthesis.body_space import SPACE_MEASUREMENTS, load_set_body_space
 from ellimann_addon.core.synthesis.manifest import MANIFEST_FILE, read_manifest
 from ellimann_addon.core.synthesis.reference_set import load_reference_set
@@ -42,6 +42,12 @@ def test_a_build_keeps_a_body_space_from_ten_bodies_on(meshes):
     space = keep_space(bodies[:10], labels, fractions, lambda fraction, text: told.append(text))
     assert space.names == [body.name for body in bodies[:10]] and space.keys == SPACE_MEASUREMENTS
     assert len(told) == 10 and "10 of 10" in told[-1]
+    # Bodies without joints (no skeleton.json beside them, as Build Reference Set always has them): regressed
+    bare = [BodyMesh(body.name, body.vertices, body.faces, body.edges_crc, None) for body in bodies[:10]]
+    regressed = keep_space(bare, shipped_topology_labels(bare[0].faces), fractions)  # as references build
+    assert regressed.names == space.names
+    own, guessed = space.mean[-72:], regressed.mean[-72:]  # the mean body's 24 joints, last in a flat body
+    assert not np.array_equal(own, guessed) and np.allclose(own, guessed, atol=0.05)
     twice = bodies[:9] + [BodyMesh("again", bodies[4].vertices, bodies[4].faces, bodies[4].edges_crc, bodies[4].joints)]
     with pytest.raises(BodiesError, match="the same body twice"):
         keep_space(twice, labels, fractions)

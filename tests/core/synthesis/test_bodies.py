@@ -155,8 +155,11 @@ def test_a_skeleton_file_gives_each_body_its_joints(tmp_path, female):
     for i, name in enumerate(female.names):
         assert np.abs(found[name] - female.joints[i]).max() < 1e-6  # the joints the shipped bodies were kept with
     assert skeleton_joints(tmp_path / "none.json") == {}
+    one = next(iter(json.loads((SHARED / "refmodels" / "skeleton.json").read_text())["bodies"].values()))
+    flat = {bone: head[:2] for bone, head in one.items()}  # every bone head in 2-D: 24 points of 2
     broken = tmp_path / "skeleton.json"
-    broken.write_text('{"bodies": {"a": {"root": [0, 0]}}}', encoding="utf-8")
-    with pytest.raises(BodiesError) as caught:
-        skeleton_joints(broken)
-    assert "\n" not in str(caught.value) and str(caught.value).startswith(str(broken))
+    for text in ('{"bodies": {"a": {"root": [0, 0]}}}', '{"bodies": []}', json.dumps({"bodies": {"a": flat}})):
+        broken.write_text(text, encoding="utf-8")
+        with pytest.raises(BodiesError) as caught:
+            skeleton_joints(broken)
+        assert "\n" not in str(caught.value) and str(caught.value).startswith(str(broken))
