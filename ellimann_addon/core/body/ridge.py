@@ -32,6 +32,29 @@ LAMBDAS = np.logspace(-8.0, 2.0, 41)  # the cross-validation's grid (standardize
 REFINE_STEPS = 30  # golden-section steps on log lambda inside the best grid cell
 
 
+# The fit's products and its inverse in numpy's own loops, not BLAS/LAPACK: OpenBLAS splits even an 11 x 11
+# inverse across its threads, and a body made with 1 or 2 threads differed in the last bits (the same answer on
+# every machine, tests/core/test_same_answer.py). The matrices are at most bodies x bodies (86): microseconds.
+def product(a, b):
+    """a @ b (2-D or 1-D operands) summed in numpy's own loops, whatever BLAS's threads."""
+    a, b = np.ascontiguousarray(a, float), np.ascontiguousarray(b, float)
+    return np.einsum(f"{'ij'[2 - a.ndim :]},{'jk'[: b.ndim]}->{'i'[: a.ndim - 1]}{'k'[: b.ndim - 1]}", a, b)
+
+
+def spd_inverse(a):
+    """The inverse of a symmetric positive definite matrix (a few dozen rows) by Cholesky, in numpy's loops."""
+    n = len(a)
+    low = np.zeros((n, n))
+    for j in range(n):
+        low[j, j] = np.sqrt(a[j, j] - np.sum(low[j, :j] ** 2))
+        low[j + 1 :, j] = (a[j + 1 :, j] - np.sum(low[j + 1 :, :j] * low[j, :j], axis=1)) / low[j, j]
+    inverse_low = np.zeros((n, n))  # low^-1 by forward substitution
+    for i in range(n):
+        inverse_low[i, i] = 1.0 / low[i, i]
+        inverse_low[i, :i] = -np.sum(low[i, :i, None] * inverse_low[:i, :i], axis=0) / low[i, i]
+    return product(inverse_low.T, inverse_low)
+
+
 def resolve_tolerances(tolerances, keys):
     """(len(keys),) cm: ``tolerances`` None (ISO 20685's allowances), "exact" (zeros) or {key: cm} (the
     allowances for the keys it does not name). ValueError (one line) for a negative or non-finite tolerance."""
@@ -96,18 +119,19 @@ class RidgeBodyModel:
         noise = (sigma / space.scale[index]) ** 2
         count = len(x)
         gram = space.gram
+        rtr, xtgx = product(r.T, r), product(product(x.T, gram), x)
 
         def score(log_lam):
             lam = 10.0**log_lam
-            inverse = np.linalg.inv(r.T @ r + count * (lam * np.eye(len(keys)) + np.diag(noise)))
-            hat = x @ inverse @ x.T + 1.0 / count
+            inverse = spd_inverse(rtr + count * (lam * np.eye(len(keys)) + np.diag(noise)))
+            hat = product(product(x, inverse), x.T) + 1.0 / count
             rest = np.eye(count) - hat
-            loo = np.einsum("ij,ij->i", rest @ gram, rest) / (1.0 - np.diag(hat)) ** 2
-            spread = inverse @ x.T @ gram @ x @ inverse  # B B^T of the fitted coefficients
-            return (loo.mean() + float(noise @ np.diag(spread))) / self.points
+            loo = np.einsum("ij,ij->i", product(rest, gram), rest) / (1.0 - np.diag(hat)) ** 2
+            spread = product(product(inverse, xtgx), inverse)  # B B^T of the fitted coefficients
+            return (loo.mean() + float(product(noise, np.diag(spread)))) / self.points
 
         if self.lam is not None:
-            return self._solved(keys, sigma, float(self.lam), score(np.log10(self.lam)), x, r, noise)
+            return self._solved(keys, sigma, float(self.lam), score(np.log10(self.lam)), x, r, rtr, noise)
         logs = np.log10(LAMBDAS)
         scores = np.array([score(v) for v in logs])
         best = int(np.argmin(scores))
@@ -125,13 +149,13 @@ class RidgeBodyModel:
                 d = low + ratio * (high - low)
                 fd = score(d)
         log_lam = 0.5 * (low + high)
-        return self._solved(keys, sigma, 10.0**log_lam, score(log_lam), x, r, noise)
+        return self._solved(keys, sigma, 10.0**log_lam, score(log_lam), x, r, rtr, noise)
 
     @staticmethod
-    def _solved(keys, sigma, lam, score, x, r, noise):
-        inverse = np.linalg.inv(r.T @ r + len(x) * (lam * np.eye(len(keys)) + np.diag(noise)))
+    def _solved(keys, sigma, lam, score, x, r, rtr, noise):
+        inverse = spd_inverse(rtr + len(x) * (lam * np.eye(len(keys)) + np.diag(noise)))
         cv = np.sqrt(max(score, 0.0)) * 1e3
-        return RidgeFit(keys, tuple(sigma.tolist()), lam, cv, r @ inverse, x @ inverse)
+        return RidgeFit(keys, tuple(sigma.tolist()), lam, cv, product(r, inverse), product(x, inverse))
 
     def standardized(self, request, keys):
         index = [self.space.keys.index(key) for key in keys]
@@ -142,8 +166,8 @@ class RidgeBodyModel:
         """(P,) the predicted body, flattened (vertices on the floor, then joints)."""
         keys = self.inputs(request)
         found = self.fit(keys, tolerances)
-        weights = found.coefficients @ self.standardized(request, keys)
-        return self.space.mean + weights @ self.directions
+        weights = product(found.coefficients, self.standardized(request, keys))
+        return self.space.mean + product(weights, self.directions)
 
     def body(self, request, tolerances=None):
         """(vertices (V, 3), joints (24, 3)) m for ``request`` ({key: cm}; every key the space knows is an input),
@@ -158,4 +182,4 @@ class RidgeBodyModel:
         """(N,) the space's bodies' weights in the prediction (they sum to 1; they may be negative)."""
         keys = self.inputs(request)
         found = self.fit(keys, tolerances)
-        return found.dual @ self.standardized(request, keys) + 1.0 / len(self.space)
+        return product(found.dual, self.standardized(request, keys)) + 1.0 / len(self.space)

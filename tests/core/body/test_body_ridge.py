@@ -6,7 +6,7 @@ within float16's rounding, and bad files and tolerances are refused in one line.
 import numpy as np
 import pytest
 
-from ellimann_addon.core.body.ridge import EXACT, LAMBDAS, RidgeBodyModel, resolve_tolerances
+from ellimann_addon.core.body.ridge import EXACT, LAMBDAS, RidgeBodyModel, product, resolve_tolerances, spd_inverse
 from ellimann_addon.core.measurements import ALL_MEASUREMENTS, MEASUREMENTS
 from ellimann_addon.core.synthesis.bodies import BodiesError, load_set_bodies
 from ellimann_addon.core.synthesis.body_space import (
@@ -150,3 +150,18 @@ def test_too_few_bodies_or_missing_measurements_make_no_space(synthetic):
     holed[2, 4] = np.nan
     with pytest.raises(BodiesError, match="finite"):
         space_from_arrays([f"b{i}" for i in range(12)], vertices, joints, holed, fractions)
+
+
+def test_the_fits_own_products_and_inverse_are_numpys_within_rounding():
+    """product and spd_inverse (numpy's loops, not BLAS's threads: the same bits with 1 or 2 threads) against @ and
+    np.linalg.inv, on shapes the fit has."""
+    rng = np.random.default_rng(3)
+    for n in (1, 5, 21):
+        a = rng.normal(size=(86, n))
+        spd = a.T @ a + 1e-3 * np.eye(n)
+        inverse = spd_inverse(spd)
+        assert np.allclose(inverse, np.linalg.inv(spd), rtol=1e-9, atol=1e-12)
+        assert np.allclose(product(spd, inverse), np.eye(n), atol=1e-9)
+        v, w = rng.normal(size=n), rng.normal(size=86)
+        assert np.allclose(product(a, v), a @ v) and np.allclose(product(w, a), w @ a)
+        assert np.allclose(product(a.T, a), a.T @ a) and np.isclose(product(v, v), v @ v)
