@@ -34,7 +34,8 @@ REFINE_STEPS = 30  # golden-section steps on log lambda inside the best grid cel
 
 # The fit's products and its inverse in numpy's own loops, not BLAS/LAPACK: OpenBLAS splits even an 11 x 11
 # inverse across its threads, and a body made with 1 or 2 threads differed in the last bits (the same answer on
-# every machine, tests/core/test_same_answer.py). The matrices are at most bodies x bodies (86): microseconds.
+# every machine, tests/core/test_same_answer.py). The fit's matrices are at most bodies x bodies (86) and the
+# body one (21,) x (21, 40116) product: under a millisecond each (docs/body_space.md, Speed).
 def product(a, b):
     """a @ b (2-D or 1-D operands) summed in numpy's own loops, whatever BLAS's threads."""
     a, b = np.ascontiguousarray(a, float), np.ascontiguousarray(b, float)
