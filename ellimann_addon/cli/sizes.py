@@ -215,15 +215,21 @@ def run(args):
             except (ElliMannError, OSError, RuntimeError) as error:  # RuntimeError: a Blender writer's
                 made.fail(f"{read.path} size {row.label!r}: {output.one_line(error)}")
                 remove_outputs(request.outputs)
+            except KeyboardInterrupt:  # the sizes done so far keep their files and are reported; this one has none
+                remove_outputs(request.outputs)
+                done.pop()
+                progress.done()
+                report = write_report(read, reference, command.skin, done, formats, out, None, interrupted=True)
+                output.say(
+                    f"{PROG} sizes: interrupted: {report.count('ok', 'missed')} of {len(read.rows)} sizes done, "
+                    f"report {os.path.join(out, 'report.md')}"
+                )
+                return output.INTERRUPTED
         for line in made.lines():
             output.say(f"{PROG} sizes: {line}")
         progress.step(row.label)
     progress.done()
-    report = sizes_report.Report(read, reference, command.skin, done, formats)
-    picture = lineup(args, out, done)
-    report.picture = picture
-    writing.write_text(os.path.join(out, "report.csv"), report.csv())
-    writing.write_text(os.path.join(out, "report.md"), report.markdown())
+    report = write_report(read, reference, command.skin, done, formats, out, lineup(args, out, done))
     failed, missed = report.count("error"), report.count("missed")
     output.say(
         f"{PROG} sizes: {report.count('ok', 'missed')} of {len(done)} avatars written to {out} ({reference.name} set, "
@@ -235,6 +241,15 @@ def run(args):
         output.say(f"{PROG} sizes: error: {failed} row(s) failed; see {os.path.join(out, 'report.md')}")
         return 1
     return output.MISSED if missed else 0
+
+
+def write_report(read, reference, skin, done, formats, out, picture, interrupted=False):
+    """The run's report.csv and report.md in ``out``, of the sizes ``done`` (sizes_report.Made)."""
+    report = sizes_report.Report(read, reference, skin, done, formats)
+    report.picture, report.interrupted = picture, interrupted
+    writing.write_text(os.path.join(out, "report.csv"), report.csv())
+    writing.write_text(os.path.join(out, "report.md"), report.markdown())
+    return report
 
 
 def avatar_replace(avatar, told):

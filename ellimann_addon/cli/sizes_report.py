@@ -85,6 +85,7 @@ class Report:
     def __init__(self, read, reference, skin, made, formats):
         self.read, self.reference, self.skin, self.made, self.formats = read, reference, skin, made, formats
         self.picture = None
+        self.interrupted = False  # Ctrl-C: the sizes after the last made are not in the report
 
     def count(self, *statuses):
         return sum(m.status in statuses for m in self.made)
@@ -209,8 +210,13 @@ class Report:
         if failed:
             lines += ["", "## Failed rows", ""]
             lines += [f"- {_md(m.row.label)}: {_md(m.error)}" for m in failed]
+        if self.interrupted:
+            made, rows = len(self.made), len(read.rows)
+            lines += ["", f"Interrupted (Ctrl-C) after {made} of {rows} sizes: the rest were not made."]
         lines += ["", "## Line-up", ""]
-        if self.picture:
+        if self.interrupted:
+            lines.append("No line-up picture (the run was interrupted).")
+        elif self.picture:
             lines.append(f"![The run's skins in size order]({os.path.basename(self.picture)})")
         else:
             lines.append("No line-up picture (it needs Blender, or --no-picture was given).")

@@ -267,3 +267,25 @@ def test_extra_measurements_given_are_met_and_predicted_ones_are_not_asked(tmp_p
         *MEASUREMENTS,
         *(key for key in EXTRA_MEASUREMENTS if key in ("neck", "thigh", "calf", "crotch_height")),
     ]
+
+
+def test_ctrl_c_keeps_the_sizes_made_reports_them_and_leaves_nothing_of_the_one_being_made(tmp_path, monkeypatch):
+    from ellimann_addon.cli import sizes as sizes_command
+
+    made = sizes_command.make_row
+
+    def interrupted_on_the_second(request, *args):
+        if "S" in request.options.name.split()[-1:]:
+            with open(request.outputs[0], "w") as half:  # a file of the size being made, already written
+                half.write("{")
+            raise KeyboardInterrupt
+        return made(request, *args)
+
+    monkeypatch.setattr(sizes_command, "make_row", interrupted_on_the_second)
+    folder = tmp_path / "run"
+    code, _, stderr = sizes(DATA / "women_run.vst", "-o", folder, "--sizes", "42,44,46", *QUIET)
+    assert code == 130
+    assert "interrupted: 1 of 3 sizes done" in stderr
+    assert sorted(p.name for p in folder.iterdir()) == ["XS.json", "XS.obj", "report.csv", "report.md"]
+    assert [row["size"] for row in report_rows(folder)] == ["XS"] * 8
+    assert "Interrupted (Ctrl-C) after 1 of 3 sizes" in (folder / "report.md").read_text()
