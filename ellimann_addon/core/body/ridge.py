@@ -36,14 +36,19 @@ REFINE_STEPS = 30  # golden-section steps on log lambda inside the best grid cel
 # inverse across its threads, and a body made with 1 or 2 threads differed in the last bits (the same answer on
 # every machine, tests/core/test_same_answer.py). The fit's matrices are at most bodies x bodies (86) and the
 # body one (21,) x (21, 40116) product: under a millisecond each (docs/body_space.md, Speed).
+PRODUCTS = {(2, 2): "ij,jk->ik", (2, 1): "ij,j->i", (1, 2): "j,jk->k", (1, 1): "j,j->"}  # by the operands' ndim
+
+
 def product(a, b):
     """a @ b (2-D or 1-D operands) summed in numpy's own loops, whatever BLAS's threads."""
     a, b = np.ascontiguousarray(a, float), np.ascontiguousarray(b, float)
-    return np.einsum(f"{'ij'[2 - a.ndim :]},{'jk'[: b.ndim]}->{'i'[: a.ndim - 1]}{'k'[: b.ndim - 1]}", a, b)
+    return np.einsum(PRODUCTS[a.ndim, b.ndim], a, b)
 
 
 def spd_inverse(a):
-    """The inverse of a symmetric positive definite matrix (a few dozen rows) by Cholesky, in numpy's loops."""
+    """The inverse of a symmetric positive definite matrix (a few dozen rows) by Cholesky, in numpy's loops: each
+    row's sums vectorized, since a fit inverts one 74 times (core.synthesis.population.cholesky, one scalar at a
+    time, keeps the bits of the sampled populations and checks a survey's covariance)."""
     n = len(a)
     low = np.zeros((n, n))
     for j in range(n):
